@@ -1,0 +1,55 @@
+/* capdem device-safe definitions: compiled as C11 (host, OpenMP) and as
+ * OpenCL C 1.2.  Everything a kernel header needs from the language lives
+ * here: the real type, index types, vector structs and the macros that hide
+ * address spaces and OpenMP declare-target regions. */
+#ifndef CD_DEFS_H
+#define CD_DEFS_H
+
+#ifdef __OPENCL_VERSION__
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+/* Bitwise agreement with the host build (-ffp-contract=off). */
+#pragma OPENCL FP_CONTRACT OFF
+typedef double cd_real;
+typedef int cd_int;
+typedef uint cd_uint;
+typedef long cd_long;
+typedef ulong cd_ulong;
+#define CD_GLOBAL __global
+#define CD_CONST_TABLE __constant
+#define CD_DEVICE_BEGIN
+#define CD_DEVICE_END
+#else
+#include <math.h>
+#include <stdint.h>
+typedef double cd_real;
+typedef int32_t cd_int;
+typedef uint32_t cd_uint;
+typedef int64_t cd_long;
+typedef uint64_t cd_ulong;
+#define CD_GLOBAL
+#define CD_CONST_TABLE static const
+#if defined(_OPENMP)
+/* Functions between these markers are compiled for the offload target too. */
+#define CD_DEVICE_BEGIN _Pragma("omp declare target")
+#define CD_DEVICE_END _Pragma("omp end declare target")
+#else
+#define CD_DEVICE_BEGIN
+#define CD_DEVICE_END
+#endif
+#endif
+
+#define CD_INLINE static inline
+#define CD_R(x) ((cd_real)(x))
+#define CD_PI CD_R(3.14159265358979323846)
+
+/* Named index types: what an integer indexes is part of its type name. */
+typedef cd_int cd_particle_id; /* index into particle columns */
+typedef cd_int cd_prim_id;     /* index into primitive (arm) columns */
+typedef cd_int cd_pair_id;     /* index into pair/contact columns */
+typedef cd_int cd_shape_id;    /* index into the shape catalogue */
+
+/* Own vector structs: OpenCL's double3 is 32 bytes and differs from C. */
+typedef struct { cd_real x, y, z; } cd_vec3;
+typedef struct { cd_real w, x, y, z; } cd_quat; /* unit quaternion, w scalar */
+
+#endif

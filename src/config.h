@@ -1,0 +1,87 @@
+/* A run file (YAML), read and validated into plain values.  Every key is
+ * listed in docs/config.md; the table in config.c is the single source of
+ * the key names, types, units and ranges. */
+#ifndef CD_CONFIG_H
+#define CD_CONFIG_H
+#include <stddef.h>
+#include "../kernels/geom_types.h"
+
+#define CD_MAX_SPECIES 8
+#define CD_MAX_CFG_WALLS 8
+#define CD_MAX_ARMS 16
+#define CD_PATH_MAX 1024
+
+/* One kind of particle in the run. */
+typedef struct {
+    char shape[32];          /* sphere | rod | cross | hexapod | segments */
+    double aspect;           /* alpha = L / d_p [1] (named shapes) */
+    double diameter;         /* arm diameter d_p [m] (named shapes) */
+    int n_segments;          /* shape: segments */
+    double seg_a[CD_MAX_ARMS][3], seg_b[CD_MAX_ARMS][3]; /* body-frame axis ends [m] */
+    double seg_radius[CD_MAX_ARMS];                      /* [m] */
+    long count;              /* number of particles of this species */
+    double polydispersity;   /* p: scale factor uniform in [1-p, 1+p] [1] */
+} cd_species_config;
+
+typedef struct {
+    char source_path[CD_PATH_MAX]; /* file the config was read from */
+    char *source_text;             /* the file verbatim (echoed into the output) */
+
+    /* run */
+    char name[128];
+    unsigned long long seed;       /* random seed */
+    double dt;                     /* time step [s] */
+    long long steps;               /* steps to take */
+    char output[CD_PATH_MAX];      /* HDF5 output path ("" = <name>.h5 next to cwd) */
+    long long snapshot_every;      /* steps between snapshots */
+    long long thermo_every;        /* steps between time-series rows */
+    int force_dt;                  /* 1: run even when dt > t_col/5 */
+
+    /* physics */
+    int dimension;                 /* 3, or 2 (x-y plane motion only) */
+    double gravity[3];             /* [m/s^2] */
+    double density;                /* rho [kg/m^3] */
+    double kn, kt;                 /* particle stiffness [N/m] */
+    double eta_n, eta_t;           /* damping ratios [1] */
+    double friction;               /* mu between particles [1] */
+    double wall_friction;          /* mu_w [1] */
+    int friction_limit_total;      /* 0: mu (kn/2) delta_n (seed 000); 1: mu F_n (seed 001, LAMMPS) */
+    double parallel_angle_deg;     /* parallel-contact cut-off [deg] */
+
+    /* particles */
+    int n_species;
+    cd_species_config species[CD_MAX_SPECIES];
+
+    /* domain: box | cylinder | ball | none, plus extra walls */
+    char domain[16];
+    double box_width, box_thickness, box_height;  /* x, z, y extents [m] */
+    double cyl_diameter, cyl_height;              /* [m] */
+    double ball_radius;                            /* [m] */
+    int n_extra_walls;
+    cd_wall extra_walls[CD_MAX_CFG_WALLS];
+
+    /* initial placement */
+    char placement[16];            /* lattice | random */
+    double clearance;              /* lattice spacing / particle size [1] */
+    double init_speed;             /* velocity components uniform in (-v, v) [m/s] */
+
+    /* neighbour list */
+    double skin;                   /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
+} cd_config;
+
+/* Fills c with the documented defaults. */
+void cd_config_defaults(cd_config *c);
+
+/* Reads and validates path.  On failure returns -1 and writes a message that
+ * names the file, the key, the value and what was expected into err. */
+int cd_config_load(const char *path, cd_config *c, char *err, size_t errlen);
+
+/* Same, from text in memory (tests, resume from the echoed config). */
+int cd_config_parse(const char *text, const char *name_for_errors, cd_config *c, char *err, size_t errlen);
+
+void cd_config_free(cd_config *c);
+
+/* Prints every key with type, unit, default and meaning (capdem run --help). */
+void cd_config_print_keys(void *stream);
+
+#endif

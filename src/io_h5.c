@@ -1,0 +1,347 @@
+/* HDF5 output of a run, after H5MD 1.1: creating, reopening for a resume
+ * (truncating what came after the checkpoint), time series, closing.
+ * Snapshots: io_h5_snapshot.c; header and helpers: io_h5_write.c; reading
+ * back: io_h5_read.c.  The layout, the order of writes and what a crash
+ * leaves behind are documented in docs/output.md. */
+#include "io_h5.h"
+#include "io_h5_internal.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- observables (time series) ------------------------------------------ */
+
+hid_t cdh5_make_clock(cd_output *o, const char *path, int is_time)
+{
+    hsize_t d = 0, m = H5S_UNLIMITED, c = CDH5_CLOCK_CHUNK;
+    return cdh5_make_dset(o, path, is_time ? H5T_IEEE_F64LE : H5T_STD_I64LE, 1, &d, &m, &c, is_time ? "s" : NULL);
+}
+
+/* Names usable as HDF5 group names, given once, ncomp >= 1 and, for a
+ * series already in the file, its ncomp. */
+static int obs_check(cd_output *o, const cd_observable_info *obs, int n_obs)
+{
+    for (int i = 0; i < n_obs; i++) {
+        const char *name = obs[i].name;
+        if (!name || !*name || strchr(name, '/') || !strcmp(name, ".") || strlen(name) > 200 || obs[i].ncomp < 1)
+            return FAIL("%s: observable %d: invalid name \"%s\" or ncomp %d (need a non-empty name without '/' and "
+                        "ncomp >= 1)", o->path, i, name ? name : "(null)", obs[i].ncomp);
+        for (int j = 0; j < i; j++)
+            if (!strcmp(obs[j].name, name)) return FAIL("%s: observable \"%s\" given twice", o->path, name);
+        char p[CDH5_PATH_LEN];
+        snprintf(p, sizeof p, "/observables/%s/value", name);
+        if (!cdh5_exists(o->file, p)) continue;
+        hsize_t dims[3];
+        hid_t d = cdh5_open_dset(o, p);
+        int rank = d < 0 ? -1 : cdh5_dims(d, dims);
+        cdh5_close_dset(&d);
+        if (rank < 0) return -1;
+        if (rank != (obs[i].ncomp > 1 ? 2 : 1) || (rank == 2 && dims[1] != (hsize_t)obs[i].ncomp))
+            return FAIL("%s: %s has %llu components per row, the run gives %d", o->path, p,
+                        rank == 2 ? (unsigned long long)dims[1] : 1ULL, obs[i].ncomp);
+    }
+    return 0;
+}
+
+static int obs_setup(cd_output *o, const cd_observable_info *obs, int n_obs)
+{
+    char p[CDH5_PATH_LEN];
+    o->obs = calloc(n_obs > 0 ? (size_t)n_obs : 1, sizeof *o->obs);
+    if (!o->obs) return FAIL("%s: out of memory", o->path);
+    for (int i = 0; i < n_obs; i++) {
+        cdh5_obs *b = &o->obs[i];
+        b->step = b->time = b->value = H5I_INVALID_HID;
+    }
+    o->n_obs = n_obs;
+    for (int i = 0; i < n_obs; i++) {
+        cdh5_obs *b = &o->obs[i];
+        const char *name = obs[i].name;
+        b->name = malloc(strlen(name) + 1);
+        if (!b->name) return FAIL("%s: out of memory", o->path);
+        strcpy(b->name, name);
+        b->ncomp = obs[i].ncomp;
+        o->width += b->ncomp;
+        snprintf(p, sizeof p, "/observables/%s", name);
+        if (cdh5_exists(o->file, p)) {
+            hsize_t dims[3];
+            snprintf(p, sizeof p, "/observables/%s/value", name);
+            b->value = cdh5_open_dset(o, p);
+            if (b->value < 0 || cdh5_dims(b->value, dims) < 1) return -1;
+            b->rows = dims[0];
+            snprintf(p, sizeof p, "/observables/%s/step", name);
+            b->step = cdh5_open_dset(o, p);
+            snprintf(p, sizeof p, "/observables/%s/time", name);
+            b->time = cdh5_open_dset(o, p);
+            if (b->step < 0 || b->time < 0) return -1;
+        } else {
+            hsize_t d[2] = {0, (hsize_t)b->ncomp}, m[2] = {H5S_UNLIMITED, (hsize_t)b->ncomp};
+            hsize_t c[2] = {CDH5_CLOCK_CHUNK, (hsize_t)b->ncomp};
+            snprintf(p, sizeof p, "/observables/%s/step", name);
+            b->step = cdh5_make_clock(o, p, 0);
+            snprintf(p, sizeof p, "/observables/%s/time", name);
+            b->time = cdh5_make_clock(o, p, 1);
+            snprintf(p, sizeof p, "/observables/%s/value", name);
+            b->value = cdh5_make_dset(o, p, H5T_IEEE_F64LE, b->ncomp > 1 ? 2 : 1, d, m, c,
+                                      obs[i].unit ? obs[i].unit : "1");
+            if (b->step < 0 || b->time < 0 || b->value < 0) return -1;
+            b->rows = 0;
+        }
+    }
+    if (n_obs > 0) {
+        o->buf_step = malloc(CDH5_OBS_BLOCK * sizeof *o->buf_step);
+        o->buf_time = malloc(CDH5_OBS_BLOCK * sizeof *o->buf_time);
+        o->buf_val = malloc((size_t)CDH5_OBS_BLOCK * (size_t)o->width * sizeof *o->buf_val);
+        if (!o->buf_step || !o->buf_time || !o->buf_val) return FAIL("%s: out of memory", o->path);
+    }
+    return 0;
+}
+
+int cdh5_obs_flush(cd_output *o)
+{
+    if (o->buf_n == 0) return 0;
+    size_t n = o->buf_n;
+    double *tmp = malloc(n * (size_t)o->width * sizeof *tmp);
+    if (!tmp) return FAIL("%s: out of memory", o->path);
+    int rc = 0, col = 0;
+    for (int i = 0; i < o->n_obs && !rc; i++) {
+        cdh5_obs *b = &o->obs[i];
+        for (size_t r = 0; r < n; r++)
+            memcpy(tmp + r * (size_t)b->ncomp, o->buf_val + r * (size_t)o->width + col, (size_t)b->ncomp * sizeof *tmp);
+        col += b->ncomp;
+        rc = cdh5_append(o, b->value, b->name, b->rows, n, H5T_NATIVE_DOUBLE, tmp);
+        if (!rc) rc = cdh5_append(o, b->time, b->name, b->rows, n, H5T_NATIVE_DOUBLE, o->buf_time);
+        if (!rc) rc = cdh5_append(o, b->step, b->name, b->rows, n, H5T_NATIVE_LLONG, o->buf_step);
+        if (!rc) b->rows += n;
+    }
+    free(tmp);
+    if (!rc) o->buf_n = 0;
+    return rc;
+}
+
+int cd_output_thermo(cd_output *o, long long step, double time, const double *values)
+{
+    if (o->n_obs == 0) return 0;
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    int rc = o->buf_n == CDH5_OBS_BLOCK ? cdh5_obs_flush(o) : 0;
+    if (!rc) {
+        o->buf_step[o->buf_n] = step;
+        o->buf_time[o->buf_n] = time;
+        memcpy(o->buf_val + o->buf_n * (size_t)o->width, values, (size_t)o->width * sizeof *values);
+        o->buf_n++;
+    }
+    cdh5_quiet_end(&q);
+    return rc;
+}
+
+/* ---- opening and closing -------------------------------------------------- */
+
+static cd_output *output_new(const char *path, char *err, size_t errlen)
+{
+    cd_output *o = calloc(1, sizeof *o);
+    if (o) o->cols = calloc(cd_n_fields, sizeof *o->cols);
+    if (!o || !o->cols || strlen(path) >= sizeof o->path) {
+        snprintf(err, errlen, "%s: %s", path, o && o->cols ? "path too long" : "out of memory");
+        if (o) free(o->cols);
+        free(o);
+        return NULL;
+    }
+    strcpy(o->path, path);
+    o->file = o->step = o->time = o->walls = o->wall_type = H5I_INVALID_HID;
+    o->c_offset = o->c_pi = o->c_pj = o->w_offset = o->w_index = H5I_INVALID_HID;
+    for (size_t k = 0; k < cd_n_fields; k++) o->cols[k].dset = H5I_INVALID_HID;
+    return o;
+}
+
+static void output_free(cd_output *o)
+{
+    hid_t *ds[] = {&o->step, &o->time, &o->walls, &o->c_offset, &o->c_pi, &o->c_pj, &o->w_offset, &o->w_index};
+    for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++) cdh5_close_dset(ds[i]);
+    if (o->wall_type >= 0) H5Tclose(o->wall_type);
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        cdh5_close_dset(&o->cols[k].dset);
+        free(o->cols[k].fixed);
+    }
+    for (int i = 0; i < o->n_obs; i++) {
+        cdh5_close_dset(&o->obs[i].step);
+        cdh5_close_dset(&o->obs[i].time);
+        cdh5_close_dset(&o->obs[i].value);
+        free(o->obs[i].name);
+    }
+    if (o->file >= 0) H5Fclose(o->file);
+    free(o->obs);
+    free(o->cols);
+    free(o->buf_step);
+    free(o->buf_time);
+    free(o->buf_val);
+    free(o);
+}
+
+static hid_t file_access(void)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG);
+    return fapl;
+}
+
+cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
+                            const cd_observable_info *obs, int n_obs, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    cd_output *o = output_new(path, err, errlen);
+    if (!o) {
+        cdh5_quiet_end(&q);
+        return NULL;
+    }
+    hid_t fapl = file_access();
+    o->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    int rc = o->file < 0 ? FAIL("%s: cannot create the output file", path) : 0;
+    H5Pclose(fapl);
+    if (!rc) rc = obs_check(o, obs, n_obs);
+    if (!rc) rc = cdh5_write_header(o, cfg, shapes, n_shapes);
+    if (!rc) rc = obs_setup(o, obs, n_obs);
+    if (!rc && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", path);
+    if (rc) {
+        snprintf(err, errlen, "%s", o->err);
+        output_free(o);
+        o = NULL;
+    }
+    cdh5_quiet_end(&q);
+    return o;
+}
+
+int cd_output_close(cd_output *o)
+{
+    if (!o) return 0;
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    int rc = cdh5_obs_flush(o);
+    if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
+    output_free(o);
+    cdh5_quiet_end(&q);
+    return rc;
+}
+
+const char *cd_output_error(const cd_output *o)
+{
+    return o ? o->err : "";
+}
+
+/* ---- resume ------------------------------------------------------------------ */
+
+static int read_ll(cd_output *o, hid_t d, const char *what, hsize_t row, long long *v)
+{
+    if (cdh5_read_rows(d, row, 1, H5T_NATIVE_LLONG, v) < 0)
+        return FAIL("%s: cannot read row %llu of %s", o->path, (unsigned long long)row, what);
+    return 0;
+}
+
+/* Leading rows of a 1-D step dataset (first n) with step <= resume_step. */
+static long long rows_upto(cd_output *o, hid_t step, const char *what, hsize_t n, long long resume_step)
+{
+    long long *v = malloc((n ? n : 1) * sizeof *v);
+    if (!v) return FAIL("%s: out of memory", o->path);
+    if (n && cdh5_read_rows(step, 0, n, H5T_NATIVE_LLONG, v) < 0) {
+        free(v);
+        return FAIL("%s: cannot read %s", o->path, what);
+    }
+    hsize_t keep = 0;
+    while (keep < n && v[keep] <= resume_step) keep++;
+    free(v);
+    return (long long)keep;
+}
+
+static int truncate_snapshots(cd_output *o, long long resume_step)
+{
+    long long keep = rows_upto(o, o->step, CDH5_SNAP_STEP, o->n_snap, resume_step), cend, wend;
+    if (keep < 0 || read_ll(o, o->c_offset, CDH5_C_OFFSET, (hsize_t)keep, &cend) ||
+        read_ll(o, o->w_offset, CDH5_W_OFFSET, (hsize_t)keep, &wend))
+        return -1;
+    hsize_t n = (hsize_t)keep;
+    /* Commit the smaller count before cutting, so that a crash in between
+     * never leaves a counted snapshot without its rows. */
+    if (cdh5_write_commit(o, n)) return -1;
+    if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) return FAIL("%s: cannot flush", o->path);
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        enum cdh5_store st = cdh5_store_of(&cd_fields[k]);
+        if (st == CDH5_FIXED) continue;
+        hsize_t rows = st == CDH5_SERIES ? n : (hsize_t)(cd_fields[k].group == CD_GROUP_PAIR ? cend : wend);
+        if (cdh5_set_rows(o, o->cols[k].dset, cd_fields[k].name, rows)) return -1;
+    }
+    if (cdh5_set_rows(o, o->step, CDH5_SNAP_STEP, n) || cdh5_set_rows(o, o->time, CDH5_SNAP_TIME, n) ||
+        cdh5_set_rows(o, o->walls, CDH5_WALLS_VALUE, n) || cdh5_set_rows(o, o->c_offset, CDH5_C_OFFSET, n + 1) ||
+        cdh5_set_rows(o, o->w_offset, CDH5_W_OFFSET, n + 1) || cdh5_set_rows(o, o->c_pi, "particle_i", (hsize_t)cend) ||
+        cdh5_set_rows(o, o->c_pj, "particle_j", (hsize_t)cend) ||
+        cdh5_set_rows(o, o->w_index, CDH5_W_INDEX, (hsize_t)wend))
+        return -1;
+    o->n_snap = n;
+    o->c_rows = (hsize_t)cend;
+    o->w_rows = (hsize_t)wend;
+    return 0;
+}
+
+/* Every series under /observables, given now or not, loses its rows for
+ * steps > resume_step. */
+static int truncate_observables(cd_output *o, long long resume_step)
+{
+    hid_t g = H5Gopen2(o->file, "/observables", H5P_DEFAULT);
+    if (g < 0) return FAIL("%s: cannot open /observables", o->path);
+    H5G_info_t info;
+    int rc = H5Gget_info(g, &info) < 0 ? FAIL("%s: cannot list /observables", o->path) : 0;
+    for (hsize_t i = 0; !rc && i < info.nlinks; i++) {
+        char name[256], p[CDH5_PATH_LEN];
+        if (H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT) < 0) {
+            rc = FAIL("%s: cannot list /observables", o->path);
+            break;
+        }
+        hid_t d[3];
+        static const char *parts[3] = {"step", "time", "value"};
+        hsize_t n = (hsize_t)-1, dims[3];
+        for (int j = 0; j < 3; j++) {
+            snprintf(p, sizeof p, "/observables/%s/%s", name, parts[j]);
+            d[j] = cdh5_open_dset(o, p);
+            if (d[j] < 0 || cdh5_dims(d[j], dims) < 1) rc = -1;
+            else if (dims[0] < n) n = dims[0];
+        }
+        long long keep = rc ? -1 : rows_upto(o, d[0], name, n, resume_step);
+        for (int j = 0; j < 3; j++) {
+            if (keep >= 0 && cdh5_set_rows(o, d[j], name, (hsize_t)keep)) keep = -1;
+            cdh5_close_dset(&d[j]);
+        }
+        if (keep < 0) rc = -1;
+    }
+    cdh5_close_id(&g);
+    return rc;
+}
+
+cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_observable_info *obs, int n_obs,
+                            char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    cd_output *o = output_new(path, err, errlen);
+    if (!o) {
+        cdh5_quiet_end(&q);
+        return NULL;
+    }
+    hid_t fapl = file_access();
+    o->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
+    int rc = o->file < 0 ? FAIL("%s: cannot open the run file for appending", path) : 0;
+    H5Pclose(fapl);
+    if (!rc && (!cdh5_exists(o->file, "/h5md") || !cdh5_exists(o->file, "/observables")))
+        rc = FAIL("%s: not a capdem run file (no /h5md or /observables)", path);
+    if (!rc) rc = obs_check(o, obs, n_obs);
+    if (!rc && cdh5_exists(o->file, CDH5_SNAP_STEP))
+        rc = (cdh5_layout_open(o) || truncate_snapshots(o, resume_step)) ? -1 : 0;
+    if (!rc) rc = truncate_observables(o, resume_step);
+    if (!rc) rc = obs_setup(o, obs, n_obs);
+    if (!rc && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", path);
+    if (rc) {
+        snprintf(err, errlen, "%s", o->err);
+        output_free(o);
+        o = NULL;
+    }
+    cdh5_quiet_end(&q);
+    return o;
+}

@@ -1,0 +1,61 @@
+/* HDF5 output of a run (layout after H5MD) and reading it back for resume.
+ * The layout is documented in docs/output.md. */
+#ifndef CD_IO_H5_H
+#define CD_IO_H5_H
+#include <stddef.h>
+#include "state.h"
+#include "config.h"
+#include "shapes.h"
+
+typedef struct cd_output cd_output;
+
+/* One named series of the time series (H5MD observables): ncomp values per row. */
+typedef struct {
+    const char *name;  /* dataset group name under /observables */
+    const char *unit;  /* SI unit */
+    int ncomp;         /* values per row (1 for scalars) */
+} cd_observable_info;
+
+/* Creates (truncates) path and writes the config text verbatim, units, the
+ * shape catalogue and the static particle columns.  Returns NULL with a
+ * message in err on failure. */
+cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
+                            const cd_observable_info *obs, int n_obs, char *err, size_t errlen);
+
+/* Opens an existing run file to append to it after a resume: later snapshots
+ * and time-series rows are added after the ones for steps <= resume_step, and
+ * rows for steps > resume_step (written after that checkpoint by the
+ * interrupted run) are discarded. */
+cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_observable_info *obs, int n_obs,
+                            char *err, size_t errlen);
+
+/* Appends a snapshot: every PARTICLE column, the active contacts (every PAIR
+ * column of the active rows) and the active wall contacts, the walls, time
+ * and step.  Everything needed to resume bit for bit.  Flushes the file. */
+int cd_output_snapshot(cd_output *o, const cd_state *s);
+
+/* Appends one time-series row: values holds, for each observable in the
+ * order given at creation, ncomp doubles. */
+int cd_output_thermo(cd_output *o, long long step, double time, const double *values);
+
+/* Message of the last failure of a cd_output_* call on o (also printed to
+ * stderr when it happened); "" when none. */
+const char *cd_output_error(const cd_output *o);
+
+/* Flushes and closes. Returns 0 or -1. */
+int cd_output_close(cd_output *o);
+
+/* Number of snapshots in a run file, or -1 (message in err). */
+int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
+
+/* Reads snapshot k (k < 0: the last) into s, which must already hold the
+ * particles, primitives and walls of the same run set up from its config
+ * (counts are checked).  Restores every PARTICLE column, the pair list as
+ * the active contacts with their history, the wall contacts, walls, time and
+ * step. */
+int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t errlen);
+
+/* Reads the config text echoed in a run file (malloc'd, caller frees). */
+char *cd_h5_read_config_text(const char *path, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,149 @@
+/* Private to io_h5.c and io_h5_read.c: names of the run-file layout and
+ * small HDF5 helpers shared by the writer and the reader.  The layout
+ * itself is documented in docs/output.md. */
+#ifndef CD_IO_H5_INTERNAL_H
+#define CD_IO_H5_INTERNAL_H
+#include <stddef.h>
+#include <hdf5.h>
+#include "state.h"
+#include "config.h"
+#include "shapes.h"
+#include "io_h5.h"
+
+/* Snapshot clock, hard-linked into every snapshot-indexed group. */
+#define CDH5_SNAP_STEP "/walls/step"
+#define CDH5_SNAP_TIME "/walls/time"
+#define CDH5_WALLS_VALUE "/walls/value"
+#define CDH5_C_OFFSET "/contacts/offset"
+#define CDH5_W_OFFSET "/wall_contacts/offset"
+#define CDH5_W_INDEX "/wall_contacts/index"
+/* Root attribute: snapshots completely on disk (the commit record). */
+#define CDH5_COMMIT_ATTR "n_snapshots"
+#define CDH5_PATH_LEN 512
+
+/* How a column of fields.def is stored. */
+enum cdh5_store {
+    CDH5_FIXED,    /* once, H5MD fixed data: <group>/<name> (rows[, ncomp]) */
+    CDH5_SERIES,   /* per snapshot: <group>/<name>/value (snapshots, rows[, ncomp]) */
+    CDH5_ROWS      /* active rows of all snapshots concatenated: <group>/<name> (rows[, ncomp]) */
+};
+
+enum cdh5_store cdh5_store_of(const cd_field_info *f);
+/* "/particles/all", "/particles/prims", "/contacts", "/wall_contacts". */
+const char *cdh5_group_path(enum cd_field_group g);
+/* Path of the dataset that holds the column's values. */
+void cdh5_field_path(const cd_field_info *f, char *buf, size_t len);
+/* H5T_NATIVE_DOUBLE or H5T_NATIVE_INT32 (not to be closed). */
+hid_t cdh5_mem_type(const cd_field_info *f);
+/* 0 when a row of f is ncomp scalars of its kind, else -1 with a message. */
+int cdh5_field_check(const cd_field_info *f, char *err, size_t errlen);
+
+/* Rows of column f in dataset d (FIXED: dims[0], SERIES: dims[1], ROWS:
+ * dims[0]) after checking its rank, ncomp and number class; -1 with a
+ * message naming file and dpath when they do not fit. */
+long long cdh5_field_rows(hid_t d, const cd_field_info *f, const char *dpath, const char *file, char *err,
+                          size_t errlen);
+
+/* Largest row of any column, and at least 8 (int64 scratch). */
+size_t cdh5_max_row_bytes(void);
+
+/* Compound type of cd_wall in memory (caller closes). */
+hid_t cdh5_wall_mem_type(void);
+
+/* snprintf into err, followed by the innermost message of HDF5's error
+ * stack when it holds one. */
+void cdh5_msg(char *err, size_t errlen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* 1 when every link of the absolute or relative path exists, else 0. */
+int cdh5_exists(hid_t loc, const char *path);
+/* Rank of the dataset, dims (up to 3) in dims; -1 on failure. */
+int cdh5_dims(hid_t dset, hsize_t dims[3]);
+/* Reads count0 rows from row start0 of a dataset of rank 1..3 into buf. */
+herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype, void *buf);
+/* Snapshots completely on disk: min(commit attribute, length of the
+ * snapshot step and time); 0 when the file has no snapshot yet; -1 on error. */
+long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen);
+
+/* Silences HDF5's automatic error printing inside a public function. */
+typedef struct { H5E_auto2_t func; void *data; } cdh5_quiet;
+void cdh5_quiet_begin(cdh5_quiet *q);
+void cdh5_quiet_end(const cdh5_quiet *q);
+
+/* ---- writer: io_h5.c, io_h5_write.c, io_h5_snapshot.c ------------------- */
+
+#define CDH5_OBS_BLOCK 1024               /* time-series rows buffered before a write */
+#define CDH5_CLOCK_CHUNK 1024             /* rows per chunk of step, time, offset, observables */
+#define CDH5_SMALL_CHUNK (64u * 1024u)    /* bytes: target chunk of a small per-snapshot dataset */
+#define CDH5_LARGE_CHUNK (1024u * 1024u)  /* bytes: largest chunk */
+
+typedef struct {
+    hid_t dset;        /* FIXED: the data; SERIES: value; ROWS: the rows */
+    void *fixed;       /* FIXED: what the file holds, to catch changes */
+    size_t fixed_bytes;
+} cdh5_col;
+
+typedef struct {
+    char *name;
+    int ncomp;
+    hid_t step, time, value;
+    hsize_t rows;
+} cdh5_obs;
+
+struct cd_output {
+    hid_t file;
+    char path[1024];
+    char err[1024];
+    int have_layout;
+    size_t n_particles, n_prims, n_walls;
+    hsize_t n_snap, c_rows, w_rows;  /* snapshots, contact rows, wall-contact rows written */
+    hid_t step, time, walls, wall_type, c_offset, c_pi, c_pj, w_offset, w_index;
+    cdh5_col *cols;                  /* one per cd_fields[] entry */
+    int n_obs, width;                /* width: sum of ncomp */
+    cdh5_obs *obs;
+    size_t buf_n;
+    long long *buf_step;
+    double *buf_time, *buf_val;
+};
+
+/* Every writer failure goes through FAIL: message into o->err (with the
+ * HDF5 detail), printed to stderr, value -1. */
+int cdh5_report(cd_output *o);
+#define FAIL(...) (cdh5_msg(o->err, sizeof o->err, __VA_ARGS__), cdh5_report(o))
+
+void cdh5_close_id(hid_t *id);   /* group or any object */
+void cdh5_close_dset(hid_t *id);
+
+int cdh5_attr_write(cd_output *o, hid_t obj, const char *where, const char *name, hid_t type, hid_t space,
+                    const void *buf);
+int cdh5_attr_str(cd_output *o, hid_t obj, const char *where, const char *name, const char *value);
+int cdh5_attr_ints(cd_output *o, hid_t obj, const char *where, const char *name, const int *v, hsize_t n);
+/* Root attribute n_snapshots = n (the commit record). */
+int cdh5_write_commit(cd_output *o, hsize_t n);
+hid_t cdh5_make_group(cd_output *o, const char *path);
+/* Creates a dataset; chunk NULL: contiguous; unit NULL: no unit attribute. */
+hid_t cdh5_make_dset(cd_output *o, const char *path, hid_t ftype, int rank, const hsize_t *dims,
+                     const hsize_t *maxdims, const hsize_t *chunk, const char *unit);
+/* 1-D extendible step (int64) or time (double, unit s) dataset. */
+hid_t cdh5_make_clock(cd_output *o, const char *path, int is_time);
+int cdh5_write_all(cd_output *o, hid_t d, const char *path, hid_t mtype, const void *buf);
+int cdh5_write_real(cd_output *o, const char *path, int rank, const hsize_t *dims, const double *v, const char *unit);
+hid_t cdh5_open_dset(cd_output *o, const char *path);
+/* Sets the first dimension to n rows. */
+int cdh5_set_rows(cd_output *o, hid_t d, const char *what, hsize_t n);
+/* Writes count rows at row `at` of an extendible dataset, which then has
+ * at + count rows. */
+int cdh5_append(cd_output *o, hid_t d, const char *what, hsize_t at, hsize_t count, hid_t mtype, const void *buf);
+
+/* /h5md, /parameters (config, shapes), the empty groups, box, commit 0. */
+int cdh5_write_header(cd_output *o, const cd_config *cfg, const cd_shape *shapes, int n_shapes);
+/* Writes the buffered time-series rows. */
+int cdh5_obs_flush(cd_output *o);
+/* Snapshot datasets: created at the first snapshot, or opened on reopen. */
+int cdh5_layout_create(cd_output *o, const cd_state *s);
+int cdh5_layout_open(cd_output *o);
+
+#endif

@@ -1,0 +1,126 @@
+/* capdem command line: run, shape, --version. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "run.h"
+#include "shapes.h"
+#include "config.h"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: capdem <command> [options]\n"
+            "commands:\n"
+            "  run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n"
+            "                  run a simulation; `capdem run --help` lists every config key\n"
+            "  shape KIND [--aspect A] [--diameter D] [--density RHO] [--json]\n"
+            "                  mass properties of a sphere, rod, cross or hexapod (SI units)\n"
+            "  --version       version, build variant and OpenMP devices\n");
+}
+
+static int parse_double(const char *opt, const char *s, double *out)
+{
+    char *end;
+    *out = strtod(s, &end);
+    if (end == s || *end) {
+        fprintf(stderr, "capdem: %s %s: expected a number\n", opt, s);
+        return -1;
+    }
+    return 0;
+}
+
+static int cmd_shape(int argc, char **argv)
+{
+    if (argc < 1) { usage(stderr); return 2; }
+    const char *kind = argv[0];
+    double aspect = 1, diameter = 0.005, density = 1000; /* [1], [m], [kg/m^3] */
+    int json = 0;
+    for (int i = 1; i < argc; i++) {
+        double *target = !strcmp(argv[i], "--aspect") ? &aspect : !strcmp(argv[i], "--diameter") ? &diameter
+                       : !strcmp(argv[i], "--density") ? &density : NULL;
+        if (target && i + 1 < argc) {
+            if (parse_double(argv[i], argv[i + 1], target)) return 2;
+            i++;
+        } else if (!strcmp(argv[i], "--json")) {
+            json = 1;
+        } else {
+            fprintf(stderr, "capdem shape: unknown or incomplete option '%s'\n", argv[i]);
+            return 2;
+        }
+    }
+    cd_shape s;
+    char err[512];
+    if (cd_shape_make_named(kind, aspect, diameter, density, &s, err, sizeof err)) {
+        fprintf(stderr, "capdem shape: %s\n", err);
+        return 2;
+    }
+    if (json) {
+        cd_shape_print_json(&s, stdout);
+    } else {
+        printf("%s  aspect %g  diameter %g m  L %g m\n", s.kind, s.aspect, s.diameter, s.tip_length);
+        printf("volume %.10g m^3  area %.10g m^2  sphericity %.6f\n", s.volume, s.area, s.sphericity);
+        printf("mass %.10g kg  principal moments %.10g %.10g %.10g kg m^2\n", s.mass, s.principal[0], s.principal[1], s.principal[2]);
+    }
+    return 0;
+}
+
+static int cmd_run(int argc, char **argv)
+{
+    cd_run_options opt = {NULL, NULL, NULL, -1, 0};
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        int has_value = i + 1 < argc;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            printf("usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n\n"
+                   "Config keys (YAML; SI units):\n");
+            cd_config_print_keys(stdout);
+            return 0;
+        } else if (!strcmp(a, "--resume") && has_value) opt.resume_path = argv[++i];
+        else if (!strcmp(a, "--output") && has_value) opt.output_path = argv[++i];
+        else if (!strcmp(a, "--steps") && has_value) opt.steps = atoll(argv[++i]);
+        else if (!strcmp(a, "--quiet")) opt.quiet = 1;
+        else if (!strcmp(a, "--threads") && has_value) {
+            int n = atoi(argv[++i]);
+            if (n < 1) { fprintf(stderr, "capdem run: --threads %s: expected an integer >= 1\n", argv[i]); return 2; }
+#ifdef _OPENMP
+            omp_set_num_threads(n);
+#endif
+        } else if (a[0] != '-' && !opt.config_path) opt.config_path = a;
+        else {
+            fprintf(stderr, "capdem run: unknown or incomplete option '%s'\n", a);
+            return 2;
+        }
+    }
+    if (!opt.config_path) {
+        fprintf(stderr, "capdem run: missing CONFIG.yaml (see capdem run --help)\n");
+        return 2;
+    }
+    return cd_run(&opt);
+}
+
+static void print_version(void)
+{
+    printf("capdem %s\n", CAPDEM_VERSION);
+    printf("omp backend: offload variant '%s'", CAPDEM_OFFLOAD_VARIANT);
+#ifdef _OPENMP
+    printf(", OpenMP %d, %d host thread(s), %d offload device(s)\n", _OPENMP, omp_get_max_threads(), omp_get_num_devices());
+#else
+    printf(", built without OpenMP\n");
+#endif
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) { usage(stderr); return 2; }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) { print_version(); return 0; }
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) { usage(stdout); return 0; }
+    if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
+    if (!strcmp(cmd, "shape")) return cmd_shape(argc - 2, argv + 2);
+    fprintf(stderr, "capdem: unknown command '%s'\n", cmd);
+    usage(stderr);
+    return 2;
+}

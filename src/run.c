@@ -1,0 +1,182 @@
+/* `capdem run`: set up from a config (or resume from a run file), step, and
+ * write snapshots and the time series; report progress; stop with a
+ * diagnostic when the run blows up. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include "run.h"
+#include "sim.h"
+#include "io_h5.h"
+
+/* Overlaps beyond this fraction of the arm diameter are not a packing any
+ * more but a numerical failure (dt too large, stiffness too low). */
+#define CD_MAX_OVERLAP_RATIO 0.5
+
+enum { OBS_KT, OBS_KR, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
+
+static int observable_table(const cd_sim *sim, cd_observable_info *info)
+{
+    int W = (int)sim->s.n_walls;
+    cd_observable_info t[OBS_COUNT] = {
+        {"kinetic_energy_translational", "J", 1}, {"kinetic_energy_rotational", "J", 1},
+        {"elastic_energy", "J", 1}, {"potential_energy", "J", 1},
+        {"contacts", "1", 1}, {"wall_contacts", "1", 1}, {"momentum", "kg m/s", 3},
+        {"wall_force", "N", 3 * W}, {"wall_position", "m", 3 * W}, {"wall_radius", "m", W},
+    };
+    int n = 0;
+    for (int k = 0; k < OBS_COUNT; k++)
+        if (t[k].ncomp > 0) info[n++] = t[k];
+    return n;
+}
+
+/* One time-series row in the order of observable_table. */
+static void observable_row(const cd_sim *sim, const cd_observables *o, double *row)
+{
+    int n = 0;
+    row[n++] = o->kinetic_translational;
+    row[n++] = o->kinetic_rotational;
+    row[n++] = o->elastic;
+    row[n++] = o->potential;
+    row[n++] = o->n_contacts;
+    row[n++] = o->n_wall_contacts;
+    for (int c = 0; c < 3; c++) row[n++] = o->momentum[c];
+    for (size_t w = 0; w < sim->s.n_walls; w++)
+        for (int c = 0; c < 3; c++) row[n++] = o->wall_force[w][c];
+    for (size_t w = 0; w < sim->s.n_walls; w++) {
+        row[n++] = sim->s.walls[w].point.x;
+        row[n++] = sim->s.walls[w].point.y;
+        row[n++] = sim->s.walls[w].point.z;
+    }
+    for (size_t w = 0; w < sim->s.n_walls; w++) row[n++] = sim->s.walls[w].radius;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct {
+    int tty;            /* stderr is a terminal */
+    double start, last; /* wall-clock seconds */
+    long long step0;    /* step at start */
+} progress_t;
+
+static void progress(progress_t *pg, const cd_sim *sim, long long total, int final)
+{
+    double t = now_seconds();
+    double interval = pg->tty ? 0.5 : 10.0; /* [s] between lines */
+    if (!final && t - pg->last < interval) return;
+    pg->last = t;
+    long long done = sim->s.step - pg->step0;
+    double rate = done > 0 ? (double)done / (t - pg->start) : 0; /* steps/s */
+    double eta = rate > 0 ? (double)(total - sim->s.step) / rate : 0;
+    fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  %.3g particle-steps/s  ETA %.0f s%s",
+            pg->tty ? "\r" : "", sim->s.step, total, sim->s.time, rate * (double)sim->s.n_particles, eta,
+            pg->tty ? (final ? "\n" : "   ") : "\n");
+    fflush(stderr);
+}
+
+static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
+{
+    observable_row(sim, o, row);
+    return cd_output_thermo(out, sim->s.step, sim->s.time, row);
+}
+
+int cd_run(const cd_run_options *opt)
+{
+    char err[2048];
+    cd_config cfg;
+    if (cd_config_load(opt->config_path, &cfg, err, sizeof err)) {
+        fprintf(stderr, "capdem: %s\n", err);
+        return 2;
+    }
+    if (opt->steps >= 0) cfg.steps = opt->steps;
+    if (opt->output_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->output_path);
+    if (!cfg.output[0]) snprintf(cfg.output, sizeof cfg.output, "%s.h5", cfg.name);
+    if (opt->resume_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->resume_path);
+
+    static cd_sim sim;
+    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) {
+        fprintf(stderr, "capdem: %s\n", err);
+        cd_config_free(&cfg);
+        return 2;
+    }
+    cd_observable_info info[OBS_COUNT];
+    int n_obs = observable_table(&sim, info);
+    double row[16 + 7 * CD_MAX_WALLS];
+    cd_output *out = NULL;
+    int status = 0;
+    if (opt->resume_path) {
+        if (cd_h5_read_snapshot(opt->resume_path, -1, &sim.s, err, sizeof err)) {
+            fprintf(stderr, "capdem: --resume %s: %s\n", opt->resume_path, err);
+            status = 2;
+            goto done;
+        }
+        cd_sim_refresh(&sim);
+        out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
+        fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
+    } else {
+        if (cd_sim_initial_forces(&sim)) {
+            fprintf(stderr, "capdem: out of memory building the first neighbour list\n");
+            status = 1;
+            goto done;
+        }
+        out = cd_output_create(cfg.output, &cfg, sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
+    }
+    if (!out) {
+        fprintf(stderr, "capdem: %s\n", err);
+        status = 1;
+        goto done;
+    }
+    fprintf(stderr, "capdem: %zu particles, %zu primitives, %zu walls, dt = %g s (t_col/%.1f), %d thread(s), output %s\n",
+            sim.s.n_particles, sim.s.n_prims, sim.s.n_walls, sim.p.dt, sim.collision_time / sim.p.dt, sim.threads, cfg.output);
+
+    cd_observables o;
+    if (!opt->resume_path) {
+        cd_sim_observe(&sim, &o);
+        if (write_thermo(out, &sim, &o, row) || cd_output_snapshot(out, &sim.s)) { status = 1; goto done; }
+    }
+    progress_t pg = {isatty(STDERR_FILENO), now_seconds(), 0, sim.s.step};
+    pg.last = pg.start;
+    const long long batch_max = 200; /* steps between progress checks */
+    while (sim.s.step < cfg.steps) {
+        long long to_thermo = cfg.thermo_every - sim.s.step % cfg.thermo_every;
+        long long to_snap = cfg.snapshot_every - sim.s.step % cfg.snapshot_every;
+        long long n = to_thermo < to_snap ? to_thermo : to_snap;
+        if (n > cfg.steps - sim.s.step) n = cfg.steps - sim.s.step;
+        if (n > batch_max) n = batch_max;
+        if (cd_sim_step(&sim, n, err, sizeof err)) {
+            fprintf(stderr, "\ncapdem: run stopped: %s\ncapdem: %s keeps the snapshots written before step %lld\n",
+                    err, cfg.output, sim.s.step);
+            status = 3;
+            break;
+        }
+        int thermo_due = sim.s.step % cfg.thermo_every == 0, snap_due = sim.s.step % cfg.snapshot_every == 0;
+        int last = sim.s.step == cfg.steps;
+        if (thermo_due || snap_due || last) {
+            cd_sim_observe(&sim, &o);
+            if (o.max_overlap_ratio > CD_MAX_OVERLAP_RATIO) {
+                fprintf(stderr, "\ncapdem: run stopped at step %lld (t = %.9g s): an overlap reached %.3g of the arm diameter "
+                        "(limit %.2g); the time step %g s or the stiffness is unsuitable. %s keeps the snapshots written so far\n",
+                        sim.s.step, sim.s.time, o.max_overlap_ratio, CD_MAX_OVERLAP_RATIO, sim.p.dt, cfg.output);
+                status = 3;
+                break;
+            }
+            if (write_thermo(out, &sim, &o, row)) { status = 1; break; }
+        }
+        if ((snap_due || last) && cd_output_snapshot(out, &sim.s)) { status = 1; break; }
+        if (!opt->quiet) progress(&pg, &sim, cfg.steps, 0);
+    }
+    if (!opt->quiet && status == 0) progress(&pg, &sim, cfg.steps, 1);
+done:
+    if (out && cd_output_close(out)) status = status ? status : 1;
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+    return status;
+}

@@ -1,0 +1,17 @@
+/* The `capdem run` command: set-up, stepping, output, progress, resume. */
+#ifndef CD_RUN_H
+#define CD_RUN_H
+
+typedef struct {
+    const char *config_path;  /* run file */
+    const char *resume_path;  /* run file to continue from its last snapshot, or NULL */
+    const char *output_path;  /* overrides run.output, or NULL */
+    long long steps;          /* overrides run.steps when >= 0 */
+    int quiet;                /* 1: no progress lines */
+} cd_run_options;
+
+/* Returns the process exit status: 0 success, 2 bad input, 3 the run blew
+ * up (the output written so far stays readable), 1 other failures. */
+int cd_run(const cd_run_options *opt);
+
+#endif

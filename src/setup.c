@@ -1,0 +1,316 @@
+/* Builds a simulation from a validated config (SPEC sections 1, 3, 5, 6):
+ * the shapes, the particles with their polydisperse scale factors, random
+ * orientations and velocities, their placement, the walls of the domain and
+ * the time-step check against the collision time. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "sim.h"
+#include "rng.h"
+#include "../kernels/rigid.h"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* Uniformly random rotation (Shoemake's method); about z only in 2D. */
+static cd_quat random_orientation(cd_rng *r, int dimension)
+{
+    if (dimension == 2) return cd_q_from_axis_angle(cd_v3(0, 0, 1), cd_rng_range(r, 0, 2 * CD_PI));
+    double u1 = cd_rng_uniform(r), u2 = cd_rng_uniform(r), u3 = cd_rng_uniform(r);
+    double a = sqrt(1 - u1), b = sqrt(u1);
+    return cd_q_normalize(cd_q(a * sin(2 * CD_PI * u2), a * cos(2 * CD_PI * u2), b * sin(2 * CD_PI * u3), b * cos(2 * CD_PI * u3)));
+}
+
+static int add_wall(cd_sim *sim, cd_wall w, char *err, size_t errlen)
+{
+    if (sim->s.n_walls >= CD_MAX_WALLS) {
+        snprintf(err, errlen, "%s: domain.walls: too many walls (at most %d in all, the domain's included)",
+                 sim->cfg.source_path, CD_MAX_WALLS);
+        return -1;
+    }
+    sim->s.walls[sim->s.n_walls++] = w;
+    return 0;
+}
+
+static cd_wall plane(cd_vec3 point, cd_vec3 normal, double mu)
+{
+    cd_wall w;
+    memset(&w, 0, sizeof(w));
+    w.type = CD_WALL_PLANE;
+    w.point = point;
+    w.normal = normal;
+    w.friction = mu;
+    return w;
+}
+
+/* Walls of the domain (y is up). box: [0,W] x [0,H] x [0,T], closed;
+ * cylinder: axis along y through the origin, floor at y = 0; ball: sphere
+ * about the origin. */
+static int make_walls(cd_sim *sim, char *err, size_t errlen)
+{
+    const cd_config *c = &sim->cfg;
+    double mu = c->wall_friction;
+    int rc = 0;
+    if (!strcmp(c->domain, "box")) {
+        rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(0, 1, 0), mu), err, errlen);
+        rc |= add_wall(sim, plane(cd_v3(0, c->box_height, 0), cd_v3(0, -1, 0), mu), err, errlen);
+        rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(1, 0, 0), mu), err, errlen);
+        rc |= add_wall(sim, plane(cd_v3(c->box_width, 0, 0), cd_v3(-1, 0, 0), mu), err, errlen);
+        rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(0, 0, 1), mu), err, errlen);
+        rc |= add_wall(sim, plane(cd_v3(0, 0, c->box_thickness), cd_v3(0, 0, -1), mu), err, errlen);
+    } else if (!strcmp(c->domain, "cylinder")) {
+        cd_wall w;
+        memset(&w, 0, sizeof(w));
+        w.type = CD_WALL_CYLINDER;
+        w.point = cd_v3(0, 0, 0);
+        w.normal = cd_v3(0, 1, 0);
+        w.radius = 0.5 * c->cyl_diameter;
+        w.friction = mu;
+        rc |= add_wall(sim, w, err, errlen);
+        rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(0, 1, 0), mu), err, errlen);
+    } else if (!strcmp(c->domain, "ball")) {
+        cd_wall w;
+        memset(&w, 0, sizeof(w));
+        w.type = CD_WALL_SPHERE;
+        w.radius = c->ball_radius;
+        w.friction = mu;
+        rc |= add_wall(sim, w, err, errlen);
+    }
+    for (int k = 0; k < c->n_extra_walls && !rc; k++) {
+        cd_wall w = c->extra_walls[k];
+        w.friction = mu;
+        rc |= add_wall(sim, w, err, errlen);
+    }
+    return rc ? -1 : 0;
+}
+
+/* Is a ball of radius R at p inside the domain? */
+static int inside_domain(const cd_config *c, cd_vec3 p, double R)
+{
+    if (!strcmp(c->domain, "box"))
+        return p.x >= R && p.x <= c->box_width - R && p.y >= R && p.y <= c->box_height - R &&
+               (c->dimension == 2 || (p.z >= R && p.z <= c->box_thickness - R));
+    if (!strcmp(c->domain, "cylinder"))
+        return p.y >= R && p.y <= c->cyl_height - R && sqrt(p.x * p.x + p.z * p.z) <= 0.5 * c->cyl_diameter - R;
+    if (!strcmp(c->domain, "ball")) return cd_v3_norm(p) <= c->ball_radius - R;
+    return 1;
+}
+
+/* Lattice sites (square in 2D, simple cubic in 3D) with spacing a inside
+ * the domain, lowest layers first.  Returns the number of sites written
+ * (at most max). */
+static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out, size_t max)
+{
+    double lo[3], hi[3];
+    if (!strcmp(c->domain, "box")) {
+        lo[0] = 0; hi[0] = c->box_width; lo[1] = 0; hi[1] = c->box_height; lo[2] = 0; hi[2] = c->box_thickness;
+    } else if (!strcmp(c->domain, "cylinder")) {
+        double rc = 0.5 * c->cyl_diameter;
+        lo[0] = -rc; hi[0] = rc; lo[1] = 0; hi[1] = c->cyl_height; lo[2] = -rc; hi[2] = rc;
+    } else if (!strcmp(c->domain, "ball")) {
+        for (int k = 0; k < 3; k++) { lo[k] = -c->ball_radius; hi[k] = c->ball_radius; }
+    } else {
+        /* Free space: a cube of sites about the origin. */
+        double side = a * ceil(cbrt((double)max) + 1);
+        if (c->dimension == 2) side = a * ceil(sqrt((double)max) + 1);
+        for (int k = 0; k < 3; k++) { lo[k] = -0.5 * side; hi[k] = 0.5 * side; }
+    }
+    long n[3];
+    double off[3];
+    for (int k = 0; k < 3; k++) {
+        n[k] = (long)floor((hi[k] - lo[k]) / a);
+        if (n[k] < 1) n[k] = 1;
+        off[k] = lo[k] + 0.5 * (hi[k] - lo[k] - (double)(n[k] - 1) * a); /* centred rows */
+    }
+    if (c->dimension == 2) { n[2] = 1; off[2] = 0.5 * (lo[2] + hi[2]); }
+    if (!strcmp(c->domain, "box") && c->dimension == 3 && n[2] == 1) off[2] = 0.5 * c->box_thickness; /* pseudo-2D */
+    size_t count = 0;
+    for (long iy = 0; iy < n[1] && count < max; iy++)
+        for (long iz = 0; iz < n[2] && count < max; iz++)
+            for (long ix = 0; ix < n[0] && count < max; ix++) {
+                cd_vec3 p = cd_v3(off[0] + a * ix, off[1] + a * iy, off[2] + a * iz);
+                if (c->dimension == 2) p.z = off[2];
+                if (inside_domain(c, p, R)) out[count++] = p;
+            }
+    return count;
+}
+
+/* Random non-overlapping bounding spheres in the domain (rejection with a
+ * bounded number of tries per particle). */
+static size_t random_sites(const cd_config *c, cd_rng *r, double R, cd_vec3 *out, size_t max)
+{
+    double lo[3], hi[3];
+    if (!strcmp(c->domain, "box")) {
+        lo[0] = 0; hi[0] = c->box_width; lo[1] = 0; hi[1] = c->box_height; lo[2] = 0; hi[2] = c->box_thickness;
+    } else if (!strcmp(c->domain, "cylinder")) {
+        lo[0] = lo[2] = -0.5 * c->cyl_diameter; hi[0] = hi[2] = 0.5 * c->cyl_diameter; lo[1] = 0; hi[1] = c->cyl_height;
+    } else if (!strcmp(c->domain, "ball")) {
+        for (int k = 0; k < 3; k++) { lo[k] = -c->ball_radius; hi[k] = c->ball_radius; }
+    } else {
+        double side = 2 * R * cbrt(4.0 * (double)max) + 2 * R;
+        for (int k = 0; k < 3; k++) { lo[k] = -0.5 * side; hi[k] = 0.5 * side; }
+    }
+    size_t count = 0;
+    for (size_t tries = 0; count < max && tries < 2000 * max; tries++) {
+        cd_vec3 p = cd_v3(cd_rng_range(r, lo[0], hi[0]), cd_rng_range(r, lo[1], hi[1]), cd_rng_range(r, lo[2], hi[2]));
+        if (c->dimension == 2) p.z = 0.5 * (lo[2] + hi[2]);
+        if (!inside_domain(c, p, R)) continue;
+        int ok = 1;
+        for (size_t k = 0; k < count && ok; k++) ok = cd_v3_norm2(cd_v3_sub(p, out[k])) >= 4 * R * R;
+        if (ok) out[count++] = p;
+    }
+    return count;
+}
+
+static void describe_domain(const cd_config *c, char *buf, size_t n)
+{
+    if (!strcmp(c->domain, "box")) snprintf(buf, n, "domain.width/height/thickness = %g/%g/%g m", c->box_width, c->box_height, c->box_thickness);
+    else if (!strcmp(c->domain, "cylinder")) snprintf(buf, n, "domain.diameter/height = %g/%g m", c->cyl_diameter, c->cyl_height);
+    else if (!strcmp(c->domain, "ball")) snprintf(buf, n, "domain.radius = %g m", c->ball_radius);
+    else snprintf(buf, n, "domain.type = none");
+}
+
+static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
+{
+    const cd_config *c = &sim->cfg;
+    cd_state *s = &sim->s;
+    double rmax = 0, pmax = 0;
+    for (int k = 0; k < sim->n_shapes; k++) {
+        if (sim->shapes[k].bounding_radius > rmax) rmax = sim->shapes[k].bounding_radius;
+        if (c->species[k].polydispersity > pmax) pmax = c->species[k].polydispersity;
+    }
+    double R = rmax * (1 + pmax);            /* largest bounding radius [m] */
+    double a = c->clearance * 2 * R;          /* lattice spacing [m] */
+    size_t N = s->n_particles;
+    cd_vec3 *sites = malloc((N + 1) * sizeof(cd_vec3));
+    if (!sites) return -1;
+    size_t got = !strcmp(c->placement, "random") ? random_sites(c, rng, R, sites, N) : lattice_sites(c, a, R, sites, N);
+    if (got < N) {
+        char dom[256];
+        describe_domain(c, dom, sizeof dom);
+        snprintf(err, errlen, "%s: particles: %zu particles of size %g m (init.clearance %g) do not fit: %s holds only %zu %s sites; "
+                 "enlarge the domain or lower the counts", c->source_path, N, 2 * R, c->clearance, dom, got, c->placement);
+        free(sites);
+        return -1;
+    }
+    for (size_t q = 0; q < N; q++) {
+        s->position[q] = sites[q];
+        s->orientation[q] = random_orientation(rng, c->dimension);
+        double v = c->init_speed;
+        s->velocity[q] = cd_v3(cd_rng_range(rng, -v, v), cd_rng_range(rng, -v, v), c->dimension == 2 ? 0 : cd_rng_range(rng, -v, v));
+        s->angmom[q] = cd_v3_zero();
+    }
+    free(sites);
+    return 0;
+}
+
+static int check_time_step(cd_sim *sim, char *err, size_t errlen)
+{
+    const cd_config *c = &sim->cfg;
+    const cd_state *s = &sim->s;
+    /* The two lightest particles give the shortest collision. */
+    double m1 = INFINITY, m2 = INFINITY;
+    for (size_t q = 0; q < s->n_particles; q++) {
+        if (s->mass[q] < m1) { m2 = m1; m1 = s->mass[q]; }
+        else if (s->mass[q] < m2) m2 = s->mass[q];
+    }
+    double m_eff = s->n_particles > 1 ? cd_law_effective_mass(m1, m2) : m1;
+    sim->collision_time = cd_law_collision_time(c->kn, m_eff, c->eta_n);
+    if (c->dt > sim->collision_time / 5 && !c->force_dt) {
+        snprintf(err, errlen, "%s: run.dt = %g s: expected at most t_col/5 = %g s (collision time %g s of the lightest pair); "
+                 "lower dt or set run.force_dt: true", c->source_path, c->dt, sim->collision_time / 5, sim->collision_time);
+        return -1;
+    }
+    if (c->dt > sim->collision_time / 20)
+        fprintf(stderr, "capdem: warning: run.dt = %g s is above t_col/20 = %g s; contacts are resolved in fewer than 20 steps\n",
+                c->dt, sim->collision_time / 20);
+    return 0;
+}
+
+int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
+{
+    memset(sim, 0, sizeof(*sim));
+    sim->cfg = *cfg;
+    sim->cfg.source_text = NULL; /* owned by the caller's config */
+    const cd_config *c = &sim->cfg;
+    size_t N = 0, P = 0;
+    sim->n_shapes = c->n_species;
+    for (int k = 0; k < c->n_species; k++) {
+        char why[512];
+        if (cd_shape_from_species(&c->species[k], c->density, &sim->shapes[k], why, sizeof why)) {
+            snprintf(err, errlen, "%s: particles[%d]: %s", c->source_path, k, why);
+            return -1;
+        }
+        N += (size_t)c->species[k].count;
+        P += (size_t)c->species[k].count * (size_t)sim->shapes[k].n_prims;
+    }
+    if (cd_state_alloc(&sim->s, N, P, 0, 2 * P + 64)) {
+        snprintf(err, errlen, "out of memory for %zu particles", N);
+        return -1;
+    }
+    if (make_walls(sim, err, errlen)) return -1;
+    /* wall-contact columns depend on the wall count: allocate them now */
+    cd_state *s = &sim->s;
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group != CD_GROUP_WALLC) continue;
+        void **slot = cd_field_ptr(s, &cd_fields[f]);
+        free(*slot);
+        *slot = calloc(P * (s->n_walls ? s->n_walls : 1), cd_fields[f].elem_size);
+        if (!*slot) return -1;
+    }
+
+    cd_rng rng;
+    cd_rng_seed(&rng, c->seed);
+    size_t q = 0, prim = 0;
+    double dmin = INFINITY;
+    for (int k = 0; k < c->n_species; k++) {
+        const cd_shape *sh = &sim->shapes[k];
+        double p = c->species[k].polydispersity;
+        for (long n = 0; n < c->species[k].count; n++, q++) {
+            double f = p > 0 ? cd_rng_range(&rng, 1 - p, 1 + p) : 1.0; /* length scale [1] */
+            s->shape[q] = k;
+            s->scale[q] = f;
+            s->mass[q] = sh->mass * f * f * f;
+            s->inertia[q] = cd_v3(sh->principal[0] * pow(f, 5), sh->principal[1] * pow(f, 5), sh->principal[2] * pow(f, 5));
+            s->prim_first[q] = (cd_int)prim;
+            s->prim_count[q] = sh->n_prims;
+            for (int a = 0; a < sh->n_prims; a++, prim++) {
+                s->prim_particle[prim] = (cd_int)q;
+                s->prim_a_body[prim] = cd_v3_scale(sh->a[a], f);
+                s->prim_b_body[prim] = cd_v3_scale(sh->b[a], f);
+                s->prim_radius[prim] = sh->radius[a] * f;
+                if (2 * s->prim_radius[prim] < dmin) dmin = 2 * s->prim_radius[prim];
+            }
+        }
+    }
+    if (place_particles(sim, &rng, err, errlen)) return -1;
+    if (check_time_step(sim, err, errlen)) return -1;
+
+    cd_step_params *sp = &sim->p;
+    sp->dt = c->dt;
+    sp->gravity = cd_v3(c->gravity[0], c->gravity[1], c->gravity[2]);
+    sp->dimension = c->dimension;
+    sp->sin_parallel = sin(c->parallel_angle_deg * CD_PI / 180);
+    sp->law.kn = c->kn;
+    sp->law.kt = c->kt;
+    sp->law.eta_n = c->eta_n;
+    sp->law.eta_t = c->eta_t;
+    sp->law.mu = c->friction;
+    sp->law.limit_total = c->friction_limit_total;
+    sp->law.clip_normal = 1;
+    sp->wall_law = sp->law;
+    sp->wall_law.mu = c->wall_friction;
+    cd_neighbors_init(&sim->nb, c->skin > 0 ? c->skin : 0.1 * dmin);
+    sim->threads = 1;
+#ifdef _OPENMP
+    sim->threads = omp_get_max_threads();
+#endif
+    return 0;
+}
+
+void cd_sim_free(cd_sim *sim)
+{
+    cd_state_free(&sim->s);
+    cd_neighbors_free(&sim->nb);
+}

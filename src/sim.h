@@ -1,0 +1,91 @@
+/* A simulation: the state, the parameters every kernel needs, the shape
+ * catalogue and the neighbour-list workspace. */
+#ifndef CD_SIM_H
+#define CD_SIM_H
+#include <stdio.h>
+#include "state.h"
+#include "config.h"
+#include "shapes.h"
+#include "../kernels/contact_law.h"
+
+/* Loops over fewer rows than this run on one thread: a parallel region
+ * costs microseconds, more than a small loop, and on a loaded machine the
+ * threads' barriers cost far more.  Results do not depend on it. */
+extern long cd_parallel_min_rows;
+#define CD_PARALLEL(rows) ((long)(rows) >= cd_parallel_min_rows)
+
+/* Per-step constants handed to every kernel. */
+typedef struct {
+    cd_real dt;               /* time step [s] */
+    cd_vec3 gravity;          /* [m/s^2] */
+    cd_law_params law;        /* particle-particle contact law */
+    cd_law_params wall_law;   /* particle-wall contact law (mu = wall friction) */
+    cd_real sin_parallel;     /* sine of the parallel-contact cut-off angle [1] */
+    cd_int dimension;         /* 3, or 2: motion in the x-y plane only */
+} cd_step_params;
+
+/* Neighbour-list workspace (host side). */
+typedef struct {
+    double skin;              /* Verlet skin [m] */
+    long long builds;         /* rebuilds so far */
+    int force_rebuild;        /* 1: rebuild at the next step regardless of motion */
+    /* per-particle gather lists (CSR over pair rows): for particle p the rows
+     * gather_rows[gather_start[p] .. gather_start[p+1]) in ascending pair order */
+    cd_int *gather_start;     /* n_particles + 1 */
+    cd_pair_id *gather_rows;  /* 2 n_pairs */
+    size_t gather_cap;
+    /* scratch */
+    cd_int *cell_start, *cell_prims, *prim_cell, *pair_count;
+    size_t cell_cap;
+} cd_neighbors;
+
+typedef struct cd_sim {
+    cd_config cfg;
+    cd_state s;
+    cd_step_params p;
+    cd_shape shapes[CD_MAX_SPECIES];
+    int n_shapes;
+    cd_neighbors nb;
+    double collision_time;    /* smallest pair collision time [s] */
+    int threads;              /* OpenMP threads in use */
+} cd_sim;
+
+/* Builds a simulation from a validated config: shapes, particles placed as
+ * init.* says, walls of the domain, step parameters.  Checks the time step
+ * against the collision time.  Returns 0, or -1 with a message that names
+ * the file and key in err (exit status 2 for the caller). */
+int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen);
+void cd_sim_free(cd_sim *sim);
+
+/* After positions/orientations changed outside the step (setup, resume):
+ * recompute world endpoints, angular velocities and forces, and force a
+ * neighbour rebuild. */
+void cd_sim_refresh(cd_sim *sim);
+
+/* Refresh, neighbour list and the forces of the initial state (before the
+ * first step of a new run; a resumed run reads its forces instead). */
+int cd_sim_initial_forces(cd_sim *sim);
+
+/* Advances n steps. Returns 0, or -1 when the run blew up (message in err). */
+int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen);
+
+/* Observables (deterministic sums). */
+typedef struct {
+    double kinetic_translational, kinetic_rotational; /* [J] */
+    double elastic;           /* energy stored in contact springs [J] */
+    double potential;         /* gravitational potential energy -m g.x [J] */
+    double n_contacts;        /* active particle-particle contacts */
+    double n_wall_contacts;   /* active particle-wall contacts */
+    double momentum[3];       /* total linear momentum [kg m/s] */
+    double wall_force[CD_MAX_WALLS][3]; /* force of the particles on each wall [N] */
+    double max_overlap_ratio; /* largest overlap / arm diameter [1] */
+} cd_observables;
+void cd_sim_observe(const cd_sim *sim, cd_observables *o);
+
+/* Neighbour list (neighbors.c). */
+void cd_neighbors_init(cd_neighbors *nb, double skin);
+void cd_neighbors_free(cd_neighbors *nb);
+int cd_neighbors_needed(cd_sim *sim);
+int cd_neighbors_build(cd_sim *sim);
+
+#endif

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Bad input is refused with exit status 2 and a message naming the file and
+# the key; a good short run writes a readable file.
+# usage: test_cli_errors.sh CAPDEM SOURCE_DIR
+set -u
+capdem=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+pass=0
+
+# expect_refusal NAME KEY_REGEX  (config text on stdin)
+expect_refusal() {
+  local name=$1 pattern=$2 file="$work/$1.yaml"
+  cat > "$file"
+  "$capdem" run "$file" --quiet > "$work/out" 2> "$work/err"
+  local rc=$?
+  if [ $rc -ne 2 ]; then
+    echo "FAIL $name: exit status $rc, expected 2"; cat "$work/err"; fails=$((fails+1)); return
+  fi
+  if ! grep -q "$name.yaml" "$work/err" || ! grep -Eq "$pattern" "$work/err"; then
+    echo "FAIL $name: message does not name the file and /$pattern/:"; cat "$work/err"; fails=$((fails+1)); return
+  fi
+  pass=$((pass+1))
+}
+
+base='particles: [{shape: sphere, diameter: 0.005, count: 8}]
+domain: {type: box, width: 0.05, height: 0.05, thickness: 0.05}'
+
+expect_refusal unknown_key 'material\.stiffness' < <(printf '%s\nmaterial: {stiffness: 1e5}\n' "$base")
+expect_refusal wrong_type 'run\.steps' < <(printf '%s\nrun: {steps: many}\n' "$base")
+expect_refusal negative_stiffness 'material\.kn' < <(printf '%s\nmaterial: {kn: -1.0e5}\n' "$base")
+expect_refusal negative_friction 'material\.friction' < <(printf '%s\nmaterial: {friction: -0.1}\n' "$base")
+expect_refusal restitution_above_one 'material\.restitution' < <(printf '%s\nmaterial: {restitution: 1.2}\n' "$base")
+expect_refusal dt_above_fifth_of_collision_time 'run\.dt' < <(printf '%s\nrun: {dt: 1.0e-4}\n' "$base")
+expect_refusal particles_do_not_fit 'particles.*do not fit' < <(printf 'particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 500}]\ndomain: {type: box, width: 0.05, height: 0.05, thickness: 0.05}\n')
+
+# dt above t_col/5 runs when forced (with a warning)
+printf '%s\nrun: {dt: 1.0e-4, steps: 10, force_dt: true, output: %s}\n' "$base" "$work/forced.h5" > "$work/forced.yaml"
+if "$capdem" run "$work/forced.yaml" --quiet 2> "$work/err" && grep -q warning "$work/err"; then
+  pass=$((pass+1))
+else
+  echo "FAIL forced dt"; cat "$work/err"; fails=$((fails+1))
+fi
+
+# a good run writes a file h5dump can read, with the config echoed
+printf '%s\nrun: {steps: 200, snapshot_every: 100, output: %s}\n' "$base" "$work/good.h5" > "$work/good.yaml"
+if "$capdem" run "$work/good.yaml" --quiet 2> "$work/err" && h5dump -d /parameters/config "$work/good.h5" | grep -q 'shape: sphere'; then
+  pass=$((pass+1))
+else
+  echo "FAIL good run"; cat "$work/err"; fails=$((fails+1))
+fi
+
+# shape JSON has the documented keys
+ok=1
+"$capdem" shape hexapod --aspect 3 --diameter 0.005 --density 1000 --json > "$work/shape.json" || ok=0
+for k in volume area sphericity mass inertia; do grep -q "\"$k\"" "$work/shape.json" || ok=0; done
+if [ $ok -eq 1 ]; then pass=$((pass+1)); else echo "FAIL shape --json"; cat "$work/shape.json"; fails=$((fails+1)); fi
+
+"$capdem" shape hexapod --aspect 0.5 > /dev/null 2>&1
+if [ $? -eq 2 ]; then pass=$((pass+1)); else echo "FAIL shape with aspect < 1 not refused"; fails=$((fails+1)); fi
+
+echo "$pass passed, $fails failed"
+[ $fails -eq 0 ]

@@ -1,0 +1,543 @@
+/* HDF5 run file: snapshots and time series round-trip bit for bit, resume
+ * truncates what came after the checkpoint, a killed writer leaves a
+ * readable file, mismatched states are refused with a clear message. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include <hdf5.h>
+
+#include "io_h5.h"
+
+#define NP 5     /* particles */
+#define NPRIM 10 /* primitives, two per particle */
+#define NW 2     /* walls */
+#define NPAIR 9  /* rows of the pair list */
+
+static const cd_observable_info OBS[2] = {{"energy", "J", 1}, {"momentum", "kg m/s", 3}};
+static const char *CONFIG_TEXT =
+    "run:\n  name: \"io test\"\t# t\xc3\xa4" "b, quote ' and \\\n\nphysics: {dt: 1e-6}\n  \n";
+
+/* ---- deterministic random contents ------------------------------------- */
+
+static uint64_t rng;
+static uint64_t next_u64(void)
+{
+    uint64_t z = (rng += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* Mostly ordinary values, and negative zero, subnormals and arbitrary bit
+ * patterns (NaN payloads, infinities) that a conversion would disturb. */
+static double rand_double(void)
+{
+    uint64_t u = next_u64(), bits;
+    double d;
+    switch (u % 8) {
+    case 0: return -0.0;
+    case 1: bits = (next_u64() & 0x800FFFFFFFFFFFFFULL) | 1; break; /* subnormal */
+    case 2: bits = next_u64(); break;
+    default: return ((double)(next_u64() >> 11) * 0x1.0p-53) * 20.0 - 10.0;
+    }
+    memcpy(&d, &bits, sizeof d);
+    return d;
+}
+
+static void fill_random(void *col, size_t rows, const cd_field_info *f)
+{
+    size_t n = rows * (size_t)f->ncomp;
+    for (size_t i = 0; i < n; i++) {
+        if (f->kind == CD_KIND_REAL) ((double *)col)[i] = rand_double();
+        else ((int32_t *)col)[i] = (int32_t)next_u64();
+    }
+}
+
+static int is_fixed(const char *name)
+{
+    static const char *fixed[] = {"mass", "inertia", "scale", "shape", "prim_first", "prim_count",
+                                  "prim_particle", "prim_a_body", "prim_b_body", "prim_radius"};
+    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
+        if (!strcmp(name, fixed[i])) return 1;
+    return 0;
+}
+
+/* State of snapshot j of a run: columns that never change come from one
+ * seed, the rest from j.  Snapshot 1 has no active contact. */
+static void fill_state(cd_state *s, int j)
+{
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        rng = is_fixed(f->name) ? 1000 + k : (uint64_t)j * 7919 + k;
+        size_t rows = f->group == CD_GROUP_PAIR ? NPAIR : cd_state_rows(s, f->group);
+        fill_random(*cd_field_ptr(s, f), rows, f);
+    }
+    rng = (uint64_t)j * 104729 + 17;
+    s->n_pairs = NPAIR;
+    for (int p = 0; p < NPRIM; p++) s->prim_particle[p] = p / 2;
+    for (int r = 0; r < NPAIR; r++) {
+        s->pair_prim_i[r] = r % NPRIM;
+        s->pair_prim_j[r] = (r + 3 + j) % NPRIM;
+        s->pair_active[r] = j == 1 ? 0 : (int)(next_u64() % 2) || r == 0;
+    }
+    for (size_t r = 0; r < NPRIM * NW; r++) s->wallc_active[r] = (int)(next_u64() % 3 == 0) || r == 4;
+    memset(s->walls, 0, sizeof s->walls);
+    for (int w = 0; w < NW; w++) {
+        cd_wall *wl = &s->walls[w];
+        wl->type = (cd_int)(next_u64() % 3);
+        double *v[] = {&wl->point.x, &wl->point.y, &wl->point.z, &wl->normal.x, &wl->normal.y, &wl->normal.z,
+                       &wl->velocity.x, &wl->velocity.y, &wl->velocity.z, &wl->radius, &wl->radial_velocity,
+                       &wl->friction};
+        for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) *v[i] = rand_double();
+    }
+    s->time = j == 0 ? 0.0 : rand_double();
+    s->step = 100LL * j;
+}
+
+static void alloc_state(cd_state *s, size_t np, size_t nprim, size_t nw, size_t cap)
+{
+    assert_int_equal(cd_state_alloc(s, np, nprim, nw, cap), 0);
+}
+
+/* A state to read into, full of garbage so that every byte must be written. */
+static void alloc_garbage(cd_state *s)
+{
+    alloc_state(s, NP, NPRIM, NW, 1);
+    rng = 424242;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        fill_random(*cd_field_ptr(s, f), f->group == CD_GROUP_PAIR ? 1 : cd_state_rows(s, f->group), f);
+    }
+    s->n_pairs = 1;
+    memset(s->walls, 0x5a, sizeof s->walls);
+    s->time = 1.5;
+    s->step = -7;
+}
+
+/* What reading a snapshot of `want` must give, compared byte for byte. */
+static void expect_snapshot(const cd_state *want, const cd_state *got)
+{
+    cd_state *w = (cd_state *)want, *g = (cd_state *)got;
+    size_t active = 0;
+    for (size_t r = 0; r < want->n_pairs; r++) active += want->pair_active[r] != 0;
+    assert_int_equal(got->n_pairs, active);
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        const char *a = *cd_field_ptr(w, f), *b = *cd_field_ptr(g, f);
+        size_t e = f->elem_size;
+        if (f->group == CD_GROUP_PARTICLE || f->group == CD_GROUP_PRIM) {
+            assert_memory_equal(a, b, cd_state_rows(want, f->group) * e);
+        } else if (f->group == CD_GROUP_PAIR) {
+            for (size_t r = 0, j = 0; r < want->n_pairs; r++)
+                if (want->pair_active[r]) assert_memory_equal(a + r * e, b + (j++) * e, e);
+        } else {
+            static const char zero[64];
+            for (size_t r = 0; r < cd_state_rows(want, f->group); r++)
+                assert_memory_equal(want->wallc_active[r] ? a + r * e : zero, b + r * e, e);
+        }
+    }
+    assert_memory_equal(want->walls, got->walls, want->n_walls * sizeof(cd_wall));
+    assert_memory_equal(&want->time, &got->time, sizeof want->time);
+    assert_int_equal(want->step, got->step);
+}
+
+static void check_snapshot(const char *path, int k, const cd_state *want)
+{
+    char err[1024] = "";
+    cd_state g;
+    alloc_garbage(&g);
+    int rc = cd_h5_read_snapshot(path, k, &g, err, sizeof err);
+    if (rc) print_error("%s\n", err);
+    assert_int_equal(rc, 0);
+    expect_snapshot(want, &g);
+    cd_state_free(&g);
+}
+
+static void test_path(char *buf, size_t len, const char *what)
+{
+    snprintf(buf, len, "test_io_h5_%ld_%s.h5", (long)getpid(), what);
+}
+
+static cd_output *create(const char *path)
+{
+    cd_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.source_text = (char *)CONFIG_TEXT;
+    strcpy(cfg.source_path, "/runs/io test/run.yaml");
+    cd_shape sh[2];
+    memset(sh, 0, sizeof sh);
+    strcpy(sh[0].kind, "cross");
+    sh[0].n_prims = 2;
+    sh[0].a[0] = (cd_vec3){-1e-3, 0, 0};
+    sh[0].b[0] = (cd_vec3){1e-3, 0, 0};
+    sh[0].a[1] = (cd_vec3){0, -1e-3, 0};
+    sh[0].b[1] = (cd_vec3){0, 1e-3, 0};
+    sh[0].radius[0] = sh[0].radius[1] = 2.5e-4;
+    sh[0].volume = 1.23e-9;
+    sh[0].principal[0] = 1e-12;
+    strcpy(sh[1].kind, "sphere");
+    sh[1].n_prims = 1;
+    sh[1].radius[0] = 5e-4;
+    char err[1024] = "";
+    cd_output *o = cd_output_create(path, &cfg, sh, 2, OBS, 2, err, sizeof err);
+    if (!o) print_error("%s\n", err);
+    assert_non_null(o);
+    return o;
+}
+
+static void thermo(cd_output *o, long long step)
+{
+    double v[4] = {(double)step * 0.5, (double)step, -(double)step, 1.0 / ((double)step + 1)};
+    assert_int_equal(cd_output_thermo(o, step, (double)step * 1e-6, v), 0);
+}
+
+/* Writes snapshots 0..n-1 (steps 0, 100, ...) with time-series rows at
+ * every 50 steps up to 100 n - 50. */
+static void write_run(const char *path, int n, cd_state *s)
+{
+    cd_output *o = create(path);
+    for (int j = 0; j < n; j++) {
+        fill_state(&s[j], j);
+        thermo(o, 100LL * j);
+        assert_int_equal(cd_output_snapshot(o, &s[j]), 0);
+        thermo(o, 100LL * j + 50);
+    }
+    assert_int_equal(cd_output_close(o), 0);
+}
+
+static long long read_ll_dataset(hid_t f, const char *path, long long *v, size_t cap)
+{
+    hid_t d = H5Dopen2(f, path, H5P_DEFAULT);
+    assert_true(d >= 0);
+    hid_t sp = H5Dget_space(d);
+    hssize_t n = H5Sget_simple_extent_npoints(sp);
+    assert_true(n >= 0 && (size_t)n <= cap);
+    if (n) assert_true(H5Dread(d, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0);
+    H5Sclose(sp);
+    H5Dclose(d);
+    return (long long)n;
+}
+
+static void test_io_h5_snapshots_round_trip_bit_for_bit(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    test_path(path, sizeof path, "rt");
+    cd_state s[3];
+    for (int j = 0; j < 3; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
+    write_run(path, 3, s);
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 3);
+    for (int j = 0; j < 3; j++) check_snapshot(path, j, &s[j]);
+    check_snapshot(path, -1, &s[2]);
+
+    char *text = cd_h5_read_config_text(path, err, sizeof err);
+    assert_non_null(text);
+    assert_string_equal(text, CONFIG_TEXT);
+    free(text);
+
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(f >= 0);
+    /* H5MD header */
+    int version[2] = {0, 0};
+    hid_t a = H5Aopen_by_name(f, "/h5md", "version", H5P_DEFAULT, H5P_DEFAULT);
+    assert_true(a >= 0 && H5Aread(a, H5T_NATIVE_INT, version) >= 0);
+    H5Aclose(a);
+    assert_int_equal(version[0], 1);
+    assert_int_equal(version[1], 1);
+    assert_true(H5Aexists_by_name(f, "/h5md/creator", "version", H5P_DEFAULT) > 0);
+    assert_true(H5Aexists_by_name(f, "/parameters/config", "source_path", H5P_DEFAULT) > 0);
+    assert_true(H5Aexists_by_name(f, "/parameters/shapes/0/volume", "unit", H5P_DEFAULT) > 0);
+    assert_true(H5Aexists_by_name(f, "/particles/all/position/value", "unit", H5P_DEFAULT) > 0);
+    /* time series: 6 rows of steps 0, 50, ..., 250 */
+    long long steps[16];
+    assert_int_equal(read_ll_dataset(f, "/observables/momentum/step", steps, 16), 6);
+    for (int i = 0; i < 6; i++) assert_int_equal(steps[i], 50 * i);
+    double mom[6][3];
+    hid_t d = H5Dopen2(f, "/observables/momentum/value", H5P_DEFAULT);
+    assert_true(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, mom) >= 0);
+    H5Dclose(d);
+    for (int i = 0; i < 6; i++) {
+        assert_true(mom[i][0] == 50.0 * i && mom[i][1] == -50.0 * i && mom[i][2] == 1.0 / (50.0 * i + 1));
+    }
+    /* contacts: offsets and owning particles */
+    long long off[8];
+    assert_int_equal(read_ll_dataset(f, "/contacts/offset", off, 8), 4);
+    assert_int_equal(off[0], 0);
+    assert_int_equal(off[2] - off[1], 0); /* snapshot 1 has no contact */
+    long long pi[64];
+    assert_int_equal(read_ll_dataset(f, "/contacts/particle_i", pi, 64), off[3]);
+    for (int r = 0, j = 0; r < NPAIR; r++)
+        if (s[0].pair_active[r]) assert_int_equal(pi[j++], s[0].prim_particle[s[0].pair_prim_i[r]]);
+    H5Fclose(f);
+    for (int j = 0; j < 3; j++) cd_state_free(&s[j]);
+    remove(path);
+}
+
+static void test_io_h5_reopen_truncates_after_resume_step(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    test_path(path, sizeof path, "resume");
+    cd_state s[4];
+    for (int j = 0; j < 4; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
+    write_run(path, 3, s);
+
+    cd_output *o = cd_output_reopen(path, 100, OBS, 2, err, sizeof err);
+    if (!o) print_error("%s\n", err);
+    assert_non_null(o);
+    fill_state(&s[3], 3);
+    s[3].step = 150;
+    thermo(o, 150);
+    assert_int_equal(cd_output_snapshot(o, &s[3]), 0);
+    assert_int_equal(cd_output_close(o), 0);
+
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 3);
+    check_snapshot(path, 0, &s[0]);
+    check_snapshot(path, 1, &s[1]);
+    check_snapshot(path, 2, &s[3]);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    long long v[16];
+    static const long long want_obs[] = {0, 50, 100, 150};
+    assert_int_equal(read_ll_dataset(f, "/observables/energy/step", v, 16), 4);
+    assert_memory_equal(v, want_obs, sizeof want_obs);
+    static const long long want_snap[] = {0, 100, 150};
+    assert_int_equal(read_ll_dataset(f, "/particles/all/velocity/step", v, 16), 3);
+    assert_memory_equal(v, want_snap, sizeof want_snap);
+    long long off[8];
+    assert_int_equal(read_ll_dataset(f, "/contacts/offset", off, 8), 4);
+    assert_int_equal(read_ll_dataset(f, "/contacts/particle_j", v, 16), off[3]);
+    assert_int_equal(read_ll_dataset(f, "/wall_contacts/offset", off, 8), 4);
+    long long idx[64];
+    assert_int_equal(read_ll_dataset(f, "/wall_contacts/index", idx, 64), off[3]);
+    H5Fclose(f);
+    for (int j = 0; j < 4; j++) cd_state_free(&s[j]);
+    remove(path);
+}
+
+static void test_io_h5_reopen_before_first_snapshot(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    test_path(path, sizeof path, "empty");
+    assert_int_equal(cd_output_close(create(path)), 0);
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 0);
+    assert_int_equal(cd_h5_read_snapshot(path, -1, &(cd_state){0}, err, sizeof err), -1);
+    assert_non_null(strstr(err, "no complete snapshot"));
+    cd_output *o = cd_output_reopen(path, 0, OBS, 2, err, sizeof err);
+    assert_non_null(o);
+    cd_state s;
+    alloc_state(&s, NP, NPRIM, NW, NPAIR);
+    fill_state(&s, 2);
+    assert_int_equal(cd_output_snapshot(o, &s), 0);
+    assert_int_equal(cd_output_close(o), 0);
+    check_snapshot(path, 0, &s);
+    cd_state_free(&s);
+    remove(path);
+}
+
+/* Child: 3 snapshots, tell the parent, then keep writing (mode 0) until
+ * killed, or buffer a time-series row and leave without closing (mode 1). */
+static void child_writer(const char *path, int fd, int mode)
+{
+    cd_state s;
+    if (cd_state_alloc(&s, NP, NPRIM, NW, NPAIR)) _exit(3);
+    char err[512];
+    cd_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.source_text = (char *)CONFIG_TEXT;
+    cd_output *o = cd_output_create(path, &cfg, NULL, 0, OBS, 2, err, sizeof err);
+    if (!o) _exit(4);
+    double v[4] = {1, 2, 3, 4};
+    for (int j = 0;; j++) {
+        fill_state(&s, j);
+        if (cd_output_thermo(o, s.step, s.time, v) || cd_output_snapshot(o, &s)) _exit(5);
+        if (j == 2) {
+            if (write(fd, "3", 1) != 1) _exit(6);
+            if (mode == 1) {
+                cd_output_thermo(o, s.step + 1, s.time, v);
+                _exit(0);
+            }
+        }
+    }
+}
+
+static void check_killed_file(const char *path, int exact_count)
+{
+    char err[1024] = "";
+    int n = cd_h5_snapshot_count(path, err, sizeof err);
+    if (n < 0) print_error("%s\n", err);
+    assert_true(exact_count ? n == exact_count : n >= 3);
+    cd_state want;
+    alloc_state(&want, NP, NPRIM, NW, NPAIR);
+    for (int j = 0; j < n; j++) {
+        fill_state(&want, j);
+        check_snapshot(path, j, &want);
+    }
+    cd_state_free(&want);
+    if (system("command -v h5dump > /dev/null 2>&1") == 0) {
+        char cmd[300];
+        snprintf(cmd, sizeof cmd, "h5dump '%s' > /dev/null", path);
+        assert_int_equal(system(cmd), 0);
+    }
+}
+
+static void run_child(const char *path, int mode, long delay_us)
+{
+    int fd[2];
+    assert_int_equal(pipe(fd), 0);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        close(fd[0]);
+        child_writer(path, fd[1], mode);
+        _exit(7);
+    }
+    close(fd[1]);
+    char c;
+    assert_int_equal(read(fd[0], &c, 1), 1);
+    close(fd[0]);
+    int status;
+    if (mode == 0) {
+        struct timespec ts = {0, (long)delay_us * 1000};
+        if (delay_us) nanosleep(&ts, NULL);
+        kill(pid, SIGKILL);
+        assert_int_equal(waitpid(pid, &status, 0), pid);
+        assert_true(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+    } else {
+        assert_int_equal(waitpid(pid, &status, 0), pid);
+        assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    }
+}
+
+static void test_io_h5_killed_writer_leaves_readable_file(void **state)
+{
+    (void)state;
+    char path[128];
+    static const long delays[] = {0, 300, 3000, 20000};
+    for (size_t i = 0; i < sizeof delays / sizeof delays[0]; i++) {
+        test_path(path, sizeof path, "kill");
+        run_child(path, 0, delays[i]);
+        check_killed_file(path, 0);
+        remove(path);
+    }
+    test_path(path, sizeof path, "exit");
+    run_child(path, 1, 0);
+    check_killed_file(path, 3);
+    /* the time-series rows flushed with the snapshots survive, the buffered one is lost */
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    long long v[8];
+    assert_int_equal(read_ll_dataset(f, "/observables/energy/step", v, 8), 3);
+    H5Fclose(f);
+    remove(path);
+}
+
+static void test_io_h5_wrong_counts_are_refused(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    test_path(path, sizeof path, "counts");
+    cd_state s[1];
+    alloc_state(&s[0], NP, NPRIM, NW, NPAIR);
+    write_run(path, 1, s);
+    cd_state g;
+    alloc_state(&g, NP + 1, NPRIM, NW, 4);
+    assert_int_equal(cd_h5_read_snapshot(path, 0, &g, err, sizeof err), -1);
+    assert_non_null(strstr(err, path));
+    assert_non_null(strstr(err, "holds 5 particles"));
+    assert_non_null(strstr(err, "the state 6"));
+    cd_state_free(&g);
+    alloc_state(&g, NP, NPRIM, NW - 1, 4);
+    assert_int_equal(cd_h5_read_snapshot(path, 0, &g, err, sizeof err), -1);
+    assert_non_null(strstr(err, "holds 2 walls"));
+    cd_state_free(&g);
+    alloc_state(&g, NP, NPRIM, NW, 4);
+    assert_int_equal(cd_h5_read_snapshot(path, 1, &g, err, sizeof err), -1);
+    assert_non_null(strstr(err, "snapshot 1 requested"));
+    cd_state_free(&g);
+
+    /* appending a state of another size, or one whose fixed columns changed */
+    cd_output *o = cd_output_reopen(path, 1000, OBS, 2, err, sizeof err);
+    assert_non_null(o);
+    alloc_state(&g, NP + 1, NPRIM, NW, 4);
+    assert_int_equal(cd_output_snapshot(o, &g), -1);
+    assert_non_null(strstr(cd_output_error(o), "5 particles"));
+    cd_state_free(&g);
+    s[0].mass[2] += 1.0;
+    assert_int_equal(cd_output_snapshot(o, &s[0]), -1);
+    assert_non_null(strstr(cd_output_error(o), "column mass changed"));
+    assert_int_equal(cd_output_close(o), 0);
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 1);
+    cd_state_free(&s[0]);
+    remove(path);
+}
+
+static void test_io_h5_missing_file_is_named(void **state)
+{
+    (void)state;
+    char err[1024] = "";
+    const char *path = "no_such_dir_io_h5/run.h5";
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), -1);
+    assert_non_null(strstr(err, path));
+    assert_null(cd_h5_read_config_text(path, err, sizeof err));
+    assert_non_null(strstr(err, path));
+    assert_null(cd_output_reopen(path, 0, NULL, 0, err, sizeof err));
+    assert_non_null(strstr(err, path));
+    assert_null(cd_output_create(path, NULL, NULL, 0, NULL, 0, err, sizeof err));
+    assert_non_null(strstr(err, path));
+}
+
+static void test_io_h5_bad_observables_are_refused(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    test_path(path, sizeof path, "obs");
+    static const cd_observable_info slash[1] = {{"a/b", "1", 1}}, twice[2] = {{"e", "J", 1}, {"e", "J", 1}};
+    assert_null(cd_output_create(path, NULL, NULL, 0, slash, 1, err, sizeof err));
+    assert_non_null(strstr(err, "invalid name \"a/b\""));
+    assert_null(cd_output_create(path, NULL, NULL, 0, twice, 2, err, sizeof err));
+    assert_non_null(strstr(err, "\"e\" given twice"));
+    cd_state s[2];
+    for (int j = 0; j < 2; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
+    write_run(path, 2, s);
+    static const cd_observable_info other[2] = {{"energy", "J", 1}, {"momentum", "kg m/s", 2}};
+    assert_null(cd_output_reopen(path, 0, other, 2, err, sizeof err));
+    assert_non_null(strstr(err, "/observables/momentum/value has 3 components per row, the run gives 2"));
+    assert_null(cd_output_reopen(path, 0, twice, 2, err, sizeof err));
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 2); /* refused before truncating */
+    for (int j = 0; j < 2; j++) cd_state_free(&s[j]);
+    remove(path);
+}
+
+/* Every function closes what it opened. */
+static void test_io_h5_leaves_no_hdf5_object_open(void **state)
+{
+    (void)state;
+    assert_int_equal(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_io_h5_snapshots_round_trip_bit_for_bit),
+        cmocka_unit_test(test_io_h5_reopen_truncates_after_resume_step),
+        cmocka_unit_test(test_io_h5_reopen_before_first_snapshot),
+        cmocka_unit_test(test_io_h5_killed_writer_leaves_readable_file),
+        cmocka_unit_test(test_io_h5_wrong_counts_are_refused),
+        cmocka_unit_test(test_io_h5_missing_file_is_named),
+        cmocka_unit_test(test_io_h5_bad_observables_are_refused),
+        cmocka_unit_test(test_io_h5_leaves_no_hdf5_object_open),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
