@@ -15,6 +15,7 @@ static void usage(FILE *f)
             "usage: capdem <command> [options]\n"
             "commands:\n"
             "  run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n"
+            "                  [--backend omp|opencl] [--device cpu|gpu|auto]\n"
             "                  run a simulation; `capdem run --help` lists every config key\n"
             "  shape KIND [--aspect A] [--diameter D] [--density RHO] [--json]\n"
             "                  mass properties of a sphere, rod, cross or hexapod (SI units)\n"
@@ -69,12 +70,13 @@ static int cmd_shape(int argc, char **argv)
 
 static int cmd_run(int argc, char **argv)
 {
-    cd_run_options opt = {NULL, NULL, NULL, -1, 0};
+    cd_run_options opt = {NULL, NULL, NULL, -1, 0, NULL, NULL};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         int has_value = i + 1 < argc;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            printf("usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n\n"
+            printf("usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n"
+                   "                  [--backend omp|opencl] [--device cpu|gpu|auto]\n\n"
                    "Config keys (YAML; SI units):\n");
             cd_config_print_keys(stdout);
             return 0;
@@ -82,6 +84,8 @@ static int cmd_run(int argc, char **argv)
         else if (!strcmp(a, "--output") && has_value) opt.output_path = argv[++i];
         else if (!strcmp(a, "--steps") && has_value) opt.steps = atoll(argv[++i]);
         else if (!strcmp(a, "--quiet")) opt.quiet = 1;
+        else if (!strcmp(a, "--backend") && has_value) opt.backend = argv[++i];
+        else if (!strcmp(a, "--device") && has_value) opt.device = argv[++i];
         else if (!strcmp(a, "--threads") && has_value) {
             int n = atoi(argv[++i]);
             if (n < 1) { fprintf(stderr, "capdem run: --threads %s: expected an integer >= 1\n", argv[i]); return 2; }

@@ -107,6 +107,12 @@ int cd_run(const cd_run_options *opt)
         cd_config_free(&cfg);
         return 2;
     }
+    if (cd_sim_use_backend(&sim, opt->backend ? opt->backend : "omp", opt->device, err, sizeof err)) {
+        fprintf(stderr, "capdem: %s\n", err);
+        cd_sim_free(&sim);
+        cd_config_free(&cfg);
+        return 2;
+    }
     cd_observable_info info[OBS_COUNT];
     int n_obs = observable_table(&sim, info);
     double row[16 + 7 * CD_MAX_WALLS];
@@ -118,13 +124,17 @@ int cd_run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        cd_sim_refresh(&sim);
+        if (cd_sim_start(&sim, 0, err, sizeof err)) {
+            fprintf(stderr, "capdem: %s\n", err);
+            status = 2;
+            goto done;
+        }
         out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
     } else {
-        if (cd_sim_initial_forces(&sim)) {
-            fprintf(stderr, "capdem: out of memory building the first neighbour list\n");
-            status = 1;
+        if (cd_sim_start(&sim, 1, err, sizeof err)) {
+            fprintf(stderr, "capdem: %s\n", err);
+            status = 2;
             goto done;
         }
         out = cd_output_create(cfg.output, &cfg, sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
@@ -134,11 +144,17 @@ int cd_run(const cd_run_options *opt)
         status = 1;
         goto done;
     }
-    fprintf(stderr, "capdem: %zu particles, %zu primitives, %zu walls, dt = %g s (t_col/%.1f), %d thread(s), output %s\n",
-            sim.s.n_particles, sim.s.n_prims, sim.s.n_walls, sim.p.dt, sim.collision_time / sim.p.dt, sim.threads, cfg.output);
+    fprintf(stderr, "capdem: %zu particles, %zu primitives, %zu walls, dt = %g s (t_col/%.1f), backend %s on %s, output %s\n",
+            sim.s.n_particles, sim.s.n_prims, sim.s.n_walls, sim.p.dt, sim.collision_time / sim.p.dt, sim.backend->name,
+            sim.backend->device(&sim), cfg.output);
 
     cd_observables o;
     if (!opt->resume_path) {
+        if (cd_sim_sync(&sim, err, sizeof err)) {
+            fprintf(stderr, "capdem: %s\n", err);
+            status = 1;
+            goto done;
+        }
         cd_sim_observe(&sim, &o);
         if (write_thermo(out, &sim, &o, row) || cd_output_snapshot(out, &sim.s)) { status = 1; goto done; }
     }
@@ -160,6 +176,11 @@ int cd_run(const cd_run_options *opt)
         int thermo_due = sim.s.step % cfg.thermo_every == 0, snap_due = sim.s.step % cfg.snapshot_every == 0;
         int last = sim.s.step == cfg.steps;
         if (thermo_due || snap_due || last) {
+            if (cd_sim_sync(&sim, err, sizeof err)) {
+                fprintf(stderr, "\ncapdem: %s\n", err);
+                status = 1;
+                break;
+            }
             cd_sim_observe(&sim, &o);
             if (o.max_overlap_ratio > CD_MAX_OVERLAP_RATIO) {
                 fprintf(stderr, "\ncapdem: run stopped at step %lld (t = %.9g s): an overlap reached %.3g of the arm diameter "

@@ -8,6 +8,8 @@ typedef struct {
     const char *output_path;  /* overrides run.output, or NULL */
     long long steps;          /* overrides run.steps when >= 0 */
     int quiet;                /* 1: no progress lines */
+    const char *backend;      /* omp | opencl (NULL: omp) */
+    const char *device;       /* cpu | gpu | auto (NULL: auto; OpenCL) */
 } cd_run_options;
 
 /* Returns the process exit status: 0 success, 2 bad input, 3 the run blew

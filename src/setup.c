@@ -311,6 +311,7 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
 
 void cd_sim_free(cd_sim *sim)
 {
+    if (sim->backend) sim->backend->stop(sim);
     cd_state_free(&sim->s);
     cd_neighbors_free(&sim->nb);
 }

@@ -7,6 +7,7 @@
 #include "config.h"
 #include "shapes.h"
 #include "../kernels/contact_law.h"
+#include "backend.h"
 
 /* Loops over fewer rows than this run on one thread: a parallel region
  * costs microseconds, more than a small loop, and on a loaded machine the
@@ -48,6 +49,9 @@ typedef struct cd_sim {
     cd_neighbors nb;
     double collision_time;    /* smallest pair collision time [s] */
     int threads;              /* OpenMP threads in use */
+    const cd_backend *backend;/* runs the steps; omp unless chosen otherwise */
+    void *backend_data;       /* the backend's own state (device buffers) */
+    char device_request[16];  /* --device: cpu | gpu | auto (OpenCL) */
 } cd_sim;
 
 /* Builds a simulation from a validated config: shapes, particles placed as
@@ -57,17 +61,32 @@ typedef struct cd_sim {
 int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen);
 void cd_sim_free(cd_sim *sim);
 
-/* After positions/orientations changed outside the step (setup, resume):
- * recompute world endpoints, angular velocities and forces, and force a
- * neighbour rebuild. */
-void cd_sim_refresh(cd_sim *sim);
+/* Chooses the backend (before cd_sim_start).  device: cpu | gpu | auto,
+ * used by OpenCL.  Returns 0, or -1 with a message. */
+int cd_sim_use_backend(cd_sim *sim, const char *name, const char *device, char *err, size_t errlen);
 
-/* Refresh, neighbour list and the forces of the initial state (before the
- * first step of a new run; a resumed run reads its forces instead). */
+/* Hands the host state to the backend.  compute_forces = 1 for a new run
+ * (neighbour list and forces of the initial state), 0 after reading a
+ * checkpoint (its forces are kept, the neighbour list is rebuilt). */
+int cd_sim_start(cd_sim *sim, int compute_forces, char *err, size_t errlen);
+
+/* Refresh, neighbour list and the forces of the initial state on the
+ * chosen backend: cd_sim_start(sim, 1, ...) failing the process on error.
+ * For tests and tools. */
 int cd_sim_initial_forces(cd_sim *sim);
 
 /* Advances n steps. Returns 0, or -1 when the run blew up (message in err). */
 int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen);
+
+/* Makes sim->s current (copies the device state back). */
+int cd_sim_sync(cd_sim *sim, char *err, size_t errlen);
+
+/* Checks the host state for non-finite values (a blown-up run). */
+int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen);
+
+/* Host-side helpers of the omp backend, shared with other backends for
+ * set-up work: world axis ends and angular velocities from the poses. */
+void cd_sim_refresh(cd_sim *sim);
 
 /* Observables (deterministic sums). */
 typedef struct {

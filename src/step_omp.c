@@ -154,7 +154,7 @@ static void drift(cd_state *s, const cd_step_params *p)
 }
 
 /* Forces for the current positions (neighbour list up to date). */
-static void compute_forces(cd_sim *sim)
+static void compute_forces_host(cd_sim *sim)
 {
     pair_forces(&sim->s, &sim->p);
     wall_forces(&sim->s, &sim->p);
@@ -169,16 +169,8 @@ void cd_sim_refresh(cd_sim *sim)
     sim->nb.force_rebuild = 1;
 }
 
-int cd_sim_initial_forces(cd_sim *sim)
-{
-    cd_sim_refresh(sim);
-    if (cd_neighbors_build(sim)) return -1;
-    compute_forces(sim);
-    return 0;
-}
-
 /* A run that blew up must stop before it writes garbage. */
-static int check_state(const cd_sim *sim, char *err, size_t errlen)
+int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
 {
     const cd_state *s = &sim->s;
     long bad = -1;
@@ -195,7 +187,19 @@ static int check_state(const cd_sim *sim, char *err, size_t errlen)
     return 0;
 }
 
-int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen)
+static int omp_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
+{
+    cd_sim_refresh(sim);
+    if (!compute_forces) return 0; /* the neighbour list is rebuilt at the first step */
+    if (cd_neighbors_build(sim)) {
+        snprintf(err, errlen, "out of memory while building the first neighbour list");
+        return -1;
+    }
+    compute_forces_host(sim);
+    return 0;
+}
+
+static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
     for (long long it = 0; it < n; it++) {
@@ -206,10 +210,27 @@ int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen)
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }
-        compute_forces(sim);
+        compute_forces_host(sim);
         kick(s, &sim->p);
         s->step++;
         s->time += sim->p.dt;
     }
-    return check_state(sim, err, errlen);
+    return cd_sim_check_state(sim, err, errlen);
 }
+
+static int omp_sync(cd_sim *sim, char *err, size_t errlen)
+{
+    (void)sim; (void)err; (void)errlen;
+    return 0; /* the state lives in host memory */
+}
+
+static void omp_stop(cd_sim *sim) { (void)sim; }
+
+static const char *omp_device(const cd_sim *sim)
+{
+    static char buf[64];
+    snprintf(buf, sizeof buf, "host, %d OpenMP thread(s)", sim->threads);
+    return buf;
+}
+
+const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device};

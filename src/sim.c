@@ -1,0 +1,53 @@
+/* A simulation's life cycle, independent of the backend that steps it. */
+#include <stdio.h>
+#include <string.h>
+#include "sim.h"
+
+int cd_sim_use_backend(cd_sim *sim, const char *name, const char *device, char *err, size_t errlen)
+{
+    const cd_backend *b = cd_backend_find(name);
+    if (!b) {
+        snprintf(err, errlen, "--backend %s: expected omp or opencl (this build has: omp%s)", name,
+                 cd_backend_find("opencl") ? ", opencl" : "");
+        return -1;
+    }
+    sim->backend = b;
+    snprintf(sim->device_request, sizeof sim->device_request, "%s", device ? device : "auto");
+    return 0;
+}
+
+int cd_sim_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
+{
+    if (!sim->backend) sim->backend = &cd_backend_omp;
+    return sim->backend->start(sim, compute_forces, err, errlen);
+}
+
+int cd_sim_initial_forces(cd_sim *sim)
+{
+    char err[1024];
+    if (cd_sim_start(sim, 1, err, sizeof err)) {
+        fprintf(stderr, "capdem: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen)
+{
+    if (!sim->backend) sim->backend = &cd_backend_omp;
+    return sim->backend->step(sim, n, err, errlen);
+}
+
+int cd_sim_sync(cd_sim *sim, char *err, size_t errlen)
+{
+    return sim->backend ? sim->backend->sync(sim, err, errlen) : 0;
+}
+
+const cd_backend *cd_backend_find(const char *name)
+{
+    if (!strcmp(name, "omp")) return &cd_backend_omp;
+#ifdef CAPDEM_HAVE_OPENCL
+    if (!strcmp(name, "opencl")) return &cd_backend_opencl;
+#endif
+    return NULL;
+}
