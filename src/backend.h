@@ -21,6 +21,9 @@ typedef struct cd_backend {
     void (*stop)(struct cd_sim *sim);
     /* Human-readable device description. */
     const char *(*device)(const struct cd_sim *sim);
+    /* Optional (may be NULL): sum of the normal forces of all contacts on
+     * wall w at the last force evaluation [N], without a full sync. */
+    int (*wall_load)(struct cd_sim *sim, int w, double *load, char *err, size_t errlen);
 } cd_backend;
 
 extern const cd_backend cd_backend_omp;

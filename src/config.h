@@ -67,6 +67,20 @@ typedef struct {
 
     /* neighbour list */
     double skin;                   /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
+
+    /* protocol (SPEC section 6; src/protocol.c) */
+    char protocol[24];             /* none | deposit_compress | radial_compaction | bulk_modulus */
+    double settle_time;            /* deposit: settling time [s] (0 = 3 sqrt(2 h / g)) */
+    double piston_speed;           /* deposit: piston speed while compressing [m/s] */
+    double piston_force;           /* deposit: target force on the piston [N] */
+    double piston_mass;            /* deposit: piston mass while holding [kg] (0 = total particle mass) */
+    double pressure;               /* ball: applied pressure [Pa] (0 = pressure_ratio kn / L) */
+    double pressure_ratio;         /* ball: p L / kn [1] */
+    double relax_ratio;            /* stop when kinetic energy < relax_ratio x elastic energy [1] */
+    double energy_tolerance;       /* ... and the elastic energy changed by less than this between checks [1] */
+    long long check_every;         /* steps between convergence checks */
+    double strain_max, strain_min; /* bulk: largest and smallest volumetric strain dV/V [1] */
+    long long probe_steps;         /* bulk: relaxation steps after each strain */
 } cd_config;
 
 /* Fills c with the documented defaults. */

@@ -15,6 +15,10 @@
 #define S_HEXAPOD 8u
 #define S_SEGMENTS 16u
 #define S_NAMED (S_SPHERE | S_ROD | S_CROSS | S_HEXAPOD)
+#define P_DEPOSIT 2u
+#define P_RADIAL 4u
+#define P_BULK 8u
+#define P_ANY (P_DEPOSIT | P_RADIAL | P_BULK)
 
 _Static_assert(CD_WALL_PLANE == 0, "domain.walls[].type stores the index of \"plane\" in its choices");
 
@@ -139,6 +143,35 @@ const cd_key cd_config_keys[] = {
     /* neighbour list */
     {"neighbor.skin", CD_KT_REAL, "m", "0", CFG(skin), GE(0),
      .label = "Verlet skin", .meaning = "neighbour-list skin; 0: automatic (0.1 x smallest arm diameter)"},
+
+    /* protocol */
+    {"protocol.type", CD_KT_ENUM, "-", "none", CFG_SIZED(protocol), .flags = CD_KF_SELECTOR,
+     .choices = "none|deposit_compress|radial_compaction|bulk_modulus",
+     .label = "protocol", .meaning = "none: run.steps of plain dynamics; else the SPEC 6 procedure (docs/protocols.md)"},
+    {"protocol.settle_time", CD_KT_REAL, "s", "0", CFG(settle_time), GE(0), .applies = P_DEPOSIT,
+     .label = "settling time", .meaning = "deposit: settling before the piston moves; 0: 3 sqrt(2 h / g)"},
+    {"protocol.piston_speed", CD_KT_REAL, "m/s", "0.25", CFG(piston_speed), GT(0), .applies = P_DEPOSIT,
+     .label = "piston speed", .meaning = "deposit: speed of the top piston while it moves down"},
+    {"protocol.piston_force", CD_KT_REAL, "N", "500", CFG(piston_force), GT(0), .applies = P_DEPOSIT,
+     .label = "piston force", .meaning = "deposit: the piston stops advancing and holds this load"},
+    {"protocol.piston_mass", CD_KT_REAL, "kg", "0", CFG(piston_mass), GE(0), .applies = P_DEPOSIT,
+     .label = "piston mass", .meaning = "deposit: inertia of the load-controlled piston; 0: total particle mass"},
+    {"protocol.pressure", CD_KT_REAL, "Pa", "0", CFG(pressure), GE(0), .applies = P_RADIAL | P_BULK,
+     .label = "pressure", .meaning = "ball: pressure on the ball; 0: pressure_ratio x kn / L"},
+    {"protocol.pressure_ratio", CD_KT_REAL, "1", "1e-5", CFG(pressure_ratio), GT(0), .applies = P_RADIAL | P_BULK,
+     .label = "pressure ratio", .meaning = "ball: p L / kn when protocol.pressure is 0 (seed 001)"},
+    {"protocol.relax_ratio", CD_KT_REAL, "1", "1e-6", CFG(relax_ratio), GT(0), .applies = P_ANY,
+     .label = "relaxation ratio", .meaning = "relaxed when kinetic energy < relax_ratio x elastic energy"},
+    {"protocol.energy_tolerance", CD_KT_REAL, "1", "1e-3", CFG(energy_tolerance), GT(0), .applies = P_ANY,
+     .label = "elastic-energy tolerance", .meaning = "...and the elastic energy changed by less than this fraction since the last check"},
+    {"protocol.check_every", CD_KT_INT, "-", "1000", CFG_SIZED(check_every), GE(1), .applies = P_ANY,
+     .label = "check interval, steps", .meaning = "steps between checks of the relaxation criterion"},
+    {"protocol.strain_max", CD_KT_REAL, "1", "1e-6", CFG(strain_max), GT(0), LT(0.1), .applies = P_BULK,
+     .label = "largest strain", .meaning = "bulk: largest volumetric strain -dV/V of the probe"},
+    {"protocol.strain_min", CD_KT_REAL, "1", "1e-11", CFG(strain_min), GT(0), LT(0.1), .applies = P_BULK,
+     .label = "smallest strain", .meaning = "bulk: smallest strain; one probe per decade from strain_max down"},
+    {"protocol.probe_steps", CD_KT_INT, "-", "20000", CFG_SIZED(probe_steps), GE(1), .applies = P_BULK,
+     .label = "probe relaxation steps", .meaning = "bulk: steps of relaxation after each strain before the pressure is read"},
 };
 const size_t cd_config_nkeys = sizeof cd_config_keys / sizeof cd_config_keys[0];
 

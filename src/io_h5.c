@@ -148,14 +148,15 @@ static cd_output *output_new(const char *path, char *err, size_t errlen)
     }
     strcpy(o->path, path);
     o->file = o->step = o->time = o->walls = o->wall_type = H5I_INVALID_HID;
-    o->c_offset = o->c_pi = o->c_pj = o->w_offset = o->w_index = H5I_INVALID_HID;
+    o->c_offset = o->c_pi = o->c_pj = o->w_offset = o->w_index = o->control = H5I_INVALID_HID;
     for (size_t k = 0; k < cd_n_fields; k++) o->cols[k].dset = H5I_INVALID_HID;
     return o;
 }
 
 static void output_free(cd_output *o)
 {
-    hid_t *ds[] = {&o->step, &o->time, &o->walls, &o->c_offset, &o->c_pi, &o->c_pj, &o->w_offset, &o->w_index};
+    hid_t *ds[] = {&o->step, &o->time, &o->walls, &o->c_offset, &o->c_pi, &o->c_pj, &o->w_offset, &o->w_index,
+                   &o->control};
     for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++) cdh5_close_dset(ds[i]);
     if (o->wall_type >= 0) H5Tclose(o->wall_type);
     for (size_t k = 0; k < cd_n_fields; k++) {
@@ -270,7 +271,8 @@ static int truncate_snapshots(cd_output *o, long long resume_step)
         if (cdh5_set_rows(o, o->cols[k].dset, cd_fields[k].name, rows)) return -1;
     }
     if (cdh5_set_rows(o, o->step, CDH5_SNAP_STEP, n) || cdh5_set_rows(o, o->time, CDH5_SNAP_TIME, n) ||
-        cdh5_set_rows(o, o->walls, CDH5_WALLS_VALUE, n) || cdh5_set_rows(o, o->c_offset, CDH5_C_OFFSET, n + 1) ||
+        cdh5_set_rows(o, o->walls, CDH5_WALLS_VALUE, n) || cdh5_set_rows(o, o->control, CDH5_CONTROL_VALUE, n) ||
+        cdh5_set_rows(o, o->c_offset, CDH5_C_OFFSET, n + 1) ||
         cdh5_set_rows(o, o->w_offset, CDH5_W_OFFSET, n + 1) || cdh5_set_rows(o, o->c_pi, "particle_i", (hsize_t)cend) ||
         cdh5_set_rows(o, o->c_pj, "particle_j", (hsize_t)cend) ||
         cdh5_set_rows(o, o->w_index, CDH5_W_INDEX, (hsize_t)wend))

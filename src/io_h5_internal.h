@@ -14,6 +14,7 @@
 #define CDH5_SNAP_STEP "/walls/step"
 #define CDH5_SNAP_TIME "/walls/time"
 #define CDH5_WALLS_VALUE "/walls/value"
+#define CDH5_CONTROL_VALUE "/walls/control"
 #define CDH5_C_OFFSET "/contacts/offset"
 #define CDH5_W_OFFSET "/wall_contacts/offset"
 #define CDH5_W_INDEX "/wall_contacts/index"
@@ -100,7 +101,7 @@ struct cd_output {
     int have_layout;
     size_t n_particles, n_prims, n_walls;
     hsize_t n_snap, c_rows, w_rows;  /* snapshots, contact rows, wall-contact rows written */
-    hid_t step, time, walls, wall_type, c_offset, c_pi, c_pj, w_offset, w_index;
+    hid_t step, time, walls, wall_type, c_offset, c_pi, c_pj, w_offset, w_index, control;
     cdh5_col *cols;                  /* one per cd_fields[] entry */
     int n_obs, width;                /* width: sum of ncomp */
     cdh5_obs *obs;

@@ -249,7 +249,7 @@ typedef struct {
     size_t errlen;
     hid_t file;
     hid_t *ds;         /* one per cd_fields[] entry */
-    hid_t walls, step, time, c_offset, w_offset, w_index;
+    hid_t walls, step, time, c_offset, w_offset, w_index, control;
     long long c0, c1, w0, w1;
     long long *windex;
     void *tmp;
@@ -292,6 +292,8 @@ static int check_snapshot(reader *r, long long k, const cd_state *s)
     r->c_offset = ropen(r, CDH5_C_OFFSET);
     r->w_offset = ropen(r, CDH5_W_OFFSET);
     r->w_index = ropen(r, CDH5_W_INDEX);
+    r->control = ropen(r, CDH5_CONTROL_VALUE);
+    if (r->control < 0) return -1;
     if (r->walls < 0 || r->step < 0 || r->time < 0 || r->c_offset < 0 || r->w_offset < 0 || r->w_index < 0) return -1;
     if (cdh5_dims(r->walls, dims) != 2 || dims[0] <= (hsize_t)k)
         return rfail(r, "%s lacks snapshot %lld", CDH5_WALLS_VALUE, k);
@@ -380,6 +382,8 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
     H5Tclose(wt);
     if (e < 0) return rfail(r, "cannot read %s of snapshot %lld", CDH5_WALLS_VALUE, k);
     memcpy(s->walls, walls, s->n_walls * sizeof walls[0]);
+    if (cdh5_read_rows(r->control, (hsize_t)k, 1, H5T_NATIVE_DOUBLE, s->control) < 0)
+        return rfail(r, "cannot read %s of snapshot %lld", CDH5_CONTROL_VALUE, k);
     long long step;
     if (read_ll(r, r->step, CDH5_SNAP_STEP, k, &step)) return -1;
     if (cdh5_read_rows(r->time, (hsize_t)k, 1, H5T_NATIVE_DOUBLE, &s->time) < 0)
@@ -393,7 +397,7 @@ int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t 
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
     reader r = {path, err, errlen, H5I_INVALID_HID, NULL, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID,
-                H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, 0, 0, 0, 0, NULL, NULL};
+                H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, 0, 0, 0, 0, NULL, NULL};
     int rc = -1;
     r.ds = malloc(cd_n_fields * sizeof *r.ds);
     if (!r.ds) {
@@ -419,7 +423,7 @@ done:
     if (r.ds)
         for (size_t i = 0; i < cd_n_fields; i++)
             if (r.ds[i] >= 0) H5Dclose(r.ds[i]);
-    hid_t ids[] = {r.walls, r.step, r.time, r.c_offset, r.w_offset, r.w_index};
+    hid_t ids[] = {r.walls, r.step, r.time, r.c_offset, r.w_offset, r.w_index, r.control};
     for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++)
         if (ids[i] >= 0) H5Dclose(ids[i]);
     if (r.file >= 0) H5Fclose(r.file);

@@ -107,6 +107,9 @@ int cdh5_layout_create(cd_output *o, const cd_state *s)
     if (o->walls < 0 || cdh5_attr_str(o, o->walls, CDH5_WALLS_VALUE, "units",
                                  "type 1, point m, normal 1, velocity m/s, radius m, radial_velocity m/s, friction 1"))
         return -1;
+    hsize_t cd0[2] = {0, CD_CONTROL_SLOTS}, cdm[2] = {H5S_UNLIMITED, CD_CONTROL_SLOTS}, cdc[2] = {64, CD_CONTROL_SLOTS};
+    o->control = cdh5_make_dset(o, CDH5_CONTROL_VALUE, H5T_IEEE_F64LE, 2, cd0, cdm, cdc, "mixed, see docs/protocols.md");
+    if (o->control < 0) return -1;
     if (link_clock(o, "/contacts") || link_clock(o, "/wall_contacts")) return -1;
     for (size_t k = 0; k < cd_n_fields; k++) {
         if (cdh5_field_check(&cd_fields[k], o->err, sizeof o->err)) return cdh5_report(o);
@@ -140,6 +143,8 @@ int cdh5_layout_open(cd_output *o)
     o->c_pj = cdh5_open_dset(o, "/contacts/particle_j");
     o->w_offset = cdh5_open_dset(o, CDH5_W_OFFSET);
     o->w_index = cdh5_open_dset(o, CDH5_W_INDEX);
+    o->control = cdh5_open_dset(o, CDH5_CONTROL_VALUE);
+    if (o->control < 0) return -1;
     if (o->step < 0 || o->time < 0 || o->walls < 0 || o->c_offset < 0 || o->c_pi < 0 || o->c_pj < 0 ||
         o->w_offset < 0 || o->w_index < 0)
         return -1;
@@ -264,6 +269,7 @@ static int snapshot(cd_output *o, const cd_state *s)
     free(tmp);
     if (rc) return -1;
     if (cdh5_append(o, o->walls, CDH5_WALLS_VALUE, n, 1, o->wall_type, s->walls) ||
+        cdh5_append(o, o->control, CDH5_CONTROL_VALUE, n, 1, H5T_NATIVE_DOUBLE, s->control) ||
         cdh5_append(o, o->time, CDH5_SNAP_TIME, n, 1, H5T_NATIVE_DOUBLE, &s->time) ||
         cdh5_append(o, o->step, CDH5_SNAP_STEP, n, 1, H5T_NATIVE_LLONG, &s->step) || cdh5_obs_flush(o))
         return -1;

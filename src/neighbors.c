@@ -9,7 +9,7 @@
 #include <string.h>
 #include <math.h>
 #include "sim.h"
-#include "../kernels/segseg.h"
+#include "../kernels/broadphase.h"
 
 void cd_neighbors_init(cd_neighbors *nb, double skin)
 {
@@ -33,113 +33,29 @@ int cd_neighbors_needed(cd_sim *sim)
 {
     if (sim->nb.force_rebuild) return 1;
     const cd_state *s = &sim->s;
-    double limit2 = 0.25 * sim->nb.skin * sim->nb.skin; /* (skin/2)^2 [m^2] */
+    double limit2 = cd_bp_skin_limit2(sim->nb.skin); /* (skin/2)^2 [m^2] */
     int moved = 0;
 #pragma omp parallel for schedule(static) reduction(|| : moved) if (CD_PARALLEL(s->n_prims))
-    for (size_t i = 0; i < s->n_prims; i++) {
-        double da = cd_v3_norm2(cd_v3_sub(s->prim_a[i], s->prim_a_ref[i]));
-        double db = cd_v3_norm2(cd_v3_sub(s->prim_b[i], s->prim_b_ref[i]));
-        moved = moved || da > limit2 || db > limit2;
-    }
+    for (size_t i = 0; i < s->n_prims; i++)
+        moved = moved || cd_bp_moved(s->prim_a[i], s->prim_a_ref[i], s->prim_b[i], s->prim_b_ref[i], limit2);
     return moved;
 }
 
-/* Uniform grid over the primitives' bounding-sphere centres. */
-typedef struct {
-    double lo[3];      /* lower corner [m] */
-    double cell;       /* edge [m] */
-    long dim[3];       /* cells per axis */
-} grid_t;
-
-static cd_vec3 prim_centre(const cd_state *s, size_t i) { return cd_v3_scale(cd_v3_add(s->prim_a[i], s->prim_b[i]), 0.5); }
-static double prim_bound(const cd_state *s, size_t i)
-{
-    return 0.5 * cd_v3_norm(cd_v3_sub(s->prim_b[i], s->prim_a[i])) + s->prim_radius[i];
-}
-
-static long cell_coord(const grid_t *g, double x, int axis)
-{
-    long c = (long)floor((x - g->lo[axis]) / g->cell);
-    return c < 0 ? 0 : (c >= g->dim[axis] ? g->dim[axis] - 1 : c);
-}
-
-static long cell_of(const grid_t *g, cd_vec3 p)
-{
-    return (cell_coord(g, p.z, 2) * g->dim[1] + cell_coord(g, p.y, 1)) * g->dim[0] + cell_coord(g, p.x, 0);
-}
-
-static void make_grid(const cd_state *s, double skin, grid_t *g)
+/* The grid of the primitives' bounding-sphere centres (kernels/broadphase.h). */
+static void make_grid(const cd_state *s, double skin, cd_grid *g)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double rmax = 0;
-    for (size_t i = 0; i < s->n_prims; i++) {
-        cd_vec3 c = prim_centre(s, i);
-        double v[3] = {c.x, c.y, c.z};
-        for (int k = 0; k < 3; k++) {
-            if (v[k] < lo[k]) lo[k] = v[k];
-            if (v[k] > hi[k]) hi[k] = v[k];
-        }
-        double r = prim_bound(s, i);
-        if (r > rmax) rmax = r;
-    }
-    g->cell = 2 * rmax + skin;
-    /* Keep the number of cells of the order of the number of primitives so
-     * that memory and the empty-cell scan stay linear in N. */
-    for (;;) {
-        double cells = 1;
-        for (int k = 0; k < 3; k++) {
-            g->lo[k] = lo[k];
-            g->dim[k] = (long)floor((hi[k] - lo[k]) / g->cell) + 1;
-            cells *= (double)g->dim[k];
-        }
-        if (cells <= 8.0 * (double)s->n_prims + 64) break;
-        g->cell *= 1.26;
-    }
+    for (size_t i = 0; i < s->n_prims; i++) cd_bp_bounds_add(lo, hi, &rmax, s->prim_a[i], s->prim_b[i], s->prim_radius[i]);
+    cd_grid_make(g, lo, hi, rmax, skin, (cd_long)s->n_prims);
 }
 
-/* Candidate test: bounding spheres, then the exact axis distance. */
-static int is_candidate(const cd_state *s, size_t i, size_t j, double skin)
-{
-    double reach = s->prim_radius[i] + s->prim_radius[j] + skin;
-    double rb = prim_bound(s, i) + prim_bound(s, j) + skin;
-    if (cd_v3_norm2(cd_v3_sub(prim_centre(s, i), prim_centre(s, j))) > rb * rb) return 0;
-    cd_real u, w;
-    cd_segseg_closest(s->prim_a[i], s->prim_b[i], s->prim_a[j], s->prim_b[j], &u, &w);
-    cd_vec3 d = cd_v3_sub(cd_v3_lerp(s->prim_a[j], s->prim_b[j], w), cd_v3_lerp(s->prim_a[i], s->prim_b[i], u));
-    return cd_v3_norm2(d) <= reach * reach;
-}
-
-/* Visits the candidates j > i of primitive i; writes them to out (if not
- * NULL) in ascending order and returns how many there are. */
-static cd_int scan_prim(const cd_state *s, const grid_t *g, const cd_int *cell_start, const cd_int *cell_prims,
+/* Candidates j > i of primitive i, ascending, into out (if not NULL). */
+static cd_int scan_prim(const cd_state *s, const cd_grid *g, const cd_int *cell_start, const cd_int *cell_prims,
                         size_t i, double skin, cd_prim_id *out)
 {
-    cd_vec3 c = prim_centre(s, i);
-    long cx = cell_coord(g, c.x, 0), cy = cell_coord(g, c.y, 1), cz = cell_coord(g, c.z, 2);
-    cd_int n = 0;
-    for (long z = cz - 1; z <= cz + 1; z++) {
-        if (z < 0 || z >= g->dim[2]) continue;
-        for (long y = cy - 1; y <= cy + 1; y++) {
-            if (y < 0 || y >= g->dim[1]) continue;
-            for (long x = cx - 1; x <= cx + 1; x++) {
-                if (x < 0 || x >= g->dim[0]) continue;
-                long cell = (z * g->dim[1] + y) * g->dim[0] + x;
-                for (cd_int k = cell_start[cell]; k < cell_start[cell + 1]; k++) {
-                    size_t j = (size_t)cell_prims[k];
-                    if (j <= i || s->prim_particle[j] == s->prim_particle[i]) continue;
-                    if (!is_candidate(s, i, j, skin)) continue;
-                    if (out) {
-                        /* insertion keeps the row sorted by j */
-                        cd_int m = n;
-                        while (m > 0 && out[m - 1] > (cd_prim_id)j) { out[m] = out[m - 1]; m--; }
-                        out[m] = (cd_prim_id)j;
-                    }
-                    n++;
-                }
-            }
-        }
-    }
-    return n;
+    return cd_bp_scan_prim(s->prim_a, s->prim_b, s->prim_radius, s->prim_particle, g, cell_start, cell_prims,
+                           (cd_prim_id)i, skin, out);
 }
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -151,20 +67,6 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     *p = q;
     *cap = n;
     return 0;
-}
-
-/* Key of a primitive pair, ordered by i then j. */
-static cd_ulong pair_key(cd_prim_id i, cd_prim_id j) { return ((cd_ulong)(cd_uint)i << 32) | (cd_uint)j; }
-
-/* Index of key in the sorted old keys, or -1. */
-static long find_key(const cd_ulong *keys, size_t n, cd_ulong key)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (keys[mid] < key) lo = mid + 1; else hi = mid;
-    }
-    return (lo < n && keys[lo] == key) ? (long)lo : -1;
 }
 
 static int build_gather(cd_sim *sim)
@@ -200,7 +102,7 @@ int cd_neighbors_build(cd_sim *sim)
     cd_neighbors *nb = &sim->nb;
     size_t P = s->n_prims;
     double skin = nb->skin;
-    grid_t g;
+    cd_grid g;
     make_grid(s, skin, &g);
     size_t ncell = (size_t)(g.dim[0] * g.dim[1] * g.dim[2]);
 
@@ -215,7 +117,7 @@ int cd_neighbors_build(cd_sim *sim)
 
     /* Counting sort of primitives into cells, stable in primitive order. */
     for (size_t i = 0; i < P; i++) {
-        nb->prim_cell[i] = (cd_int)cell_of(&g, prim_centre(s, i));
+        nb->prim_cell[i] = (cd_int)cd_grid_cell_of(&g, cd_bp_centre(s->prim_a[i], s->prim_b[i]));
         nb->cell_start[nb->prim_cell[i] + 1]++;
     }
     for (size_t c = 0; c < ncell; c++) nb->cell_start[c + 1] += nb->cell_start[c];
@@ -241,7 +143,7 @@ int cd_neighbors_build(cd_sim *sim)
     cd_vec3 *old_shear = malloc((n_old + 1) * sizeof(cd_vec3));
     cd_int *old_active = malloc((n_old + 1) * sizeof(cd_int));
     if (!old_keys || !old_shear || !old_active) { free(old_keys); free(old_shear); free(old_active); return -1; }
-    for (size_t k = 0; k < n_old; k++) old_keys[k] = pair_key(s->pair_prim_i[k], s->pair_prim_j[k]);
+    for (size_t k = 0; k < n_old; k++) old_keys[k] = cd_bp_pair_key(s->pair_prim_i[k], s->pair_prim_j[k]);
     memcpy(old_shear, s->pair_shear, n_old * sizeof(cd_vec3));
     memcpy(old_active, s->pair_active, n_old * sizeof(cd_int));
 
@@ -255,7 +157,7 @@ int cd_neighbors_build(cd_sim *sim)
         cd_int n = scan_prim(s, &g, nb->cell_start, nb->cell_prims, i, skin, s->pair_prim_j + first);
         for (cd_int k = first; k < first + n; k++) {
             s->pair_prim_i[k] = (cd_prim_id)i;
-            long o = find_key(old_keys, n_old, pair_key((cd_prim_id)i, s->pair_prim_j[k]));
+            long o = cd_bp_find_key(old_keys, (cd_long)n_old, cd_bp_pair_key((cd_prim_id)i, s->pair_prim_j[k]));
             s->pair_active[k] = o >= 0 ? old_active[o] : 0;
             s->pair_shear[k] = o >= 0 ? old_shear[o] : cd_v3_zero();
         }

@@ -1,23 +1,29 @@
 /* Observables of the state: energies, momentum, wall forces.  Sums run over
  * fixed blocks of rows, each block in order, then the blocks in order, so
  * the result does not depend on the number of threads. */
+#include <stdlib.h>
 #include <string.h>
 #include <math.h>
 #include "sim.h"
 #include "../kernels/rigid.h"
 
 #define CD_SUM_BLOCK 4096
-#define CD_OBS_SLOTS (8 + 3 * CD_MAX_WALLS)
+#define CD_OBS_SLOTS (10 + 3 * CD_MAX_WALLS)
 
-enum { O_KT, O_KR, O_EL, O_PE, O_NC, O_NW, O_PX, O_PY, O_PZ, O_WALL };
+enum { O_KT, O_KR, O_EL, O_PE, O_NC, O_NW, O_PX, O_PY, O_PZ, O_KC, O_WALL };
 
 /* Adds the contributions of particle q into acc (slots as in the enum). */
+/* Particles with at least one active contact (pair or wall), or NULL. */
+static const unsigned char *touching;
+
 static void particle_terms(const cd_sim *sim, size_t q, double *acc)
 {
     const cd_state *s = &sim->s;
     cd_vec3 v = s->velocity[q];
-    acc[O_KT] += 0.5 * s->mass[q] * cd_v3_norm2(v);
-    acc[O_KR] += cd_rigid_rot_energy(s->orientation[q], s->angmom[q], s->inertia[q]);
+    double kt = 0.5 * s->mass[q] * cd_v3_norm2(v), kr = cd_rigid_rot_energy(s->orientation[q], s->angmom[q], s->inertia[q]);
+    acc[O_KT] += kt;
+    acc[O_KR] += kr;
+    if (touching && touching[q]) acc[O_KC] += kt + kr;
     acc[O_PE] -= s->mass[q] * cd_v3_dot(sim->p.gravity, s->position[q]);
     acc[O_PX] += s->mass[q] * v.x;
     acc[O_PY] += s->mass[q] * v.y;
@@ -69,12 +75,25 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o)
 {
     const cd_state *s = &sim->s;
     double acc[CD_OBS_SLOTS] = {0};
+    /* Rattlers move freely in their cages (without gravity and friction
+     * forever): relaxation criteria look at the particles that touch. */
+    unsigned char *mark = calloc(s->n_particles + 1, 1);
+    if (mark) {
+        for (size_t k = 0; k < s->n_pairs; k++)
+            if (s->pair_active[k]) mark[s->prim_particle[s->pair_prim_i[k]]] = mark[s->prim_particle[s->pair_prim_j[k]]] = 1;
+        for (size_t r = 0; r < s->n_prims * s->n_walls; r++)
+            if (s->wallc_active[r]) mark[s->prim_particle[r / s->n_walls]] = 1;
+    }
+    touching = mark;
     block_sum(sim, s->n_particles, particle_terms, acc);
+    touching = NULL;
+    free(mark);
     block_sum(sim, s->n_pairs, pair_terms, acc);
     block_sum(sim, s->n_prims * s->n_walls, wall_terms, acc);
     memset(o, 0, sizeof(*o));
     o->kinetic_translational = acc[O_KT];
     o->kinetic_rotational = acc[O_KR];
+    o->kinetic_in_contact = acc[O_KC];
     o->elastic = acc[O_EL];
     o->potential = acc[O_PE];
     o->n_contacts = acc[O_NC];

@@ -11,18 +11,20 @@
 #include "run.h"
 #include "sim.h"
 #include "io_h5.h"
+#include "protocol.h"
 
 /* Overlaps beyond this fraction of the arm diameter are not a packing any
  * more but a numerical failure (dt too large, stiffness too low). */
 #define CD_MAX_OVERLAP_RATIO 0.5
 
-enum { OBS_KT, OBS_KR, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
+enum { OBS_KT, OBS_KR, OBS_KC, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
 
 static int observable_table(const cd_sim *sim, cd_observable_info *info)
 {
     int W = (int)sim->s.n_walls;
     cd_observable_info t[OBS_COUNT] = {
         {"kinetic_energy_translational", "J", 1}, {"kinetic_energy_rotational", "J", 1},
+        {"kinetic_energy_in_contact", "J", 1},
         {"elastic_energy", "J", 1}, {"potential_energy", "J", 1},
         {"contacts", "1", 1}, {"wall_contacts", "1", 1}, {"momentum", "kg m/s", 3},
         {"wall_force", "N", 3 * W}, {"wall_position", "m", 3 * W}, {"wall_radius", "m", W},
@@ -30,6 +32,9 @@ static int observable_table(const cd_sim *sim, cd_observable_info *info)
     int n = 0;
     for (int k = 0; k < OBS_COUNT; k++)
         if (t[k].ncomp > 0) info[n++] = t[k];
+    const char *names[CD_PROTOCOL_OBSERVABLES], *units[CD_PROTOCOL_OBSERVABLES];
+    cd_protocol_observable_info(names, units);
+    for (int k = 0; k < CD_PROTOCOL_OBSERVABLES; k++) info[n++] = (cd_observable_info){names[k], units[k], 1};
     return n;
 }
 
@@ -39,6 +44,7 @@ static void observable_row(const cd_sim *sim, const cd_observables *o, double *r
     int n = 0;
     row[n++] = o->kinetic_translational;
     row[n++] = o->kinetic_rotational;
+    row[n++] = o->kinetic_in_contact;
     row[n++] = o->elastic;
     row[n++] = o->potential;
     row[n++] = o->n_contacts;
@@ -52,6 +58,7 @@ static void observable_row(const cd_sim *sim, const cd_observables *o, double *r
         row[n++] = sim->s.walls[w].point.z;
     }
     for (size_t w = 0; w < sim->s.n_walls; w++) row[n++] = sim->s.walls[w].radius;
+    cd_protocol_observables(sim, o, row + n);
 }
 
 static double now_seconds(void)
@@ -113,9 +120,9 @@ int cd_run(const cd_run_options *opt)
         cd_config_free(&cfg);
         return 2;
     }
-    cd_observable_info info[OBS_COUNT];
+    cd_observable_info info[OBS_COUNT + CD_PROTOCOL_OBSERVABLES];
     int n_obs = observable_table(&sim, info);
-    double row[16 + 7 * CD_MAX_WALLS];
+    double row[16 + 7 * CD_MAX_WALLS + CD_PROTOCOL_OBSERVABLES];
     cd_output *out = NULL;
     int status = 0;
     if (opt->resume_path) {
@@ -132,6 +139,7 @@ int cd_run(const cd_run_options *opt)
         out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
     } else {
+        cd_protocol_begin(&sim);
         if (cd_sim_start(&sim, 1, err, sizeof err)) {
             fprintf(stderr, "capdem: %s\n", err);
             status = 2;
@@ -161,20 +169,29 @@ int cd_run(const cd_run_options *opt)
     progress_t pg = {isatty(STDERR_FILENO), now_seconds(), 0, sim.s.step};
     pg.last = pg.start;
     const long long batch_max = 200; /* steps between progress checks */
-    while (sim.s.step < cfg.steps) {
+    int protocol_done = 0;
+    while (sim.s.step < cfg.steps && !protocol_done) {
         long long to_thermo = cfg.thermo_every - sim.s.step % cfg.thermo_every;
         long long to_snap = cfg.snapshot_every - sim.s.step % cfg.snapshot_every;
         long long n = to_thermo < to_snap ? to_thermo : to_snap;
         if (n > cfg.steps - sim.s.step) n = cfg.steps - sim.s.step;
         if (n > batch_max) n = batch_max;
+        long long to_control = cd_protocol_steps_until_control(&sim);
+        if (n > to_control) n = to_control;
         if (cd_sim_step(&sim, n, err, sizeof err)) {
             fprintf(stderr, "\ncapdem: run stopped: %s\ncapdem: %s keeps the snapshots written before step %lld\n",
                     err, cfg.output, sim.s.step);
             status = 3;
             break;
         }
+        protocol_done = cd_protocol_control(&sim, opt->quiet ? NULL : stderr, err, sizeof err);
+        if (protocol_done < 0) {
+            fprintf(stderr, "\ncapdem: protocol: %s\n", err);
+            status = 1;
+            break;
+        }
         int thermo_due = sim.s.step % cfg.thermo_every == 0, snap_due = sim.s.step % cfg.snapshot_every == 0;
-        int last = sim.s.step == cfg.steps;
+        int last = sim.s.step == cfg.steps || protocol_done;
         if (thermo_due || snap_due || last) {
             if (cd_sim_sync(&sim, err, sizeof err)) {
                 fprintf(stderr, "\ncapdem: %s\n", err);
@@ -195,6 +212,10 @@ int cd_run(const cd_run_options *opt)
         if (!opt->quiet) progress(&pg, &sim, cfg.steps, 0);
     }
     if (!opt->quiet && status == 0) progress(&pg, &sim, cfg.steps, 1);
+    if (status == 0 && strcmp(cfg.protocol, "none") && !protocol_done)
+        fprintf(stderr, "capdem: warning: run.steps = %lld reached in protocol phase '%s'; continue with "
+                "`capdem run %s --resume %s --steps N`\n", cfg.steps, cd_protocol_phase_name((int)sim.s.control[0]),
+                opt->config_path, cfg.output);
 done:
     if (out && cd_output_close(out)) status = status ? status : 1;
     cd_sim_free(&sim);

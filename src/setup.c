@@ -8,6 +8,7 @@
 #include <string.h>
 #include "sim.h"
 #include "rng.h"
+#include "protocol.h"
 #include "../kernels/rigid.h"
 #ifdef _OPENMP
 #include <omp.h>
@@ -69,6 +70,9 @@ static int make_walls(cd_sim *sim, char *err, size_t errlen)
         w.friction = mu;
         rc |= add_wall(sim, w, err, errlen);
         rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(0, 1, 0), mu), err, errlen);
+        /* deposit and compress: the top piston (the box has its top wall) */
+        if (!strcmp(c->protocol, "deposit_compress"))
+            rc |= add_wall(sim, plane(cd_v3(0, c->cyl_height, 0), cd_v3(0, -1, 0), mu), err, errlen);
     } else if (!strcmp(c->domain, "ball")) {
         cd_wall w;
         memset(&w, 0, sizeof(w));
@@ -249,6 +253,7 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory for %zu particles", N);
         return -1;
     }
+    if (cd_protocol_check(c, err, errlen)) return -1;
     if (make_walls(sim, err, errlen)) return -1;
     /* wall-contact columns depend on the wall count: allocate them now */
     cd_state *s = &sim->s;

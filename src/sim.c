@@ -51,3 +51,14 @@ const cd_backend *cd_backend_find(const char *name)
 #endif
     return NULL;
 }
+
+int cd_sim_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    if (sim->backend && sim->backend->wall_load) return sim->backend->wall_load(sim, w, load, err, errlen);
+    if (cd_sim_sync(sim, err, errlen)) return -1;
+    const cd_state *s = &sim->s;
+    double sum = 0;
+    for (size_t i = 0; i < s->n_prims; i++) sum += s->wallc_fn[i * s->n_walls + (size_t)w];
+    *load = sum;
+    return 0;
+}

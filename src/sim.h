@@ -81,6 +81,11 @@ int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen);
 /* Makes sim->s current (copies the device state back). */
 int cd_sim_sync(cd_sim *sim, char *err, size_t errlen);
 
+/* Sum of the normal forces the particles exert on wall w [N] at the last
+ * force evaluation: the backend's reduction, or a sync and a host sum in a
+ * fixed order. */
+int cd_sim_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen);
+
 /* Checks the host state for non-finite values (a blown-up run). */
 int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen);
 
@@ -91,6 +96,7 @@ void cd_sim_refresh(cd_sim *sim);
 /* Observables (deterministic sums). */
 typedef struct {
     double kinetic_translational, kinetic_rotational; /* [J] */
+    double kinetic_in_contact; /* kinetic energy of the particles that touch something [J] */
     double elastic;           /* energy stored in contact springs [J] */
     double potential;         /* gravitational potential energy -m g.x [J] */
     double n_contacts;        /* active particle-particle contacts */

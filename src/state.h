@@ -19,6 +19,11 @@ typedef struct cd_state {
 #include "fields.def"
 #undef CD_FIELD
     cd_wall walls[CD_MAX_WALLS];   /* current wall positions and motion */
+    /* State of the protocol driving the run (phase, wall dynamics,
+     * convergence checks): doubles saved with every snapshot, so that a
+     * protocol resumes in the middle of any phase.  Meaning: src/protocol.c. */
+#define CD_CONTROL_SLOTS 32
+    double control[CD_CONTROL_SLOTS];
     double time;                   /* simulated time [s] */
     long long step;                /* steps taken since the start of the run */
 } cd_state;

@@ -1,0 +1,136 @@
+/* OpenCL backend: the Verlet list rebuilt on the device (docs/opencl.md,
+ * "Neighbour list").  The sequence mirrors src/neighbors.c: grid from the
+ * box of the primitive centres, primitives binned by cell, candidates
+ * counted per primitive, a prefix sum giving each primitive its rows, rows
+ * filled sorted by (prim_i, prim_j), history found by binary search of each
+ * new key among the old sorted keys, and the per-particle gather lists.
+ * The only transfer to the host is the number of pairs (one int), which
+ * sizes the buffers. */
+#include "backend_cl.h"
+#include "../kernels/broadphase.h"
+
+#define F CD_CL_N_FIELDS /* first kernel argument after the columns */
+
+static int copy(cd_cl *cl, cl_mem src, cl_mem dst, size_t bytes)
+{
+    if (cl->status || bytes == 0) return cl->status ? -1 : 0;
+    cl_int rc = clEnqueueCopyBuffer(cl->queue, src, dst, 0, 0, bytes, 0, NULL, NULL);
+    return cd_cl_check(cl, rc, "copying a buffer") ? -1 : 0;
+}
+
+/* Grid and cell lists (CSR cell_start / cell_prims). */
+static void bin_prims(cd_cl *cl, cd_int P, cd_real skin)
+{
+    cd_int parts = (P + 63) / 64;
+    if (parts > CD_CL_MAX_BLOCKS) parts = CD_CL_MAX_BLOCKS;
+    cd_int chunk = (P + parts - 1) / parts;
+    parts = (P + chunk - 1) / chunk;
+    cd_cl_arg(cl, CD_CLK_BOUNDS, F, sizeof P, &P);
+    cd_cl_arg(cl, CD_CLK_BOUNDS, F + 1, sizeof chunk, &chunk);
+    cd_cl_arg(cl, CD_CLK_BOUNDS, F + 2, sizeof cl->partial, &cl->partial);
+    cd_cl_run(cl, CD_CLK_BOUNDS, (size_t)parts);
+    cd_cl_arg(cl, CD_CLK_GRID, 0, sizeof cl->partial, &cl->partial);
+    cd_cl_arg(cl, CD_CLK_GRID, 1, sizeof parts, &parts);
+    cd_cl_arg(cl, CD_CLK_GRID, 2, sizeof skin, &skin);
+    cd_cl_arg(cl, CD_CLK_GRID, 3, sizeof P, &P);
+    cd_cl_arg(cl, CD_CLK_GRID, 4, sizeof cl->grid, &cl->grid);
+    cd_cl_run(cl, CD_CLK_GRID, 1);
+
+    /* The scan runs over every cell the grid may have: the empty tail
+     * costs little and spares reading the grid back. */
+    cd_cl_fill_int(cl, cl->cell_count, 0, cl->cell_cap);
+    cd_cl_arg(cl, CD_CLK_BIN, F, sizeof P, &P);
+    cd_cl_arg(cl, CD_CLK_BIN, F + 1, sizeof cl->grid, &cl->grid);
+    cd_cl_arg(cl, CD_CLK_BIN, F + 2, sizeof cl->prim_cell, &cl->prim_cell);
+    cd_cl_arg(cl, CD_CLK_BIN, F + 3, sizeof cl->cell_count, &cl->cell_count);
+    cd_cl_run(cl, CD_CLK_BIN, (size_t)P);
+    cd_cl_scan(cl, cl->cell_count, cl->cell_cap, cl->cell_start);
+    copy(cl, cl->cell_start, cl->cell_cursor, cl->cell_cap * sizeof(cd_int));
+    cd_cl_arg(cl, CD_CLK_CELL_FILL, 0, sizeof P, &P);
+    cd_cl_arg(cl, CD_CLK_CELL_FILL, 1, sizeof cl->prim_cell, &cl->prim_cell);
+    cd_cl_arg(cl, CD_CLK_CELL_FILL, 2, sizeof cl->cell_cursor, &cl->cell_cursor);
+    cd_cl_arg(cl, CD_CLK_CELL_FILL, 3, sizeof cl->cell_prims, &cl->cell_prims);
+    cd_cl_run(cl, CD_CLK_CELL_FILL, (size_t)P);
+}
+
+/* Arguments shared by the count and the fill of the candidates. */
+static void scan_args(cd_cl *cl, enum cd_cl_kernel k, cd_int P, cd_real skin)
+{
+    cd_cl_arg(cl, k, F, sizeof P, &P);
+    cd_cl_arg(cl, k, F + 1, sizeof cl->grid, &cl->grid);
+    cd_cl_arg(cl, k, F + 2, sizeof cl->cell_start, &cl->cell_start);
+    cd_cl_arg(cl, k, F + 3, sizeof cl->cell_prims, &cl->cell_prims);
+    cd_cl_arg(cl, k, F + 4, sizeof skin, &skin);
+}
+
+/* Per-particle lists of pair rows in ascending order (CSR gather_start /
+ * gather_rows), for the gather's fixed summation order. */
+static void gather_lists(cd_cl *cl, cd_int N, cd_int n_pairs)
+{
+    cd_cl_fill_int(cl, cl->gather_count, 0, (size_t)N);
+    cd_cl_arg(cl, CD_CLK_GATHER_COUNT, F, sizeof n_pairs, &n_pairs);
+    cd_cl_arg(cl, CD_CLK_GATHER_COUNT, F + 1, sizeof cl->gather_count, &cl->gather_count);
+    cd_cl_run(cl, CD_CLK_GATHER_COUNT, (size_t)n_pairs);
+    cd_cl_scan(cl, cl->gather_count, (size_t)N, cl->gather_start);
+    copy(cl, cl->gather_start, cl->gather_cursor, (size_t)N * sizeof(cd_int));
+    cd_cl_arg(cl, CD_CLK_GATHER_FILL, F, sizeof n_pairs, &n_pairs);
+    cd_cl_arg(cl, CD_CLK_GATHER_FILL, F + 1, sizeof cl->gather_cursor, &cl->gather_cursor);
+    cd_cl_arg(cl, CD_CLK_GATHER_FILL, F + 2, sizeof cl->gather_rows, &cl->gather_rows);
+    cd_cl_run(cl, CD_CLK_GATHER_FILL, (size_t)n_pairs);
+    cd_cl_arg(cl, CD_CLK_GATHER_SORT, 0, sizeof N, &N);
+    cd_cl_arg(cl, CD_CLK_GATHER_SORT, 1, sizeof cl->gather_start, &cl->gather_start);
+    cd_cl_arg(cl, CD_CLK_GATHER_SORT, 2, sizeof cl->gather_rows, &cl->gather_rows);
+    cd_cl_run(cl, CD_CLK_GATHER_SORT, (size_t)N);
+}
+
+int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
+{
+    const cd_state *s = &sim->s;
+    cd_int P = (cd_int)s->n_prims, N = (cd_int)s->n_particles;
+    cd_real skin = sim->nb.skin; /* [m] */
+    cd_int n_new = 0;
+    if (P > 0) {
+        bin_prims(cl, P, skin);
+        scan_args(cl, CD_CLK_PAIR_COUNT, P, skin);
+        cd_cl_arg(cl, CD_CLK_PAIR_COUNT, F + 5, sizeof cl->pair_count, &cl->pair_count);
+        cd_cl_run(cl, CD_CLK_PAIR_COUNT, (size_t)P);
+        cd_cl_scan(cl, cl->pair_count, (size_t)P, cl->pair_offset);
+        /* the one read of a rebuild: how many pairs, to size the buffers */
+        if (!cl->status)
+            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->pair_offset, CL_TRUE, (size_t)P * sizeof(cd_int),
+                                                sizeof n_new, &n_new, 0, NULL, NULL), "reading the number of pairs");
+    }
+    if (cl->status) return -1;
+
+    /* The new list goes into the spare history set; the old set stays for
+     * the carry-over, then becomes the spare. */
+    int old = cl->cur, nxt = 1 - cl->cur;
+    cd_int n_old = (cd_int)cl->n_pairs;
+    if (cd_cl_reserve_pairs(cl, (size_t)n_new, nxt)) return -1;
+    cl->cur = nxt;
+    if (cd_cl_bind_cols(cl)) return -1;
+    if (n_new > 0) {
+        scan_args(cl, CD_CLK_PAIR_FILL, P, skin);
+        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 5, sizeof cl->pair_offset, &cl->pair_offset);
+        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 6, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
+        cd_cl_run(cl, CD_CLK_PAIR_FILL, (size_t)P);
+        cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F, sizeof n_new, &n_new);
+        cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F + 1, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
+        cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F + 2, sizeof cl->hist[old].keys, &cl->hist[old].keys);
+        cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F + 3, sizeof n_old, &n_old);
+        cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F + 4, sizeof cl->hist[old].active, &cl->hist[old].active);
+        cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F + 5, sizeof cl->hist[old].shear, &cl->hist[old].shear);
+        cd_cl_run(cl, CD_CLK_PAIR_CARRY, (size_t)n_new);
+    }
+    gather_lists(cl, N, n_new);
+
+    /* Reference ends for the skin criterion; clear its flag. */
+    copy(cl, cl->col[CD_CL_F_prim_a], cl->col[CD_CL_F_prim_a_ref], (size_t)P * sizeof(cd_vec3));
+    copy(cl, cl->col[CD_CL_F_prim_b], cl->col[CD_CL_F_prim_b_ref], (size_t)P * sizeof(cd_vec3));
+    cd_cl_fill_int(cl, cl->flags, 0, 1);
+    if (cl->status) return -1;
+    cl->n_pairs = (size_t)n_new;
+    sim->nb.force_rebuild = 0;
+    sim->nb.builds++;
+    return 0;
+}

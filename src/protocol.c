@@ -1,0 +1,346 @@
+/* Protocols of SPEC section 6; see protocol.h and docs/protocols.md. */
+#include <math.h>
+#include <string.h>
+#include "protocol.h"
+
+/* Slots of sim->s.control. */
+enum {
+    CTL_PHASE,       /* CD_PHASE_* */
+    CTL_PHASE_TIME,  /* simulated time at which the phase began [s] */
+    CTL_WALL,        /* index of the driven wall (piston or ball) */
+    CTL_EEL_LAST,    /* elastic energy at the last relaxation check [J] */
+    CTL_LOAD,        /* last normal load on the driven wall [N] */
+    CTL_R_BASE,      /* bulk: ball radius of the base state [m] */
+    CTL_P_BASE,      /* bulk: pressure of the base state [Pa] */
+    CTL_STRAIN,      /* bulk: current volumetric strain -dV/V [1] */
+    CTL_PROBE_STEP,  /* bulk: step at which the current probe began */
+    CTL_N_PROBES,    /* bulk: probes done */
+    CTL_P_SUM,       /* bulk: sum of pressure samples over the second half of a window [Pa] */
+    CTL_P_COUNT,     /* bulk: number of those samples */
+    CTL_K_FIRST = 16 /* bulk: K of probe k in slot CTL_K_FIRST + k [Pa] */
+};
+#define CTL_MAX_PROBES (CD_CONTROL_SLOTS - CTL_K_FIRST)
+
+static int phase_of(const cd_sim *sim) { return (int)sim->s.control[CTL_PHASE]; }
+
+const char *cd_protocol_phase_name(int phase)
+{
+    static const char *const names[] = {"free", "settle", "compress", "hold", "compact", "base", "probe", "done"};
+    return phase >= 0 && phase <= CD_PHASE_DONE ? names[phase] : "?";
+}
+
+int cd_protocol_check(const cd_config *c, char *err, size_t errlen)
+{
+    const char *p = c->protocol;
+    if (!strcmp(p, "deposit_compress") && strcmp(c->domain, "box") && strcmp(c->domain, "cylinder")) {
+        snprintf(err, errlen, "%s: protocol.type = deposit_compress: expected domain.type box or cylinder, not %s",
+                 c->source_path, c->domain);
+        return -1;
+    }
+    if ((!strcmp(p, "radial_compaction") || !strcmp(p, "bulk_modulus")) && strcmp(c->domain, "ball")) {
+        snprintf(err, errlen, "%s: protocol.type = %s: expected domain.type ball, not %s", c->source_path, p, c->domain);
+        return -1;
+    }
+    if (!strcmp(p, "deposit_compress") && !(c->gravity[0] != 0 || c->gravity[1] != 0 || c->gravity[2] != 0)) {
+        snprintf(err, errlen, "%s: physics.gravity = [0, 0, 0]: deposit_compress needs gravity to deposit", c->source_path);
+        return -1;
+    }
+    if (!strcmp(p, "bulk_modulus") && c->strain_min > c->strain_max) {
+        snprintf(err, errlen, "%s: protocol.strain_min = %g: expected at most protocol.strain_max = %g", c->source_path,
+                 c->strain_min, c->strain_max);
+        return -1;
+    }
+    return 0;
+}
+
+static double total_mass(const cd_sim *sim)
+{
+    double m = 0;
+    for (size_t q = 0; q < sim->s.n_particles; q++) m += sim->s.mass[q];
+    return m;
+}
+
+/* Pressure on the ball [Pa]: given, or p L / kn = pressure_ratio (seed 001). */
+static double ball_pressure(const cd_sim *sim)
+{
+    if (sim->cfg.pressure > 0) return sim->cfg.pressure;
+    double L = 0;
+    for (int k = 0; k < sim->n_shapes; k++)
+        if (sim->shapes[k].tip_length > L) L = sim->shapes[k].tip_length;
+    return sim->cfg.pressure_ratio * sim->cfg.kn / L;
+}
+
+static void enter(cd_sim *sim, int phase, FILE *log)
+{
+    sim->s.control[CTL_PHASE] = phase;
+    sim->s.control[CTL_PHASE_TIME] = sim->s.time;
+    sim->s.control[CTL_EEL_LAST] = -1;
+    if (log)
+        fprintf(log, "\ncapdem: protocol phase %s at step %lld (t = %.6g s)\n", cd_protocol_phase_name(phase),
+                sim->s.step, sim->s.time);
+}
+
+/* Removes the centre-of-mass velocity and the rigid rotation about the
+ * ball centre from the initial velocities.  Inside a frictionless ball and
+ * without gravity both are conserved: a packing that starts with some net
+ * angular momentum keeps turning as a whole for ever, and its kinetic
+ * energy never falls below the relaxation criterion. */
+static void remove_net_motion(cd_sim *sim, cd_vec3 centre)
+{
+    cd_state *s = &sim->s;
+    double M = 0, P[3] = {0, 0, 0}, L[3] = {0, 0, 0}, I[3][3] = {{0}};
+    for (size_t q = 0; q < s->n_particles; q++) {
+        double m = s->mass[q];
+        M += m;
+        P[0] += m * s->velocity[q].x; P[1] += m * s->velocity[q].y; P[2] += m * s->velocity[q].z;
+    }
+    cd_vec3 vcm = cd_v3(P[0] / M, P[1] / M, P[2] / M);
+    for (size_t q = 0; q < s->n_particles; q++) {
+        s->velocity[q] = cd_v3_sub(s->velocity[q], vcm);
+        double m = s->mass[q];
+        cd_vec3 r = cd_v3_sub(s->position[q], centre);
+        cd_vec3 l = cd_v3_add(cd_v3_scale(cd_v3_cross(r, s->velocity[q]), m), s->angmom[q]);
+        L[0] += l.x; L[1] += l.y; L[2] += l.z;
+        double rr[3] = {r.x, r.y, r.z}, r2 = cd_v3_norm2(r);
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) I[a][b] += m * ((a == b ? r2 : 0) - rr[a] * rr[b]);
+    }
+    /* omega = I^-1 L by Cramer's rule (I is positive definite for more than
+     * two particles not on a line) */
+    double det = I[0][0] * (I[1][1] * I[2][2] - I[1][2] * I[2][1]) - I[0][1] * (I[1][0] * I[2][2] - I[1][2] * I[2][0]) +
+                 I[0][2] * (I[1][0] * I[2][1] - I[1][1] * I[2][0]);
+    if (!(fabs(det) > 0)) return;
+    double w[3];
+    for (int c = 0; c < 3; c++) {
+        double A[3][3];
+        memcpy(A, I, sizeof A);
+        for (int a = 0; a < 3; a++) A[a][c] = L[a];
+        w[c] = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+                A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) / det;
+    }
+    cd_vec3 omega = cd_v3(w[0], w[1], w[2]);
+    for (size_t q = 0; q < s->n_particles; q++)
+        s->velocity[q] = cd_v3_sub(s->velocity[q], cd_v3_cross(omega, cd_v3_sub(s->position[q], centre)));
+}
+
+void cd_protocol_begin(cd_sim *sim)
+{
+    const char *p = sim->cfg.protocol;
+    memset(sim->s.control, 0, sizeof sim->s.control);
+    if (!strcmp(p, "deposit_compress")) {
+        /* the piston is the last wall: the box's top wall, or the one added
+         * over the cylinder */
+        sim->s.control[CTL_WALL] = !strcmp(sim->cfg.domain, "box") ? 1 : (double)(sim->s.n_walls - 1);
+        enter(sim, CD_PHASE_SETTLE, NULL);
+    } else if (!strcmp(p, "radial_compaction") || !strcmp(p, "bulk_modulus")) {
+        sim->s.control[CTL_WALL] = 0;
+        remove_net_motion(sim, sim->s.walls[0].point);
+        enter(sim, CD_PHASE_COMPACT, NULL);
+    } else {
+        enter(sim, CD_PHASE_FREE, NULL);
+    }
+}
+
+static double settle_time(const cd_sim *sim)
+{
+    if (sim->cfg.settle_time > 0) return sim->cfg.settle_time;
+    const double *g = sim->cfg.gravity;
+    double h = !strcmp(sim->cfg.domain, "box") ? sim->cfg.box_height : sim->cfg.cyl_height; /* [m] */
+    return 3 * sqrt(2 * h / sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]));
+}
+
+long long cd_protocol_steps_until_control(const cd_sim *sim)
+{
+    switch (phase_of(sim)) {
+    case CD_PHASE_SETTLE: {
+        double left = sim->s.control[CTL_PHASE_TIME] + settle_time(sim) - sim->s.time;
+        long long n = (long long)ceil(left / sim->p.dt);
+        return n > 1 ? n : 1;
+    }
+    case CD_PHASE_COMPRESS:
+    case CD_PHASE_HOLD:
+    case CD_PHASE_COMPACT: return 1; /* the driven wall responds to the load every step */
+    case CD_PHASE_BASE:
+        if (sim->s.control[CTL_PROBE_STEP] > 0) return 1; /* averaging the base pressure */
+        return sim->cfg.check_every - (sim->s.step % sim->cfg.check_every);
+    case CD_PHASE_PROBE: return 1; /* the pressure is averaged every step of the window's second half */
+    default: return 1LL << 40;
+    }
+}
+
+/* Bulk probe: the pressure on the ball averaged over the second half of a
+ * window of probe_steps steps that began at control[CTL_PROBE_STEP].  The
+ * relaxed packing still vibrates a little; the average removes most of it.
+ * Returns 1 when the window is complete (mean in *p). */
+static int window_pressure(cd_sim *sim, double load, double *p)
+{
+    double *c = sim->s.control;
+    double R = sim->s.walls[(int)c[CTL_WALL]].radius;
+    double elapsed = (double)sim->s.step - c[CTL_PROBE_STEP], n = (double)sim->cfg.probe_steps;
+    if (elapsed >= 0.5 * n) {
+        c[CTL_P_SUM] += load / (4 * CD_PI * R * R);
+        c[CTL_P_COUNT] += 1;
+    }
+    if (elapsed < n) return 0;
+    *p = c[CTL_P_SUM] / c[CTL_P_COUNT];
+    c[CTL_P_SUM] = c[CTL_P_COUNT] = 0;
+    return 1;
+}
+
+/* Relaxed: kinetic energy of the particles in contact below relax_ratio of
+ * the elastic energy and the elastic energy steady since the last check
+ * (checked every check_every steps).  Rattlers are left out: without gravity
+ * and friction they can tumble in their cages indefinitely. */
+static int relaxed(cd_sim *sim, char *err, size_t errlen, int *done)
+{
+    *done = 0;
+    if (sim->s.step % sim->cfg.check_every) return 0;
+    if (cd_sim_sync(sim, err, errlen)) return -1;
+    cd_observables o;
+    cd_sim_observe(sim, &o);
+    double ke = o.kinetic_in_contact, eel = o.elastic, last = sim->s.control[CTL_EEL_LAST];
+    *done = eel > 0 && ke < sim->cfg.relax_ratio * eel && last > 0 && fabs(eel - last) < sim->cfg.energy_tolerance * eel;
+    sim->s.control[CTL_EEL_LAST] = eel;
+    return 0;
+}
+
+/* Scales particle positions about the ball centre and the ball radius to
+ * the volumetric strain eps = -dV/V of the base state. */
+static int apply_strain(cd_sim *sim, double eps, char *err, size_t errlen)
+{
+    if (cd_sim_sync(sim, err, errlen)) return -1;
+    cd_state *s = &sim->s;
+    int w = (int)s->control[CTL_WALL];
+    double r_new = s->control[CTL_R_BASE] * cbrt(1 - eps);
+    double f = r_new / s->walls[w].radius;
+    cd_vec3 c = s->walls[w].point;
+    for (size_t q = 0; q < s->n_particles; q++) s->position[q] = cd_v3_axpy(c, f, cd_v3_sub(s->position[q], c));
+    s->walls[w].radius = r_new;
+    s->control[CTL_STRAIN] = eps;
+    /* positions changed on the host: hand the state back, forces recomputed */
+    if (sim->backend) sim->backend->stop(sim);
+    return cd_sim_start(sim, 1, err, errlen);
+}
+
+int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
+{
+    cd_state *s = &sim->s;
+    int phase = phase_of(sim), w = (int)s->control[CTL_WALL], done = 0;
+    double dt = sim->p.dt, load = 0;
+    if (phase == CD_PHASE_FREE || phase == CD_PHASE_DONE) return phase == CD_PHASE_DONE;
+    if (phase != CD_PHASE_SETTLE && cd_sim_wall_load(sim, w, &load, err, errlen)) return -1;
+    s->control[CTL_LOAD] = load;
+    switch (phase) {
+    case CD_PHASE_SETTLE:
+        if (s->time >= s->control[CTL_PHASE_TIME] + settle_time(sim) - 0.5 * dt) {
+            enter(sim, CD_PHASE_COMPRESS, log);
+            s->walls[w].velocity = cd_v3_scale(s->walls[w].normal, sim->cfg.piston_speed);
+        }
+        break;
+    case CD_PHASE_COMPRESS:
+        if (load >= sim->cfg.piston_force) {
+            enter(sim, CD_PHASE_HOLD, log);
+            s->walls[w].velocity = cd_v3_zero();
+        }
+        break;
+    case CD_PHASE_HOLD: {
+        /* load control: m_p x'' = (load - F) along the outward direction */
+        double m = sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : total_mass(sim);
+        double a = (load - sim->cfg.piston_force) / m; /* [m/s^2], positive outwards */
+        s->walls[w].velocity = cd_v3_axpy(s->walls[w].velocity, -a * dt, s->walls[w].normal);
+        if (relaxed(sim, err, errlen, &done)) return -1;
+        if (done) enter(sim, CD_PHASE_DONE, log);
+        break;
+    }
+    case CD_PHASE_COMPACT: {
+        /* m_w R'' = sum f_i - p 4 pi R^2, m_w the total particle mass */
+        double R = s->walls[w].radius;
+        double a = (load - ball_pressure(sim) * 4 * CD_PI * R * R) / total_mass(sim);
+        s->walls[w].radial_velocity += a * dt;
+        if (relaxed(sim, err, errlen, &done)) return -1;
+        if (done) {
+            if (!strcmp(sim->cfg.protocol, "bulk_modulus")) {
+                enter(sim, CD_PHASE_BASE, log);
+                s->walls[w].radial_velocity = 0;
+                s->control[CTL_R_BASE] = s->walls[w].radius;
+            } else {
+                enter(sim, CD_PHASE_DONE, log);
+            }
+        }
+        break;
+    }
+    case CD_PHASE_BASE: {
+        double p0;
+        if (s->control[CTL_PROBE_STEP] > 0) {
+            /* relaxed: average the base pressure over a window */
+            if (!window_pressure(sim, load, &p0)) break;
+            s->control[CTL_P_BASE] = p0;
+            enter(sim, CD_PHASE_PROBE, log);
+            s->control[CTL_PROBE_STEP] = (double)s->step;
+            if (apply_strain(sim, sim->cfg.strain_min, err, errlen)) return -1;
+            break;
+        }
+        if (relaxed(sim, err, errlen, &done)) return -1;
+        if (done) s->control[CTL_PROBE_STEP] = (double)s->step;
+        break;
+    }
+    case CD_PHASE_PROBE: {
+        double p;
+        if (!window_pressure(sim, load, &p)) break;
+        double eps = s->control[CTL_STRAIN];
+        double dp = p - s->control[CTL_P_BASE];
+        double K = dp / eps; /* K = -V dp / dV with dV/V = -eps [Pa] */
+        int k = (int)s->control[CTL_N_PROBES];
+        if (k < CTL_MAX_PROBES) s->control[CTL_K_FIRST + k] = K;
+        s->control[CTL_N_PROBES] = k + 1;
+        if (log) fprintf(log, "\ncapdem: bulk probe: strain %.3g  dp %.6g Pa  K %.6g Pa\n", eps, dp, K);
+        double next = eps * 10;
+        if (next > sim->cfg.strain_max * (1 + 1e-9) || k + 1 >= CTL_MAX_PROBES) {
+            enter(sim, CD_PHASE_DONE, log);
+        } else {
+            s->control[CTL_PROBE_STEP] = (double)s->step;
+            if (apply_strain(sim, next, err, errlen)) return -1;
+        }
+        break;
+    }
+    default: break;
+    }
+    return phase_of(sim) == CD_PHASE_DONE;
+}
+
+void cd_protocol_observable_info(const char **names, const char **units)
+{
+    static const char *const n[CD_PROTOCOL_OBSERVABLES] = {"packing_fraction", "coordination", "phase", "wall_load", "pressure"};
+    static const char *const u[CD_PROTOCOL_OBSERVABLES] = {"1", "1", "1", "N", "Pa"};
+    for (int k = 0; k < CD_PROTOCOL_OBSERVABLES; k++) { names[k] = n[k]; units[k] = u[k]; }
+}
+
+/* Container volume [m^3] (0 when there is none): up to the piston for the
+ * deposit protocol, the ball for the ball protocols. */
+static double container_volume(const cd_sim *sim)
+{
+    const cd_config *c = &sim->cfg;
+    const cd_state *s = &sim->s;
+    int w = (int)s->control[CTL_WALL];
+    int deposit = !strcmp(c->protocol, "deposit_compress");
+    if (!strcmp(c->domain, "box")) return c->box_width * c->box_thickness * (deposit ? s->walls[w].point.y : c->box_height);
+    if (!strcmp(c->domain, "cylinder"))
+        return CD_PI * 0.25 * c->cyl_diameter * c->cyl_diameter * (deposit ? s->walls[w].point.y : c->cyl_height);
+    if (!strcmp(c->domain, "ball")) return 4.0 / 3.0 * CD_PI * pow(s->walls[0].radius, 3);
+    return 0;
+}
+
+void cd_protocol_observables(const cd_sim *sim, const cd_observables *o, double *v)
+{
+    const cd_state *s = &sim->s;
+    double solid = 0; /* [m^3] */
+    for (size_t q = 0; q < s->n_particles; q++) solid += sim->shapes[s->shape[q]].volume * pow(s->scale[q], 3);
+    double V = container_volume(sim);
+    v[0] = V > 0 ? solid / V : 0;
+    v[1] = s->n_particles ? 2 * o->n_contacts / (double)s->n_particles : 0;
+    v[2] = s->control[CTL_PHASE];
+    v[3] = s->control[CTL_LOAD];
+    int w = (int)s->control[CTL_WALL];
+    double R = s->n_walls ? s->walls[w].radius : 0;
+    v[4] = !strcmp(sim->cfg.domain, "ball") && R > 0 ? s->control[CTL_LOAD] / (4 * CD_PI * R * R) : 0;
+}

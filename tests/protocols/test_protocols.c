@@ -1,0 +1,171 @@
+/* The SPEC 6 protocols on their CI-size presets (configs/protocols/ci). */
+#include "test_util.h"
+#include <math.h>
+#include <unistd.h>
+#include "run.h"
+#include "io_h5.h"
+#include "protocol.h"
+
+static const char *preset(const char *name)
+{
+    static char path[2048];
+    const char *src = getenv("CAPDEM_SOURCE_DIR");
+    snprintf(path, sizeof path, "%s/configs/protocols/ci/%s.yaml", src ? src : CAPDEM_SOURCE_DIR, name);
+    return path;
+}
+
+/* Runs a preset (optionally capped at steps) into out; returns the status. */
+static int run_preset(const char *name, const char *out, const char *resume, long long steps)
+{
+    cd_run_options o = {.config_path = preset(name), .resume_path = resume, .output_path = resume ? NULL : out,
+                        .steps = steps, .quiet = 1, .backend = cdt_backend()};
+    return cd_run(&o);
+}
+
+/* Sets up the simulation of a preset and reads snapshot k of a run file. */
+static void load(cd_sim *sim, cd_config *cfg, const char *name, const char *file, int k)
+{
+    char err[2048];
+    if (cd_config_load(preset(name), cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_setup(sim, cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_h5_read_snapshot(file, k, &sim->s, err, sizeof err)) fail_msg("%s", err);
+}
+
+/* After compression the piston carries the target load as a body of mass
+ * m_p: m_p y'' = load - F.  The run ends only when the packing has relaxed
+ * (kinetic energy below 1e-4 of the elastic energy), so the piston's
+ * acceleration, and with it load - F, is a small residue: 1 % allows for the
+ * vibration left at that kinetic energy. */
+static void test_piston_reaches_and_holds_target_force(void **state)
+{
+    (void)state;
+    assert_int_equal(run_preset("deposit_2d_crosses", "proto_dep2d.h5", NULL, -1), 0);
+    static cd_sim sim;
+    cd_config cfg;
+    load(&sim, &cfg, "deposit_2d_crosses", "proto_dep2d.h5", -1);
+    assert_int_equal((int)sim.s.control[0], CD_PHASE_DONE);
+    assert_true(sim.s.step < cfg.steps); /* the relaxation criterion ended the run */
+    double load_n = sim.s.control[4];
+    print_message("piston load %.4f N, target %.1f N\n", load_n, cfg.piston_force);
+    assert_true(fabs(load_n - cfg.piston_force) / cfg.piston_force < 0.01);
+
+    /* 2D mode: every snapshot keeps every particle in its plane, exactly */
+    char err[1024];
+    int n = cd_h5_snapshot_count("proto_dep2d.h5", err, sizeof err);
+    assert_true(n >= 3);
+    double z0 = sim.s.position[0].z;
+    for (int k = 0; k < n; k++) {
+        if (cd_h5_read_snapshot("proto_dep2d.h5", k, &sim.s, err, sizeof err)) fail_msg("%s", err);
+        for (size_t q = 0; q < sim.s.n_particles; q++) {
+            assert_true(sim.s.position[q].z == z0);
+            assert_true(sim.s.velocity[q].z == 0);
+            assert_true(sim.s.angvel[q].x == 0 && sim.s.angvel[q].y == 0);
+        }
+    }
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+}
+
+/* A deposit-and-compress run stopped in the compression phase and resumed
+ * ends with the same bits as the uninterrupted run. */
+static void test_deposit_resumed_equals_uninterrupted(void **state)
+{
+    (void)state;
+    assert_int_equal(run_preset("deposit_2d_crosses", "proto_dep2d_part.h5", NULL, 150000), 0);
+    assert_int_equal(run_preset("deposit_2d_crosses", NULL, "proto_dep2d_part.h5", -1), 0);
+    static cd_sim a, b;
+    cd_config ca, cb;
+    load(&a, &ca, "deposit_2d_crosses", "proto_dep2d.h5", -1);
+    load(&b, &cb, "deposit_2d_crosses", "proto_dep2d_part.h5", -1);
+    assert_int_equal(a.s.step, b.s.step);
+    assert_memory_equal(a.s.position, b.s.position, a.s.n_particles * sizeof(cd_vec3));
+    assert_memory_equal(a.s.velocity, b.s.velocity, a.s.n_particles * sizeof(cd_vec3));
+    assert_memory_equal(a.s.control, b.s.control, sizeof a.s.control);
+    cd_sim_free(&a); cd_sim_free(&b);
+    cd_config_free(&ca); cd_config_free(&cb);
+    unlink("proto_dep2d.h5");
+    unlink("proto_dep2d_part.h5");
+}
+
+/* Contacts per particle over the particles that have any (rattlers out),
+ * counted as constraints: Z_c = 2 (n_pp + n_w) / N_p*.  Isostaticity is
+ * n_constraints = n_dof; a particle-particle contact and a wall contact are
+ * one constraint each, but only the first is shared by two particles, so
+ * the wall contacts count twice here.  (With pair contacts only, Z_c would
+ * fall short of 12 by the share of wall contacts, ~2 n_w / N_p*.) */
+static double contact_coordination(const cd_state *s, size_t *np_star, double *max_overlap_ratio)
+{
+    int *count = calloc(s->n_particles, sizeof *count);
+    size_t nc = 0;
+    *max_overlap_ratio = 0;
+    for (size_t k = 0; k < s->n_pairs; k++) {
+        if (!s->pair_active[k]) continue;
+        count[s->prim_particle[s->pair_prim_i[k]]]++;
+        count[s->prim_particle[s->pair_prim_j[k]]]++;
+        nc++;
+        double d = 2 * s->prim_radius[s->pair_prim_i[k]];
+        if (s->pair_overlap[k] / d > *max_overlap_ratio) *max_overlap_ratio = s->pair_overlap[k] / d;
+    }
+    for (size_t r = 0; r < s->n_prims * s->n_walls; r++) {
+        if (!s->wallc_active[r]) continue;
+        count[s->prim_particle[r / s->n_walls]]++;
+        nc++;
+    }
+    *np_star = 0;
+    for (size_t q = 0; q < s->n_particles; q++) *np_star += count[q] > 0;
+    free(count);
+    return 2.0 * (double)nc / (double)*np_star;
+}
+
+/* Radial compaction ends in equilibrium: the particles' outward force on the
+ * ball balances p 4 pi R^2 (the ball's acceleration m_w R'' is the
+ * difference and vanishes at rest; 1 %), and frictionless particles jam
+ * near isostaticity with overlaps far below the arm diameter. */
+static void radial_case(const char *name, double z_iso_per_particle_dof)
+{
+    char file[256];
+    snprintf(file, sizeof file, "proto_%s.h5", name);
+    assert_int_equal(run_preset(name, file, NULL, -1), 0);
+    static cd_sim sim;
+    cd_config cfg;
+    load(&sim, &cfg, name, file, -1);
+    assert_int_equal((int)sim.s.control[0], CD_PHASE_DONE);
+    double R = sim.s.walls[0].radius, L = sim.shapes[0].tip_length;
+    double p = cfg.pressure_ratio * cfg.kn / L;
+    double balance = sim.s.control[4] / (p * 4 * CD_PI * R * R);
+    size_t np;
+    double worst;
+    double zc = contact_coordination(&sim.s, &np, &worst);
+    double iso = z_iso_per_particle_dof * (1 - 1.0 / (double)np);
+    print_message("%s: load / p 4 pi R^2 = %.5f, Z_c = %.3f over %zu particles, isostatic %.3f, max overlap %.2e d\n",
+                  name, balance, zc, np, iso, worst);
+    assert_true(fabs(balance - 1) < 0.01);
+    assert_true(fabs(zc - iso) / iso < 0.05);
+    assert_true(worst < 1e-3);
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+    unlink(file);
+}
+
+static void test_radial_compaction_frictionless_hexapods_isostatic(void **state)
+{
+    (void)state;
+    radial_case("radial_hexapods_a3", 12); /* 6 degrees of freedom: Z_c = 12 - 12/N */
+}
+
+static void test_radial_compaction_frictionless_spheres_isostatic(void **state)
+{
+    (void)state;
+    radial_case("radial_spheres", 6); /* 3 translational degrees of freedom: Z = 6 - 6/N */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_piston_reaches_and_holds_target_force),
+        cmocka_unit_test(test_deposit_resumed_equals_uninterrupted),
+        cmocka_unit_test(test_radial_compaction_frictionless_hexapods_isostatic),
+        cmocka_unit_test(test_radial_compaction_frictionless_spheres_isostatic),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
