@@ -112,8 +112,12 @@ static int cl_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
         forces(cl, sim, 1);
         cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof one, &one);
     }
-    /* (not compute_forces: the forces of the checkpoint are kept and the
-     * list is rebuilt at the first step, sim->nb.force_rebuild being set) */
+    /* Not compute_forces: the forces of the checkpoint are kept and the
+     * list is rebuilt at the first step (sim->nb.force_rebuild is set), as
+     * on the omp backend.  Otherwise the new forces and contacts are copied
+     * back once, so that the host state is current after start on every
+     * backend (tests and tools read energies right after it). */
+    if (compute_forces) cd_cl_buffers_download(cl, sim);
     if (!cl->status) cd_cl_check(cl, clFinish(cl->queue), "starting");
     return cl->status ? fail(sim, err, errlen) : 0;
 }

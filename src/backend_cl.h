@@ -52,7 +52,7 @@ typedef struct cd_cl {
     cl_program program;
     cl_kernel k[CD_CLK_COUNT];
     size_t local;               /* work-group size of the one-item-per-row kernels */
-    char desc[320];             /* platform and device, for messages */
+    char desc[800];             /* platform and device, for messages */
 
     /* state columns; pair columns have cap_pairs rows, except pair_active
      * and pair_shear, which are those of hist[cur] (cd_cl_col) */

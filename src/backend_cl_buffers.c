@@ -197,9 +197,8 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
                                         0, NULL, NULL);
         cd_cl_check(cl, rc, "downloading the state");
     }
-    if (s->n_walls && !cl->status)
-        cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->walls, CL_FALSE, 0, s->n_walls * sizeof(cd_wall), s->walls,
-                                            0, NULL, NULL), "downloading the walls");
+    /* Not the walls: the host's copy is current after every call of step
+     * and may since have been changed by a protocol (docs/opencl.md). */
     if (!cl->status) cd_cl_check(cl, clFinish(cl->queue), "downloading the state");
     return cl->status ? -1 : 0;
 }

@@ -371,7 +371,7 @@ static int build_program(cd_cl *cl, char *err, size_t errlen)
 int cd_cl_open(cd_cl *cl, const char *device_request, char *err, size_t errlen)
 {
     if (choose_device(cl, device_request, err, errlen)) return -1;
-    char pname[128], dname[128], ver[64];
+    char pname[256], dname[256], ver[256];
     if (clGetPlatformInfo(cl->platform, CL_PLATFORM_NAME, sizeof pname, pname, NULL) != CL_SUCCESS) pname[0] = 0;
     pname[sizeof pname - 1] = 0;
     info_string(cl->device, CL_DEVICE_NAME, dname, sizeof dname);

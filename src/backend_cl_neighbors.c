@@ -23,7 +23,7 @@ static void bin_prims(cd_cl *cl, cd_int P, cd_real skin)
 {
     cd_int parts = (P + 63) / 64;
     if (parts > CD_CL_MAX_BLOCKS) parts = CD_CL_MAX_BLOCKS;
-    cd_int chunk = (P + parts - 1) / parts;
+    cd_int chunk = (P + parts - 1) / parts, cell_cap = (cd_int)cl->cell_cap;
     parts = (P + chunk - 1) / chunk;
     cd_cl_arg(cl, CD_CLK_BOUNDS, F, sizeof P, &P);
     cd_cl_arg(cl, CD_CLK_BOUNDS, F + 1, sizeof chunk, &chunk);
@@ -43,6 +43,7 @@ static void bin_prims(cd_cl *cl, cd_int P, cd_real skin)
     cd_cl_arg(cl, CD_CLK_BIN, F + 1, sizeof cl->grid, &cl->grid);
     cd_cl_arg(cl, CD_CLK_BIN, F + 2, sizeof cl->prim_cell, &cl->prim_cell);
     cd_cl_arg(cl, CD_CLK_BIN, F + 3, sizeof cl->cell_count, &cl->cell_count);
+    cd_cl_arg(cl, CD_CLK_BIN, F + 4, sizeof cell_cap, &cell_cap);
     cd_cl_run(cl, CD_CLK_BIN, (size_t)P);
     cd_cl_scan(cl, cl->cell_count, cl->cell_cap, cl->cell_start);
     copy(cl, cl->cell_start, cl->cell_cursor, cl->cell_cap * sizeof(cd_int));

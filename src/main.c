@@ -5,6 +5,8 @@
 #include "run.h"
 #include "shapes.h"
 #include "config.h"
+#include "export.h"
+#include "analyze.h"
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -19,6 +21,12 @@ static void usage(FILE *f)
             "                  run a simulation; `capdem run --help` lists every config key\n"
             "  shape KIND [--aspect A] [--diameter D] [--density RHO] [--json]\n"
             "                  mass properties of a sphere, rod, cross or hexapod (SI units)\n"
+            "  analyze RUN.h5 [--snapshot last|N] [--json]\n"
+            "                  microstructure of a packing (docs/analysis.md)\n"
+            "  export RUN.h5 [-o OUT.xmf]\n"
+            "                  ParaView-ready XDMF description of a run (docs/visualization.md)\n"
+            "  render RUN.h5 [--snapshot N] -o PIC.png [--mode arms|forces] [--color particle|height|shape|speed]\n"
+            "                [--view ELEV,AZIM]   picture of a packing (matplotlib)\n"
             "  --version       version, build variant and OpenMP devices\n");
 }
 
@@ -124,6 +132,9 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) { usage(stdout); return 0; }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "shape")) return cmd_shape(argc - 2, argv + 2);
+    if (!strcmp(cmd, "analyze")) return cd_cmd_analyze(argc - 2, argv + 2);
+    if (!strcmp(cmd, "export")) return cd_cmd_export(argc - 2, argv + 2);
+    if (!strcmp(cmd, "render")) return cd_cmd_render(argc - 2, argv + 2);
     fprintf(stderr, "capdem: unknown command '%s'\n", cmd);
     usage(stderr);
     return 2;

@@ -82,13 +82,18 @@ static void test_history_survives_forced_rebuilds(void **state)
     assert_true(k >= 0);
     cd_prim_id pi = b.s.pair_prim_i[k], pj = b.s.pair_prim_j[k];
     cd_vec3 shear = b.s.pair_shear[k];
-    b.nb.force_rebuild = 1;
-    assert_int_equal(cd_neighbors_build(&b), 0);
-    long found = -1;
-    for (size_t r = 0; r < b.s.n_pairs; r++)
-        if (b.s.pair_prim_i[r] == pi && b.s.pair_prim_j[r] == pj) found = (long)r;
-    assert_true(found >= 0);
-    assert_memory_equal(&b.s.pair_shear[found], &shear, sizeof shear);
+    /* cd_neighbors_build is the omp backend's host list; on OpenCL the
+     * list lives on the device and the forced rebuilds below exercise its
+     * carry-over. */
+    if (!strcmp(cdt_backend(), "omp")) {
+        b.nb.force_rebuild = 1;
+        assert_int_equal(cd_neighbors_build(&b), 0);
+        long found = -1;
+        for (size_t r = 0; r < b.s.n_pairs; r++)
+            if (b.s.pair_prim_i[r] == pi && b.s.pair_prim_j[r] == pj) found = (long)r;
+        assert_true(found >= 0);
+        assert_memory_equal(&b.s.pair_shear[found], &shear, sizeof shear);
+    }
     long long before = b.nb.builds;
     for (int it = 0; it < 500; it++) {
         b.nb.force_rebuild = 1;

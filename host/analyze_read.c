@@ -1,0 +1,337 @@
+/* Reads what the analysis needs from one snapshot of a run file, straight
+ * from the datasets of docs/output.md (no simulation state is set up):
+ * centres, scale and shape of the particles, the world axis ends of the
+ * primitives, the contact rows of the snapshot, the wall contacts, the
+ * walls, the shape catalogue and the echoed config. */
+#include "analyze.h"
+#include "io_h5.h"
+#include <hdf5.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    const char *path;
+    hid_t file;
+    char *err;
+    size_t errlen;
+} rd;
+
+static int rd_fail(rd *r, int code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static int rd_fail(rd *r, int code, const char *fmt, ...)
+{
+    char msg[700];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    snprintf(r->err, r->errlen, "%s: %s", r->path, msg);
+    return code;
+}
+
+/* Shape of dataset dpath: rank and dims (up to 3); -1 when absent. */
+static int rd_dims(rd *r, const char *dpath, hsize_t dims[3])
+{
+    if (H5Lexists(r->file, dpath, H5P_DEFAULT) <= 0) return -1;
+    hid_t d = H5Dopen2(r->file, dpath, H5P_DEFAULT);
+    if (d < 0) return -1;
+    hid_t sp = H5Dget_space(d);
+    int rank = H5Sget_simple_extent_ndims(sp);
+    dims[0] = dims[1] = dims[2] = 1;
+    if (rank >= 0 && rank <= 3) H5Sget_simple_extent_dims(sp, dims, NULL);
+    H5Sclose(sp);
+    H5Dclose(d);
+    return rank;
+}
+
+/* Reads count0 rows from row start0 of dataset dpath (rank 1..3; rows are
+ * the first dimension; every other dimension is read whole) as memtype.
+ * The dataset must have inner elements per row (1 for rank 1). */
+static int rd_rows(rd *r, const char *dpath, hsize_t start0, hsize_t count0, hsize_t inner, hid_t memtype,
+                   void *buf)
+{
+    hsize_t dims[3];
+    int rank = rd_dims(r, dpath, dims);
+    if (rank < 0) return rd_fail(r, 2, "dataset %s is missing: is this a capdem run file?", dpath);
+    if (rank == 0) { /* scalar dataset: one value */
+        if (start0 != 0 || count0 != 1 || inner != 1) return rd_fail(r, 2, "dataset %s is a scalar", dpath);
+        hid_t d = H5Dopen2(r->file, dpath, H5P_DEFAULT);
+        herr_t st = H5Dread(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+        H5Dclose(d);
+        return st < 0 ? rd_fail(r, 2, "cannot read dataset %s", dpath) : 0;
+    }
+    if (rank > 3) return rd_fail(r, 2, "dataset %s has rank %d, expected 1 to 3", dpath, rank);
+    hsize_t row = rank == 1 ? 1 : rank == 2 ? dims[1] : dims[1] * dims[2];
+    if (row != inner)
+        return rd_fail(r, 2, "dataset %s has %llu values per row, expected %llu", dpath, (unsigned long long)row,
+                       (unsigned long long)inner);
+    if (start0 + count0 > dims[0])
+        return rd_fail(r, 2, "dataset %s has %llu rows, rows %llu..%llu were asked for", dpath,
+                       (unsigned long long)dims[0], (unsigned long long)start0,
+                       (unsigned long long)(start0 + count0));
+    if (count0 == 0) return 0;
+    hid_t d = H5Dopen2(r->file, dpath, H5P_DEFAULT);
+    hid_t fs = H5Dget_space(d);
+    hsize_t start[3] = {start0, 0, 0}, count[3] = {count0, dims[1], dims[2]};
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+    hid_t ms = H5Screate_simple(rank, count, NULL);
+    herr_t st = H5Dread(d, memtype, ms, fs, H5P_DEFAULT, buf);
+    H5Sclose(ms);
+    H5Sclose(fs);
+    H5Dclose(d);
+    return st < 0 ? rd_fail(r, 2, "cannot read dataset %s", dpath) : 0;
+}
+
+/* Scalar double dataset at gpath/name (shape catalogue). */
+static int rd_scalar(rd *r, const char *gpath, const char *name, double *out)
+{
+    char p[256];
+    snprintf(p, sizeof p, "%s/%s", gpath, name);
+    return rd_rows(r, p, 0, 1, 1, H5T_NATIVE_DOUBLE, out);
+}
+
+/* String dataset (fixed or variable length) into buf. */
+static int rd_string(rd *r, const char *dpath, char *buf, size_t len)
+{
+    buf[0] = 0;
+    if (H5Lexists(r->file, dpath, H5P_DEFAULT) <= 0) return rd_fail(r, 2, "dataset %s is missing", dpath);
+    hid_t d = H5Dopen2(r->file, dpath, H5P_DEFAULT), t = H5Dget_type(d);
+    int rc = 0;
+    if (H5Tget_class(t) != H5T_STRING) {
+        rc = rd_fail(r, 2, "dataset %s is not a string", dpath);
+    } else if (H5Tis_variable_str(t) > 0) {
+        char *s = NULL;
+        if (H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &s) < 0 || !s) rc = rd_fail(r, 2, "cannot read %s", dpath);
+        else snprintf(buf, len, "%s", s);
+        if (s) H5free_memory(s);
+    } else {
+        size_t sz = H5Tget_size(t);
+        char *s = calloc(sz + 1, 1);
+        if (!s || H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, s) < 0) rc = rd_fail(r, 2, "cannot read %s", dpath);
+        else snprintf(buf, len, "%s", s);
+        free(s);
+    }
+    H5Tclose(t);
+    H5Dclose(d);
+    return rc;
+}
+
+static int rd_shapes(rd *r, cd_an_snapshot *s)
+{
+    if (H5Lexists(r->file, "/parameters/shapes", H5P_DEFAULT) <= 0 ||
+        H5Aexists_by_name(r->file, "/parameters/shapes", "count", H5P_DEFAULT) <= 0)
+        return rd_fail(r, 2, "/parameters/shapes or its attribute count is missing");
+    int32_t count = 0;
+    hid_t a = H5Aopen_by_name(r->file, "/parameters/shapes", "count", H5P_DEFAULT, H5P_DEFAULT);
+    herr_t st = H5Aread(a, H5T_NATIVE_INT32, &count);
+    H5Aclose(a);
+    if (st < 0 || count < 1 || count > 4096) return rd_fail(r, 2, "/parameters/shapes: bad count %d", (int)count);
+    s->shapes = calloc((size_t)count, sizeof(cd_an_shape));
+    if (!s->shapes) return rd_fail(r, 1, "out of memory");
+    s->n_shapes = count;
+    for (int k = 0; k < count; k++) {
+        char g[64], p[96];
+        cd_an_shape *sh = &s->shapes[k];
+        snprintf(g, sizeof g, "/parameters/shapes/%d", k);
+        snprintf(p, sizeof p, "%s/kind", g);
+        int rc = rd_string(r, p, sh->kind, sizeof sh->kind);
+        if (!rc) rc = rd_scalar(r, g, "volume", &sh->volume);
+        if (!rc) rc = rd_scalar(r, g, "tip_length", &sh->tip_length);
+        if (!rc) rc = rd_scalar(r, g, "bounding_radius", &sh->bounding_radius);
+        if (rc) return rc;
+        hsize_t dims[3];
+        snprintf(p, sizeof p, "%s/arms", g);
+        int rank = rd_dims(r, p, dims);
+        if (rank != 2 || dims[1] != 7 || dims[0] < 1 || dims[0] > CD_MAX_ARMS)
+            return rd_fail(r, 2, "%s: expected (arms, 7) with 1 to %d arms", p, CD_MAX_ARMS);
+        sh->n_arms = (int)dims[0];
+        if ((rc = rd_rows(r, p, 0, dims[0], 7, H5T_NATIVE_DOUBLE, sh->arms))) return rc;
+        if (!(sh->volume > 0) || !(sh->tip_length > 0))
+            return rd_fail(r, 2, "%s: volume and tip_length must be > 0", g);
+    }
+    return 0;
+}
+
+/* cd_wall in memory as the compound the writer stores (docs/output.md). */
+static hid_t wall_type(void)
+{
+    hsize_t three = 3;
+    hid_t t = H5Tcreate(H5T_COMPOUND, sizeof(cd_wall));
+    hid_t v3 = H5Tarray_create2(H5T_NATIVE_DOUBLE, 1, &three);
+    H5Tinsert(t, "type", HOFFSET(cd_wall, type), H5T_NATIVE_INT32);
+    H5Tinsert(t, "point", HOFFSET(cd_wall, point), v3);
+    H5Tinsert(t, "normal", HOFFSET(cd_wall, normal), v3);
+    H5Tinsert(t, "velocity", HOFFSET(cd_wall, velocity), v3);
+    H5Tinsert(t, "radius", HOFFSET(cd_wall, radius), H5T_NATIVE_DOUBLE);
+    H5Tinsert(t, "radial_velocity", HOFFSET(cd_wall, radial_velocity), H5T_NATIVE_DOUBLE);
+    H5Tinsert(t, "friction", HOFFSET(cd_wall, friction), H5T_NATIVE_DOUBLE);
+    H5Tclose(v3);
+    return t;
+}
+
+int cd_an_snapshot_alloc(cd_an_snapshot *s, size_t n, size_t P, size_t nc, size_t nw, int W)
+{
+    s->n = n;
+    s->n_prims = P;
+    s->nc = nc;
+    s->nw = nw;
+    s->n_walls = W;
+#define A(ptr, cnt) ((ptr) = calloc((cnt) ? (cnt) : 1, sizeof(*(ptr)))) == NULL
+    if (A(s->pos, n) || A(s->scale, n) || A(s->shape, n) || A(s->prim_a, P) || A(s->prim_b, P) ||
+        A(s->prim_radius, P) || A(s->prim_particle, P) || A(s->ci, nc) || A(s->cj, nc) || A(s->fn, nc) ||
+        A(s->normal, nc) || A(s->ft, nc) || A(s->point, nc) || A(s->w_prim, nw) || A(s->w_wall, nw) ||
+        A(s->w_force, nw) || A(s->w_point, nw) || A(s->walls, (size_t)W))
+        return -1;
+#undef A
+    return 0;
+}
+
+void cd_an_snapshot_free(cd_an_snapshot *s)
+{
+    void *p[] = {s->pos, s->scale, s->shape, s->prim_a, s->prim_b, s->prim_radius, s->prim_particle, s->ci, s->cj,
+                 s->fn, s->normal, s->ft, s->point, s->w_prim, s->w_wall, s->w_force, s->w_point, s->walls,
+                 s->shapes};
+    for (size_t k = 0; k < sizeof p / sizeof p[0]; k++) free(p[k]);
+    cd_config_free(&s->cfg);
+    memset(s, 0, sizeof(*s));
+}
+
+/* The echoed config: domain type, dimension, k_n, parallel angle. */
+static void rd_config(rd *r, cd_an_snapshot *s)
+{
+    char err[1024];
+    cd_config_defaults(&s->cfg);
+    char *text = cd_h5_read_config_text(r->path, err, sizeof err);
+    s->cfg_ok = text && cd_config_parse(text, r->path, &s->cfg, err, sizeof err) == 0;
+    if (!s->cfg_ok) {
+        cd_config_free(&s->cfg);
+        cd_config_defaults(&s->cfg);
+    }
+    free(text);
+}
+
+static int rd_all(rd *r, int k, int S, cd_an_snapshot *s)
+{
+    int rc;
+    if (S == 0) return rd_fail(r, 2, "the file holds no complete snapshot");
+    int kk = k < 0 ? S + k : k;
+    if (kk < 0 || kk >= S)
+        return rd_fail(r, 2, "snapshot %d does not exist (the file holds %d, 0..%d, or -1 for the last)", k, S, S - 1);
+    s->snapshot = kk;
+    s->n_snapshots = S;
+    if ((rc = rd_rows(r, "/walls/step", (hsize_t)kk, 1, 1, H5T_NATIVE_INT64, &s->step))) return rc;
+    if ((rc = rd_rows(r, "/walls/time", (hsize_t)kk, 1, 1, H5T_NATIVE_DOUBLE, &s->time))) return rc;
+    if ((rc = rd_shapes(r, s))) return rc;
+
+    hsize_t dp[3], dq[3], dw[3];
+    if (rd_dims(r, "/particles/all/position/value", dp) != 3 || dp[2] != 3)
+        return rd_fail(r, 2, "/particles/all/position/value is missing or not (snapshots, N, 3)");
+    if (rd_dims(r, "/particles/prims/prim_a/value", dq) != 3 || dq[2] != 3)
+        return rd_fail(r, 2, "/particles/prims/prim_a/value is missing or not (snapshots, P, 3)");
+    int wrank = rd_dims(r, "/walls/value", dw);
+    size_t W = wrank == 2 ? (size_t)dw[1] : 0;
+    if (wrank != 2 && wrank != 1) return rd_fail(r, 2, "/walls/value is missing");
+
+    long long coff[2] = {0, 0}, woff[2] = {0, 0};
+    if ((rc = rd_rows(r, "/contacts/offset", (hsize_t)kk, 2, 1, H5T_NATIVE_INT64, coff))) return rc;
+    if ((rc = rd_rows(r, "/wall_contacts/offset", (hsize_t)kk, 2, 1, H5T_NATIVE_INT64, woff))) return rc;
+    if (coff[1] < coff[0] || woff[1] < woff[0]) return rd_fail(r, 2, "contact offsets of snapshot %d decrease", kk);
+    size_t N = (size_t)dp[1], P = (size_t)dq[1], nc = (size_t)(coff[1] - coff[0]), nw = (size_t)(woff[1] - woff[0]);
+    if (cd_an_snapshot_alloc(s, N, P, nc, nw, (int)W)) return rd_fail(r, 1, "out of memory");
+
+    hid_t D = H5T_NATIVE_DOUBLE, I = H5T_NATIVE_INT32;
+    hsize_t c0 = (hsize_t)coff[0], w0 = (hsize_t)woff[0], K = (hsize_t)kk;
+    if ((rc = rd_rows(r, "/particles/all/position/value", K, 1, N * 3, D, s->pos)) ||
+        (rc = rd_rows(r, "/particles/all/scale", 0, N, 1, D, s->scale)) ||
+        (rc = rd_rows(r, "/particles/all/shape", 0, N, 1, I, s->shape)) ||
+        (rc = rd_rows(r, "/particles/prims/prim_a/value", K, 1, P * 3, D, s->prim_a)) ||
+        (rc = rd_rows(r, "/particles/prims/prim_b/value", K, 1, P * 3, D, s->prim_b)) ||
+        (rc = rd_rows(r, "/particles/prims/prim_radius", 0, P, 1, D, s->prim_radius)) ||
+        (rc = rd_rows(r, "/particles/prims/prim_particle", 0, P, 1, I, s->prim_particle)) ||
+        (rc = rd_rows(r, "/contacts/particle_i", c0, nc, 1, I, s->ci)) ||
+        (rc = rd_rows(r, "/contacts/particle_j", c0, nc, 1, I, s->cj)) ||
+        (rc = rd_rows(r, "/contacts/pair_fn", c0, nc, 1, D, s->fn)) ||
+        (rc = rd_rows(r, "/contacts/pair_normal", c0, nc, 3, D, s->normal)) ||
+        (rc = rd_rows(r, "/contacts/pair_ft", c0, nc, 3, D, s->ft)) ||
+        (rc = rd_rows(r, "/contacts/pair_point", c0, nc, 3, D, s->point)) ||
+        (rc = rd_rows(r, "/wall_contacts/wallc_force", w0, nw, 3, D, s->w_force)))
+        return rc;
+    if (W > 0) {
+        hid_t t = wall_type();
+        rc = rd_rows(r, "/walls/value", K, 1, W, t, s->walls);
+        H5Tclose(t);
+        if (rc) return rc;
+    }
+    /* protocol state (measured bulk modulus); older files have none */
+    hsize_t dc[3];
+    if (rd_dims(r, "/walls/control", dc) == 2 && dc[0] > K && dc[1] <= 64) {
+        if ((rc = rd_rows(r, "/walls/control", K, 1, dc[1], D, s->control))) return rc;
+        s->n_control = (int)dc[1];
+    }
+    long long *idx = malloc((nw ? nw : 1) * sizeof(long long));
+    if (!idx) return rd_fail(r, 1, "out of memory");
+    rc = rd_rows(r, "/wall_contacts/index", w0, nw, 1, H5T_NATIVE_INT64, idx);
+    for (size_t c = 0; !rc && c < nw; c++) {
+        if (W == 0 || idx[c] < 0 || (size_t)idx[c] >= P * W) {
+            rc = rd_fail(r, 2, "/wall_contacts/index row %llu = %lld is out of range (P = %zu, W = %zu)",
+                         (unsigned long long)(w0 + c), idx[c], P, W);
+            break;
+        }
+        s->w_prim[c] = (int32_t)(idx[c] / (long long)W);
+        s->w_wall[c] = (int32_t)(idx[c] % (long long)W);
+    }
+    free(idx);
+    if (rc) return rc;
+    for (size_t p = 0; p < N; p++)
+        if (s->shape[p] < 0 || s->shape[p] >= s->n_shapes)
+            return rd_fail(r, 2, "/particles/all/shape: particle %zu has shape %d, the catalogue %d", p,
+                           (int)s->shape[p], s->n_shapes);
+    for (size_t q = 0; q < P; q++)
+        if (s->prim_particle[q] < 0 || (size_t)s->prim_particle[q] >= N)
+            return rd_fail(r, 2, "/particles/prims/prim_particle: primitive %zu names particle %d of %zu", q,
+                           (int)s->prim_particle[q], N);
+    cd_an_wall_points(s);
+    return 0;
+}
+
+int cd_an_read_snapshot(const char *path, int k, cd_an_snapshot *s, char *err, size_t errlen)
+{
+    memset(s, 0, sizeof(*s));
+    snprintf(s->path, sizeof s->path, "%s", path);
+    rd r = {path, H5I_INVALID_HID, err, errlen};
+    FILE *probe = fopen(path, "rb");
+    if (!probe) {
+        snprintf(err, errlen, "%s: cannot open the run file: no such file or not readable", path);
+        return 2;
+    }
+    fclose(probe);
+    H5E_auto2_t func;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    int rc;
+    if (H5Fis_hdf5(path) <= 0) {
+        rc = rd_fail(&r, 2, "not an HDF5 file");
+    } else {
+        /* io_h5 opens run files with the strong close degree; a second open
+         * in the same process must use the same, so the count and the
+         * config (read through io_h5) come first and the file is opened the
+         * same way. */
+        int S = cd_h5_snapshot_count(path, err, errlen);
+        rd_config(&r, s);
+        hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+        H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG);
+        r.file = S < 0 ? H5I_INVALID_HID : H5Fopen(path, H5F_ACC_RDONLY, fapl);
+        H5Pclose(fapl);
+        rc = S < 0 ? 2 : r.file < 0 ? rd_fail(&r, 2, "cannot open the HDF5 file") : rd_all(&r, k, S, s);
+        if (r.file >= 0) H5Fclose(r.file);
+    }
+    H5Eset_auto2(H5E_DEFAULT, func, data);
+    return rc;
+}

@@ -1,0 +1,254 @@
+#!/usr/bin/python3
+"""Draws the figures of `capdem analyze` from a run file's /analysis group.
+
+usage: host/plot_run.py RUN.h5 [-o DIR] [--step STEP]
+
+Reads /analysis/snapshot_<step> (the latest analysed snapshot unless --step
+is given), /analysis/compaction and /analysis/jamming, and writes PNGs into
+DIR (default: next to the run file, in <run>_plots/):
+
+  pf.png            P(f) of normal contact forces, log scale, with the tail
+                    fit exp(-k f) and Mueth's fit
+  bond_forces.png   PDF of bond forces over their mean, with the cascade fit
+  rdf.png           G(r) and the cumulative rho(r) against r/L
+  stress.png        P(i), i = I1 / <I1>
+  branch.png        PDF of branch lengths l/L
+  connectivity.png  P_c (contacts per particle) and P_b (neighbours per particle)
+  valence.png       P_k and the mean bond force F_k against valence k
+  compaction.png    the time series: stress or load, coordination, packing
+                    fraction; and Z against Phi with the jamming fit
+
+Figures whose data the file lacks are skipped with a note.  Needs Debian's
+python3-matplotlib, python3-h5py and python3-numpy.  The layout of
+/analysis is in docs/analysis.md.
+"""
+import argparse
+import os
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def table(group, name):
+    """A table of /analysis as a dict column name -> array, or None."""
+    if group is None or name not in group:
+        return None
+    d = group[name]
+    cols = d.attrs["columns"]
+    cols = cols.decode() if isinstance(cols, bytes) else str(cols)
+    data = np.asarray(d[()])
+    return {c: data[:, k] for k, c in enumerate(cols.split(","))}
+
+
+def attr(group, name, default=None):
+    if group is None or name not in group.attrs:
+        return default
+    return float(group.attrs[name])
+
+
+def save(fig, outdir, name, made):
+    path = os.path.join(outdir, name)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    made.append(path)
+
+
+def plot_pf(snap, outdir, made):
+    g = snap.get("normal_forces")
+    t = table(g, "pdf")
+    if t is None:
+        return "no normal_forces/pdf"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    keep = t["P"] > 0
+    ax.semilogy(t["f"][keep], t["P"][keep], "o", ms=4, label="P(f)")
+    k = attr(g, "k")
+    if k is not None:
+        # MLE tail: the samples above f = 1 (a fraction tail_n / n of all)
+        # have density k exp(-k (f - 1)) among themselves
+        frac = attr(g, "tail_n") / attr(g, "n_contacts")
+        f = np.linspace(1, 10, 100)
+        lo, hi = attr(g, "k_lo"), attr(g, "k_hi")
+        ax.semilogy(f, frac * k * np.exp(-k * (f - 1)), "-", label=f"tail: k = {k:.3f} [{lo:.3f}, {hi:.3f}]")
+    m = table(g, "mueth_fit")
+    if m is not None:
+        ax.semilogy(m["f"], m["P"], "--", label=f"Mueth: beta = {attr(g, 'mueth_beta'):.3f}")
+    ax.set_xlabel("f = F_n / <F_n>")
+    ax.set_ylabel("P(f)")
+    ax.set_ylim(bottom=max(1e-6, 0.5 * t["P"][keep].min()))
+    ax.legend(fontsize=8)
+    save(fig, outdir, "pf.png", made)
+
+
+def plot_bonds(snap, outdir, made):
+    g = snap.get("bond_forces")
+    t = table(g, "pdf_mean1")
+    if t is None:
+        return "no bond_forces/pdf_mean1"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    keep = t["P"] > 0
+    ax.semilogy(t["f_over_mean"][keep], t["P"][keep], "o", ms=4, label="bond forces")
+    c = table(g, "cascade_fit")
+    if c is not None:
+        ax.semilogy(c["f"], c["P"], "-",
+                    label=f"cascade: gamma = {attr(g, 'cascade_gamma'):.3f}, beta = {attr(g, 'cascade_beta'):.3f}")
+    ax.set_xlabel("f = |F_bond| / <|F_bond|>")
+    ax.set_ylabel("P(f)")
+    ax.set_ylim(bottom=max(1e-6, 0.5 * t["P"][keep].min()))
+    ax.legend(fontsize=8)
+    save(fig, outdir, "bond_forces.png", made)
+
+
+def plot_rdf(snap, outdir, made):
+    t = table(snap.get("rdf"), "rdf")
+    if t is None:
+        return "no rdf/rdf"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(t["r_over_L"], t["G"], "-", label="G(r)")
+    ax.axhline(1, color="grey", lw=0.5)
+    ax.set_xlabel("r / L")
+    ax.set_ylabel("G(r)")
+    ax2 = ax.twinx()
+    ax2.plot(t["r_over_L"], t["rho"], "--", color="C1", label="rho(r) = N(r)/N_inf")
+    ax2.set_ylabel("rho(r)")
+    fig.legend(loc="upper right", fontsize=8)
+    save(fig, outdir, "rdf.png", made)
+
+
+def plot_density(snap, outdir, made, group, name, xcol, xlabel, fname):
+    t = table(snap.get(group), name)
+    if t is None:
+        return f"no {group}/{name}"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    keep = t["P"] > 0
+    ax.semilogy(t[xcol][keep], t["P"][keep], "o-", ms=3)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("P")
+    save(fig, outdir, fname, made)
+
+
+def plot_connectivity(snap, outdir, made):
+    g = snap.get("network")
+    pc, pb = table(g, "contacts_per_particle"), table(g, "neighbours_per_particle")
+    if pc is None or pb is None:
+        return "no network tables"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(pc["c"], pc["P_c"], "o-", ms=3, label=f"P_c (Z_c = {attr(g, 'Z_c'):.2f})")
+    ax.plot(pb["b"], pb["P_b"], "s-", ms=3, label=f"P_b (Z = {attr(g, 'Z'):.2f})")
+    ax.set_xlabel("c, b")
+    ax.set_ylabel("proportion of particles")
+    ax.legend(fontsize=8)
+    save(fig, outdir, "connectivity.png", made)
+
+
+def plot_valence(snap, outdir, made):
+    g = snap.get("network")
+    t = table(g, "valence")
+    if t is None:
+        return "no network/valence"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.bar(t["k"], t["P_k"], color="C0", alpha=0.5, label=f"P_k (valence {attr(g, 'valence'):.2f})")
+    ax.set_xlabel("valence k (contacts per bond)")
+    ax.set_ylabel("P_k")
+    ax2 = ax.twinx()
+    ax2.plot(t["k"], t["F_k"], "o-", color="C3", label="F_k / <F_n>")
+    ax2.set_ylabel("F_k / <F_n>")
+    fig.legend(loc="upper right", fontsize=8)
+    save(fig, outdir, "valence.png", made)
+
+
+def plot_compaction(root, outdir, made):
+    t = table(root.get("compaction"), "curve")
+    if t is None:
+        return "no /analysis/compaction"
+    def varies(c):
+        v = t[c][np.isfinite(t[c])]
+        return v.size > 1 and v.max() > v.min()
+
+    # one stress-like, one coordination, one packing-fraction panel, each
+    # the first column of its kind that changes during the run
+    kinds = (("axial_stress", "pressure", "wall_load", "piston_force", "elastic_energy"),
+             ("coordination", "contacts"), ("packing_fraction", "phi_walls"))
+    panels = []
+    for kind in kinds:
+        found = [c for c in kind if c in t and varies(c)]
+        if found:
+            panels.append(found[0])
+    # SPEC 7: stress and Z against the packing fraction
+    phi = next((c for c in kinds[2] if c in panels), None)
+    against = [c for c in panels if c != phi] if phi else []
+    jam = table(root.get("jamming"), "data")
+    n = len(panels) + len(against) + (jam is not None)
+    fig, axes = plt.subplots(n, 1, figsize=(5, 2.6 * n), squeeze=False)
+    for ax, c in zip(axes[:, 0], panels):
+        ax.plot(t["time"], t[c], "-")
+        ax.set_ylabel(c)
+        ax.set_xlabel("time [s]")
+    for ax, c in zip(axes[len(panels):, 0], against):
+        ax.plot(t[phi], t[c], ".", ms=2)
+        ax.set_ylabel(c)
+        ax.set_xlabel(phi)
+    if jam is not None:
+        ax = axes[-1, 0]
+        ax.plot(jam["phi"], jam["z"], ".", ms=3, label="data")
+        keep = np.isfinite(jam["z_fit"])
+        g = root["jamming"]
+        ax.plot(jam["phi"][keep], jam["z_fit"][keep], "-",
+                label=f"Z_c + A (Phi - Phi_c)^1/2: Phi_c = {attr(g, 'phi_c'):.4f}, Z_c = {attr(g, 'z_c'):.2f}")
+        ax.set_xlabel("Phi")
+        ax.set_ylabel("Z")
+        ax.legend(fontsize=7)
+    save(fig, outdir, "compaction.png", made)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description="Figures of capdem analyze from RUN.h5/analysis")
+    ap.add_argument("run")
+    ap.add_argument("-o", "--outdir", default=None)
+    ap.add_argument("--step", type=int, default=None, help="analysed snapshot step (default: the latest)")
+    a = ap.parse_args(argv)
+    outdir = a.outdir or os.path.splitext(a.run)[0] + "_plots"
+    os.makedirs(outdir, exist_ok=True)
+    made, notes = [], []
+    with h5py.File(a.run, "r") as f:
+        if "analysis" not in f:
+            print(f"plot_run.py: {a.run} has no /analysis group: run `capdem analyze {a.run}` first", file=sys.stderr)
+            return 2
+        root = f["analysis"]
+        steps = sorted(int(k.split("_", 1)[1]) for k in root if k.startswith("snapshot_"))
+        snap = None
+        if a.step is not None and a.step not in steps:
+            print(f"plot_run.py: {a.run}: no /analysis/snapshot_{a.step} (analysed: {steps})", file=sys.stderr)
+            return 2
+        if steps:
+            snap = root[f"snapshot_{a.step if a.step is not None else steps[-1]}"]
+            jobs = [
+                lambda: plot_pf(snap, outdir, made),
+                lambda: plot_bonds(snap, outdir, made),
+                lambda: plot_rdf(snap, outdir, made),
+                lambda: plot_density(snap, outdir, made, "stress", "pdf", "i", "i = I1 / <I1>", "stress.png"),
+                lambda: plot_density(snap, outdir, made, "branch", "pdf", "l_over_L", "l / L", "branch.png"),
+                lambda: plot_connectivity(snap, outdir, made),
+                lambda: plot_valence(snap, outdir, made),
+            ]
+            for job in jobs:
+                note = job()
+                if note:
+                    notes.append(note)
+        note = plot_compaction(root, outdir, made)
+        if note:
+            notes.append(note)
+    for p in made:
+        print(p)
+    for n in notes:
+        print(f"plot_run.py: skipped: {n}", file=sys.stderr)
+    return 0 if made else 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,165 @@
+/* Broad phase of the Verlet list (docs/architecture.md; used by
+ * src/neighbors.c on the host and kernels/cl/neighbors.cl on a device):
+ * a uniform grid over the primitives' bounding-sphere centres, the exact
+ * candidate test, the scan of one primitive's neighbour cells, the pair key
+ * and its binary search (history carry-over), and the skin criterion.
+ * Written once so that both backends build the same list of pairs.
+ * Device-safe: C11 and OpenCL C 1.2. */
+#ifndef CD_BROADPHASE_H
+#define CD_BROADPHASE_H
+#include "defs.h"
+#include "vec3.h"
+#include "segseg.h"
+
+/* Uniform grid.  Plain struct of 8-byte members: same layout in C and in
+ * OpenCL, so it can live in a device buffer. */
+typedef struct {
+    cd_real lo[3];  /* lower corner [m] */
+    cd_real cell;   /* edge [m] */
+    cd_long dim[3]; /* cells per axis */
+} cd_grid;
+
+CD_DEVICE_BEGIN
+
+/* Centre of a primitive's bounding sphere [m]. */
+CD_INLINE cd_vec3 cd_bp_centre(cd_vec3 a, cd_vec3 b) { return cd_v3_scale(cd_v3_add(a, b), CD_R(0.5)); }
+
+/* Radius of a primitive's bounding sphere about cd_bp_centre [m]. */
+CD_INLINE cd_real cd_bp_bound(cd_vec3 a, cd_vec3 b, cd_real r) { return CD_R(0.5) * cd_v3_norm(cd_v3_sub(b, a)) + r; }
+
+/* Adds a primitive to the running box of centres lo/hi [m] and the largest
+ * bounding radius rmax [m].  Minimum and maximum are exact, so any order of
+ * additions (threads, work-groups) gives the same box. */
+CD_INLINE void cd_bp_bounds_add(cd_real *lo, cd_real *hi, cd_real *rmax, cd_vec3 a, cd_vec3 b, cd_real r)
+{
+    cd_vec3 c = cd_bp_centre(a, b);
+    cd_real v[3];
+    v[0] = c.x;
+    v[1] = c.y;
+    v[2] = c.z;
+    for (int k = 0; k < 3; k++) {
+        if (v[k] < lo[k]) lo[k] = v[k];
+        if (v[k] > hi[k]) hi[k] = v[k];
+    }
+    cd_real bound = cd_bp_bound(a, b, r);
+    if (bound > *rmax) *rmax = bound;
+}
+
+/* The grid for centres inside [lo, hi] [m], largest bounding radius rmax [m]
+ * and skin [m]: cells of edge 2 rmax + skin (so that candidates lie in
+ * neighbouring cells), enlarged until there are at most 8 n_prims + 64
+ * cells, so that memory and the empty-cell scan stay linear in N. */
+CD_INLINE void cd_grid_make(cd_grid *g, const cd_real *lo, const cd_real *hi, cd_real rmax, cd_real skin,
+                            cd_long n_prims)
+{
+    g->cell = 2 * rmax + skin;
+    for (;;) {
+        cd_real cells = 1;
+        for (int k = 0; k < 3; k++) {
+            g->lo[k] = lo[k];
+            g->dim[k] = (cd_long)floor((hi[k] - lo[k]) / g->cell) + 1;
+            cells *= (cd_real)g->dim[k];
+        }
+        if (cells <= CD_R(8.0) * (cd_real)n_prims + 64) break;
+        g->cell *= CD_R(1.26);
+    }
+}
+
+/* Cell coordinate of x along axis, clamped to the grid. */
+CD_INLINE cd_long cd_grid_coord(const cd_grid *g, cd_real x, int axis)
+{
+    cd_long c = (cd_long)floor((x - g->lo[axis]) / g->cell);
+    return c < 0 ? 0 : (c >= g->dim[axis] ? g->dim[axis] - 1 : c);
+}
+
+/* Cell index of point p [m] (x fastest). */
+CD_INLINE cd_long cd_grid_cell_of(const cd_grid *g, cd_vec3 p)
+{
+    return (cd_grid_coord(g, p.z, 2) * g->dim[1] + cd_grid_coord(g, p.y, 1)) * g->dim[0] + cd_grid_coord(g, p.x, 0);
+}
+
+/* Candidate test of primitives (ai, bi, ri) and (aj, bj, rj) [m]: bounding
+ * spheres first, then the exact distance of the axes against
+ * ri + rj + skin [m]. */
+CD_INLINE int cd_bp_is_candidate(cd_vec3 ai, cd_vec3 bi, cd_real ri, cd_vec3 aj, cd_vec3 bj, cd_real rj, cd_real skin)
+{
+    cd_real reach = ri + rj + skin;
+    cd_real rb = cd_bp_bound(ai, bi, ri) + cd_bp_bound(aj, bj, rj) + skin;
+    if (cd_v3_norm2(cd_v3_sub(cd_bp_centre(ai, bi), cd_bp_centre(aj, bj))) > rb * rb) return 0;
+    cd_real u, w;
+    cd_segseg_closest(ai, bi, aj, bj, &u, &w);
+    cd_vec3 d = cd_v3_sub(cd_v3_lerp(aj, bj, w), cd_v3_lerp(ai, bi, u));
+    return cd_v3_norm2(d) <= reach * reach;
+}
+
+/* Visits the candidates j > i of primitive i (other particles only) in the
+ * 27 cells around its centre; writes them to out (unless out is 0) in
+ * ascending order and returns how many there are.  cell_start/cell_prims:
+ * primitives binned by cell (CSR, any order inside a cell: the insertion
+ * below sorts the row). */
+CD_INLINE cd_int cd_bp_scan_prim(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBAL cd_vec3 *prim_b,
+                                 const CD_GLOBAL cd_real *prim_radius, const CD_GLOBAL cd_particle_id *prim_particle,
+                                 const cd_grid *g, const CD_GLOBAL cd_int *cell_start,
+                                 const CD_GLOBAL cd_int *cell_prims, cd_prim_id i, cd_real skin,
+                                 CD_GLOBAL cd_prim_id *out)
+{
+    cd_vec3 ai = prim_a[i], bi = prim_b[i];
+    cd_real ri = prim_radius[i];
+    cd_particle_id pi = prim_particle[i];
+    cd_vec3 c = cd_bp_centre(ai, bi);
+    cd_long cx = cd_grid_coord(g, c.x, 0), cy = cd_grid_coord(g, c.y, 1), cz = cd_grid_coord(g, c.z, 2);
+    cd_int n = 0;
+    for (cd_long z = cz - 1; z <= cz + 1; z++) {
+        if (z < 0 || z >= g->dim[2]) continue;
+        for (cd_long y = cy - 1; y <= cy + 1; y++) {
+            if (y < 0 || y >= g->dim[1]) continue;
+            for (cd_long x = cx - 1; x <= cx + 1; x++) {
+                if (x < 0 || x >= g->dim[0]) continue;
+                cd_long cell = (z * g->dim[1] + y) * g->dim[0] + x;
+                for (cd_int k = cell_start[cell]; k < cell_start[cell + 1]; k++) {
+                    cd_prim_id j = cell_prims[k];
+                    if (j <= i || prim_particle[j] == pi) continue;
+                    if (!cd_bp_is_candidate(ai, bi, ri, prim_a[j], prim_b[j], prim_radius[j], skin)) continue;
+                    if (out) {
+                        /* insertion keeps the row sorted by j */
+                        cd_int m = n;
+                        while (m > 0 && out[m - 1] > j) {
+                            out[m] = out[m - 1];
+                            m--;
+                        }
+                        out[m] = j;
+                    }
+                    n++;
+                }
+            }
+        }
+    }
+    return n;
+}
+
+/* Key of a primitive pair, ordered by i then j. */
+CD_INLINE cd_ulong cd_bp_pair_key(cd_prim_id i, cd_prim_id j) { return ((cd_ulong)(cd_uint)i << 32) | (cd_uint)j; }
+
+/* Index of key in the ascending keys[0 .. n), or -1. */
+CD_INLINE cd_long cd_bp_find_key(const CD_GLOBAL cd_ulong *keys, cd_long n, cd_ulong key)
+{
+    cd_long lo = 0, hi = n;
+    while (lo < hi) {
+        cd_long mid = lo + (hi - lo) / 2;
+        if (keys[mid] < key) lo = mid + 1; else hi = mid;
+    }
+    return (lo < n && keys[lo] == key) ? lo : -1;
+}
+
+/* Skin criterion: has either axis end moved more than half the skin since
+ * the last build?  Every point of a segment moves at most as far as its
+ * farthest end, so no pair can come into contact unseen before that.
+ * limit2 = (skin/2)^2 [m^2] from cd_bp_skin_limit2. */
+CD_INLINE cd_real cd_bp_skin_limit2(cd_real skin) { return CD_R(0.25) * skin * skin; }
+CD_INLINE int cd_bp_moved(cd_vec3 a, cd_vec3 a_ref, cd_vec3 b, cd_vec3 b_ref, cd_real limit2)
+{
+    return cd_v3_norm2(cd_v3_sub(a, a_ref)) > limit2 || cd_v3_norm2(cd_v3_sub(b, b_ref)) > limit2;
+}
+
+CD_DEVICE_END
+#endif

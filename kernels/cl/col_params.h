@@ -1,0 +1,8 @@
+/* Kernel parameters: one __global pointer per column of src/fields.def, in
+ * table order, each followed by a comma.  Included at the start of the
+ * parameter list of every kernel that reads or writes the state, so that
+ * the host binds columns by their index in cd_fields[] (no include guard:
+ * it expands at each use). */
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) __global ctype *name,
+#include "../../src/fields.def"
+#undef CD_FIELD

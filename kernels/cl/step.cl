@@ -1,0 +1,94 @@
+/* The time step as OpenCL kernels (docs/opencl.md): one work-item per
+ * particle, primitive or pair, each a thin wrapper around the per-item
+ * functions of kernels/step_items.h that the OpenMP loops of src/step_omp.c
+ * call too.  Kernels that touch the state take the columns of
+ * src/fields.def first (col_params.h), in table order. */
+#include "../step_items.h"
+#include "../broadphase.h"
+
+/* Step 1-2: first half kick and drift of particle q (the same item, as the
+ * drift reads only its own particle); item w < n_walls also moves wall w. */
+__kernel void cd_cl_kick_drift(
+#include "col_params.h"
+    __global cd_wall *walls, cd_int n_walls, cd_int n_particles, cd_real dt)
+{
+#include "col_bind.h"
+    cd_int q = (cd_int)get_global_id(0);
+    if (q < n_particles) {
+        cd_item_kick(c, q, CD_R(0.5) * dt);
+        cd_item_drift(c, q, dt);
+    }
+    if (q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
+}
+
+/* Step 3-4: world axis ends of primitive i and the skin criterion; any
+ * primitive past half the skin raises flags[0] (every writer writes 1, so
+ * the race is harmless). */
+__kernel void cd_cl_prim_ends(
+#include "col_params.h"
+    cd_int n_prims, cd_real limit2, __global cd_int *flags)
+{
+#include "col_bind.h"
+    cd_int i = (cd_int)get_global_id(0);
+    if (i >= n_prims) return;
+    cd_item_prim_ends(c, i);
+    if (cd_bp_moved(c.prim_a[i], c.prim_a_ref[i], c.prim_b[i], c.prim_b_ref[i], limit2)) flags[0] = 1;
+}
+
+/* Step 5: narrow phase and contact law of pair row k. */
+__kernel void cd_cl_pair_forces(
+#include "col_params.h"
+    cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel)
+{
+#include "col_bind.h"
+    cd_int k = (cd_int)get_global_id(0);
+    if (k < n_pairs) cd_item_pair_force(c, k, law, dt, sin_parallel);
+}
+
+/* Step 6: primitive i against every wall. */
+__kernel void cd_cl_wall_forces(
+#include "col_params.h"
+    cd_int n_prims, __global const cd_wall *walls, cd_int n_walls, cd_law_params wall_law, cd_real dt,
+    cd_real sin_parallel)
+{
+#include "col_bind.h"
+    cd_int i = (cd_int)get_global_id(0);
+    if (i < n_prims) cd_item_wall_forces(c, i, walls, n_walls, wall_law, dt, sin_parallel);
+}
+
+/* Steps 7-8: gather of particle q in fixed order, then (kick = 1) the
+ * second half kick.  kick = 0 computes the forces of a new run only. */
+__kernel void cd_cl_gather_kick(
+#include "col_params.h"
+    cd_int n_particles, __global const cd_int *gather_start, __global const cd_pair_id *gather_rows,
+    cd_int n_walls, cd_vec3 gravity, cd_int dimension, cd_int kick, cd_real dt)
+{
+#include "col_bind.h"
+    cd_int q = (cd_int)get_global_id(0);
+    if (q >= n_particles) return;
+    cd_item_gather(c, q, gather_start, gather_rows, n_walls, gravity, dimension);
+    if (kick) cd_item_kick(c, q, CD_R(0.5) * dt);
+}
+
+/* Blow-up check: the highest particle index with a non-finite state goes
+ * to flags[1] (integer atomic: the result is the same for any order). */
+__kernel void cd_cl_check_finite(
+#include "col_params.h"
+    cd_int n_particles, __global cd_int *flags)
+{
+#include "col_bind.h"
+    cd_int q = (cd_int)get_global_id(0);
+    if (q < n_particles && cd_item_not_finite(c, q)) atomic_max(&flags[1], q);
+}
+
+/* Sum of the normal forces of wall w's contacts [N], by one work-item in
+ * primitive order: the same order as the host's sum, hence the same bits. */
+__kernel void cd_cl_wall_load(
+#include "col_params.h"
+    cd_int n_prims, cd_int n_walls, cd_int w, __global cd_real *out)
+{
+#include "col_bind.h"
+    cd_real sum = 0;
+    for (cd_int i = 0; i < n_prims; i++) sum += c.wallc_fn[(cd_long)i * n_walls + w];
+    out[0] = sum;
+}
