@@ -1,5 +1,5 @@
 /* A run file (YAML), read and validated into plain values.  Every key is
- * listed in docs/config.md; the table in config.c is the single source of
+ * listed in docs/config.md; the table in config_schema.c is the single source of
  * the key names, types, units and ranges. */
 #ifndef CD_CONFIG_H
 #define CD_CONFIG_H

@@ -1,4 +1,5 @@
-/* Private to config.c and config_schema.c: the table of run-file keys.
+/* Private to the run-file reader (config.c, config_value.c,
+ * config_report.c) and config_schema.c: the table of run-file keys.
  * Each row names one key and says how to read, check, default, store and
  * document it; the reader, cd_config_defaults and cd_config_print_keys all
  * walk this one table. */
