@@ -92,16 +92,21 @@ CD_INLINE int cd_bp_is_candidate(cd_vec3 ai, cd_vec3 bi, cd_real ri, cd_vec3 aj,
     return cd_v3_norm2(d) <= reach * reach;
 }
 
+/* Writes of cd_bp_scan_prim without a bound. */
+#define CD_BP_UNBOUNDED 0x7fffffff
+
 /* Visits the candidates j > i of primitive i (other particles only) in the
  * 27 cells around its centre; writes them to out (unless out is 0) in
- * ascending order and returns how many there are.  cell_start/cell_prims:
- * primitives binned by cell (CSR, any order inside a cell: the insertion
- * below sorts the row). */
+ * ascending order and returns how many there are.  At most cap are written:
+ * a return value above cap means out is incomplete (a device fills fixed
+ * slots in one pass and re-scans the rare primitive that overflows its
+ * slot).  cell_start/cell_prims: primitives binned by cell (CSR, any order
+ * inside a cell: the insertion below sorts the row). */
 CD_INLINE cd_int cd_bp_scan_prim(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBAL cd_vec3 *prim_b,
                                  const CD_GLOBAL cd_real *prim_radius, const CD_GLOBAL cd_particle_id *prim_particle,
                                  const cd_grid *g, const CD_GLOBAL cd_int *cell_start,
                                  const CD_GLOBAL cd_int *cell_prims, cd_prim_id i, cd_real skin,
-                                 CD_GLOBAL cd_prim_id *out)
+                                 CD_GLOBAL cd_prim_id *out, cd_int cap)
 {
     cd_vec3 ai = prim_a[i], bi = prim_b[i];
     cd_real ri = prim_radius[i];
@@ -120,7 +125,7 @@ CD_INLINE cd_int cd_bp_scan_prim(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBA
                     cd_prim_id j = cell_prims[k];
                     if (j <= i || prim_particle[j] == pi) continue;
                     if (!cd_bp_is_candidate(ai, bi, ri, prim_a[j], prim_b[j], prim_radius[j], skin)) continue;
-                    if (out) {
+                    if (out && n < cap) {
                         /* insertion keeps the row sorted by j */
                         cd_int m = n;
                         while (m > 0 && out[m - 1] > j) {

@@ -15,7 +15,8 @@
 enum cd_cl_kernel {
     CD_CLK_KICK_DRIFT, CD_CLK_PRIM_ENDS, CD_CLK_PAIR_FORCES, CD_CLK_WALL_FORCES, CD_CLK_GATHER_KICK,
     CD_CLK_CHECK_FINITE, CD_CLK_WALL_LOAD,
-    CD_CLK_BOUNDS, CD_CLK_GRID, CD_CLK_BIN, CD_CLK_CELL_FILL, CD_CLK_PAIR_COUNT, CD_CLK_PAIR_FILL, CD_CLK_PAIR_KEYS,
+    CD_CLK_BOUNDS, CD_CLK_GRID, CD_CLK_BIN, CD_CLK_CELL_FILL, CD_CLK_PAIR_COLLECT, CD_CLK_PAIR_PLACE, CD_CLK_PAIR_FILL,
+    CD_CLK_PAIR_KEYS,
     CD_CLK_PAIR_CARRY, CD_CLK_GATHER_COUNT, CD_CLK_GATHER_FILL, CD_CLK_GATHER_SORT,
     CD_CLK_SCAN_BLOCKS, CD_CLK_SCAN_TOP, CD_CLK_SCAN_FILL,
     CD_CLK_COUNT
@@ -62,7 +63,7 @@ typedef struct cd_cl {
     int cur;
     size_t n_pairs;             /* rows of the current list */
     cl_mem walls;               /* cd_wall[n_walls] */
-    cl_mem flags;               /* cd_int[2]: skin exceeded, highest non-finite particle */
+    cl_mem flags;               /* cd_int[3]: skin exceeded, highest non-finite particle, slot overflow */
     cl_mem scratch_real;        /* wall load result */
 
     /* neighbour-list workspace */
@@ -70,6 +71,8 @@ typedef struct cd_cl {
     cl_mem prim_cell, cell_count, cell_start, cell_cursor, cell_prims;
     size_t cell_cap;            /* cells the grid may have: 8 n_prims + 64 */
     cl_mem pair_count, pair_offset, block_sum;
+    cl_mem cand;                /* candidates per primitive, slot entries each */
+    cd_int slot;
     cl_mem gather_count, gather_start, gather_cursor, gather_rows;
     size_t gather_cap;
     int cols_dirty;             /* a column buffer changed: rebind the column arguments */
@@ -116,7 +119,8 @@ cl_mem cd_cl_col(const cd_cl *cl, int f);
  * was created or the history sets were swapped). */
 int cd_cl_bind_cols(cd_cl *cl);
 cl_mem cd_cl_buffer(cd_cl *cl, size_t bytes, const char *what);
-int cd_cl_fill_int(cd_cl *cl, cl_mem buf, cd_int value, size_t count);
+/* Sets count ints of buf from index first to value. */
+int cd_cl_fill_int(cd_cl *cl, cl_mem buf, cd_int value, size_t first, size_t count);
 /* Exclusive scan of n ints of in into out (n + 1 entries). */
 int cd_cl_scan(cd_cl *cl, cl_mem in, size_t n, cl_mem out);
 

@@ -84,17 +84,18 @@ int cd_cl_bind_cols(cd_cl *cl)
     return 0;
 }
 
-int cd_cl_fill_int(cd_cl *cl, cl_mem buf, cd_int value, size_t count)
+int cd_cl_fill_int(cd_cl *cl, cl_mem buf, cd_int value, size_t first, size_t count)
 {
     if (cl->status) return -1;
     if (count == 0) return 0;
-    cl_int rc = clEnqueueFillBuffer(cl->queue, buf, &value, sizeof value, 0, count * sizeof value, 0, NULL, NULL);
+    cl_int rc = clEnqueueFillBuffer(cl->queue, buf, &value, sizeof value, first * sizeof value, count * sizeof value, 0,
+                                    NULL, NULL);
     return cd_cl_check(cl, rc, "clearing a buffer") ? -1 : 0;
 }
 
 int cd_cl_scan(cd_cl *cl, cl_mem in, size_t n, cl_mem out)
 {
-    if (n == 0) return cd_cl_fill_int(cl, out, 0, 1);
+    if (n == 0) return cd_cl_fill_int(cl, out, 0, 0, 1);
     /* chunks of at least 64 entries, at most CD_CL_MAX_BLOCKS of them */
     size_t blocks = (n + 63) / 64;
     if (blocks > CD_CL_MAX_BLOCKS) blocks = CD_CL_MAX_BLOCKS;
@@ -130,7 +131,7 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
         cl->col[f] = cd_cl_buffer(cl, rows_of(cl, s, &cd_fields[f]) * cd_fields[f].elem_size, "allocating the state");
     }
     cl->walls = cd_cl_buffer(cl, (W > 0 ? W : 1) * sizeof(cd_wall), "allocating the walls");
-    cl->flags = cd_cl_buffer(cl, 2 * sizeof(cd_int), "allocating the flags");
+    cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
     cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
     cl->partial = cd_cl_buffer(cl, 7 * CD_CL_MAX_BLOCKS * sizeof(cd_real), "allocating the neighbour list");
     cl->grid = cd_cl_buffer(cl, sizeof(cd_grid), "allocating the neighbour list");
@@ -144,6 +145,13 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->cell_start = cd_cl_buffer(cl, (cl->cell_cap + 1) * sizeof(cd_int), "allocating the cell lists");
     cl->pair_count = cd_cl_buffer(cl, P * sizeof(cd_int), "allocating the neighbour list");
     cl->pair_offset = cd_cl_buffer(cl, (P + 1) * sizeof(cd_int), "allocating the neighbour list");
+    /* 32 candidates per primitive cover a dense packing of hexapods with a
+     * skin of 0.1 d; the slots double whenever one overflows.
+     * CAPDEM_OPENCL_SLOTS sets the first size (test hook for the overflow
+     * path). */
+    const char *slots = getenv("CAPDEM_OPENCL_SLOTS");
+    cl->slot = slots && atoi(slots) > 0 ? atoi(slots) : 32;
+    cl->cand = cd_cl_buffer(cl, P * (size_t)cl->slot * sizeof(cd_prim_id), "allocating the neighbour list");
     cl->block_sum = cd_cl_buffer(cl, CD_CL_MAX_BLOCKS * sizeof(cd_int), "allocating the scan");
     cl->gather_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_cursor = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
@@ -165,10 +173,11 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
     cd_state *s = &sim->s;
     for (int f = 0; f < CD_CL_N_FIELDS; f++) {
         size_t rows = cd_state_rows(s, cd_fields[f].group); /* pairs: n_pairs rows */
-        write(cl, cd_cl_col(cl, f), rows * cd_fields[f].elem_size, *cd_field_ptr(s, &cd_fields[f]), "uploading the state");
+        void *host = *cd_field_ptr(s, &cd_fields[f]);
+        write(cl, cd_cl_col(cl, f), rows * cd_fields[f].elem_size, host, "uploading the state");
     }
     write(cl, cl->walls, s->n_walls * sizeof(cd_wall), s->walls, "uploading the walls");
-    cd_int flags[2] = {0, -1};
+    cd_int flags[3] = {0, -1, 0};
     write(cl, cl->flags, sizeof flags, flags, "uploading the flags");
     cl->n_pairs = s->n_pairs;
     /* Keys of the rows handed over (sorted, as every list capdem writes),
@@ -193,8 +202,8 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
     for (int f = 0; f < CD_CL_N_FIELDS && !cl->status; f++) {
         size_t bytes = cd_state_rows(s, cd_fields[f].group) * cd_fields[f].elem_size;
         if (bytes == 0) continue;
-        cl_int rc = clEnqueueReadBuffer(cl->queue, cd_cl_col(cl, f), CL_FALSE, 0, bytes, *cd_field_ptr(s, &cd_fields[f]),
-                                        0, NULL, NULL);
+        void *host = *cd_field_ptr(s, &cd_fields[f]);
+        cl_int rc = clEnqueueReadBuffer(cl->queue, cd_cl_col(cl, f), CL_FALSE, 0, bytes, host, 0, NULL, NULL);
         cd_cl_check(cl, rc, "downloading the state");
     }
     /* Not the walls: the host's copy is current after every call of step
@@ -214,8 +223,8 @@ void cd_cl_buffers_release(cd_cl *cl)
     }
     cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->partial, &cl->grid, &cl->prim_cell,
                        &cl->cell_count, &cl->cell_start, &cl->cell_cursor, &cl->cell_prims, &cl->pair_count,
-                       &cl->pair_offset, &cl->block_sum, &cl->gather_count, &cl->gather_start, &cl->gather_cursor,
-                       &cl->gather_rows};
+                       &cl->pair_offset, &cl->block_sum, &cl->cand, &cl->gather_count, &cl->gather_start,
+                       &cl->gather_cursor, &cl->gather_rows};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
     cl->cap_pairs = cl->gather_cap = 0;
 }

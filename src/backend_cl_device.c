@@ -19,8 +19,9 @@ static const struct {
 } kernel_table[CD_CLK_COUNT] = {
     {"cd_cl_kick_drift", 1},   {"cd_cl_prim_ends", 1},    {"cd_cl_pair_forces", 1}, {"cd_cl_wall_forces", 1},
     {"cd_cl_gather_kick", 1},  {"cd_cl_check_finite", 1}, {"cd_cl_wall_load", 1},   {"cd_cl_bounds", 1},
-    {"cd_cl_grid", 0},         {"cd_cl_bin", 1},          {"cd_cl_cell_fill", 0},   {"cd_cl_pair_count", 1},
-    {"cd_cl_pair_fill", 1},    {"cd_cl_pair_keys", 1},    {"cd_cl_pair_carry", 1},  {"cd_cl_gather_count", 1},
+    {"cd_cl_grid", 0},         {"cd_cl_bin", 1},          {"cd_cl_cell_fill", 0},   {"cd_cl_pair_collect", 1},
+    {"cd_cl_pair_place", 1},   {"cd_cl_pair_fill", 1},    {"cd_cl_pair_keys", 1},   {"cd_cl_pair_carry", 1},
+    {"cd_cl_gather_count", 1},
     {"cd_cl_gather_fill", 1},  {"cd_cl_gather_sort", 0},  {"cd_cl_scan_blocks", 0}, {"cd_cl_scan_top", 0},
     {"cd_cl_scan_fill", 0},
 };
@@ -175,8 +176,9 @@ static int expand(strbuf *out, const char *name, int depth, char *err, size_t er
     const char *text = source_text(name, &owned);
     if (!text) {
         const char *dir = getenv("CAPDEM_KERNEL_DIR");
-        snprintf(err, errlen, "OpenCL: kernel source '%s' not found%s%s%s", name, dir ? " under CAPDEM_KERNEL_DIR=" : "",
-                 dir ? dir : " in the embedded sources", dir ? " (it should be a source tree's kernels/ folder)" : "");
+        snprintf(err, errlen, "OpenCL: kernel source '%s' not found%s%s%s", name,
+                 dir ? " under CAPDEM_KERNEL_DIR=" : "", dir ? dir : " in the embedded sources",
+                 dir ? " (it should be a source tree's kernels/ folder)" : "");
         return -1;
     }
     if (depth > 16) {
@@ -381,7 +383,8 @@ int cd_cl_open(cd_cl *cl, const char *device_request, char *err, size_t errlen)
     cl_int rc;
     cl->ctx = clCreateContext(NULL, 1, &cl->device, NULL, NULL, &rc);
     if (rc != CL_SUCCESS) {
-        snprintf(err, errlen, "OpenCL: cannot create a context on %s: %s (%d)", cl->desc, cd_cl_error_name(rc), (int)rc);
+        snprintf(err, errlen, "OpenCL: cannot create a context on %s: %s (%d)", cl->desc, cd_cl_error_name(rc),
+                 (int)rc);
         return -1;
     }
     cl->queue = clCreateCommandQueue(cl->ctx, cl->device, 0, &rc); /* in order: no events needed */

@@ -38,7 +38,7 @@ static void bin_prims(cd_cl *cl, cd_int P, cd_real skin)
 
     /* The scan runs over every cell the grid may have: the empty tail
      * costs little and spares reading the grid back. */
-    cd_cl_fill_int(cl, cl->cell_count, 0, cl->cell_cap);
+    cd_cl_fill_int(cl, cl->cell_count, 0, 0, cl->cell_cap);
     cd_cl_arg(cl, CD_CLK_BIN, F, sizeof P, &P);
     cd_cl_arg(cl, CD_CLK_BIN, F + 1, sizeof cl->grid, &cl->grid);
     cd_cl_arg(cl, CD_CLK_BIN, F + 2, sizeof cl->prim_cell, &cl->prim_cell);
@@ -54,7 +54,18 @@ static void bin_prims(cd_cl *cl, cd_int P, cd_real skin)
     cd_cl_run(cl, CD_CLK_CELL_FILL, (size_t)P);
 }
 
-/* Arguments shared by the count and the fill of the candidates. */
+/* Twice the candidate slots, after one overflowed (a primitive in contact
+ * with unusually many others, e.g. a long rod among spheres); the buffer
+ * is released only after the kernels that use it (in-order queue). */
+static void grow_slots(cd_cl *cl, size_t P)
+{
+    if (cl->status) return;
+    clReleaseMemObject(cl->cand);
+    cl->slot *= 2;
+    cl->cand = cd_cl_buffer(cl, P * (size_t)cl->slot * sizeof(cd_prim_id), "enlarging the candidate slots");
+}
+
+/* Arguments shared by the scans of the candidates. */
 static void scan_args(cd_cl *cl, enum cd_cl_kernel k, cd_int P, cd_real skin)
 {
     cd_cl_arg(cl, k, F, sizeof P, &P);
@@ -68,7 +79,7 @@ static void scan_args(cd_cl *cl, enum cd_cl_kernel k, cd_int P, cd_real skin)
  * gather_rows), for the gather's fixed summation order. */
 static void gather_lists(cd_cl *cl, cd_int N, cd_int n_pairs)
 {
-    cd_cl_fill_int(cl, cl->gather_count, 0, (size_t)N);
+    cd_cl_fill_int(cl, cl->gather_count, 0, 0, (size_t)N);
     cd_cl_arg(cl, CD_CLK_GATHER_COUNT, F, sizeof n_pairs, &n_pairs);
     cd_cl_arg(cl, CD_CLK_GATHER_COUNT, F + 1, sizeof cl->gather_count, &cl->gather_count);
     cd_cl_run(cl, CD_CLK_GATHER_COUNT, (size_t)n_pairs);
@@ -89,17 +100,27 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
     const cd_state *s = &sim->s;
     cd_int P = (cd_int)s->n_prims, N = (cd_int)s->n_particles;
     cd_real skin = sim->nb.skin; /* [m] */
-    cd_int n_new = 0;
+    cd_int n_new = 0, overflow = 0;
     if (P > 0) {
         bin_prims(cl, P, skin);
-        scan_args(cl, CD_CLK_PAIR_COUNT, P, skin);
-        cd_cl_arg(cl, CD_CLK_PAIR_COUNT, F + 5, sizeof cl->pair_count, &cl->pair_count);
-        cd_cl_run(cl, CD_CLK_PAIR_COUNT, (size_t)P);
+        /* the skin flag (these ends become the references) and the overflow */
+        cd_cl_fill_int(cl, cl->flags, 0, 0, 1);
+        cd_cl_fill_int(cl, cl->flags, 0, 2, 1);
+        scan_args(cl, CD_CLK_PAIR_COLLECT, P, skin);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 5, sizeof cl->pair_count, &cl->pair_count);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 6, sizeof cl->cand, &cl->cand);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 7, sizeof cl->slot, &cl->slot);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 8, sizeof cl->flags, &cl->flags);
+        cd_cl_run(cl, CD_CLK_PAIR_COLLECT, (size_t)P);
         cd_cl_scan(cl, cl->pair_count, (size_t)P, cl->pair_offset);
-        /* the one read of a rebuild: how many pairs, to size the buffers */
+        /* the one wait of a rebuild: how many pairs (to size the buffers),
+         * and whether a slot overflowed */
         if (!cl->status)
-            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->pair_offset, CL_TRUE, (size_t)P * sizeof(cd_int),
+            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->pair_offset, CL_FALSE, (size_t)P * sizeof(cd_int),
                                                 sizeof n_new, &n_new, 0, NULL, NULL), "reading the number of pairs");
+        if (!cl->status)
+            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->flags, CL_TRUE, 2 * sizeof(cd_int), sizeof overflow,
+                                                &overflow, 0, NULL, NULL), "reading the number of pairs");
     }
     if (cl->status) return -1;
 
@@ -110,11 +131,21 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
     if (cd_cl_reserve_pairs(cl, (size_t)n_new, nxt)) return -1;
     cl->cur = nxt;
     if (cd_cl_bind_cols(cl)) return -1;
-    if (n_new > 0) {
+    if (n_new > 0 && !overflow) {
+        cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F, sizeof P, &P);
+        cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 1, sizeof cl->pair_offset, &cl->pair_offset);
+        cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 2, sizeof cl->cand, &cl->cand);
+        cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 3, sizeof cl->slot, &cl->slot);
+        cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 4, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
+        cd_cl_run(cl, CD_CLK_PAIR_PLACE, (size_t)P);
+    } else if (n_new > 0) {
         scan_args(cl, CD_CLK_PAIR_FILL, P, skin);
         cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 5, sizeof cl->pair_offset, &cl->pair_offset);
         cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 6, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
         cd_cl_run(cl, CD_CLK_PAIR_FILL, (size_t)P);
+        grow_slots(cl, (size_t)P);
+    }
+    if (n_new > 0) {
         cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F, sizeof n_new, &n_new);
         cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F + 1, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
         cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F + 2, sizeof cl->hist[old].keys, &cl->hist[old].keys);
@@ -125,10 +156,9 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
     }
     gather_lists(cl, N, n_new);
 
-    /* Reference ends for the skin criterion; clear its flag. */
+    /* Reference ends for the skin criterion (its flag was cleared above). */
     copy(cl, cl->col[CD_CL_F_prim_a], cl->col[CD_CL_F_prim_a_ref], (size_t)P * sizeof(cd_vec3));
     copy(cl, cl->col[CD_CL_F_prim_b], cl->col[CD_CL_F_prim_b_ref], (size_t)P * sizeof(cd_vec3));
-    cd_cl_fill_int(cl, cl->flags, 0, 1);
     if (cl->status) return -1;
     cl->n_pairs = (size_t)n_new;
     sim->nb.force_rebuild = 0;

@@ -119,6 +119,8 @@ static void print_version(void)
     printf("omp backend: offload variant '%s'", CAPDEM_OFFLOAD_VARIANT);
 #ifdef _OPENMP
     printf(", OpenMP %d, %d host thread(s), %d offload device(s)\n", _OPENMP, omp_get_max_threads(), omp_get_num_devices());
+    if (strcmp(CAPDEM_OFFLOAD_VARIANT, "none") && omp_get_num_devices() == 0)
+        printf("built for %s offload but no GPU found: running on the host (docs/offload.md)\n", CAPDEM_OFFLOAD_VARIANT);
 #else
     printf(", built without OpenMP\n");
 #endif

@@ -55,7 +55,7 @@ static cd_int scan_prim(const cd_state *s, const cd_grid *g, const cd_int *cell_
                         size_t i, double skin, cd_prim_id *out)
 {
     return cd_bp_scan_prim(s->prim_a, s->prim_b, s->prim_radius, s->prim_particle, g, cell_start, cell_prims,
-                           (cd_prim_id)i, skin, out);
+                           (cd_prim_id)i, skin, out, CD_BP_UNBOUNDED);
 }
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)

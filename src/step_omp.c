@@ -1,17 +1,60 @@
-/* The time step on the host through OpenMP: every loop is one item per
- * primitive, pair or particle calling the shared kernel headers, and forces
- * reach particles by a gather in fixed order (no floating-point atomics), so
- * results are bitwise identical for any thread count. */
+/* The time step through OpenMP: every loop is one item per primitive, pair
+ * or particle calling the shared kernel headers (kernels/step_items.h, the
+ * same functions the OpenCL kernels call), and forces reach particles by a
+ * gather in fixed order (no floating-point atomics), so results are bitwise
+ * identical for any thread count.
+ *
+ * Two variants of the same loops (docs/offload.md):
+ * - host (CAPDEM_OFFLOAD=none): `omp parallel for schedule(static)` over the
+ *   host columns of sim->s;
+ * - offload (CAPDEM_OFFLOAD=nvptx, CAPDEM_OFFLOAD_TARGET=1): `omp target
+ *   teams distribute parallel for` over device copies of the columns, mapped
+ *   once at start (target enter data over the cd_fields table), kept on the
+ *   device across steps and copied back only by sync.  The neighbour-list
+ *   rebuild stays on the host: the primitive ends and the pair history come
+ *   back, the list is built, the pair and gather arrays go out again. */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "sim.h"
 #include "../kernels/step_items.h"
+#include "../kernels/broadphase.h"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 long cd_parallel_min_rows = 4096;
 
-/* The state's columns for the per-item functions of kernels/step_items.h,
- * which the OpenCL kernels call too. */
+#define CD_PRAGMA(...) _Pragma(#__VA_ARGS__)
+#if defined(CAPDEM_OFFLOAD_TARGET) && CAPDEM_OFFLOAD_TARGET && defined(_OPENMP)
+#define CD_OFFLOAD 1
+/* One loop of the step on the offload device, or on the host when the
+ * runtime finds none: then, as in the host variant, a loop of fewer than
+ * cd_parallel_min_rows rows runs on one thread (waking threads for every
+ * small loop made the small test cases 100 times slower).  A function with
+ * such a loop declares CD_WIDE_MIN first. */
+static size_t cd_wide_min(void)
+{
+    static int devices = -1;
+    if (devices < 0) devices = omp_get_num_devices();
+    return devices > 0 ? 0 : (size_t)cd_parallel_min_rows;
+}
+#define CD_WIDE_MIN const size_t wide_min_ = cd_wide_min();
+#define CD_STEP_FOR(rows, ...) \
+    CD_PRAGMA(omp target teams distribute parallel for if (parallel : (rows) >= wide_min_) __VA_ARGS__)
+/* Clauses only the offload variant needs. */
+#define CD_DEV(...) __VA_ARGS__
+#else
+#define CD_OFFLOAD 0
+#define CD_WIDE_MIN
+#define CD_STEP_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
+#define CD_DEV(...)
+#endif
+/* Host-only loops (set-up work on the host columns). */
+#define CD_HOST_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
+
+/* The state's columns for the per-item functions of kernels/step_items.h. */
 static cd_cols cols_of(cd_state *s)
 {
     cd_cols c;
@@ -21,71 +64,332 @@ static cd_cols cols_of(cd_state *s)
     return c;
 }
 
-/* World endpoints of every primitive from its particle's pose. */
-static void update_prims(cd_state *s)
+/* ---- device residency (offload variant) -------------------------------- */
+#if CD_OFFLOAD
+typedef struct {
+    void **host;       /* per field of cd_fields: host address mapped (NULL: none) */
+    size_t *bytes;     /* per field: bytes mapped */
+    void *gs_host, *gr_host; /* gather_start / gather_rows as mapped */
+    size_t gs_bytes, gr_bytes;
+    double *part;      /* per-chunk partial sums of the wall load (mapped) */
+    size_t part_n;
+    cd_cols dev;       /* device addresses of the columns */
+} cd_off;
+
+#define CD_LOAD_CHUNK 4096
+
+static void off_map(void *p, size_t bytes)
 {
-    cd_cols c = cols_of(s);
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(s->n_prims))
-    for (size_t i = 0; i < s->n_prims; i++) cd_item_prim_ends(c, (cd_prim_id)i);
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target enter data map(to : c[0:bytes])
+    }
+}
+
+static void off_unmap(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target exit data map(delete : c[0:bytes])
+    }
+}
+
+static void off_from(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target update from(c[0:bytes])
+    }
+}
+
+static void off_to(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target update to(c[0:bytes])
+    }
+}
+
+static void *off_devptr(void *p)
+{
+    void *r = p;
+#pragma omp target data use_device_ptr(r)
+    {
+        p = r;
+    }
+    return p;
+}
+
+/* Rows of a group held in memory: the pair columns at their capacity. */
+static size_t alloc_rows(const cd_state *s, enum cd_field_group g)
+{
+    return g == CD_GROUP_PAIR ? s->cap_pairs : cd_state_rows(s, g);
+}
+
+static void off_refresh_cols(cd_sim *sim, cd_off *o)
+{
+    cd_state d = sim->s;
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        void **slot = cd_field_ptr(&d, &cd_fields[f]);
+        if (o->host[f]) *slot = off_devptr(o->host[f]);
+    }
+    o->dev = cols_of(&d);
+}
+
+/* Maps field f at its current host address and size. */
+static void off_map_field(cd_sim *sim, cd_off *o, size_t f)
+{
+    void *p = *cd_field_ptr(&sim->s, &cd_fields[f]);
+    size_t bytes = alloc_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size;
+    o->host[f] = p && bytes ? p : NULL;
+    o->bytes[f] = o->host[f] ? bytes : 0;
+    off_map(o->host[f], o->bytes[f]);
+}
+
+/* Maps (or re-maps, when the host reallocated them) the gather lists. */
+static void off_map_gather(cd_sim *sim, cd_off *o)
+{
+    cd_neighbors *nb = &sim->nb;
+    size_t gs = nb->gather_start ? (sim->s.n_particles + 1) * sizeof(cd_int) : 0;
+    size_t gr = nb->gather_rows ? nb->gather_cap * sizeof(cd_pair_id) : 0;
+    if (o->gs_host != (void *)nb->gather_start || o->gs_bytes != gs) {
+        off_unmap(o->gs_host, o->gs_bytes);
+        o->gs_host = nb->gather_start;
+        o->gs_bytes = gs;
+        off_map(o->gs_host, o->gs_bytes);
+    } else {
+        off_to(o->gs_host, o->gs_bytes);
+    }
+    if (o->gr_host != (void *)nb->gather_rows || o->gr_bytes != gr) {
+        off_unmap(o->gr_host, o->gr_bytes);
+        o->gr_host = nb->gather_rows;
+        o->gr_bytes = gr;
+        off_map(o->gr_host, o->gr_bytes);
+    } else {
+        off_to(o->gr_host, 2 * sim->s.n_pairs * sizeof(cd_pair_id));
+    }
+}
+
+static void off_release(cd_sim *sim)
+{
+    cd_off *o = sim->backend_data;
+    if (!o) return;
+    for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
+    off_unmap(o->gs_host, o->gs_bytes);
+    off_unmap(o->gr_host, o->gr_bytes);
+    off_unmap(o->part, o->part_n * sizeof(double));
+    free(o->part);
+    free(o->host);
+    free(o->bytes);
+    free(o);
+    sim->backend_data = NULL;
+}
+
+/* Copies every column of the host state to the device, once per run. */
+static int off_acquire(cd_sim *sim)
+{
+    static int warned = 0;
+    if (omp_get_num_devices() == 0 && !warned) {
+        fprintf(stderr, "capdem: built for %s offload but no GPU found: running on the host\n", CAPDEM_OFFLOAD_VARIANT);
+        warned = 1;
+    }
+    cd_off *o = calloc(1, sizeof *o);
+    if (!o) return -1;
+    sim->backend_data = o;
+    o->host = calloc(cd_n_fields, sizeof *o->host);
+    o->bytes = calloc(cd_n_fields, sizeof *o->bytes);
+    o->part_n = sim->s.n_prims / CD_LOAD_CHUNK + 1;
+    o->part = calloc(o->part_n, sizeof(double));
+    if (!o->host || !o->bytes || !o->part) { off_release(sim); return -1; }
+    for (size_t f = 0; f < cd_n_fields; f++) off_map_field(sim, o, f);
+    off_map(o->part, o->part_n * sizeof(double));
+    off_map_gather(sim, o);
+    off_refresh_cols(sim, o);
+    return 0;
+}
+
+/* The host round trip of a neighbour-list rebuild: primitive ends and pair
+ * history to the host, build, pair rows and gather lists back. */
+static int off_rebuild(cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    cd_off *o = sim->backend_data;
+    off_from(s->prim_a, s->n_prims * sizeof(cd_vec3));
+    off_from(s->prim_b, s->n_prims * sizeof(cd_vec3));
+    off_from(s->pair_active, s->n_pairs * sizeof(cd_int));
+    off_from(s->pair_shear, s->n_pairs * sizeof(cd_vec3));
+    if (cd_neighbors_build(sim)) return -1;
+    /* Pair columns: re-mapped when the capacity grew (every old mapping
+     * goes before any new one: a new block may reuse an old address),
+     * otherwise the rows the build wrote go out. */
+    int moved = 0;
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group != CD_GROUP_PAIR) continue;
+        void *p = *cd_field_ptr(s, &cd_fields[f]);
+        if (p != o->host[f] || s->cap_pairs * cd_fields[f].elem_size != o->bytes[f]) moved = 1;
+    }
+    if (moved) {
+        for (size_t f = 0; f < cd_n_fields; f++)
+            if (cd_fields[f].group == CD_GROUP_PAIR) {
+                off_unmap(o->host[f], o->bytes[f]);
+                o->host[f] = NULL;
+                o->bytes[f] = 0;
+            }
+        for (size_t f = 0; f < cd_n_fields; f++)
+            if (cd_fields[f].group == CD_GROUP_PAIR) off_map_field(sim, o, f);
+    } else {
+        off_to(s->pair_prim_i, s->n_pairs * sizeof(cd_int));
+        off_to(s->pair_prim_j, s->n_pairs * sizeof(cd_int));
+        off_to(s->pair_active, s->n_pairs * sizeof(cd_int));
+        off_to(s->pair_shear, s->n_pairs * sizeof(cd_vec3));
+    }
+    off_to(s->prim_a_ref, s->n_prims * sizeof(cd_vec3));
+    off_to(s->prim_b_ref, s->n_prims * sizeof(cd_vec3));
+    off_map_gather(sim, o);
+    if (moved) off_refresh_cols(sim, o);
+    return 0;
+}
+#endif
+
+/* Columns the step loops work on: device addresses in the offload variant,
+ * the host columns otherwise. */
+static cd_cols step_cols(cd_sim *sim)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data) return ((cd_off *)sim->backend_data)->dev;
+#endif
+    return cols_of(&sim->s);
+}
+
+/* ---- the loops of a step ------------------------------------------------ */
+
+/* World endpoints of every primitive from its particle's pose. */
+static void update_prims(cd_sim *sim)
+{
+    cd_cols c = step_cols(sim);
+    size_t n = sim->s.n_prims;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c))
+    for (size_t i = 0; i < n; i++) cd_item_prim_ends(c, (cd_prim_id)i);
 }
 
 /* One work item per pair of the Verlet list: narrow phase + contact law. */
-static void pair_forces(cd_state *s, const cd_step_params *p)
+static void pair_forces(cd_sim *sim)
 {
-    cd_cols c = cols_of(s);
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(s->n_pairs))
-    for (size_t k = 0; k < s->n_pairs; k++) cd_item_pair_force(c, (cd_pair_id)k, p->law, p->dt, p->sin_parallel);
+    cd_cols c = step_cols(sim);
+    cd_law_params law = sim->p.law;
+    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
+    size_t n = sim->s.n_pairs;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, law))
+    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel);
 }
 
-/* One work item per primitive: its contacts with every wall. */
-static void wall_forces(cd_state *s, const cd_step_params *p)
+/* One work item per primitive: its contacts with every wall.  The walls
+ * stay host data (the protocol drives them): a few hundred bytes go out. */
+static void wall_forces(cd_sim *sim)
 {
-    cd_cols c = cols_of(s);
-    cd_int W = (cd_int)s->n_walls;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(s->n_prims))
-    for (size_t i = 0; i < s->n_prims; i++)
-        cd_item_wall_forces(c, (cd_prim_id)i, s->walls, W, p->wall_law, p->dt, p->sin_parallel);
+    cd_cols c = step_cols(sim);
+    const cd_wall *walls = sim->s.walls;
+    cd_int W = (cd_int)sim->s.n_walls;
+    cd_law_params law = sim->p.wall_law;
+    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
+    size_t n = sim->s.n_prims;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, law) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    for (size_t i = 0; i < n; i++) cd_item_wall_forces(c, (cd_prim_id)i, walls, W, law, dt, sin_parallel);
 }
 
-/* One work item per particle: gravity plus its contacts in fixed order. */
-static void gather(cd_state *s, const cd_neighbors *nb, const cd_step_params *p)
+/* One work item per particle: gravity plus its contacts in fixed order.
+ * The gather lists are mapped host pointers: translated on entry. */
+static void gather(cd_sim *sim)
 {
-    cd_cols c = cols_of(s);
-    cd_int W = (cd_int)s->n_walls;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(s->n_particles))
-    for (size_t q = 0; q < s->n_particles; q++)
-        cd_item_gather(c, (cd_particle_id)q, nb->gather_start, nb->gather_rows, W, p->gravity, p->dimension);
+    cd_cols c = step_cols(sim);
+    const cd_int *gs = sim->nb.gather_start;
+    const cd_pair_id *gr = sim->nb.gather_rows;
+    cd_int W = (cd_int)sim->s.n_walls, dim = sim->p.dimension;
+    cd_vec3 g = sim->p.gravity;
+    size_t n = sim->s.n_particles;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, g))
+    for (size_t q = 0; q < n; q++) cd_item_gather(c, (cd_particle_id)q, gs, gr, W, g, dim);
 }
 
-static void kick(cd_state *s, const cd_step_params *p)
+static void kick(cd_sim *sim)
 {
-    cd_cols c = cols_of(s);
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(s->n_particles))
-    for (size_t q = 0; q < s->n_particles; q++) cd_item_kick(c, (cd_particle_id)q, 0.5 * p->dt);
+    cd_cols c = step_cols(sim);
+    cd_real h = 0.5 * sim->p.dt;
+    size_t n = sim->s.n_particles;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c))
+    for (size_t q = 0; q < n; q++) cd_item_kick(c, (cd_particle_id)q, h);
 }
 
-static void drift(cd_state *s, const cd_step_params *p)
+static void drift(cd_sim *sim)
 {
-    cd_cols c = cols_of(s);
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(s->n_particles))
-    for (size_t q = 0; q < s->n_particles; q++) cd_item_drift(c, (cd_particle_id)q, p->dt);
-    for (size_t w = 0; w < s->n_walls; w++) s->walls[w] = cd_wall_advanced(s->walls[w], p->dt);
+    cd_cols c = step_cols(sim);
+    cd_real dt = sim->p.dt;
+    size_t n = sim->s.n_particles;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c))
+    for (size_t q = 0; q < n; q++) cd_item_drift(c, (cd_particle_id)q, dt);
+    cd_state *s = &sim->s;
+    for (size_t w = 0; w < s->n_walls; w++) s->walls[w] = cd_wall_advanced(s->walls[w], dt);
 }
 
 /* Forces for the current positions (neighbour list up to date). */
-static void compute_forces_host(cd_sim *sim)
+static void compute_forces(cd_sim *sim)
 {
-    pair_forces(&sim->s, &sim->p);
-    wall_forces(&sim->s, &sim->p);
-    gather(&sim->s, &sim->nb, &sim->p);
+    pair_forces(sim);
+    wall_forces(sim);
+    gather(sim);
+}
+
+/* Has some primitive end moved more than half the skin since the last
+ * build?  On the device in the offload variant (one int comes back). */
+static int neighbors_needed(cd_sim *sim)
+{
+#if CD_OFFLOAD
+    if (sim->nb.force_rebuild) return 1;
+    cd_cols c = step_cols(sim);
+    cd_real limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    size_t n = sim->s.n_prims;
+    int moved = 0;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c) reduction(|| : moved) map(tofrom : moved))
+    for (size_t i = 0; i < n; i++)
+        moved = moved || cd_bp_moved(c.prim_a[i], c.prim_a_ref[i], c.prim_b[i], c.prim_b_ref[i], limit2);
+    return moved;
+#else
+    return cd_neighbors_needed(sim);
+#endif
+}
+
+static int rebuild(cd_sim *sim)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data) return off_rebuild(sim);
+#endif
+    return cd_neighbors_build(sim);
 }
 
 void cd_sim_refresh(cd_sim *sim)
 {
     cd_state *s = &sim->s;
     for (size_t q = 0; q < s->n_particles; q++) s->angvel[q] = cd_rigid_angvel(s->orientation[q], s->angmom[q], s->inertia[q]);
-    update_prims(s);
+    cd_cols c = cols_of(s);
+    size_t n = s->n_prims;
+    CD_HOST_FOR(n, firstprivate(c))
+    for (size_t i = 0; i < n; i++) cd_item_prim_ends(c, (cd_prim_id)i);
     sim->nb.force_rebuild = 1;
+}
+
+static int report_bad(const cd_state *s, long bad, char *err, size_t errlen)
+{
+    if (bad < 0) return 0;
+    snprintf(err, errlen, "non-finite position or velocity of particle %ld at step %lld (t = %.9g s): "
+             "the run blew up; reduce run.dt or check the material parameters", bad, s->step, s->time);
+    return -1;
 }
 
 /* A run that blew up must stop before it writes garbage. */
@@ -94,26 +398,55 @@ int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
     const cd_state *s = &sim->s;
     cd_cols c = cols_of((cd_state *)s); /* read only */
     long bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(s->n_particles))
-    for (size_t q = 0; q < s->n_particles; q++)
+    size_t n = s->n_particles;
+    CD_HOST_FOR(n, reduction(max : bad))
+    for (size_t q = 0; q < n; q++)
         if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
-    if (bad >= 0) {
-        snprintf(err, errlen, "non-finite position or velocity of particle %ld at step %lld (t = %.9g s): "
-                 "the run blew up; reduce run.dt or check the material parameters", bad, s->step, s->time);
-        return -1;
-    }
-    return 0;
+    return report_bad(s, bad, err, errlen);
 }
 
-static int omp_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
+/* The same check on the columns the steps work on (the device's). */
+static int check_step_state(cd_sim *sim, char *err, size_t errlen)
 {
+#if CD_OFFLOAD
+    cd_cols c = step_cols(sim);
+    long bad = -1;
+    size_t n = sim->s.n_particles;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c) reduction(max : bad) map(tofrom : bad))
+    for (size_t q = 0; q < n; q++)
+        if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
+    return report_bad(&sim->s, bad, err, errlen);
+#else
+    return cd_sim_check_state(sim, err, errlen);
+#endif
+}
+
+static void omp_stop(cd_sim *sim)
+{
+#if CD_OFFLOAD
+    off_release(sim);
+#else
+    (void)sim;
+#endif
+}
+
+static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
+{
+    omp_stop(sim);
     cd_sim_refresh(sim);
-    if (!compute_forces) return 0; /* the neighbour list is rebuilt at the first step */
-    if (cd_neighbors_build(sim)) {
+    if (compute && cd_neighbors_build(sim)) {
         snprintf(err, errlen, "out of memory while building the first neighbour list");
         return -1;
     }
-    compute_forces_host(sim);
+#if CD_OFFLOAD
+    if (off_acquire(sim)) {
+        snprintf(err, errlen, "out of memory while mapping the state to the offload device");
+        return -1;
+    }
+#endif
+    /* without compute the neighbour list is rebuilt at the first step */
+    if (compute) compute_forces(sim);
     return 0;
 }
 
@@ -121,34 +454,85 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
     for (long long it = 0; it < n; it++) {
-        kick(s, &sim->p);
-        drift(s, &sim->p);
-        update_prims(s);
-        if (cd_neighbors_needed(sim) && cd_neighbors_build(sim)) {
+        kick(sim);
+        drift(sim);
+        update_prims(sim);
+        if (neighbors_needed(sim) && rebuild(sim)) {
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }
-        compute_forces_host(sim);
-        kick(s, &sim->p);
+        compute_forces(sim);
+        kick(sim);
         s->step++;
         s->time += sim->p.dt;
     }
-    return cd_sim_check_state(sim, err, errlen);
+    return check_step_state(sim, err, errlen);
 }
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen)
 {
-    (void)sim; (void)err; (void)errlen;
-    return 0; /* the state lives in host memory */
+    (void)err; (void)errlen;
+#if CD_OFFLOAD
+    /* The only full copy back: every column, rows in use. */
+    if (sim->backend_data)
+        for (size_t f = 0; f < cd_n_fields; f++)
+            off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
+                     cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
+#else
+    (void)sim; /* the state lives in host memory */
+#endif
+    return 0;
 }
-
-static void omp_stop(cd_sim *sim) { (void)sim; }
 
 static const char *omp_device(const cd_sim *sim)
 {
-    static char buf[64];
+    static char buf[96];
+#if CD_OFFLOAD
+    if (omp_get_num_devices() > 0)
+        snprintf(buf, sizeof buf, "%s offload device %d of %d", CAPDEM_OFFLOAD_VARIANT, omp_get_default_device(),
+                 omp_get_num_devices());
+    else
+        snprintf(buf, sizeof buf, "host (built for %s offload, no GPU found)", CAPDEM_OFFLOAD_VARIANT);
+#else
     snprintf(buf, sizeof buf, "host, %d OpenMP thread(s)", sim->threads);
+#endif
+    (void)sim;
     return buf;
 }
 
-const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, NULL};
+#if CD_OFFLOAD
+/* Normal load on wall w summed on the device: per-chunk partial sums in
+ * parallel, then the chunks in order (deterministic, one double back). */
+static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    cd_off *o = sim->backend_data;
+    (void)err; (void)errlen;
+    if (!o) { /* not started: the host columns are current */
+        double acc = 0;
+        for (size_t i = 0; i < sim->s.n_prims; i++) acc += sim->s.wallc_fn[i * sim->s.n_walls + (size_t)w];
+        *load = acc;
+        return 0;
+    }
+    cd_cols c = o->dev;
+    double *part = o->part;
+    size_t P = sim->s.n_prims, W = sim->s.n_walls, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    double sum = 0;
+    CD_WIDE_MIN
+    CD_STEP_FOR(nch, firstprivate(c))
+    for (size_t ch = 0; ch < nch; ch++) {
+        double acc = 0;
+        size_t end = (ch + 1) * CD_LOAD_CHUNK < P ? (ch + 1) * CD_LOAD_CHUNK : P;
+        for (size_t i = ch * CD_LOAD_CHUNK; i < end; i++) acc += c.wallc_fn[i * W + (size_t)w];
+        part[ch] = acc;
+    }
+#pragma omp target map(tofrom : sum)
+    for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
+    *load = sum;
+    return 0;
+}
+#define CD_OMP_WALL_LOAD omp_wall_load
+#else
+#define CD_OMP_WALL_LOAD NULL /* cd_sim_wall_load sums the host columns */
+#endif
+
+const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, CD_OMP_WALL_LOAD};

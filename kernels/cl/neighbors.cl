@@ -23,7 +23,8 @@ __kernel void cd_cl_bounds(
         hi[k] = -(cd_real)INFINITY;
     }
     cd_int end = (g + 1) * chunk < n_prims ? (g + 1) * chunk : n_prims;
-    for (cd_int i = g * chunk; i < end; i++) cd_bp_bounds_add(lo, hi, &rmax, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
+    for (cd_int i = g * chunk; i < end; i++)
+        cd_bp_bounds_add(lo, hi, &rmax, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
     for (int k = 0; k < 3; k++) {
         partial[7 * g + k] = lo[k];
         partial[7 * g + 3 + k] = hi[k];
@@ -82,23 +83,49 @@ __kernel void cd_cl_cell_fill(cd_int n_prims, __global const cd_int *prim_cell, 
     cell_prims[atomic_inc(&cursor[prim_cell[i]])] = i;
 }
 
-/* Number of candidates j > i of primitive i. */
-__kernel void cd_cl_pair_count(
+/* One pass over the candidates of primitive i: their number, and the
+ * candidates themselves (ascending) in the fixed slot cand[i slot ..
+ * (i+1) slot).  A primitive with more than `slot` candidates raises
+ * flags[2]; the host then fills the rows with cd_cl_pair_fill instead (a
+ * second scan) and enlarges the slots for the next build. */
+__kernel void cd_cl_pair_collect(
 #include "col_params.h"
     cd_int n_prims, __global const cd_grid *grid, __global const cd_int *cell_start,
-    __global const cd_int *cell_prims, cd_real skin, __global cd_int *pair_count)
+    __global const cd_int *cell_prims, cd_real skin, __global cd_int *pair_count, __global cd_prim_id *cand,
+    cd_int slot, __global cd_int *flags)
 {
 #include "col_bind.h"
     cd_int i = (cd_int)get_global_id(0);
     if (i >= n_prims) return;
     cd_grid g = grid[0];
-    pair_count[i] = cd_bp_scan_prim(c.prim_a, c.prim_b, c.prim_radius, c.prim_particle, &g, cell_start, cell_prims, i,
-                                    skin, 0);
+    cd_int n = cd_bp_scan_prim(c.prim_a, c.prim_b, c.prim_radius, c.prim_particle, &g, cell_start, cell_prims, i, skin,
+                               cand + (cd_long)i * slot, slot);
+    pair_count[i] = n;
+    if (n > slot) flags[2] = 1;
 }
 
-/* Rows pair_offset[i] .. pair_offset[i+1] of the new list: the candidates
- * of primitive i in ascending j, so that the whole list is sorted by
- * (i, j) as on the host; their keys go to keys. */
+/* Rows pair_offset[i] .. pair_offset[i+1] of the new list from primitive
+ * i's slot: the list is sorted by (i, j) as on the host; the keys go to
+ * keys. */
+__kernel void cd_cl_pair_place(
+#include "col_params.h"
+    cd_int n_prims, __global const cd_int *pair_offset, __global const cd_prim_id *cand, cd_int slot,
+    __global cd_ulong *keys)
+{
+#include "col_bind.h"
+    cd_int i = (cd_int)get_global_id(0);
+    if (i >= n_prims) return;
+    cd_int first = pair_offset[i], n = pair_offset[i + 1] - first;
+    for (cd_int m = 0; m < n; m++) {
+        cd_prim_id j = cand[(cd_long)i * slot + m];
+        c.pair_prim_i[first + m] = i;
+        c.pair_prim_j[first + m] = j;
+        keys[first + m] = cd_bp_pair_key(i, j);
+    }
+}
+
+/* The same rows by a second scan, for a build in which some primitive
+ * overflowed its slot. */
 __kernel void cd_cl_pair_fill(
 #include "col_params.h"
     cd_int n_prims, __global const cd_grid *grid, __global const cd_int *cell_start,
@@ -110,7 +137,7 @@ __kernel void cd_cl_pair_fill(
     cd_grid g = grid[0];
     cd_int first = pair_offset[i];
     cd_int n = cd_bp_scan_prim(c.prim_a, c.prim_b, c.prim_radius, c.prim_particle, &g, cell_start, cell_prims, i,
-                               skin, c.pair_prim_j + first);
+                               skin, c.pair_prim_j + first, CD_BP_UNBOUNDED);
     for (cd_int k = first; k < first + n; k++) {
         c.pair_prim_i[k] = i;
         keys[k] = cd_bp_pair_key(i, c.pair_prim_j[k]);

@@ -5,6 +5,7 @@
  * contraction off, so the contact sets must be identical and the particle
  * state must agree to 1e-10 relative; the test reports whether every bit
  * agrees (it did on PoCL 3.1 at the time of writing). */
+#define _POSIX_C_SOURCE 200809L /* setenv */
 #include "test_util.h"
 #include <math.h>
 
@@ -119,10 +120,39 @@ static void test_omp_and_opencl_agree_on_settling_hexapods(void **state)
     cd_config_free(&cb);
 }
 
+/* Candidate slots of one entry overflow at the first builds: the device
+ * falls back to a second scan and doubles the slots, and the list, hence
+ * the trajectory, stays the same. */
+static void test_candidate_slot_overflow_changes_nothing(void **state)
+{
+    (void)state;
+    static cd_sim a, b;
+    cd_config ca, cb;
+    if (start_on(&a, &ca, "omp")) fail_msg("omp backend failed to start");
+    setenv("CAPDEM_OPENCL_SLOTS", "1", 1);
+    int no_platform = start_on(&b, &cb, "opencl");
+    unsetenv("CAPDEM_OPENCL_SLOTS");
+    if (no_platform) {
+        cd_sim_free(&a);
+        cd_config_free(&ca);
+        skip();
+    }
+    cdt_step(&a, 1000);
+    cdt_step(&b, 1000);
+    assert_int_equal(a.s.n_pairs, b.s.n_pairs);
+    assert_memory_equal(a.s.pair_prim_j, b.s.pair_prim_j, a.s.n_pairs * sizeof(cd_prim_id));
+    assert_memory_equal(a.s.position, b.s.position, a.s.n_particles * sizeof(cd_vec3));
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_omp_and_opencl_agree_on_settling_hexapods),
+        cmocka_unit_test(test_candidate_slot_overflow_changes_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
