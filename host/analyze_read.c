@@ -158,23 +158,6 @@ static int rd_shapes(rd *r, cd_an_snapshot *s)
     return 0;
 }
 
-/* cd_wall in memory as the compound the writer stores (docs/output.md). */
-static hid_t wall_type(void)
-{
-    hsize_t three = 3;
-    hid_t t = H5Tcreate(H5T_COMPOUND, sizeof(cd_wall));
-    hid_t v3 = H5Tarray_create2(H5T_NATIVE_DOUBLE, 1, &three);
-    H5Tinsert(t, "type", HOFFSET(cd_wall, type), H5T_NATIVE_INT32);
-    H5Tinsert(t, "point", HOFFSET(cd_wall, point), v3);
-    H5Tinsert(t, "normal", HOFFSET(cd_wall, normal), v3);
-    H5Tinsert(t, "velocity", HOFFSET(cd_wall, velocity), v3);
-    H5Tinsert(t, "radius", HOFFSET(cd_wall, radius), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "radial_velocity", HOFFSET(cd_wall, radial_velocity), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "friction", HOFFSET(cd_wall, friction), H5T_NATIVE_DOUBLE);
-    H5Tclose(v3);
-    return t;
-}
-
 int cd_an_snapshot_alloc(cd_an_snapshot *s, size_t n, size_t P, size_t nc, size_t nw, int W)
 {
     s->n = n;
@@ -263,7 +246,7 @@ static int rd_all(rd *r, int k, int S, cd_an_snapshot *s)
         (rc = rd_rows(r, "/wall_contacts/wallc_force", w0, nw, 3, D, s->w_force)))
         return rc;
     if (W > 0) {
-        hid_t t = wall_type();
+        hid_t t = cd_h5_wall_type(); /* the compound the writer stores */
         rc = rd_rows(r, "/walls/value", K, 1, W, t, s->walls);
         H5Tclose(t);
         if (rc) return rc;

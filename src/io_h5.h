@@ -3,6 +3,7 @@
 #ifndef CD_IO_H5_H
 #define CD_IO_H5_H
 #include <stddef.h>
+#include <stdint.h>
 #include "state.h"
 #include "config.h"
 #include "shapes.h"
@@ -54,6 +55,10 @@ int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
  * the active contacts with their history, the wall contacts, walls, time and
  * step. */
 int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t errlen);
+
+/* The HDF5 memory type of cd_wall, as /walls/value stores it (an hid_t the
+ * caller closes with H5Tclose), for readers of run files. */
+int64_t cd_h5_wall_type(void);
 
 /* Reads the config text echoed in a run file (malloc'd, caller frees). */
 char *cd_h5_read_config_text(const char *path, char *err, size_t errlen);

@@ -64,6 +64,8 @@ size_t cdh5_max_row_bytes(void)
     return m;
 }
 
+int64_t cd_h5_wall_type(void) { return cdh5_wall_mem_type(); }
+
 hid_t cdh5_wall_mem_type(void)
 {
     hsize_t three = 3;
