@@ -14,7 +14,8 @@
  * particle-steps/s, contact-updates/s (active contacts x steps / s),
  * contacts per particle and bytes per particle of the state.
  *
- * --backend takes a comma-separated list: the packing is settled on the
+ * --backend takes a comma-separated list (an entry "omp:1" runs that round
+ * with 1 thread, so thread counts are compared on one packing): the packing is settled on the
  * first backend, then each backend in turn starts from a copy of that state
  * (handed over through the host, as a resumed run) and is timed after 20
  * untimed steps (first list build, lazy kernel compilation), so that one
@@ -111,8 +112,15 @@ int main(int argc, char **argv)
     char list[256], *save = NULL, *names[8];
     int n_backends = 0;
     snprintf(list, sizeof list, "%s", backends);
-    for (char *b = strtok_r(list, ",", &save); b && n_backends < 8; b = strtok_r(NULL, ",", &save))
+    int round_threads[8];
+    for (char *b = strtok_r(list, ",", &save); b && n_backends < 8; b = strtok_r(NULL, ",", &save)) {
+        /* "omp:1" runs that round with 1 thread: thread counts compared on
+         * one packing in one invocation */
+        char *colon = strchr(b, ':');
+        round_threads[n_backends] = colon ? atoi(colon + 1) : threads;
+        if (colon) *colon = 0;
         names[n_backends++] = b;
+    }
     if (n_backends == 0) {
         fprintf(stderr, "capdem-bench: --backend: expected omp, opencl or a list of them\n");
         return 2;
@@ -139,6 +147,8 @@ int main(int argc, char **argv)
         return 3;
     }
     for (int k = 0; k < n_backends; k++) {
+        omp_set_num_threads(round_threads[k]);
+        sim.threads = round_threads[k];
         if (n_backends > 1) {
             /* hand the settled state over through the host, as a resumed run
              * does, and warm up (first list build, lazy kernel compilation) */
@@ -165,7 +175,7 @@ int main(int argc, char **argv)
                    "\"contacts_per_particle\": %.3f, \"pairs_in_list\": %zu, \"bytes_per_particle\": %.0f, "
                    "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld}\n",
                    shape, aspect, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
-                   threads, steps, wall, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
+                   round_threads[k], steps, wall, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
                    sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds);
             fflush(stdout);
         }
