@@ -320,6 +320,10 @@ typedef struct {
     size_t n;                /* points used */
 } cd_an_nlfit;
 
+/* Puts fit parameter k as names[k], with its 95% interval as
+ * names[k]_lo and names[k]_hi, for k < f->np (all dimensionless). */
+void cd_an_put_fit(cd_an_group *g, const char *const *names, const cd_an_nlfit *f);
+
 /* Mueth's P = a (1 - b exp(-f^2)) exp(-beta f) on a density histogram
  * (bin centres, counts, total samples, bin width); p = {a, b, beta}. */
 int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double width, double total,

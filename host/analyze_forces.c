@@ -95,15 +95,8 @@ int cd_an_forces(const cd_an_input *in, cd_an_report *r, char *err, size_t errle
     }
     cd_an_nlfit mu;
     if (cd_an_fit_mueth(centre, counts, PF_BINS, PF_WIDTH, (double)s->nc, ok_mle ? mle.k : 1.4, &mu) == 0) {
-        const char *names[3] = {"mueth_a", "mueth_b", "mueth_beta"};
-        for (int k = 0; k < 3; k++) {
-            char key[64];
-            cd_an_put(g, names[k], mu.p[k], "1");
-            snprintf(key, sizeof key, "%s_lo", names[k]);
-            cd_an_put(g, key, mu.lo[k], "1");
-            snprintf(key, sizeof key, "%s_hi", names[k]);
-            cd_an_put(g, key, mu.hi[k], "1");
-        }
+        static const char *const names[3] = {"mueth_a", "mueth_b", "mueth_beta"};
+        cd_an_put_fit(g, names, &mu);
         cd_an_put(g, "mueth_chi2_per_dof", mu.chi2 / mu.dof, "1");
         double *m = model_curve(g, "mueth_fit", 201);
         for (int i = 0; m && i <= 200; i++) {

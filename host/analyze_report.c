@@ -140,3 +140,15 @@ void cd_an_histogram(const double *x, size_t n, double lo, double w, int nb, dou
     if (under) *under = u;
     if (over) *over = o;
 }
+
+void cd_an_put_fit(cd_an_group *g, const char *const *names, const cd_an_nlfit *f)
+{
+    for (int k = 0; k < f->np; k++) {
+        char key[64];
+        cd_an_put(g, names[k], f->p[k], "1");
+        snprintf(key, sizeof key, "%s_lo", names[k]);
+        cd_an_put(g, key, f->lo[k], "1");
+        snprintf(key, sizeof key, "%s_hi", names[k]);
+        cd_an_put(g, key, f->hi[k], "1");
+    }
+}

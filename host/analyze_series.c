@@ -337,15 +337,8 @@ int cd_an_jamming(const char *path, const cd_an_options *opt, cd_an_report *r, c
         cd_an_put_text(g, "rows_used", "phases compress, hold, compact with a loaded wall (%zu of %zu rows)", used, ph->rows);
     cd_an_put_text(g, "phi_series", "%s", ph->name);
     cd_an_put_text(g, "z_series", "%s", z->name);
-    const char *names[3] = {"phi_c", "z_c", "amplitude"};
-    for (int k = 0; k < 3; k++) {
-        char key[64];
-        cd_an_put(g, names[k], fit.p[k], "1");
-        snprintf(key, sizeof key, "%s_lo", names[k]);
-        cd_an_put(g, key, fit.lo[k], "1");
-        snprintf(key, sizeof key, "%s_hi", names[k]);
-        cd_an_put(g, key, fit.hi[k], "1");
-    }
+    static const char *const names[3] = {"phi_c", "z_c", "amplitude"};
+    cd_an_put_fit(g, names, &fit);
     cd_an_put(g, "n_points", (double)fit.n, "1");
     cd_an_put(g, "rms_residual", sqrt(fit.chi2 / (double)fit.n), "1");
     double *c = cd_an_put_curve(g, "data", ph->rows, "phi,z,z_fit", "1,1,1");

@@ -185,6 +185,18 @@ static int poly_roots(const double *c, int deg, double lo, double hi, double *ro
     return nr;
 }
 
+/* Angles phi with A cos(phi) + B sin(phi) = C: none, or the two
+ * base -+ off with base = atan2(B, A), off = acos(C / |(A, B)|). */
+static int crossings(double A, double B, double C, unsigned src, cut *out)
+{
+    double M = sqrt(A * A + B * B);
+    if (!(M > 0) || fabs(C) > M) return 0;
+    double base = atan2(B, A), off = acos(C / M);
+    out[0].phi = base - off; out[0].src = src;
+    out[1].phi = base + off; out[1].src = src;
+    return 2;
+}
+
 /* Angles where the circle ctr + rho (cos phi U + sin phi W) crosses the
  * sphere |p - q| = R: A cos + B sin = C, solved in closed form. */
 int cd_shn_circle_sphere(const double *ctr, double rho, const double *U, const double *W, const double *q,
@@ -193,12 +205,7 @@ int cd_shn_circle_sphere(const double *ctr, double rho, const double *U, const d
     double w[3];
     sub3(ctr, q, w);
     double A = 2 * rho * dot3(w, U), B = 2 * rho * dot3(w, W), C = R * R - dot3(w, w) - rho * rho;
-    double M = sqrt(A * A + B * B);
-    if (!(M > 0) || fabs(C) > M) return 0;
-    double base = atan2(B, A), off = acos(C / M);
-    out[0].phi = base - off; out[0].src = src;
-    out[1].phi = base + off; out[1].src = src;
-    return 2;
+    return crossings(A, B, C, src, out);
 }
 
 /* Angles where the circle crosses the plane (p - q).n = 0. */
@@ -208,12 +215,7 @@ int cd_shn_circle_plane(const double *ctr, double rho, const double *U, const do
     double w[3];
     sub3(ctr, q, w);
     double A = rho * dot3(U, n), B = rho * dot3(W, n), C = -dot3(w, n);
-    double M = sqrt(A * A + B * B);
-    if (!(M > 0) || fabs(C) > M) return 0;
-    double base = atan2(B, A), off = acos(C / M);
-    out[0].phi = base - off; out[0].src = src;
-    out[1].phi = base + off; out[1].src = src;
-    return 2;
+    return crossings(A, B, C, src, out);
 }
 
 /* Angles where the circle crosses the infinite cylinder around c's axis:
