@@ -298,8 +298,27 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
             cd_cfg_render(r->doc, a, val, sizeof val, 0);
             return cd_cfg_fail(r, line_of(a), "particles[%d].aspect = %s: expected 1 for shape sphere (aspect ratio)", i, val);
         }
+        if (sp->count == 0 && !(c->fill_ratio > 0 && c->n_species == 1))
+            return cd_cfg_fail(r, line_of(item), "particles[%d].count: missing; expected an integer >= 1 (particle count)%s", i,
+                               c->n_species == 1 ? ", or protocol.fill_ratio with protocol.type deposit_compress"
+                                                 : "; protocol.fill_ratio picks the count of a single species only");
+        if (sp->count > 0 && c->fill_ratio > 0) {
+            yaml_node_t *n = lookup(r->doc, item, "count", NULL);
+            return cd_cfg_fail(r, line_of(n), "particles[%d].count = %ld: cannot be given together with protocol.fill_ratio = %g; "
+                               "expected only one of them (the fill ratio picks the count)", i, sp->count, c->fill_ratio);
+        }
         total += sp->count;
     }
+    yaml_node_t *proto = lookup(r->doc, root, "protocol", NULL);
+    if (c->fill_ratio > 0 && !(c->fill_fraction > 0))
+        return cd_cfg_fail(r, line_of(proto), "protocol.fill_fraction: missing; expected a number in (0, 1) (expected packing fraction), "
+                           "needed for protocol.fill_ratio = %g", c->fill_ratio);
+    yaml_node_t *dom = lookup(r->doc, root, "domain", NULL);
+    int tall = !strcmp(c->domain, "box") || !strcmp(c->domain, "cylinder");
+    double height = !strcmp(c->domain, "box") ? c->box_height : c->cyl_height;
+    if (tall && height == 0 && strcmp(c->placement, "lattice"))
+        return cd_cfg_fail(r, line_of(dom), "domain.height: missing; expected a number > 0 (%s height, m): "
+                           "only init.placement lattice can pick the height (init.placement = %s)", c->domain, c->placement);
     if (total > 2147483647LL)
         return cd_cfg_fail(r, line_of(plist), "particles = (%lld particles in all): expected at most 2147483647 in all (particle count)",
                     total);

@@ -73,6 +73,9 @@ typedef struct {
     double settle_time;            /* deposit: settling time [s] (0 = 3 sqrt(2 h / g)) */
     double piston_speed;           /* deposit: piston speed while compressing [m/s] */
     double piston_force;           /* deposit: target force on the piston [N] */
+    double fill_ratio;             /* deposit: packing height / width that picks the count (0 = counts given) */
+    double fill_fraction;          /* deposit: expected packing fraction for fill_ratio [1] (0 = not given) */
+    int piston_from_top;           /* deposit: 1: the piston starts at the top; 0: just above the settled packing */
     double piston_mass;            /* deposit: piston mass while holding [kg] (0 = total particle mass) */
     double pressure;               /* ball: applied pressure [Pa] (0 = pressure_ratio kn / L) */
     double pressure_ratio;         /* ball: p L / kn [1] */

@@ -215,6 +215,44 @@ static int relaxed(cd_sim *sim, char *err, size_t errlen, int *done)
     return 0;
 }
 
+/* Deposit, protocol.piston_start = packing: moves the parked piston down
+ * to one particle size (the largest bounding diameter, polydispersity
+ * included) above the highest
+ * point of any particle.  Seed 000 starts the piston at the top of the
+ * domain, but the domain is as high as the initial lattice, several times
+ * the settled packing: the piston would cross metres of empty space at
+ * 0.25 m/s (millions of steps) before touching anything.  Starting just
+ * above the packing changes nothing the packing feels. */
+static int lower_piston(cd_sim *sim, int w, char *err, size_t errlen)
+{
+    if (cd_sim_sync(sim, err, errlen)) return -1;
+    const cd_state *s = &sim->s;
+    double top = -INFINITY, size = 0; /* [m] */
+    for (size_t i = 0; i < s->n_prims; i++) {
+        double y = fmax(s->prim_a[i].y, s->prim_b[i].y) + s->prim_radius[i];
+        if (y > top) top = y;
+    }
+    for (int k = 0; k < sim->n_shapes; k++)
+        size = fmax(size, 2 * sim->shapes[k].bounding_radius * (1 + sim->cfg.species[k].polydispersity));
+    double start = top + size;
+    if (start < sim->s.walls[w].point.y) sim->s.walls[w].point.y = start;
+    return 0;
+}
+
+/* Deposit: the compressed packing's height (the piston's) against the
+ * container width, which seed 000 wants to be at least 2. */
+static void report_fill(const cd_sim *sim, FILE *log)
+{
+    const cd_config *c = &sim->cfg;
+    double width = !strcmp(c->domain, "box") ? c->box_width : c->cyl_diameter; /* [m] */
+    double h = sim->s.walls[(int)sim->s.control[CTL_WALL]].point.y;          /* [m] */
+    if (!log) return;
+    fprintf(log, "capdem: packing height %.6g m = %.3g x the %s\n", h, h / width, !strcmp(c->domain, "box") ? "width" : "diameter");
+    if (c->fill_ratio > 0 && h / width < c->fill_ratio)
+        fprintf(log, "capdem: warning: below protocol.fill_ratio = %g: the packing is denser than protocol.fill_fraction = %g "
+                "expected; set fill_fraction to the packing_fraction this run reached (time series)\n", c->fill_ratio, c->fill_fraction);
+}
+
 /* Scales particle positions about the ball centre and the ball radius to
  * the volumetric strain eps = -dV/V of the base state. */
 static int apply_strain(cd_sim *sim, double eps, char *err, size_t errlen)
@@ -244,6 +282,7 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
     switch (phase) {
     case CD_PHASE_SETTLE:
         if (s->time >= s->control[CTL_PHASE_TIME] + settle_time(sim) - 0.5 * dt) {
+            if (!sim->cfg.piston_from_top && lower_piston(sim, w, err, errlen)) return -1;
             enter(sim, CD_PHASE_COMPRESS, log);
             s->walls[w].velocity = cd_v3_scale(s->walls[w].normal, sim->cfg.piston_speed);
         }
@@ -260,7 +299,10 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
         double a = (load - sim->cfg.piston_force) / m; /* [m/s^2], positive outwards */
         s->walls[w].velocity = cd_v3_axpy(s->walls[w].velocity, -a * dt, s->walls[w].normal);
         if (relaxed(sim, err, errlen, &done)) return -1;
-        if (done) enter(sim, CD_PHASE_DONE, log);
+        if (done) {
+            enter(sim, CD_PHASE_DONE, log);
+            report_fill(sim, log);
+        }
         break;
     }
     case CD_PHASE_COMPACT: {

@@ -155,6 +155,12 @@ int cd_run(const cd_run_options *opt)
     fprintf(stderr, "capdem: %zu particles, %zu primitives, %zu walls, dt = %g s (t_col/%.1f), backend %s on %s, output %s\n",
             sim.s.n_particles, sim.s.n_prims, sim.s.n_walls, sim.p.dt, sim.collision_time / sim.p.dt, sim.backend->name,
             sim.backend->device(&sim), cfg.output);
+    if (cfg.fill_ratio > 0)
+        fprintf(stderr, "capdem: protocol.fill_ratio %g at protocol.fill_fraction %g: %ld particles\n", cfg.fill_ratio,
+                cfg.fill_fraction, sim.cfg.species[0].count);
+    if ((!strcmp(cfg.domain, "box") && cfg.box_height == 0) || (!strcmp(cfg.domain, "cylinder") && cfg.cyl_height == 0))
+        fprintf(stderr, "capdem: domain.height %g m (the lowest that holds the init lattice)\n",
+                !strcmp(cfg.domain, "box") ? sim.cfg.box_height : sim.cfg.cyl_height);
 
     cd_observables o;
     if (!opt->resume_path) {

@@ -175,16 +175,67 @@ static void describe_domain(const cd_config *c, char *buf, size_t n)
     else snprintf(buf, n, "domain.type = none");
 }
 
+/* Largest bounding radius of any particle, polydispersity included [m]. */
+static double largest_bounding_radius(const cd_sim *sim)
+{
+    double rmax = 0, pmax = 0;
+    for (int k = 0; k < sim->n_shapes; k++) {
+        if (sim->shapes[k].bounding_radius > rmax) rmax = sim->shapes[k].bounding_radius;
+        if (sim->cfg.species[k].polydispersity > pmax) pmax = sim->cfg.species[k].polydispersity;
+    }
+    return rmax * (1 + pmax);
+}
+
+/* protocol.fill_ratio (seed 000): as many particles as fill the container
+ * to fill_ratio x its width (box) or diameter (cylinder) at the expected
+ * packing fraction, i.e. N = fill_ratio W A phi / <v>, with A the cross
+ * section and <v> = v (1 + p^2) the mean particle volume when the length
+ * scale is uniform in [1 - p, 1 + p] (E[f^3] = 1 + p^2).  The packing
+ * fraction is the time series' one (solid volume over container volume up
+ * to the piston; in 2D over the slab of domain.thickness). */
+static void resolve_fill_count(cd_sim *sim)
+{
+    cd_config *c = &sim->cfg;
+    if (!(c->fill_ratio > 0) || c->n_species != 1 || c->species[0].count > 0) return;
+    double width = !strcmp(c->domain, "box") ? c->box_width : c->cyl_diameter; /* [m] */
+    double section = !strcmp(c->domain, "box") ? c->box_width * c->box_thickness
+                                               : 0.25 * CD_PI * c->cyl_diameter * c->cyl_diameter; /* [m^2] */
+    double p = c->species[0].polydispersity;
+    double v = sim->shapes[0].volume * (1 + p * p); /* mean particle volume [m^3] */
+    c->species[0].count = (long)ceil(c->fill_ratio * width * section * c->fill_fraction / v);
+}
+
+/* domain.height omitted (seed 000): the lowest box or cylinder whose
+ * lattice of spacing a holds every particle, i.e. rows x a with rows =
+ * ceil(N / sites per row).  Rows are centred, so a height of exactly
+ * rows x a puts the first row at a/2 >= R above the floor. */
+static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
+{
+    cd_config *c = &sim->cfg;
+    double *h = !strcmp(c->domain, "box") ? &c->box_height : !strcmp(c->domain, "cylinder") ? &c->cyl_height : NULL;
+    if (!h || *h > 0) return 0;
+    double R = largest_bounding_radius(sim), a = c->clearance * 2 * R; /* [m] */
+    size_t N = sim->s.n_particles, row_max = 1u << 20;
+    cd_vec3 *sites = malloc(row_max * sizeof(cd_vec3));
+    if (!sites) return -1;
+    *h = a * (1 + 1e-9); /* one row */
+    size_t per_row = lattice_sites(c, a, R, sites, row_max);
+    free(sites);
+    if (per_row == 0) {
+        char dom[256];
+        describe_domain(c, dom, sizeof dom);
+        snprintf(err, errlen, "%s: domain: no particle of size %g m fits across the domain (%s)", c->source_path, 2 * R, dom);
+        return -1;
+    }
+    *h = (double)((N + per_row - 1) / per_row) * a * (1 + 1e-9);
+    return 0;
+}
+
 static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
 {
     const cd_config *c = &sim->cfg;
     cd_state *s = &sim->s;
-    double rmax = 0, pmax = 0;
-    for (int k = 0; k < sim->n_shapes; k++) {
-        if (sim->shapes[k].bounding_radius > rmax) rmax = sim->shapes[k].bounding_radius;
-        if (c->species[k].polydispersity > pmax) pmax = c->species[k].polydispersity;
-    }
-    double R = rmax * (1 + pmax);            /* largest bounding radius [m] */
+    double R = largest_bounding_radius(sim); /* [m] */
     double a = c->clearance * 2 * R;          /* lattice spacing [m] */
     size_t N = s->n_particles;
     cd_vec3 *sites = malloc((N + 1) * sizeof(cd_vec3));
@@ -246,6 +297,9 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
             snprintf(err, errlen, "%s: particles[%d]: %s", c->source_path, k, why);
             return -1;
         }
+    }
+    resolve_fill_count(sim);
+    for (int k = 0; k < c->n_species; k++) {
         N += (size_t)c->species[k].count;
         P += (size_t)c->species[k].count * (size_t)sim->shapes[k].n_prims;
     }
@@ -254,6 +308,7 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
         return -1;
     }
     if (cd_protocol_check(c, err, errlen)) return -1;
+    if (resolve_lattice_height(sim, err, errlen)) return -1;
     if (make_walls(sim, err, errlen)) return -1;
     /* wall-contact columns depend on the wall count: allocate them now */
     cd_state *s = &sim->s;

@@ -396,6 +396,34 @@ static void test_particle_without_required_keys_is_refused(void **state)
                  "particles[0].segments[0]", "radius > 0");
 }
 
+/* A count may be left out only when protocol.fill_ratio picks it, and the
+ * fill ratio needs the expected packing fraction; a height may be left out
+ * only when the lattice decides it. */
+static void test_count_and_height_rules(void **state)
+{
+    (void)state;
+    expect_error("particles:\n  - {shape: rod, aspect: 4, diameter: 0.005}\n", "particles[0].count: missing",
+                 "protocol.fill_ratio");
+#define DEPOSIT "domain: {type: box, width: 0.1, thickness: 0.01}\nprotocol: {type: deposit_compress, fill_ratio: 2"
+    expect_error("particles:\n  - {shape: sphere, diameter: 0.005, count: 10}\n" DEPOSIT ", fill_fraction: 0.5}\n",
+                 "particles[0].count = 10: cannot be given together with protocol.fill_ratio", NULL);
+    expect_error("particles:\n  - {shape: sphere, diameter: 0.005}\n" DEPOSIT "}\n", "protocol.fill_fraction: missing",
+                 "(0, 1)");
+    expect_error("particles:\n  - {shape: sphere, diameter: 0.005}\n  - {shape: sphere, diameter: 0.004}\n" DEPOSIT
+                 ", fill_fraction: 0.5}\n", "particles[0].count: missing", "single species");
+    expect_error("particles:\n  - {shape: sphere, diameter: 0.005}\n" DEPOSIT ", fill_fraction: 1.5}\n",
+                 "protocol.fill_fraction = 1.5", "(0, 1)");
+    expect_error(PARTICLES "domain: {type: box, width: 0.1, thickness: 0.1}\ninit: {placement: random}\n",
+                 "domain.height: missing", "init.placement lattice");
+#undef DEPOSIT
+    cd_config c;
+    parse_ok("particles:\n  - {shape: sphere, diameter: 0.005}\ndomain: {type: cylinder, diameter: 0.05}\n"
+             "protocol: {type: deposit_compress, fill_ratio: 2, fill_fraction: 0.5}\n", &c);
+    assert_int_equal(c.species[0].count, 0); /* picked at set-up */
+    assert_true(c.cyl_height == 0);
+    cd_config_free(&c);
+}
+
 static void test_box_without_width_is_refused(void **state)
 {
     (void)state;
@@ -499,6 +527,7 @@ int main(void)
         cmocka_unit_test(test_yaml_syntax_error_names_the_line),
         cmocka_unit_test(test_missing_file_is_refused),
         cmocka_unit_test(test_print_keys_lists_every_key),
+        cmocka_unit_test(test_count_and_height_rules),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -71,7 +71,7 @@ static void test_piston_reaches_and_holds_target_force(void **state)
 static void test_deposit_resumed_equals_uninterrupted(void **state)
 {
     (void)state;
-    assert_int_equal(run_preset("deposit_2d_crosses", "proto_dep2d_part.h5", NULL, 150000), 0);
+    assert_int_equal(run_preset("deposit_2d_crosses", "proto_dep2d_part.h5", NULL, 135000), 0);
     assert_int_equal(run_preset("deposit_2d_crosses", NULL, "proto_dep2d_part.h5", -1), 0);
     static cd_sim a, b;
     cd_config ca, cb;
@@ -85,6 +85,80 @@ static void test_deposit_resumed_equals_uninterrupted(void **state)
     cd_config_free(&ca); cd_config_free(&cb);
     unlink("proto_dep2d.h5");
     unlink("proto_dep2d_part.h5");
+}
+
+/* protocol.fill_ratio with the count left out (seed 000's rule): N =
+ * ceil(2 W (W T) phi / <v>) with <v> = (pi d^3 / 6)(1 + p^2), the mean
+ * volume of spheres whose diameter is uniform in [(1 - p) d, (1 + p) d];
+ * and domain.height left out: rows x a for a lattice of spacing
+ * a = clearance x the largest diameter, floor(W / a) x floor(T / a) sites
+ * per row.  Both computed here from the closed forms. */
+static void test_fill_ratio_picks_count_and_lattice_picks_height(void **state)
+{
+    (void)state;
+    const double W = 0.1, T = 0.02, d = 0.005, p = 0.2, phi = 0.5, fill = 2, clearance = 1.5; /* [m] and [1] */
+    char yaml[1024];
+    snprintf(yaml, sizeof yaml,
+             "particles: [{shape: sphere, diameter: %g, polydispersity: %g}]\n"
+             "domain: {type: box, width: %g, thickness: %g}\n"
+             "init: {placement: lattice, clearance: %g}\n"
+             "run: {dt: 1.0e-6}\n"
+             "protocol: {type: deposit_compress, fill_ratio: %g, fill_fraction: %g}\n",
+             d, p, W, T, clearance, fill, phi);
+    static cd_sim sim;
+    cd_config cfg;
+    char err[2048];
+    if (cd_config_parse(yaml, "fill.yaml", &cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
+    double v_mean = CD_PI * d * d * d / 6 * (1 + p * p); /* [m^3] */
+    size_t n_expected = (size_t)ceil(fill * W * (W * T) * phi / v_mean);
+    double a = clearance * d * (1 + p);                  /* [m] */
+    size_t per_row = (size_t)floor(W / a) * (size_t)floor(T / a);
+    double h_expected = (double)((n_expected + per_row - 1) / per_row) * a;
+    print_message("N = %zu (expected %zu), height %.6g m (expected %.6g m)\n", sim.s.n_particles, n_expected,
+                  sim.cfg.box_height, h_expected);
+    assert_int_equal(sim.s.n_particles, n_expected);
+    assert_true(fabs(sim.cfg.box_height - h_expected) < 1e-6 * h_expected);
+    double top = 0;
+    for (size_t q = 0; q < sim.s.n_particles; q++) top = fmax(top, sim.s.position[q].y + 0.5 * d * sim.s.scale[q]);
+    assert_true(top <= sim.cfg.box_height && top > sim.cfg.box_height - a); /* the top row is used */
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+}
+
+/* protocol.piston_start = packing: when the settling ends, the piston is
+ * moved from the top of the domain to one particle size (largest bounding
+ * diameter x (1 + p)) above the highest point of any particle. */
+static void test_piston_starts_one_particle_size_above_the_packing(void **state)
+{
+    (void)state;
+    static cd_sim sim;
+    cd_config cfg;
+    char err[2048];
+    if (cd_config_load(preset("deposit_2d_crosses"), &cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_use_backend(&sim, cdt_backend(), NULL, err, sizeof err)) fail_msg("%s", err);
+    cd_protocol_begin(&sim);
+    if (cd_sim_start(&sim, 1, err, sizeof err)) fail_msg("%s", err);
+    int w = (int)sim.s.control[2];
+    double parked = sim.s.walls[w].point.y;
+    while ((int)sim.s.control[0] == CD_PHASE_SETTLE) {
+        if (cd_sim_step(&sim, cd_protocol_steps_until_control(&sim), err, sizeof err)) fail_msg("%s", err);
+        if (cd_protocol_control(&sim, NULL, err, sizeof err) < 0) fail_msg("%s", err);
+    }
+    assert_int_equal((int)sim.s.control[0], CD_PHASE_COMPRESS);
+    if (cd_sim_sync(&sim, err, sizeof err)) fail_msg("%s", err);
+    double top = -INFINITY;
+    for (size_t i = 0; i < sim.s.n_prims; i++)
+        top = fmax(top, fmax(sim.s.prim_a[i].y, sim.s.prim_b[i].y) + sim.s.prim_radius[i]);
+    double size = 2 * sim.shapes[0].bounding_radius * (1 + cfg.species[0].polydispersity);
+    print_message("piston parked at %.4f m, starts at %.6f m, packing top %.6f m, size %.4f m\n", parked,
+                  sim.s.walls[w].point.y, top, size);
+    /* the piston has not moved yet (its velocity is set, the step not taken) */
+    assert_true(fabs(sim.s.walls[w].point.y - (top + size)) < 1e-12);
+    assert_true(sim.s.walls[w].point.y < parked);
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
 }
 
 /* Contacts per particle over the particles that have any (rattlers out),
@@ -164,6 +238,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_piston_reaches_and_holds_target_force),
         cmocka_unit_test(test_deposit_resumed_equals_uninterrupted),
+        cmocka_unit_test(test_fill_ratio_picks_count_and_lattice_picks_height),
+        cmocka_unit_test(test_piston_starts_one_particle_size_above_the_packing),
         cmocka_unit_test(test_radial_compaction_frictionless_hexapods_isostatic),
         cmocka_unit_test(test_radial_compaction_frictionless_spheres_isostatic),
     };
