@@ -98,7 +98,8 @@ int cd_config_parse(const char *text, const char *name_for_errors, cd_config *c,
 
 void cd_config_free(cd_config *c);
 
-/* Prints every key with type, unit, default and meaning (capdem run --help). */
-void cd_config_print_keys(void *stream);
+/* Prints every key with type, unit, default and meaning (capdem run --help);
+ * markdown: as the table of docs/config.md (capdem run --help-markdown). */
+void cd_config_print_keys(void *stream, int markdown);
 
 #endif

@@ -449,10 +449,64 @@ static int bits_of(const cd_key *sel)
     return n;
 }
 
-void cd_config_print_keys(void *stream)
+/* Default and condition text of one key, as both listings print them. */
+static void key_texts(const cd_key *k, char *def, size_t ndef, char *cond, size_t ncond)
+{
+    char m[160];
+    const cd_key *sel = cd_key_selector_of(k);
+    unsigned all = sel ? (1u << bits_of(sel)) - 1u : CD_ALL_CHOICES;
+    unsigned applies = k->applies ? k->applies : all;
+    unsigned required = k->required & applies;
+    if (k->def)
+        snprintf(def, ndef, "%s", k->def);
+    else
+        snprintf(def, ndef, "%s", required == applies ? "required" : required ? "see below" : "-");
+    cond[0] = 0;
+    if (sel && applies != all) {
+        mask_text(sel, applies, m, sizeof m);
+        snprintf(cond + strlen(cond), ncond - strlen(cond), " Only for %s = %s.", sel->path, m);
+    }
+    if (sel && required && required != applies) {
+        mask_text(sel, required, m, sizeof m);
+        snprintf(cond + strlen(cond), ncond - strlen(cond), " Required for %s = %s.", sel->path, m);
+    }
+    if (k->conflicts) {
+        size_t sl = cd_key_section_len(k->path);
+        snprintf(cond + strlen(cond), ncond - strlen(cond), " Not together with %.*s.%s.", (int)sl, k->path, k->conflicts);
+    }
+}
+
+/* Text for a Markdown table cell: | and < escaped. */
+static void md_cell(FILE *f, const char *t)
+{
+    for (; *t; t++) {
+        if (*t == '|') fputs("\\|", f);
+        else if (*t == '<') fputs("&lt;", f);
+        else fputc(*t, f);
+    }
+}
+
+void cd_config_print_keys(void *stream, int markdown)
 {
     FILE *f = stream ? (FILE *)stream : stdout;
-    char type[128], def[64], cond[256], m[160];
+    char type[128], def[64], cond[256];
+    if (markdown) {
+        fprintf(f, "| key | type and range | unit | default | meaning |\n|---|---|---|---|---|\n");
+        for (size_t i = 0; i < cd_config_nkeys; i++) {
+            const cd_key *k = &cd_config_keys[i];
+            type_text(k, type, sizeof type);
+            key_texts(k, def, sizeof def, cond, sizeof cond);
+            fprintf(f, "| `%s` | ", k->path);
+            md_cell(f, type);
+            fprintf(f, " | %s | %s%s%s | ", k->unit, strcmp(def, "required") && strcmp(def, "-") && strcmp(def, "see below") ? "`" : "",
+                    def, strcmp(def, "required") && strcmp(def, "-") && strcmp(def, "see below") ? "`" : "");
+            md_cell(f, k->meaning);
+            fprintf(f, ".");
+            md_cell(f, cond);
+            fprintf(f, " |\n");
+        }
+        return;
+    }
     int wk = 3, wt = 4, wu = 4;
     for (size_t i = 0; i < cd_config_nkeys; i++) {
         const cd_key *k = &cd_config_keys[i];
@@ -466,29 +520,8 @@ void cd_config_print_keys(void *stream)
     fprintf(f, "    MEANING\n\n");
     for (size_t i = 0; i < cd_config_nkeys; i++) {
         const cd_key *k = &cd_config_keys[i];
-        const cd_key *sel = cd_key_selector_of(k);
-        unsigned all = sel ? (1u << bits_of(sel)) - 1u : CD_ALL_CHOICES;
-        unsigned applies = k->applies ? k->applies : all;
-        unsigned required = k->required & applies;
         type_text(k, type, sizeof type);
-        if (k->def)
-            snprintf(def, sizeof def, "%s", k->def);
-        else
-            snprintf(def, sizeof def, "%s", required == applies ? "required" : required ? "see below" : "-");
-        cond[0] = 0;
-        if (sel && applies != all) {
-            mask_text(sel, applies, m, sizeof m);
-            snprintf(cond + strlen(cond), sizeof cond - strlen(cond), " Only for %s = %s.", sel->path, m);
-        }
-        if (sel && required && required != applies) {
-            mask_text(sel, required, m, sizeof m);
-            snprintf(cond + strlen(cond), sizeof cond - strlen(cond), " Required for %s = %s.", sel->path, m);
-        }
-        if (k->conflicts) {
-            size_t sl = cd_key_section_len(k->path);
-            snprintf(cond + strlen(cond), sizeof cond - strlen(cond), " Not together with %.*s.%s.", (int)sl,
-                     k->path, k->conflicts);
-        }
+        key_texts(k, def, sizeof def, cond, sizeof cond);
         fprintf(f, "%-*s  %-*s  %-*s  %s\n", wk, k->path, wt, type, wu, k->unit, def);
         fprintf(f, "    %s.%s\n", k->meaning, cond);
     }

@@ -86,7 +86,10 @@ static int cmd_run(int argc, char **argv)
             printf("usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n"
                    "                  [--backend omp|opencl] [--device cpu|gpu|auto]\n\n"
                    "Config keys (YAML; SI units):\n");
-            cd_config_print_keys(stdout);
+            cd_config_print_keys(stdout, 0);
+            return 0;
+        } else if (!strcmp(a, "--help-markdown")) { /* the key table of docs/config.md */
+            cd_config_print_keys(stdout, 1);
             return 0;
         } else if (!strcmp(a, "--resume") && has_value) opt.resume_path = argv[++i];
         else if (!strcmp(a, "--output") && has_value) opt.output_path = argv[++i];

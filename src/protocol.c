@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 #include "protocol.h"
+#include "io_h5.h"
 
 /* Slots of sim->s.control. */
 enum {
@@ -17,6 +18,7 @@ enum {
     CTL_N_PROBES,    /* bulk: probes done */
     CTL_P_SUM,       /* bulk: sum of pressure samples over the second half of a window [Pa] */
     CTL_P_COUNT,     /* bulk: number of those samples */
+    CTL_BASE_STEP,   /* bulk: step of the base state every probe starts from (a snapshot holds it) */
     CTL_K_FIRST = 16 /* bulk: K of probe k in slot CTL_K_FIRST + k [Pa] */
 };
 #define CTL_MAX_PROBES (CD_CONTROL_SLOTS - CTL_K_FIRST)
@@ -161,7 +163,6 @@ long long cd_protocol_steps_until_control(const cd_sim *sim)
     case CD_PHASE_HOLD:
     case CD_PHASE_COMPACT: return 1; /* the driven wall responds to the load every step */
     case CD_PHASE_BASE:
-        if (sim->s.control[CTL_PROBE_STEP] > 0) return 1; /* averaging the base pressure */
         return sim->cfg.check_every - (sim->s.step % sim->cfg.check_every);
     case CD_PHASE_PROBE: return 1; /* the pressure is averaged every step of the window's second half */
     default: return 1LL << 40;
@@ -253,22 +254,73 @@ static void report_fill(const cd_sim *sim, FILE *log)
                 "expected; set fill_fraction to the packing_fraction this run reached (time series)\n", c->fill_ratio, c->fill_fraction);
 }
 
-/* Scales particle positions about the ball centre and the ball radius to
- * the volumetric strain eps = -dV/V of the base state. */
+/* Bulk probe: puts the base state back (every column and the walls; the
+ * step, time and protocol state go on), then scales the particle positions
+ * about the ball centre and the ball radius to the volumetric strain
+ * eps = -dV/V (eps = 0: the reference window, unstrained).  The state is
+ * handed to the backend as a resumed run (forces kept, list rebuilt): the
+ * strained packing feels the new positions from the next force
+ * evaluation on.  Every window, the reference included, starts this way
+ * from the same base state, so the reference and the strained runs differ
+ * only by the strain: whatever the base state still does (creep,
+ * vibration) is the same in both and cancels in p - p_ref. */
 static int apply_strain(cd_sim *sim, double eps, char *err, size_t errlen)
 {
-    if (cd_sim_sync(sim, err, errlen)) return -1;
     cd_state *s = &sim->s;
-    int w = (int)s->control[CTL_WALL];
-    double r_new = s->control[CTL_R_BASE] * cbrt(1 - eps);
-    double f = r_new / s->walls[w].radius;
-    cd_vec3 c = s->walls[w].point;
-    for (size_t q = 0; q < s->n_particles; q++) s->position[q] = cd_v3_axpy(c, f, cd_v3_sub(s->position[q], c));
-    s->walls[w].radius = r_new;
-    s->control[CTL_STRAIN] = eps;
-    /* positions changed on the host: hand the state back, forces recomputed */
+    double control[CD_CONTROL_SLOTS], time = s->time;
+    long long step = s->step;
+    memcpy(control, s->control, sizeof control);
     if (sim->backend) sim->backend->stop(sim);
-    return cd_sim_start(sim, 1, err, errlen);
+    if (cd_state_copy(s, &sim->probe_base)) {
+        snprintf(err, errlen, "out of memory restoring the base state of the bulk probe");
+        return -1;
+    }
+    memcpy(s->control, control, sizeof control);
+    s->time = time;
+    s->step = step;
+    int w = (int)s->control[CTL_WALL];
+    if (eps > 0) {
+        double r_new = s->control[CTL_R_BASE] * cbrt(1 - eps);
+        double f = r_new / s->walls[w].radius;
+        cd_vec3 c = s->walls[w].point;
+        for (size_t q = 0; q < s->n_particles; q++) s->position[q] = cd_v3_axpy(c, f, cd_v3_sub(s->position[q], c));
+        s->walls[w].radius = r_new;
+    }
+    s->control[CTL_STRAIN] = eps;
+    s->control[CTL_PROBE_STEP] = (double)step;
+    return cd_sim_start(sim, 0, err, errlen);
+}
+
+/* Bulk probe: keeps the relaxed base state (host copy) and asks the run
+ * for a snapshot of it, from which a resumed run gets it back. */
+static int save_base(cd_sim *sim, char *err, size_t errlen)
+{
+    if (cd_sim_sync(sim, err, errlen)) return -1;
+    sim->s.control[CTL_BASE_STEP] = (double)sim->s.step;
+    if (cd_state_copy(&sim->probe_base, &sim->s)) {
+        snprintf(err, errlen, "out of memory keeping the base state of the bulk probe");
+        return -1;
+    }
+    sim->snapshot_request = 1;
+    return 0;
+}
+
+int cd_protocol_resume(cd_sim *sim, const char *path, char *err, size_t errlen)
+{
+    if (phase_of(sim) != CD_PHASE_PROBE || sim->probe_base.position) return 0;
+    long long base_step = (long long)sim->s.control[CTL_BASE_STEP];
+    if (cd_state_copy(&sim->probe_base, &sim->s)) {
+        snprintf(err, errlen, "out of memory reading the base state of the bulk probe");
+        return -1;
+    }
+    for (int k = cd_h5_snapshot_count(path, err, errlen) - 1; k >= 0; k--) {
+        if (cd_h5_read_snapshot(path, k, &sim->probe_base, err, errlen)) return -1;
+        if (sim->probe_base.step == base_step) return 0;
+        if (sim->probe_base.step < base_step) break;
+    }
+    snprintf(err, errlen, "%s: no snapshot of step %lld, the base state of the bulk probe; resume from an earlier checkpoint",
+             path, base_step);
+    return -1;
 }
 
 int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
@@ -322,38 +374,36 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
         }
         break;
     }
-    case CD_PHASE_BASE: {
-        double p0;
-        if (s->control[CTL_PROBE_STEP] > 0) {
-            /* relaxed: average the base pressure over a window */
-            if (!window_pressure(sim, load, &p0)) break;
-            s->control[CTL_P_BASE] = p0;
-            enter(sim, CD_PHASE_PROBE, log);
-            s->control[CTL_PROBE_STEP] = (double)s->step;
-            if (apply_strain(sim, sim->cfg.strain_min, err, errlen)) return -1;
-            break;
-        }
+    case CD_PHASE_BASE:
         if (relaxed(sim, err, errlen, &done)) return -1;
-        if (done) s->control[CTL_PROBE_STEP] = (double)s->step;
+        if (done) {
+            if (save_base(sim, err, errlen)) return -1;
+            enter(sim, CD_PHASE_PROBE, log);
+            if (apply_strain(sim, 0, err, errlen)) return -1; /* the reference window first */
+        }
         break;
-    }
     case CD_PHASE_PROBE: {
         double p;
         if (!window_pressure(sim, load, &p)) break;
-        double eps = s->control[CTL_STRAIN];
-        double dp = p - s->control[CTL_P_BASE];
-        double K = dp / eps; /* K = -V dp / dV with dV/V = -eps [Pa] */
-        int k = (int)s->control[CTL_N_PROBES];
-        if (k < CTL_MAX_PROBES) s->control[CTL_K_FIRST + k] = K;
-        s->control[CTL_N_PROBES] = k + 1;
-        if (log) fprintf(log, "\ncapdem: bulk probe: strain %.3g  dp %.6g Pa  K %.6g Pa\n", eps, dp, K);
-        double next = eps * 10;
-        if (next > sim->cfg.strain_max * (1 + 1e-9) || k + 1 >= CTL_MAX_PROBES) {
-            enter(sim, CD_PHASE_DONE, log);
+        double eps = s->control[CTL_STRAIN], next;
+        if (eps == 0) {
+            s->control[CTL_P_BASE] = p;
+            if (log) fprintf(log, "\ncapdem: bulk probe: reference window, p_ref %.9g Pa\n", p);
+            next = sim->cfg.strain_min;
         } else {
-            s->control[CTL_PROBE_STEP] = (double)s->step;
-            if (apply_strain(sim, next, err, errlen)) return -1;
+            double dp = p - s->control[CTL_P_BASE];
+            double K = dp / eps; /* K = -V dp / dV with dV/V = -eps [Pa] */
+            int k = (int)s->control[CTL_N_PROBES];
+            if (k < CTL_MAX_PROBES) s->control[CTL_K_FIRST + k] = K;
+            s->control[CTL_N_PROBES] = k + 1;
+            if (log) fprintf(log, "\ncapdem: bulk probe: strain %.3g  dp %.6g Pa  K %.6g Pa\n", eps, dp, K);
+            next = eps * 10;
+            if (next > sim->cfg.strain_max * (1 + 1e-9) || k + 1 >= CTL_MAX_PROBES) {
+                enter(sim, CD_PHASE_DONE, log);
+                break;
+            }
         }
+        if (apply_strain(sim, next, err, errlen)) return -1;
         break;
     }
     default: break;

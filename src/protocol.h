@@ -26,6 +26,11 @@ int cd_protocol_check(const cd_config *c, char *err, size_t errlen);
 /* Prepares a new run (phase, driven wall). */
 void cd_protocol_begin(cd_sim *sim);
 
+/* After a resume from path: a bulk probe in progress reads back its base
+ * state (the snapshot of control slot CTL_BASE_STEP).  Returns 0, or -1
+ * with a message. */
+int cd_protocol_resume(cd_sim *sim, const char *path, char *err, size_t errlen);
+
 /* Steps until the protocol must act again (>= 1). */
 long long cd_protocol_steps_until_control(const cd_sim *sim);
 

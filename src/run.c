@@ -136,6 +136,11 @@ int cd_run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
+        if (cd_protocol_resume(&sim, opt->resume_path, err, sizeof err)) {
+            fprintf(stderr, "capdem: --resume %s\n", err);
+            status = 2;
+            goto done;
+        }
         out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
     } else {
@@ -196,7 +201,9 @@ int cd_run(const cd_run_options *opt)
             status = 1;
             break;
         }
-        int thermo_due = sim.s.step % cfg.thermo_every == 0, snap_due = sim.s.step % cfg.snapshot_every == 0;
+        int thermo_due = sim.s.step % cfg.thermo_every == 0;
+        int snap_due = sim.s.step % cfg.snapshot_every == 0 || sim.snapshot_request;
+        sim.snapshot_request = 0;
         int last = sim.s.step == cfg.steps || protocol_done;
         if (thermo_due || snap_due || last) {
             if (cd_sim_sync(&sim, err, sizeof err)) {

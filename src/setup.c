@@ -373,5 +373,6 @@ void cd_sim_free(cd_sim *sim)
 {
     if (sim->backend) sim->backend->stop(sim);
     cd_state_free(&sim->s);
+    cd_state_free(&sim->probe_base);
     cd_neighbors_free(&sim->nb);
 }

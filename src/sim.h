@@ -52,6 +52,8 @@ typedef struct cd_sim {
     const cd_backend *backend;/* runs the steps; omp unless chosen otherwise */
     void *backend_data;       /* the backend's own state (device buffers) */
     char device_request[16];  /* --device: cpu | gpu | auto (OpenCL) */
+    cd_state probe_base;      /* bulk probe: the relaxed base state every probe starts from (zeroed until then) */
+    int snapshot_request;     /* set by a protocol: write a snapshot of this step (then cleared by the run) */
 } cd_sim;
 
 /* Builds a simulation from a validated config: shapes, particles placed as

@@ -77,3 +77,21 @@ void cd_state_free(cd_state *s)
         *slot = NULL;
     }
 }
+
+int cd_state_copy(cd_state *dst, const cd_state *src)
+{
+    if (!dst->position) { /* empty: allocate with src's sizes */
+        if (cd_state_alloc(dst, src->n_particles, src->n_prims, src->n_walls, src->cap_pairs)) return -1;
+    }
+    if (dst->n_particles != src->n_particles || dst->n_prims != src->n_prims || dst->n_walls != src->n_walls) return -1;
+    if (cd_state_reserve_pairs(dst, src->n_pairs)) return -1;
+    cd_state keep = *dst;
+    *dst = *src; /* counts, walls, control, time, step */
+    dst->cap_pairs = keep.cap_pairs;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        void **slot = cd_field_ptr(dst, &cd_fields[k]);
+        *slot = *cd_field_ptr(&keep, &cd_fields[k]);
+        memcpy(*slot, *cd_field_ptr((cd_state *)src, &cd_fields[k]), cd_state_rows(src, cd_fields[k].group) * cd_fields[k].elem_size);
+    }
+    return 0;
+}

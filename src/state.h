@@ -51,5 +51,10 @@ int cd_state_alloc(cd_state *s, size_t n_particles, size_t n_prims, size_t n_wal
 /* Grows the pair columns to at least cap rows, keeping the first n_pairs. */
 int cd_state_reserve_pairs(cd_state *s, size_t cap);
 void cd_state_free(cd_state *s);
+/* Copies every column (the rows in use) and every scalar of src into dst:
+ * dst either zeroed (its columns are then allocated with src's sizes) or
+ * allocated for the same particles, primitives and walls (its pair columns
+ * grow as needed).  Returns 0, or -1 (out of memory, or other sizes). */
+int cd_state_copy(cd_state *dst, const cd_state *src);
 
 #endif

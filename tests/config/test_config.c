@@ -476,7 +476,7 @@ static void test_print_keys_lists_every_key(void **state)
     (void)state;
     FILE *f = tmpfile();
     assert_non_null(f);
-    cd_config_print_keys(f);
+    cd_config_print_keys(f, 0);
     long n = ftell(f);
     char *text = calloc(1, (size_t)n + 1);
     rewind(f);

@@ -161,6 +161,53 @@ static void test_piston_starts_one_particle_size_above_the_packing(void **state)
     cd_config_free(&cfg);
 }
 
+/* Bulk-modulus probe on its CI twin (100 frictional hexapods, strains
+ * 1e-10 ... 1e-6, each applied to the same relaxed base state, with an
+ * unstrained reference window subtracted).  Linear elasticity: while no
+ * contact opens, closes or slides, dp is proportional to the strain, so K
+ * is the same at every strain.  From 1e-9 up, the particles move less than
+ * 1e-9 x the ball radius (5e-11 m), far below the overlaps (~1e-7 m) and
+ * the tangential slip the Coulomb limit allows; 1 % is the agreement the
+ * residual motion of the base state (kinetic energy < 1e-5 of the elastic
+ * energy) leaves.  The reference window reads the applied pressure
+ * (p = 1e-5 kn / L), to 0.1 %, as the base is in equilibrium with the ball.
+ * Then: the run stopped inside the probe phase and resumed (its base state
+ * read back from the snapshot of the base step) gives the same K values and
+ * the same final state, bit for bit. */
+static void test_bulk_modulus_linear_and_resumable(void **state)
+{
+    (void)state;
+    assert_int_equal(run_preset("bulk_modulus_hexapods_a3", "proto_bulk.h5", NULL, -1), 0);
+    static cd_sim a, b;
+    cd_config ca, cb;
+    load(&a, &ca, "bulk_modulus_hexapods_a3", "proto_bulk.h5", -1);
+    assert_int_equal((int)a.s.control[0], CD_PHASE_DONE);
+    int n = (int)a.s.control[9];
+    assert_int_equal(n, 5);
+    double p_target = ca.pressure_ratio * ca.kn / a.shapes[0].tip_length, p_ref = a.s.control[6];
+    print_message("p_ref %.9g Pa, applied %.9g Pa\n", p_ref, p_target);
+    assert_true(fabs(p_ref / p_target - 1) < 1e-3);
+    double k_max = a.s.control[16 + n - 1]; /* strain 1e-6 */
+    for (int k = 0; k < n; k++) {
+        double eps = ca.strain_min * pow(10, k), K = a.s.control[16 + k];
+        print_message("strain %.0e: K = %.6g Pa (%.4f of K at 1e-6)\n", eps, K, K / k_max);
+        assert_true(K > 0);
+        if (eps >= 1e-9 * (1 - 1e-9)) assert_true(fabs(K / k_max - 1) < 0.01);
+    }
+    /* interrupted in the probe phase, resumed */
+    long long base_step = (long long)a.s.control[12];
+    assert_int_equal(run_preset("bulk_modulus_hexapods_a3", "proto_bulk_part.h5", NULL, base_step + 25000), 0);
+    assert_int_equal(run_preset("bulk_modulus_hexapods_a3", NULL, "proto_bulk_part.h5", -1), 0);
+    load(&b, &cb, "bulk_modulus_hexapods_a3", "proto_bulk_part.h5", -1);
+    assert_int_equal(a.s.step, b.s.step);
+    assert_memory_equal(a.s.control, b.s.control, sizeof a.s.control);
+    assert_memory_equal(a.s.position, b.s.position, a.s.n_particles * sizeof(cd_vec3));
+    cd_sim_free(&a); cd_sim_free(&b);
+    cd_config_free(&ca); cd_config_free(&cb);
+    unlink("proto_bulk.h5");
+    unlink("proto_bulk_part.h5");
+}
+
 /* Contacts per particle over the particles that have any (rattlers out),
  * counted as constraints: Z_c = 2 (n_pp + n_w) / N_p*.  Isostaticity is
  * n_constraints = n_dof; a particle-particle contact and a wall contact are
@@ -240,6 +287,7 @@ int main(void)
         cmocka_unit_test(test_deposit_resumed_equals_uninterrupted),
         cmocka_unit_test(test_fill_ratio_picks_count_and_lattice_picks_height),
         cmocka_unit_test(test_piston_starts_one_particle_size_above_the_packing),
+        cmocka_unit_test(test_bulk_modulus_linear_and_resumable),
         cmocka_unit_test(test_radial_compaction_frictionless_hexapods_isostatic),
         cmocka_unit_test(test_radial_compaction_frictionless_spheres_isostatic),
     };
