@@ -125,6 +125,29 @@ static void remove_net_motion(cd_sim *sim, cd_vec3 centre)
         s->velocity[q] = cd_v3_sub(s->velocity[q], cd_v3_cross(omega, cd_v3_sub(s->position[q], centre)));
 }
 
+/* Removes the rigid rotation about the cylinder axis (the y axis through
+ * x = z = 0) from the initial velocities.  Frictionless cylinder walls,
+ * floor and piston exert no torque about that axis, and neither does
+ * gravity: the angular momentum about it is conserved, so a packing that
+ * starts with some (random velocities of a finite sample do) turns for
+ * ever, its kinetic energy never falls below the relaxation criterion. */
+static void remove_axial_rotation(cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    double L = 0, I = 0; /* [kg m^2/s], [kg m^2] */
+    for (size_t q = 0; q < s->n_particles; q++) {
+        cd_vec3 r = s->position[q], v = s->velocity[q];
+        L += s->mass[q] * (r.z * v.x - r.x * v.z) + s->angmom[q].y;
+        I += s->mass[q] * (r.x * r.x + r.z * r.z);
+    }
+    if (!(I > 0)) return;
+    double w = L / I; /* [1/s] */
+    for (size_t q = 0; q < s->n_particles; q++) {
+        s->velocity[q].x -= w * s->position[q].z;
+        s->velocity[q].z += w * s->position[q].x;
+    }
+}
+
 void cd_protocol_begin(cd_sim *sim)
 {
     const char *p = sim->cfg.protocol;
@@ -133,6 +156,7 @@ void cd_protocol_begin(cd_sim *sim)
         /* the piston is the last wall: the box's top wall, or the one added
          * over the cylinder */
         sim->s.control[CTL_WALL] = !strcmp(sim->cfg.domain, "box") ? 1 : (double)(sim->s.n_walls - 1);
+        if (!strcmp(sim->cfg.domain, "cylinder") && sim->cfg.wall_friction == 0) remove_axial_rotation(sim);
         enter(sim, CD_PHASE_SETTLE, NULL);
     } else if (!strcmp(p, "radial_compaction") || !strcmp(p, "bulk_modulus")) {
         sim->s.control[CTL_WALL] = 0;
