@@ -4,8 +4,8 @@
     /usr/bin/python3 bench/preset_times.py BUILD --deposit-ref D.h5:CPU_S --radial-ref R.h5:CPU_S [--steps 3000]
 
 D.h5 and R.h5 are complete runs of one deposit preset and one radial preset
-(configs/protocols/, the file named after the preset), made with --threads
-1, and CPU_S the CPU seconds each took (/usr/bin/time).  The model, per preset
+(configs/protocols/; R.h5 named after its preset, for its twin), made with
+--threads 1, and CPU_S the CPU seconds each took (/usr/bin/time).  The model, per preset
 (docs/performance.md states it with the results):
 
     CPU seconds = N x (n_fall c_start + (n_settle - n_fall + n_after) c_dense)
@@ -17,8 +17,8 @@ D.h5 and R.h5 are complete runs of one deposit preset and one radial preset
   c_start   CPU seconds per particle-step of the preset's first --steps steps
             (one thread), measured here;
   c_dense   the reference run's: its CPU time solved for c_dense with its
-            own c_start and step counts; carried to the other presets of
-            its kind by c_start / c_start(reference);
+            own c_start (a shortened run of the config it echoes) and step
+            counts; carried to each preset by c_start / c_start(reference);
   n_after   steps after settling: the reference run's, the same for every
             deposit preset; for the radial presets, the reference's count
             times the ratio of the presets' CI twins' step counts (the
@@ -84,16 +84,27 @@ def shortened(build, cfg, steps, work):
     return n, dt, h, cpu / (n * steps)
 
 
-def reference(spec):
-    """A complete reference run 'FILE.h5:CPU_SECONDS' -> its settle-end and
-    done steps (from the time series) and its CPU seconds."""
+def reference(spec, build, steps, work):
+    """A complete reference run 'FILE.h5:CPU_SECONDS': its step counts (from
+    the time series), its own c_start (a shortened run of the config the
+    file echoes) and the c_dense its CPU time implies:
+    cpu = N (n_fall c_start + (n_done - n_fall) c_dense)."""
     path, cpu = spec.rsplit(":", 1)
     st, ph = phases(path)
     if not (ph == PHASE_DONE).any():
         sys.exit(f"preset_times: {path}: the protocol did not finish; a reference must be a complete run")
     done_at = int(st[np.argmax(ph == PHASE_DONE)])
     settle_end = int(st[np.argmax(ph > 1)]) if (ph == 1).any() else 0
-    return dict(path=path, cpu=float(cpu), done_at=done_at, settle_end=settle_end)
+    with h5py.File(path, "r") as f:
+        text = f["parameters/config"][()]
+    cfg = os.path.join(work, "reference.yaml")
+    with open(cfg, "wb") as f:
+        f.write(text if isinstance(text, bytes) else text.encode())
+    n, dt, h, c_start = shortened(build, cfg, steps, work)
+    n_fall = settle_end // 3
+    c_dense = (float(cpu) / n - n_fall * c_start) / (done_at - n_fall)
+    return dict(path=path, cpu=float(cpu), n=n, done_at=done_at, settle_end=settle_end, c_start=c_start,
+                c_dense=c_dense, after=done_at - settle_end, name=os.path.basename(path)[:-3])
 
 
 def twin_steps(build, name, presets, work):
@@ -115,7 +126,8 @@ def main():
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="preset_times.")
     try:
-        refs = {"deposit": reference(a.deposit_ref), "radial": reference(a.radial_ref)}
+        refs = {"deposit": reference(a.deposit_ref, a.build, a.steps, work),
+                "radial": reference(a.radial_ref, a.build, a.steps, work)}
         rows = []
         for cfg in sorted(glob.glob(os.path.join(a.presets, "*.yaml"))):
             name = os.path.basename(cfg)[:-5]
@@ -123,7 +135,7 @@ def main():
                 continue  # radial compaction and then the probe windows: see docs/performance.md
             kind = "deposit" if name.startswith("deposit") else "radial"
             n, dt, h, c_start = shortened(a.build, cfg, a.steps, work)
-            r = dict(preset=name, kind=kind, n=n, dt=dt, h=h, c_start=c_start, cfg=cfg)
+            r = dict(preset=name, kind=kind, n=n, dt=dt, h=h, c_start=c_start)
             if kind == "deposit":
                 r["n_settle"] = math.ceil(3 * math.sqrt(2 * h / 9.81) / dt)
                 r["n_fall"] = r["n_settle"] // 3
@@ -131,21 +143,18 @@ def main():
                 r["n_settle"] = r["n_fall"] = 0
                 r["twin"] = twin_steps(a.build, "radial_spheres" if name.endswith("_a1") else name, a.presets, work)
             rows.append(r)
-        # c_dense of each reference from its CPU time: cpu = N (n_fall c_start + (n_total - n_fall) c_dense)
         for kind, ref in refs.items():
-            me = [r for r in rows if os.path.basename(r["cfg"])[:-5] in os.path.basename(ref["path"])]
-            if not me:
-                sys.exit(f"preset_times: {ref['path']}: name it after its preset (e.g. deposit_cylinder_D6L.h5)")
-            me = me[0]
-            ref["row"] = me
-            ref["c_dense"] = (ref["cpu"] / me["n"] - me["n_fall"] * me["c_start"]) / (ref["done_at"] - me["n_fall"])
-            ref["after"] = ref["done_at"] - ref["settle_end"]
+            if kind == "radial":
+                twin = [r for r in rows if r["preset"] in ref["name"]]
+                if not twin:
+                    sys.exit(f"preset_times: {ref['path']}: name it after its preset (e.g. radial_hexapods_a3.h5)")
+                ref["twin"] = twin[0]["twin"]
         out = []
         for r in rows:
             ref = refs[r["kind"]]
-            c_dense = ref["c_dense"] * r["c_start"] / ref["row"]["c_start"]
-            n_after = ref["after"] if r["kind"] == "deposit" else round(ref["after"] * r["twin"] / ref["row"]["twin"])
-            measured = r is ref["row"]
+            c_dense = ref["c_dense"] * r["c_start"] / ref["c_start"]
+            n_after = ref["after"] if r["kind"] == "deposit" else round(ref["after"] * r["twin"] / ref["twin"])
+            measured = r["preset"] in ref["name"] and r["n"] == ref["n"]
             cpu = ref["cpu"] if measured else r["n"] * (r["n_fall"] * r["c_start"] + (r["n_settle"] - r["n_fall"] + n_after) * c_dense)
             o = dict(preset=r["preset"], N=r["n"], steps=r["n_settle"] + n_after, settle_steps=r["n_settle"],
                      us_per_particle_step_start=r["c_start"] * 1e6, us_per_particle_step_dense=c_dense * 1e6,
