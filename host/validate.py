@@ -6,7 +6,7 @@ usage:
                           [--alphas 3,9,1,1.5,2,5,7] [--seeds 1,2] [--n 1000]
                           [--friction-alphas 3,9] [--friction-mu 0.4]
                           [--threads 2] [--jobs 1] [--max-steps 20000000]
-                          [--no-run] [--figures DIR] [--markdown] [--check] [--ci] [--fresh]
+                          [--no-run] [--wait] [--figures DIR] [--markdown] [--check] [--ci] [--fresh]
 
 Study 1 (seed 001): hexapods of aspect ratio alpha under radial compaction
 at p L / k_n = 1e-5, frictionless, and alpha = 3, 9 again at mu = 0.4.  For
@@ -27,9 +27,9 @@ each case (alpha, mu, seed) the driver
   4. records every invocation's wall time, CPU time, steps and load average
      in timing.json.
 
-Then it collects every finished case of the selection into
-OUT/study1/results.json and results.csv (mean and standard error over
-seeds), prints the table (Markdown with --markdown), draws the figures into
+Then it collects every finished case under OUT/study1 (not only the
+selection) into OUT/study1/results.json and results.csv (mean and standard
+error over seeds for each alpha, mu, N), prints the selection's table (Markdown with --markdown), draws the figures into
 --figures DIR, and with --check asserts the bands of the CI smoke test
 (docs/validation.md, "Smoke test"); exit 1 when a check fails.
 
@@ -44,6 +44,7 @@ import datetime
 import json
 import math
 import os
+import re
 import resource
 import shutil
 import string
@@ -177,6 +178,56 @@ def lock_holder(case):
             continue
         return pid
     return None
+
+
+def cpu_seconds(pid):
+    """User + system CPU time of a live process [s] (Linux /proc), or None."""
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def wait_for(case, pid):
+    """Wait until no live process holds the case.  When the process was a
+    capdem whose driver was stopped (its driver's line is the lock's first),
+    its segment goes into timing.json: start from the lock file, end and CPU
+    time from the last poll (at most 5 s late)."""
+    try:
+        with open(case.lock) as f:
+            lock_text = f.read()
+        start = lock_text.split()[1]
+    except (OSError, IndexError):
+        lock_text, start = "", None
+    st0 = run_state_unlocked(case.h5)
+    cpu = None
+    while lock_holder(case) is not None:
+        c = cpu_seconds(pid)
+        cpu = c if c is not None else cpu
+        time.sleep(5)
+    st1 = run_state(case.h5)
+    if "pid=%d capdem" % pid in lock_text and start:
+        t0 = datetime.datetime.strptime(start, "%Y-%m-%dT%H:%M:%SZ").replace(tzinfo=datetime.timezone.utc)
+        wall = (datetime.datetime.now(datetime.timezone.utc) - t0).total_seconds()
+        record_timing(case, {"start": start, "end": now(), "wall_s": round(wall, 1), "cpu_s": cpu, "rc": None,
+                             "step_from": None, "step_to": st1[1] if st1 else None,
+                             "phase": st1[2] if st1 else None, "threads": None, "loadavg_start": None,
+                             "loadavg_end": os.getloadavg()[0], "cores": os.cpu_count(),
+                             "note": "run by a driver that was stopped; waited for by process %d; wall time "
+                                     "from the lock file, up to 5 s late; first step after %s" % (
+                                         os.getpid(), st0[1] if st0 else "?")})
+
+
+def run_state_unlocked(h5path):
+    """run_state of a file another process is writing (HDF5 file locking off)."""
+    try:
+        with h5py.File(h5path, "r", locking=False) as f:
+            n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]), len(f["walls/control"]))
+            return (n, int(f["walls/step"][n - 1]), int(round(float(f["walls/control"][n - 1][0])))) if n else None
+    except (OSError, KeyError, TypeError, ValueError):
+        return None
 
 
 def record_timing(case, entry):
@@ -334,7 +385,7 @@ def metrics(case):
             timing = json.load(f)
     p_applied = 1.0e-5 * 1.0e5 / d["sample"]["L"]
     return {
-        "alpha": case.alpha, "eta": eta_of(case.alpha), "mu": case.mu, "seed": case.seed, "n": case.n,
+        "alpha": case.alpha, "eta": eta_of(case.alpha), "mu": case.mu, "seed": case.seed, "n": case.n, "ci": case.ci,
         "case": case.name, "step": d["step"], "time_s": d["time"],
         "n_particles_in_contact": npc, "n_rattlers": net["n_rattlers"],
         "n_contacts": net["n_contacts"], "n_wall_contacts": net["n_wall_contacts"], "n_bonds": net["n_bonds"],
@@ -351,9 +402,10 @@ def metrics(case):
         "k_tail": nf.get("k"), "k_tail_lo": nf.get("k_lo"), "k_tail_hi": nf.get("k_hi"),
         "pressure_over_p": d["stress"]["container_pressure"] / p_applied,
         "run_wall_s": round(sum(t["wall_s"] for t in timing), 1),
-        "run_cpu_s": round(sum(t["cpu_s"] for t in timing), 1),
+        "run_cpu_s": round(sum(t["cpu_s"] or 0 for t in timing), 1),
         "run_segments": len(timing),
-        "run_max_loadavg": max([t["loadavg_start"] for t in timing] + [t["loadavg_end"] for t in timing] or [0]),
+        "run_max_loadavg": max([t[k] for t in timing for k in ("loadavg_start", "loadavg_end")
+                                if t.get(k) is not None] or [0]),
     }
 
 
@@ -363,13 +415,13 @@ AGG_KEYS = ["phi_container", "phi_core_1L", "phi_core_3L", "lambda", "Z", "Z_c",
 
 
 def aggregate(rows):
-    """Mean and standard error over seeds for each (alpha, mu)."""
+    """Mean and standard error over seeds for each (alpha, mu, N, CI settings)."""
     groups = {}
     for r in rows:
-        groups.setdefault((r["alpha"], r["mu"]), []).append(r)
+        groups.setdefault((r["alpha"], r["mu"], r["n"], r["ci"]), []).append(r)
     out = []
-    for (a, mu), rs in sorted(groups.items()):
-        g = {"alpha": a, "eta": eta_of(a), "mu": mu, "n": rs[0]["n"], "seeds": sorted(r["seed"] for r in rs)}
+    for (a, mu, n, ci), rs in sorted(groups.items()):
+        g = {"alpha": a, "eta": eta_of(a), "mu": mu, "n": n, "ci": ci, "seeds": sorted(r["seed"] for r in rs)}
         for k in AGG_KEYS:
             v = np.array([r[k] for r in rs if r.get(k) is not None], dtype=float)
             g[k] = float(v.mean()) if len(v) else None
@@ -400,12 +452,12 @@ def ref(v, digits=2):
 
 def markdown(agg):
     lines = []
-    lines.append("| α | η | μ | seeds | Φ ball (paper fit; text) | Φ core 1 L | λ (paper) | Z (paper) "
+    lines.append("| α | η | μ | N | seeds | Φ ball (paper fit; text) | Φ core 1 L | λ (paper) | Z (paper) "
                  "| Z_c (paper) | Z_c with wall contacts / isostatic | valence (paper) | cascade β (paper) |")
-    lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for g in agg:
-        lines.append("| %g | %.3f | %g | %s | %s (%.3f; %s) | %s | %s (%s) | %s (%s) | %s (%s) | %s / %.2f | %s (%s) | %s (%s) |" % (
-            g["alpha"], g["eta"], g["mu"], ",".join(str(s) for s in g["seeds"]),
+        lines.append("| %g | %.3f | %g | %d | %s | %s (%.3f; %s) | %s | %s (%s) | %s (%s) | %s (%s) | %s / %.2f | %s (%s) | %s (%s) |" % (
+            g["alpha"], g["eta"], g["mu"], g["n"], ",".join(str(s) for s in g["seeds"]),
             pm(g, "phi_container"), g["phi_fit_paper"], ref(g["phi_text_paper"]),
             pm(g, "phi_core_1L"), pm(g, "lambda"), ref(g["lambda_paper"], 1), pm(g, "Z", 2), ref(g["Z_paper"], 1),
             pm(g, "Z_c", 2), ref(g["Z_c_paper"], 0), pm(g, "Z_c_walls", 2), g["Z_c_isostatic"],
@@ -414,13 +466,13 @@ def markdown(agg):
 
 
 def print_table(agg):
-    hdr = "%5s %5s %4s %5s  %-15s %-6s %-15s %-15s %-13s %-13s %-13s %-13s %-13s %s" % (
-        "alpha", "eta", "mu", "seeds", "phi_ball", "fit", "phi_core_1L", "lambda", "Z", "Z_c", "Z_c+walls",
+    hdr = "%5s %5s %4s %5s %5s  %-15s %-6s %-15s %-15s %-13s %-13s %-13s %-13s %-13s %s" % (
+        "alpha", "eta", "mu", "N", "seeds", "phi_ball", "fit", "phi_core_1L", "lambda", "Z", "Z_c", "Z_c+walls",
         "valence", "beta", "wall_s")
     print(hdr)
     for g in agg:
-        print("%5g %5.3f %4g %5d  %-15s %-6.3f %-15s %-15s %-13s %-13s %-13s %-13s %-13s %s" % (
-            g["alpha"], g["eta"], g["mu"], len(g["seeds"]), pm(g, "phi_container"), g["phi_fit_paper"],
+        print("%5g %5.3f %4g %5d %5d  %-15s %-6.3f %-15s %-15s %-13s %-13s %-13s %-13s %-13s %s" % (
+            g["alpha"], g["eta"], g["mu"], g["n"], len(g["seeds"]), pm(g, "phi_container"), g["phi_fit_paper"],
             pm(g, "phi_core_1L"), pm(g, "lambda"), pm(g, "Z", 2), pm(g, "Z_c", 2), pm(g, "Z_c_walls", 2),
             pm(g, "valence", 2), pm(g, "cascade_beta", 2), pm(g, "run_wall_s", 0)))
 
@@ -430,7 +482,7 @@ def write_results(out, rows, agg):
         json.dump({"generated": now(), "paper": {k: {str(a): v for a, v in t.items()} if isinstance(t, dict) else t
                                                   for k, t in PAPER1.items()},
                    "runs": rows, "cases": agg}, f, indent=1)
-    keys = ["alpha", "eta", "mu", "n", "seeds"] + [x for k in AGG_KEYS for x in (k, k + "_se")] + [
+    keys = ["alpha", "eta", "mu", "n", "ci", "seeds"] + [x for k in AGG_KEYS for x in (k, k + "_se")] + [
         "phi_fit_paper", "phi_text_paper", "lambda_paper", "Z_paper", "Z_c_paper", "valence_paper", "beta_paper"]
     with open(os.path.join(out, "results.csv"), "w", newline="") as f:
         w = csv.writer(f)
@@ -582,6 +634,21 @@ def check_bands(rows):
 
 # --------------------------------------------------------------------------- main
 
+def finished_cases_in(out):
+    """Every case folder under OUT/study1 whose run is done and analysed."""
+    found = []
+    for name in sorted(os.listdir(out)):
+        m = re.fullmatch(r"a([0-9p]+)_mu([0-9p]+)_n(\d+)_s(\d+)(_ci)?", name)
+        if not m:
+            continue
+        c = Case(float(m.group(1).replace("p", ".")), float(m.group(2).replace("p", ".")), int(m.group(4)),
+                 int(m.group(3)), out, bool(m.group(5)))
+        if c.name == name and os.path.exists(c.analysis) and os.path.exists(c.packing_m1) \
+                and lock_holder(c) is None:
+            found.append(c)
+    return found
+
+
 def parse_list(s, typ=float):
     return [typ(x) for x in s.split(",") if x.strip()] if s else []
 
@@ -610,6 +677,10 @@ def study1(args):
 
     def one(c):
         holder = lock_holder(c)
+        if holder is not None and args.wait:
+            say("  %s: being run by process %d (%s); waiting for it" % (c.name, holder, peek(c.h5)))
+            wait_for(c, holder)
+            holder = None
         if holder is not None:
             say("  %s: being run by process %d (%s); skipped" % (c.name, holder, peek(c.h5)))
             return False
@@ -638,7 +709,8 @@ def study1(args):
         print("  %-22s %8d steps  %7.1f s wall (%d segment(s))  N_p* %d" % (
             r["case"], r["step"], r["run_wall_s"], r["run_segments"], r["n_particles_in_contact"]))
     agg = aggregate(rows)
-    write_results(out, rows, agg)
+    every = [metrics(c) for c in finished_cases_in(out)]  # results.json: every finished case of OUT
+    write_results(out, every, aggregate(every))
     if agg:
         print_table(agg)
         if args.markdown:
@@ -670,6 +742,9 @@ def main():
     p1.add_argument("--steps", type=int, default=5000000, help="first step cap (the presets')")
     p1.add_argument("--max-steps", type=int, default=20000000, help="largest cap a resume may set")
     p1.add_argument("--no-run", action="store_true", help="only collect finished cases")
+    p1.add_argument("--wait", action="store_true",
+                    help="wait for a case another process is running (a capdem left by a killed driver) "
+                         "instead of skipping it, so that one simulation runs at a time")
     p1.add_argument("--reanalyse", action="store_true", help="run capdem analyze again on finished cases")
     p1.add_argument("--fresh", action="store_true", help="delete the selected cases' folders first")
     p1.add_argument("--figures", help="write the PNG figures into this folder")
