@@ -493,7 +493,7 @@ def write_results(out, rows, agg):
 
 # ----------------------------------------------------------------------- figures
 
-def figures(outdir, cases, agg, n):
+def figures(outdir, cases, agg, n, agg_all=None):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -605,6 +605,35 @@ def figures(outdir, cases, agg, n):
     fig.savefig(os.path.join(outdir, "study1_bond_forces.png"), dpi=110)
     plt.close(fig)
     written.append("study1_bond_forces.png")
+    # finite size: Phi of the ball and of the core against N^(-1/3), every N of OUT
+    by_alpha = {}
+    for g in agg_all or []:
+        if g["mu"] == 0:
+            by_alpha.setdefault(g["alpha"], []).append(g)
+    by_alpha = {a: gs for a, gs in by_alpha.items() if len({g["n"] for g in gs}) >= 2}
+    if by_alpha:
+        fig, ax = plt.subplots(figsize=(5.5, 4))
+        for k, (a, gs) in enumerate(sorted(by_alpha.items())):
+            gs = sorted(gs, key=lambda g: g["n"])
+            x = np.array([g["n"] ** (-1.0 / 3.0) for g in gs])
+            col = "C%d" % k
+            for key, mfc, name in (("phi_container", None, "ball"), ("phi_core_1L", "none", "core 1 L")):
+                y = np.array([g[key] for g in gs])
+                e = np.array([g[key + "_se"] or 0.0 for g in gs])
+                ax.errorbar(x, y, e, fmt="o", mfc=mfc, color=col, capsize=3, label="α = %g, %s" % (a, name))
+            ax.axhline(phi_fit(eta_of(a)), color=col, ls="--", lw=0.8)
+            ax.axvline(PAPER1["n_particles"] ** (-1.0 / 3.0), color="gray", lw=0.8)
+            for g in gs:
+                ax.annotate("%d%s" % (g["n"], " ci" if g["ci"] else ""), (g["n"] ** (-1.0 / 3.0), g["phi_container"]),
+                            textcoords="offset points", xytext=(3, -10), fontsize=7)
+        ax.set_xlabel("N^(-1/3) (grey line: the paper's N = 8385)")
+        ax.set_ylabel("packing fraction Φ")
+        ax.set_title("finite size (dashed: seed 001 fit at that η)")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "study1_phi_finite_size.png"), dpi=110)
+        plt.close(fig)
+        written.append("study1_phi_finite_size.png")
     print("figures: %s (%s)" % (outdir, ", ".join(written)))
 
 
@@ -693,6 +722,10 @@ def study1(args):
                 break
         if done:
             return analyse(c, capdem, force=args.reanalyse)
+        if args.no_run:
+            st = run_state(c.h5)
+            say("  %s: %s" % (c.name, "not started" if st is None else
+                              "stopped at step %d in phase %d (resumable)" % (st[1], st[2])))
         return False
 
     if args.jobs > 1:
@@ -710,14 +743,15 @@ def study1(args):
             r["case"], r["step"], r["run_wall_s"], r["run_segments"], r["n_particles_in_contact"]))
     agg = aggregate(rows)
     every = [metrics(c) for c in finished_cases_in(out)]  # results.json: every finished case of OUT
-    write_results(out, every, aggregate(every))
+    agg_all = aggregate(every)
+    write_results(out, every, agg_all)
     if agg:
         print_table(agg)
         if args.markdown:
             print()
             print(markdown(agg))
     if args.figures and done_cases:
-        figures(args.figures, done_cases, agg, args.n)
+        figures(args.figures, done_cases, agg, args.n, agg_all)
     if args.check:
         if pending:
             print("FAIL: cases not finished: " + ", ".join(pending))
