@@ -7,6 +7,8 @@ usage:
                           [--friction-alphas 3,9] [--friction-mu 0.4]
                           [--threads 2] [--jobs 1] [--max-steps 20000000]
                           [--no-run] [--wait] [--figures DIR] [--markdown] [--check] [--ci] [--fresh]
+  host/validate.py study2|study3|study4 [--build build] [--out runs/validation] [--psis ...] [--seeds 1,2]
+                          [--n N] [--plan] [--no-run] [--figures DIR]     (host/validate_deposit.py)
 
 Study 1 (seed 001): hexapods of aspect ratio alpha under radial compaction
 at p L / k_n = 1e-5, frictionless, and alpha = 3, 9 again at mu = 0.4.  For
@@ -788,15 +790,30 @@ def main():
                     help="the CI presets' relaxation check (energy steady to 1e-3 every 2000 steps, not 1e-4 "
                          "every 5000); case folders get a _ci suffix")
     for name, what in (("study2", "2D crosses, deposit and compress (seed 000)"),
-                       ("study3", "3D stars in a cylinder (seed 000)"),
-                       ("study4", "spheres as the reference (seed 000, Mueth)")):
-        sub.add_parser(name, help=what + ": not implemented yet")
+                       ("study3", "3D stars in a cylinder, deposit and compress (seed 000)"),
+                       ("study4", "spheres in the 2D box and the cylinder (seed 000, Mueth)")):
+        p = sub.add_parser(name, help=what)
+        p.add_argument("--build", default="build", help="build folder holding capdem")
+        p.add_argument("--out", default="runs/validation", help="output folder (runs under OUT/%s)" % name)
+        if name != "study4":
+            p.add_argument("--psis", default="", help="sphericities of Table S1 (default: the issue's four)")
+        p.add_argument("--seeds", default="1,2")
+        p.add_argument("--n", type=int, default=0, help="particles per run (default: the paper's count rule)")
+        p.add_argument("--width-l", type=float, default=0,
+                       help="box width / cylinder diameter in L (default: the study's; smaller only for tests)")
+        p.add_argument("--threads", type=int, default=2)
+        p.add_argument("--steps", type=int, default=5000000)
+        p.add_argument("--max-steps", type=int, default=40000000)
+        p.add_argument("--plan", action="store_true", help="print the cases (count, size, dt) and stop")
+        p.add_argument("--no-run", action="store_true")
+        p.add_argument("--reanalyse", action="store_true")
+        p.add_argument("--figures", help="write the PNG figures into this folder")
     args = ap.parse_args()
     if args.study == "study1":
         return study1(args)
-    print("validate.py %s: not implemented yet (docs/validation.md says what is pending)" % args.study,
-          file=sys.stderr)
-    return 2
+    sys.dont_write_bytecode = True  # no host/__pycache__ in the worktree
+    import validate_deposit
+    return validate_deposit.run_study(args)
 
 
 if __name__ == "__main__":
