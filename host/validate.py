@@ -31,9 +31,10 @@ each case (alpha, mu, seed) the driver
 
 Then it collects every finished case under OUT/study1 (not only the
 selection) into OUT/study1/results.json and results.csv (mean and standard
-error over seeds for each alpha, mu, N), prints the selection's table (Markdown with --markdown), draws the figures into
---figures DIR, and with --check asserts the bands of the CI smoke test
-(docs/validation.md, "Smoke test"); exit 1 when a check fails.
+error over seeds for each alpha, mu, N), prints the selection's table
+(Markdown with --markdown), draws the figures into --figures DIR, and with
+--check asserts the bands of the CI smoke test (docs/validation.md, "Smoke
+test"); exit 1 when a check fails.
 
 Everything is resumable: run it again with the same arguments and it skips
 what is done, resumes what was interrupted and analyses what is new.  Every
@@ -314,7 +315,7 @@ def advance(case, args, capdem):
                 f.write("pid=%d capdem\n" % proc.pid)
             rc = proc.wait()
         wall = time.time() - t0
-        ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)  # with --jobs > 1, includes runs that ended meanwhile
         st1 = run_state(case.h5)
         entry = {"start": start, "end": now(), "wall_s": round(wall, 2),
                  "cpu_s": round(ru1.ru_utime + ru1.ru_stime - ru0.ru_utime - ru0.ru_stime, 2),
@@ -439,6 +440,38 @@ def aggregate(rows):
     return out
 
 
+def finite_size(agg_all):
+    """Phi of the ball against N^(-1/3) for each frictionless alpha with three
+    or more N: least squares Phi = Phi_inf + c N^(-1/3) over the per-N means
+    (a wall layer of fixed thickness in a ball of radius ~ N^(1/3)), and the
+    line's value at the paper's N = 8385 and at N -> infinity, with standard
+    errors from the residuals.  Mixes the smoke-test (--ci) and the study's
+    relaxation checks, which end in the same Phi (Phi stops changing long
+    before either check is met)."""
+    out = []
+    by_alpha = {}
+    for g in agg_all:
+        if g["mu"] == 0:
+            by_alpha.setdefault(g["alpha"], []).append(g)
+    for a, gs in sorted(by_alpha.items()):
+        if len({g["n"] for g in gs}) < 3:
+            continue
+        x = np.array([g["n"] ** (-1.0 / 3.0) for g in gs])
+        y = np.array([g["phi_container"] for g in gs])
+        A = np.c_[np.ones_like(x), x]
+        coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+        dof = len(x) - 2
+        s2 = float(np.sum((y - A @ coef) ** 2) / dof) if dof > 0 else float("nan")
+        cov = s2 * np.linalg.inv(A.T @ A)
+        x8 = PAPER1["n_particles"] ** (-1.0 / 3.0)
+        v8 = np.array([1.0, x8])
+        out.append({"alpha": a, "eta": eta_of(a), "points": [[int(g["n"]), g["phi_container"]] for g in gs],
+                    "phi_inf": float(coef[0]), "phi_inf_se": float(math.sqrt(cov[0, 0])),
+                    "slope": float(coef[1]), "phi_at_8385": float(v8 @ coef),
+                    "phi_at_8385_se": float(math.sqrt(v8 @ cov @ v8)), "phi_fit_paper": phi_fit(eta_of(a))})
+    return out
+
+
 def pm(g, k, digits=3):
     v = g.get(k)
     if v is None:
@@ -480,10 +513,16 @@ def print_table(agg):
 
 
 def write_results(out, rows, agg):
+    fs = finite_size(agg)
     with open(os.path.join(out, "results.json"), "w") as f:
         json.dump({"generated": now(), "paper": {k: {str(a): v for a, v in t.items()} if isinstance(t, dict) else t
                                                   for k, t in PAPER1.items()},
-                   "runs": rows, "cases": agg}, f, indent=1)
+                   "runs": rows, "cases": agg, "finite_size": fs}, f, indent=1)
+    for r in fs:
+        print("finite size, alpha %g: Phi_ball = %.3f %+.3f N^(-1/3) over N = %s: %.3f +- %.3f at N = 8385 "
+              "(paper's fit %.3f), %.3f +- %.3f for N -> infinity" % (
+                  r["alpha"], r["phi_inf"], r["slope"], ",".join(str(p[0]) for p in r["points"]),
+                  r["phi_at_8385"], r["phi_at_8385_se"], r["phi_fit_paper"], r["phi_inf"], r["phi_inf_se"]))
     keys = ["alpha", "eta", "mu", "n", "ci", "seeds"] + [x for k in AGG_KEYS for x in (k, k + "_se")] + [
         "phi_fit_paper", "phi_text_paper", "lambda_paper", "Z_paper", "Z_c_paper", "valence_paper", "beta_paper"]
     with open(os.path.join(out, "results.csv"), "w", newline="") as f:
@@ -624,13 +663,16 @@ def figures(outdir, cases, agg, n, agg_all=None):
                 e = np.array([g[key + "_se"] or 0.0 for g in gs])
                 ax.errorbar(x, y, e, fmt="o", mfc=mfc, color=col, capsize=3, label="α = %g, %s" % (a, name))
             ax.axhline(phi_fit(eta_of(a)), color=col, ls="--", lw=0.8)
+            for r in finite_size(gs):
+                xx = np.linspace(0, x.max(), 50)
+                ax.plot(xx, r["phi_inf"] + r["slope"] * xx, ":", color=col, lw=1)
             ax.axvline(PAPER1["n_particles"] ** (-1.0 / 3.0), color="gray", lw=0.8)
             for g in gs:
                 ax.annotate("%d%s" % (g["n"], " ci" if g["ci"] else ""), (g["n"] ** (-1.0 / 3.0), g["phi_container"]),
                             textcoords="offset points", xytext=(3, -10), fontsize=7)
         ax.set_xlabel("N^(-1/3) (grey line: the paper's N = 8385)")
         ax.set_ylabel("packing fraction Φ")
-        ax.set_title("finite size (dashed: seed 001 fit at that η)")
+        ax.set_title("finite size (dashed: seed 001 fit; dotted: line through the ball's Φ)", fontsize=9)
         ax.legend(fontsize=7)
         fig.tight_layout()
         fig.savefig(os.path.join(outdir, "study1_phi_finite_size.png"), dpi=110)
