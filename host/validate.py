@@ -449,9 +449,9 @@ def finite_size(agg_all):
     share of particles in a wall layer of fixed thickness falls as the ball's
     surface over its volume, ~ N^(-1/3)), and the line at the paper's
     N = 8385 and at N -> infinity, with standard errors from the residuals.
-    Mixes the smoke-test (--ci) and the study's relaxation checks (Phi stops
-    changing long before either check is met; Z and Z_c creep up until the
-    end, so a --ci point may sit a little low)."""
+    At each N the study's relaxation check is used where it ran, else the
+    smoke test's (--ci): Phi stops changing long before either check is met,
+    but Z and Z_c creep up until the end, so a --ci point may sit low."""
     out = []
     by_alpha = {}
     for g in agg_all:
@@ -459,11 +459,16 @@ def finite_size(agg_all):
             by_alpha.setdefault(g["alpha"], []).append(g)
     x8 = PAPER1["n_particles"] ** (-1.0 / 3.0)
     for a, gs in sorted(by_alpha.items()):
-        if len({g["n"] for g in gs}) < 3:
+        per_n = {}
+        for g in sorted(gs, key=lambda g: not g["ci"]):  # the study's settings win over --ci at one N
+            per_n[g["n"]] = g
+        gs = [per_n[n] for n in sorted(per_n)]
+        if len(gs) < 3:
             continue
         x = np.array([g["n"] ** (-1.0 / 3.0) for g in gs])
         A = np.c_[np.ones_like(x), x]
-        r = {"alpha": a, "eta": eta_of(a), "n": [int(g["n"]) for g in gs], "phi_fit_paper": phi_fit(eta_of(a))}
+        r = {"alpha": a, "eta": eta_of(a), "n": [int(g["n"]) for g in gs], "ci": [bool(g["ci"]) for g in gs],
+             "phi_fit_paper": phi_fit(eta_of(a))}
         for key in FS_KEYS:
             y = np.array([g[key] for g in gs], dtype=float)
             coef, *_ = np.linalg.lstsq(A, y, rcond=None)
@@ -527,7 +532,8 @@ def write_results(out, rows, agg):
                                                   for k, t in PAPER1.items()},
                    "runs": rows, "cases": agg, "finite_size": fs}, f, indent=1)
     for r in fs:
-        print("finite size, alpha %g, N = %s (X = X_inf + c N^(-1/3)):" % (r["alpha"], ",".join(map(str, r["n"]))))
+        print("finite size, alpha %g, N = %s (X = X_inf + c N^(-1/3)):" % (
+            r["alpha"], ",".join("%d%s" % (n, " (ci)" if c else "") for n, c in zip(r["n"], r["ci"]))))
         for key in FS_KEYS:
             q = r[key]
             print("  %-14s %s  ->  %.3f +- %.3f at N = 8385, %.3f +- %.3f for N -> infinity" % (
