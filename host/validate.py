@@ -504,11 +504,14 @@ def markdown(agg):
                  "| Z_c (paper) | Z_c with wall contacts / isostatic | valence (paper) | cascade β (paper) |")
     lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for g in agg:
-        lines.append("| %g | %.3f | %g | %d | %s | %s (%.3f; %s) | %s | %s (%s) | %s (%s) | %s (%s) | %s / %.2f | %s (%s) | %s (%s) |" % (
+        fric = g["mu"] > 0  # the paper's fit and the isostatic count are frictionless references
+        lines.append("| %g | %.3f | %g | %d | %s | %s (%s; %s) | %s | %s (%s) | %s (%s) | %s (%s) | %s / %s | %s (%s) | %s (%s) |" % (
             g["alpha"], g["eta"], g["mu"], g["n"], ",".join(str(s) for s in g["seeds"]),
-            pm(g, "phi_container"), g["phi_fit_paper"], ref(g["phi_text_paper"]),
+            pm(g, "phi_container"), "—" if fric else "%.3f" % g["phi_fit_paper"],
+            "—" if fric else ref(g["phi_text_paper"]),
             pm(g, "phi_core_1L"), pm(g, "lambda"), ref(g["lambda_paper"], 1), pm(g, "Z", 2), ref(g["Z_paper"], 1),
-            pm(g, "Z_c", 2), ref(g["Z_c_paper"], 0), pm(g, "Z_c_walls", 2), g["Z_c_isostatic"],
+            pm(g, "Z_c", 2), ref(g["Z_c_paper"], 0), pm(g, "Z_c_walls", 2),
+            "—" if fric else "%.2f" % g["Z_c_isostatic"],
             pm(g, "valence", 2), ref(g["valence_paper"]), pm(g, "cascade_beta", 2), ref(g["beta_paper"])))
     return "\n".join(lines)
 
