@@ -613,7 +613,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
     ax.axhline(12, color="gray", lw=0.8)
     ax.set_xlabel("η = 1 − 1/α")
     ax.set_ylabel("coordination")
-    ax.legend(fontsize=6.5)
+    ax.legend(fontsize=6.5, loc="center left", bbox_to_anchor=(0.04, 0.55))
     fig.tight_layout()
     fig.savefig(os.path.join(outdir, "study1_coordination.png"), dpi=110)
     plt.close(fig)
