@@ -1,0 +1,872 @@
+#!/usr/bin/python3
+"""Validation studies of docs/validation.md: runs, analysis, tables, figures.
+
+usage:
+  host/validate.py study1 [--build build] [--out runs/validation]
+                          [--alphas 3,9,1,1.5,2,5,7] [--seeds 1,2] [--n 1000]
+                          [--friction-alphas 3,9] [--friction-mu 0.4]
+                          [--threads 2] [--jobs 1] [--max-steps 20000000]
+                          [--no-run] [--wait] [--figures DIR] [--markdown] [--check] [--ci] [--fresh]
+  host/validate.py study2|study3|study4 [--build build] [--out runs/validation] [--psis ...] [--seeds 1,2]
+                          [--n N] [--plan] [--no-run] [--figures DIR]     (host/validate_deposit.py)
+
+Study 1 (seed 001): hexapods of aspect ratio alpha under radial compaction
+at p L / k_n = 1e-5, frictionless, and alpha = 3, 9 again at mu = 0.4.  For
+each case (alpha, mu, seed) the driver
+
+  1. writes OUT/study1/a<alpha>_mu<mu>_n<N>_s<seed>/config.yaml from
+     configs/validation/study1/radial_compaction.yaml;
+  2. runs `capdem run` there, or, when run.h5 exists and its last snapshot
+     is not in phase 7 (done, /walls/control slot 0), resumes it with
+     `capdem run config.yaml --resume run.h5 --steps CAP` (CAP doubled, up
+     to --max-steps, when the previous cap was reached); a case whose lock
+     file names a live process is left to that process;
+  3. when the protocol is done, `capdem analyze run.h5 --json` (all
+     measures, written into run.h5 too) into analysis.json, and
+     `capdem analyze run.h5 --measures packing --margins 1,1 --no-write
+     --json` into packing_m1.json (a core region 1 L from the ball; the
+     default 3 L leaves almost nothing of a 1000-particle ball);
+  4. records every invocation's wall time, CPU time, steps and load average
+     in timing.json.
+
+Then it collects every finished case under OUT/study1 (not only the
+selection) into OUT/study1/results.json and results.csv (mean and standard
+error over seeds for each alpha, mu, N), prints the selection's table
+(Markdown with --markdown), draws the figures into --figures DIR, and with
+--check asserts the bands of the CI smoke test (docs/validation.md, "Smoke
+test"); exit 1 when a check fails.
+
+Everything is resumable: run it again with the same arguments and it skips
+what is done, resumes what was interrupted and analyses what is new.  Every
+number comes from `capdem analyze`; the driver only adds the paper's
+references and Z_c counted with the ball's contacts (2 (N_c + N_w) / N_p*).
+"""
+import argparse
+import csv
+import datetime
+import json
+import math
+import os
+import re
+import resource
+import shutil
+import string
+import subprocess
+import sys
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import h5py
+import numpy as np
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TEMPLATE1 = os.path.join(REPO, "configs", "validation", "study1", "radial_compaction.yaml")
+ARM_D = 0.005  # arm diameter [m] (SPEC 3)
+PHASE_DONE = 7
+
+# alpha -> (shape, dt): the time steps of configs/protocols/radial_hexapods_a*.yaml
+STUDY1_SHAPES = {1.0: ("sphere", 4.0e-6), 1.5: ("hexapod", 9.0e-6), 2.0: ("hexapod", 1.0e-5),
+                 3.0: ("hexapod", 1.0e-5), 5.0: ("hexapod", 1.0e-5), 7.0: ("hexapod", 1.0e-5),
+                 9.0: ("hexapod", 1.0e-5)}
+
+# Seed 001 (Tran et al. 2024), as its text states them (figures are not in
+# the extracted text; only the numbers the text gives are used).
+PAPER1 = {
+    "n_particles": 8385,
+    "Z": {1.0: 6.0, 1.5: 7.0, 2.0: 7.0, 3.0: 7.0, 9.0: 8.5},
+    "Z_note": "~7 for alpha <= 3 (spheres: Z = Z_c ~ 6), rising to ~8.5 for thin hexapods",
+    "Z_c": {1.0: 6.0, 1.5: 12.0, 2.0: 12.0, 3.0: 13.0, 5.0: 12.0, 7.0: 12.0, 9.0: 12.0},
+    "valence": {1.0: 1.0, 1.5: 1.75, 2.0: 1.75, 3.0: 1.8, 9.0: 1.5},
+    "valence_note": "1 for spheres, 1.7-1.8 for thick hexapods, above 1.8 at alpha = 3, 1.5 for thin",
+    "lambda": {1.0: 0.0, 9.0: 0.5},
+    "phi_text": {1.0: 0.62, 2.0: 0.68, 9.0: 0.25},
+    "beta": {1.0: 1.64, 9.0: 1.13},
+}
+
+
+def eta_of(alpha):
+    """Seed 001 eq. (4): eta = 1 - 1/alpha."""
+    return 1.0 - 1.0 / alpha
+
+
+def phi_fit(eta):
+    """Seed 001 eq. (6) with a = 0.85, b = 1.5, Phi_0 = 0.62."""
+    return 0.62 + 0.85 * eta ** 2 - 1.5 * eta ** 3
+
+
+def fmt_alpha(a):
+    return ("%g" % a).replace(".", "p")
+
+
+def fmt_mu(m):
+    return ("%g" % m).replace(".", "p")
+
+
+def now():
+    return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+# --------------------------------------------------------------------------- runs
+
+class Case:
+    def __init__(self, alpha, mu, seed, n, out, ci=False):
+        self.alpha, self.mu, self.seed, self.n, self.ci = alpha, mu, seed, n, ci
+        self.name = "a%s_mu%s_n%d_s%d%s" % (fmt_alpha(alpha), fmt_mu(mu), n, seed, "_ci" if ci else "")
+        self.dir = os.path.join(out, self.name)
+        self.config = os.path.join(self.dir, "config.yaml")
+        self.h5 = os.path.join(self.dir, "run.h5")
+        self.log = os.path.join(self.dir, "run.log")
+        self.timing = os.path.join(self.dir, "timing.json")
+        self.analysis = os.path.join(self.dir, "analysis.json")
+        self.packing_m1 = os.path.join(self.dir, "packing_m1.json")
+        self.lock = os.path.join(self.dir, "lock")
+
+    def write_config(self, steps):
+        shape, dt = STUDY1_SHAPES[self.alpha]
+        L = self.alpha * ARM_D
+        radius = 9.5 * L * (self.n / 1000.0) ** (1.0 / 3.0)
+        with open(TEMPLATE1) as f:
+            text = string.Template(f.read()).substitute(
+                name=self.name, seed=self.seed, dt="%.3g" % dt, steps=steps, mu="%g" % self.mu,
+                shape=shape, aspect="" if shape == "sphere" else "aspect: %g," % self.alpha,
+                n=self.n, radius="%.6g" % radius,
+                energy_tolerance="1.0e-3" if self.ci else "1.0e-4", check_every=2000 if self.ci else 5000)
+        os.makedirs(self.dir, exist_ok=True)
+        with open(self.config, "w") as f:
+            f.write(text)
+
+
+def run_state(h5path):
+    """(complete snapshots, last step, last phase) of a run file, or None."""
+    if not os.path.exists(h5path):
+        return None
+    try:
+        with h5py.File(h5path, "r") as f:
+            n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]), len(f["walls/control"]))
+            if n == 0:
+                return (0, 0, -1)
+            return (n, int(f["walls/step"][n - 1]), int(round(float(f["walls/control"][n - 1][0]))))
+    except (OSError, KeyError) as e:
+        print("  %s: unreadable (%s)" % (h5path, e), flush=True)
+        return None
+
+
+def peek(h5path):
+    """Progress of a run file another process is writing (HDF5 file locking off;
+    only committed snapshots are read)."""
+    try:
+        with h5py.File(h5path, "r", locking=False) as f:
+            n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]))
+            return "last snapshot at step %d" % int(f["walls/step"][n - 1]) if n else "no snapshot yet"
+    except (OSError, KeyError, TypeError, ValueError) as e:
+        return "run file not readable now: %s" % e
+
+
+def lock_holder(case):
+    """PID of a live process that holds the case (the driver that took it, or
+    its capdem child, which outlives a killed driver), or None: stale locks
+    are ignored."""
+    try:
+        with open(case.lock) as f:
+            pids = [int(w.split("=")[1]) for w in f.read().split() if w.startswith("pid=")]
+    except (OSError, ValueError, IndexError):
+        return None
+    for pid in pids:
+        if pid == os.getpid():
+            continue
+        try:
+            os.kill(pid, 0)
+        except OSError:
+            continue
+        return pid
+    return None
+
+
+def cpu_seconds(pid):
+    """User + system CPU time of a live process [s] (Linux /proc), or None."""
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def wait_for(case, pid):
+    """Wait until no live process holds the case.  When the process was a
+    capdem whose driver was stopped (its driver's line is the lock's first),
+    its segment goes into timing.json: start from the lock file, end and CPU
+    time from the last poll (at most 5 s late)."""
+    try:
+        with open(case.lock) as f:
+            lock_text = f.read()
+        start = lock_text.split()[1]
+    except (OSError, IndexError):
+        lock_text, start = "", None
+    st0 = run_state_unlocked(case.h5)
+    cpu = None
+    while lock_holder(case) is not None:
+        c = cpu_seconds(pid)
+        cpu = c if c is not None else cpu
+        time.sleep(5)
+    st1 = run_state(case.h5)
+    if "pid=%d capdem" % pid in lock_text and start:
+        t0 = datetime.datetime.strptime(start, "%Y-%m-%dT%H:%M:%SZ").replace(tzinfo=datetime.timezone.utc)
+        wall = (datetime.datetime.now(datetime.timezone.utc) - t0).total_seconds()
+        record_timing(case, {"start": start, "end": now(), "wall_s": round(wall, 1), "cpu_s": cpu, "rc": None,
+                             "step_from": None, "step_to": st1[1] if st1 else None,
+                             "phase": st1[2] if st1 else None, "threads": None, "loadavg_start": None,
+                             "loadavg_end": os.getloadavg()[0], "cores": os.cpu_count(),
+                             "note": "run by a driver that was stopped; waited for by process %d; wall time "
+                                     "from the lock file, up to 5 s late; first step after %s" % (
+                                         os.getpid(), st0[1] if st0 else "?")})
+
+
+def run_state_unlocked(h5path):
+    """run_state of a file another process is writing (HDF5 file locking off)."""
+    try:
+        with h5py.File(h5path, "r", locking=False) as f:
+            n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]), len(f["walls/control"]))
+            return (n, int(f["walls/step"][n - 1]), int(round(float(f["walls/control"][n - 1][0])))) if n else None
+    except (OSError, KeyError, TypeError, ValueError):
+        return None
+
+
+def record_timing(case, entry):
+    rows = []
+    if os.path.exists(case.timing):
+        with open(case.timing) as f:
+            rows = json.load(f)
+    rows.append(entry)
+    with open(case.timing, "w") as f:
+        json.dump(rows, f, indent=1)
+
+
+def capdem_version(capdem):
+    try:
+        return subprocess.run([capdem, "--version"], capture_output=True, text=True).stdout.splitlines()[0]
+    except (OSError, IndexError):
+        return "?"
+
+
+def git_head():
+    try:
+        return subprocess.run(["git", "-C", REPO, "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True).stdout.strip()
+    except OSError:
+        return "?"
+
+
+_print_lock = threading.Lock()
+
+
+def say(*a):
+    with _print_lock:
+        print(*a, flush=True)
+
+
+def advance(case, args, capdem):
+    """Run or resume one case once.  Returns 'done', 'capped' (step cap reached,
+    not done), 'failed' (capdem exit status not 0: FAILED marker written) or
+    'skipped' (held by another process, failed before, or beyond --max-steps)."""
+    os.makedirs(case.dir, exist_ok=True)
+    holder = lock_holder(case)
+    if holder is not None:
+        say("  %s: being run by process %d; skipped" % (case.name, holder))
+        return "skipped"
+    st = run_state(case.h5)
+    if st is not None and st[2] == PHASE_DONE:
+        return "done"
+    failed = os.path.join(case.dir, "FAILED")
+    if os.path.exists(failed):
+        with open(failed) as f:
+            say("  %s: failed before (%s); see run.log, delete FAILED to retry" % (case.name, f.read().strip()))
+        return "skipped"
+    with open(case.lock, "w") as f:
+        f.write("pid=%d %s\n" % (os.getpid(), now()))
+    try:
+        cap = args.steps
+        if st is not None and st[0] > 0 and st[1] >= cap:
+            cap = st[1] * 2
+        if cap > args.max_steps:
+            say("  %s: step %d, not done, cap %d would pass --max-steps %d; skipped"
+                % (case.name, st[1], cap, args.max_steps))
+            return "skipped"
+        case.write_config(cap)
+        cmd = [capdem, "run", "config.yaml", "--output", "run.h5", "--steps", str(cap), "--threads",
+               str(args.threads), "--quiet"]
+        if st is not None and st[0] > 0:
+            cmd[3:3] = ["--resume", "run.h5"]
+            say("  %s: resuming at step %d (phase %d), cap %d" % (case.name, st[1], st[2], cap))
+        else:
+            if os.path.exists(case.h5):
+                os.remove(case.h5)  # no complete snapshot: start again
+            say("  %s: starting" % case.name)
+        load0 = os.getloadavg()
+        ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t0 = time.time()
+        start = now()
+        with open(case.log, "a") as log:
+            log.write("# %s %s\n" % (start, " ".join(cmd)))
+            log.flush()
+            proc = subprocess.Popen(cmd, cwd=case.dir, stdout=log, stderr=log)
+            with open(case.lock, "a") as f:
+                f.write("pid=%d capdem\n" % proc.pid)
+            rc = proc.wait()
+        wall = time.time() - t0
+        ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)  # with --jobs > 1, includes runs that ended meanwhile
+        st1 = run_state(case.h5)
+        entry = {"start": start, "end": now(), "wall_s": round(wall, 2),
+                 "cpu_s": round(ru1.ru_utime + ru1.ru_stime - ru0.ru_utime - ru0.ru_stime, 2),
+                 "rc": rc, "step_from": st[1] if st else 0, "step_to": st1[1] if st1 else None,
+                 "phase": st1[2] if st1 else None, "threads": args.threads, "loadavg_start": load0[0],
+                 "loadavg_end": os.getloadavg()[0], "cores": os.cpu_count(), "capdem": capdem_version(capdem),
+                 "git": git_head(), "niceness": os.nice(0)}
+        record_timing(case, entry)
+        say("  %s: rc %d, %.1f s wall, %.1f s CPU, steps %s -> %s, phase %s"
+            % (case.name, rc, wall, entry["cpu_s"], entry["step_from"], entry["step_to"], entry["phase"]))
+        if rc < 0:
+            return "skipped"  # killed by a signal: resumable, not a failure of the run
+        if rc != 0:
+            with open(failed, "w") as f:
+                f.write("capdem exit status %d at %s\n" % (rc, now()))
+            return "failed"
+        if st1 is not None and st1[2] == PHASE_DONE:
+            return "done"
+        return "capped"
+    finally:
+        try:
+            os.remove(case.lock)
+        except OSError:
+            pass
+
+
+def analyse(case, capdem, force=False):
+    """analysis.json and packing_m1.json of a finished case (kept when newer than run.h5)."""
+    fresh = (os.path.exists(case.analysis) and os.path.exists(case.packing_m1)
+             and os.path.getmtime(case.packing_m1) >= os.path.getmtime(case.analysis) - 1)
+    if fresh and not force:
+        with open(case.analysis) as f:
+            d = json.load(f)
+        st = run_state(case.h5)
+        if st and d.get("step") == st[1]:
+            return True
+    t0 = time.time()
+    r = subprocess.run([capdem, "analyze", "run.h5", "--json", "--quiet"], cwd=case.dir, capture_output=True,
+                       text=True)
+    if r.returncode != 0:
+        say("  %s: capdem analyze failed (%d): %s" % (case.name, r.returncode, r.stderr.strip()))
+        return False
+    with open(case.analysis, "w") as f:
+        f.write(r.stdout)
+    r = subprocess.run([capdem, "analyze", "run.h5", "--measures", "packing", "--margins", "1,1", "--no-write",
+                        "--json", "--quiet"], cwd=case.dir, capture_output=True, text=True)
+    if r.returncode != 0:
+        say("  %s: capdem analyze --margins 1,1 failed (%d): %s" % (case.name, r.returncode, r.stderr.strip()))
+        return False
+    with open(case.packing_m1, "w") as f:
+        f.write(r.stdout)
+    say("  %s: analysed in %.1f s" % (case.name, time.time() - t0))
+    return True
+
+
+# ----------------------------------------------------------------------- results
+
+def metrics(case):
+    """The numbers of one finished case, straight from capdem analyze."""
+    with open(case.analysis) as f:
+        d = json.load(f)
+    with open(case.packing_m1) as f:
+        m1 = json.load(f)
+    net, pk, br, bf, nf = d["network"], d["packing"], d["branch"], d["bond_forces"], d["normal_forces"]
+    npc = net["n_particles_in_contact"]
+    iso_dof = 3.0 if case.alpha == 1.0 else 6.0  # spheres: translations only
+    timing = []
+    if os.path.exists(case.timing):
+        with open(case.timing) as f:
+            timing = json.load(f)
+    p_applied = 1.0e-5 * 1.0e5 / d["sample"]["L"]
+    return {
+        "alpha": case.alpha, "eta": eta_of(case.alpha), "mu": case.mu, "seed": case.seed, "n": case.n, "ci": case.ci,
+        "case": case.name, "step": d["step"], "time_s": d["time"],
+        "n_particles_in_contact": npc, "n_rattlers": net["n_rattlers"],
+        "n_contacts": net["n_contacts"], "n_wall_contacts": net["n_wall_contacts"], "n_bonds": net["n_bonds"],
+        "phi_container": pk["phi_container"],
+        "phi_core_3L": pk.get("phi_core"), "phi_core_3L_err": pk.get("phi_core_error"),
+        "phi_core_1L": m1["packing"].get("phi_core"), "phi_core_1L_err": m1["packing"].get("phi_core_error"),
+        "lambda": br["lambda"],
+        "Z": net["Z"], "Z_c": net["Z_c"],
+        "Z_c_walls": 2.0 * (net["n_contacts"] + net["n_wall_contacts"]) / npc,
+        "Z_c_isostatic": 2.0 * iso_dof * (1.0 - 1.0 / npc),
+        "valence": net["valence"],
+        "cascade_beta": bf.get("cascade_beta"), "cascade_beta_lo": bf.get("cascade_beta_lo"),
+        "cascade_beta_hi": bf.get("cascade_beta_hi"), "cascade_gamma": bf.get("cascade_gamma"),
+        "k_tail": nf.get("k"), "k_tail_lo": nf.get("k_lo"), "k_tail_hi": nf.get("k_hi"),
+        "pressure_over_p": d["stress"]["container_pressure"] / p_applied,
+        "run_wall_s": round(sum(t["wall_s"] for t in timing), 1),
+        "run_cpu_s": round(sum(t["cpu_s"] or 0 for t in timing), 1),
+        "run_segments": len(timing),
+        "run_max_loadavg": max([t[k] for t in timing for k in ("loadavg_start", "loadavg_end")
+                                if t.get(k) is not None] or [0]),
+    }
+
+
+AGG_KEYS = ["phi_container", "phi_core_1L", "phi_core_3L", "lambda", "Z", "Z_c", "Z_c_walls", "Z_c_isostatic",
+            "valence", "cascade_beta", "k_tail", "n_particles_in_contact", "n_rattlers", "pressure_over_p",
+            "step", "run_wall_s"]
+
+
+def aggregate(rows):
+    """Mean and standard error over seeds for each (alpha, mu, N, CI settings)."""
+    groups = {}
+    for r in rows:
+        groups.setdefault((r["alpha"], r["mu"], r["n"], r["ci"]), []).append(r)
+    out = []
+    for (a, mu, n, ci), rs in sorted(groups.items()):
+        g = {"alpha": a, "eta": eta_of(a), "mu": mu, "n": n, "ci": ci, "seeds": sorted(r["seed"] for r in rs)}
+        for k in AGG_KEYS:
+            v = np.array([r[k] for r in rs if r.get(k) is not None], dtype=float)
+            g[k] = float(v.mean()) if len(v) else None
+            g[k + "_se"] = float(v.std(ddof=1) / math.sqrt(len(v))) if len(v) >= 2 else None
+        g["phi_fit_paper"] = phi_fit(g["eta"])
+        g["phi_text_paper"] = PAPER1["phi_text"].get(a)
+        g["lambda_paper"] = PAPER1["lambda"].get(a)
+        g["Z_paper"] = PAPER1["Z"].get(a) if mu == 0 else None
+        g["Z_c_paper"] = PAPER1["Z_c"].get(a) if mu == 0 else None
+        g["valence_paper"] = PAPER1["valence"].get(a) if mu == 0 else None
+        g["beta_paper"] = PAPER1["beta"].get(a) if mu == 0 else None
+        out.append(g)
+    return out
+
+
+FS_KEYS = ["phi_container", "Z", "Z_c", "Z_c_walls", "valence", "lambda"]
+
+
+def finite_size(agg_all):
+    """Each of FS_KEYS against N^(-1/3), for each frictionless alpha with three
+    or more N: least squares X = X_inf + c N^(-1/3) over the per-N means (the
+    share of particles in a wall layer of fixed thickness falls as the ball's
+    surface over its volume, ~ N^(-1/3)), and the line at the paper's
+    N = 8385 and at N -> infinity, with standard errors from the residuals.
+    At each N the study's relaxation check is used where it ran, else the
+    smoke test's (--ci): Phi stops changing long before either check is met,
+    but Z and Z_c creep up until the end, so a --ci point may sit low."""
+    out = []
+    by_alpha = {}
+    for g in agg_all:
+        if g["mu"] == 0:
+            by_alpha.setdefault(g["alpha"], []).append(g)
+    x8 = PAPER1["n_particles"] ** (-1.0 / 3.0)
+    for a, gs in sorted(by_alpha.items()):
+        per_n = {}
+        for g in sorted(gs, key=lambda g: not g["ci"]):  # the study's settings win over --ci at one N
+            per_n[g["n"]] = g
+        gs = [per_n[n] for n in sorted(per_n)]
+        if len(gs) < 3:
+            continue
+        x = np.array([g["n"] ** (-1.0 / 3.0) for g in gs])
+        A = np.c_[np.ones_like(x), x]
+        r = {"alpha": a, "eta": eta_of(a), "n": [int(g["n"]) for g in gs], "ci": [bool(g["ci"]) for g in gs],
+             "phi_fit_paper": phi_fit(eta_of(a))}
+        for key in FS_KEYS:
+            y = np.array([g[key] for g in gs], dtype=float)
+            coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+            dof = len(x) - 2
+            s2 = float(np.sum((y - A @ coef) ** 2) / dof) if dof > 0 else float("nan")
+            cov = s2 * np.linalg.inv(A.T @ A)
+            v8 = np.array([1.0, x8])
+            r[key] = {"values": y.tolist(), "inf": float(coef[0]), "inf_se": float(math.sqrt(cov[0, 0])),
+                      "slope": float(coef[1]), "at_8385": float(v8 @ coef),
+                      "at_8385_se": float(math.sqrt(v8 @ cov @ v8))}
+        # kept for the figure
+        r["phi_inf"], r["slope"] = r["phi_container"]["inf"], r["phi_container"]["slope"]
+        out.append(r)
+    return out
+
+
+def pm(g, k, digits=3):
+    v = g.get(k)
+    if v is None:
+        return "—"
+    se = g.get(k + "_se")
+    f = "%%.%df" % digits
+    return (f % v) + ((" ± " + f % se) if se is not None else " (1 seed)")
+
+
+def ref(v, digits=2):
+    return "—" if v is None else ("%%.%df" % digits) % v
+
+
+def markdown(agg):
+    lines = []
+    lines.append("| α | η | μ | N | seeds | Φ ball (paper fit; text) | Φ core 1 L | λ (paper) | Z (paper) "
+                 "| Z_c (paper) | Z_c with wall contacts / isostatic | valence (paper) | cascade β (paper) |")
+    lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for g in agg:
+        fric = g["mu"] > 0  # the paper's fit and the isostatic count are frictionless references
+        lines.append("| %g | %.3f | %g | %d | %s | %s (%s; %s) | %s | %s (%s) | %s (%s) | %s (%s) | %s / %s | %s (%s) | %s (%s) |" % (
+            g["alpha"], g["eta"], g["mu"], g["n"], ",".join(str(s) for s in g["seeds"]),
+            pm(g, "phi_container"), "—" if fric else "%.3f" % g["phi_fit_paper"],
+            "—" if fric else ref(g["phi_text_paper"]),
+            pm(g, "phi_core_1L"), pm(g, "lambda"), ref(g["lambda_paper"], 1), pm(g, "Z", 2), ref(g["Z_paper"], 1),
+            pm(g, "Z_c", 2), ref(g["Z_c_paper"], 0), pm(g, "Z_c_walls", 2),
+            "—" if fric else "%.2f" % g["Z_c_isostatic"],
+            pm(g, "valence", 2), ref(g["valence_paper"]), pm(g, "cascade_beta", 2), ref(g["beta_paper"])))
+    return "\n".join(lines)
+
+
+def print_table(agg):
+    hdr = "%5s %5s %4s %5s %5s  %-15s %-6s %-15s %-15s %-13s %-13s %-13s %-13s %-13s %s" % (
+        "alpha", "eta", "mu", "N", "seeds", "phi_ball", "fit", "phi_core_1L", "lambda", "Z", "Z_c", "Z_c+walls",
+        "valence", "beta", "wall_s")
+    print(hdr)
+    for g in agg:
+        print("%5g %5.3f %4g %5d %5d  %-15s %-6.3f %-15s %-15s %-13s %-13s %-13s %-13s %-13s %s" % (
+            g["alpha"], g["eta"], g["mu"], g["n"], len(g["seeds"]), pm(g, "phi_container"), g["phi_fit_paper"],
+            pm(g, "phi_core_1L"), pm(g, "lambda"), pm(g, "Z", 2), pm(g, "Z_c", 2), pm(g, "Z_c_walls", 2),
+            pm(g, "valence", 2), pm(g, "cascade_beta", 2), pm(g, "run_wall_s", 0)))
+
+
+def write_results(out, rows, agg):
+    fs = finite_size(agg)
+    with open(os.path.join(out, "results.json"), "w") as f:
+        json.dump({"generated": now(), "paper": {k: {str(a): v for a, v in t.items()} if isinstance(t, dict) else t
+                                                  for k, t in PAPER1.items()},
+                   "runs": rows, "cases": agg, "finite_size": fs}, f, indent=1)
+    for r in fs:
+        print("finite size, alpha %g, N = %s (X = X_inf + c N^(-1/3)):" % (
+            r["alpha"], ",".join("%d%s" % (n, " (ci)" if c else "") for n, c in zip(r["n"], r["ci"]))))
+        for key in FS_KEYS:
+            q = r[key]
+            print("  %-14s %s  ->  %.3f +- %.3f at N = 8385, %.3f +- %.3f for N -> infinity" % (
+                key, " ".join("%.3f" % v for v in q["values"]), q["at_8385"], q["at_8385_se"], q["inf"],
+                q["inf_se"]))
+
+
+def figures(outdir, cases, agg, n, agg_all=None):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    os.makedirs(outdir, exist_ok=True)
+    et = np.linspace(0, 0.92, 200)
+    styles = {0.0: ("o", "C0", "μ = 0"), 0.4: ("s", "C3", "μ = 0.4")}
+
+    def series(key, mu):
+        gs = [g for g in agg if g["mu"] == mu and g.get(key) is not None]
+        x = np.array([g["eta"] for g in gs])
+        y = np.array([g[key] for g in gs])
+        e = np.array([g[key + "_se"] if g.get(key + "_se") is not None else 0.0 for g in gs])
+        return x, y, e
+
+    def paper_points(ax, table, label):
+        pts = sorted((eta_of(a), v) for a, v in table.items())
+        if pts:
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "k*", ms=10, label=label)
+
+    written = []
+    # packing fraction
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    ax.plot(et, phi_fit(et), "k--", label="seed 001 fit 0.62 + 0.85η² − 1.5η³")
+    paper_points(ax, PAPER1["phi_text"], "seed 001 text")
+    for mu, (m, c, lab) in styles.items():
+        x, y, e = series("phi_container", mu)
+        if len(x):
+            ax.errorbar(x, y, e, fmt=m, color=c, label="capdem, ball, " + lab, capsize=3)
+        x, y, e = series("phi_core_1L", mu)
+        if len(x):
+            ax.errorbar(x, y, e, fmt=m, mfc="none", color=c, label="capdem, core 1 L, " + lab, capsize=3)
+    ax.set_xlabel("η = 1 − 1/α")
+    ax.set_ylabel("packing fraction Φ")
+    ax.set_title("Study 1: Φ(η), N = %d (paper: 8385)" % n)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "study1_phi.png"), dpi=110)
+    plt.close(fig)
+    written.append("study1_phi.png")
+    # interlocking
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    paper_points(ax, PAPER1["lambda"], "seed 001 text (α = 1, 9)")
+    for mu, (m, c, lab) in styles.items():
+        x, y, e = series("lambda", mu)
+        if len(x):
+            ax.errorbar(x, y, e, fmt=m, color=c, label="capdem, " + lab, capsize=3)
+    ax.set_xlabel("η = 1 − 1/α")
+    ax.set_ylabel("interlocking λ = 1 − <l>/L")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "study1_lambda.png"), dpi=110)
+    plt.close(fig)
+    written.append("study1_lambda.png")
+    # coordination
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    paper_points(ax, PAPER1["Z_c"], "seed 001 Z_c (text)")
+    zs = sorted((eta_of(a), v) for a, v in PAPER1["Z"].items())
+    ax.plot([p[0] for p in zs], [p[1] for p in zs], "kx", ms=9, label="seed 001 Z (text)")
+    for mu, (m, c, lab) in styles.items():
+        for key, fill, name in (("Z_c", "full", "Z_c"), ("Z_c_walls", "none", "Z_c with wall contacts"),
+                                ("Z", "full", "Z")):
+            x, y, e = series(key, mu)
+            if len(x):
+                ax.errorbar(x, y, e, fmt=m if key != "Z" else "^", mfc=None if fill == "full" else "none",
+                            color=c, label="capdem %s, %s" % (name, lab), capsize=3)
+    ax.axhline(12, color="gray", lw=0.8)
+    ax.set_xlabel("η = 1 − 1/α")
+    ax.set_ylabel("coordination")
+    ax.legend(fontsize=6.5, loc="center left", bbox_to_anchor=(0.04, 0.55))
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "study1_coordination.png"), dpi=110)
+    plt.close(fig)
+    written.append("study1_coordination.png")
+    # valence
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    paper_points(ax, PAPER1["valence"], "seed 001 text")
+    for mu, (m, c, lab) in styles.items():
+        x, y, e = series("valence", mu)
+        if len(x):
+            ax.errorbar(x, y, e, fmt=m, color=c, label="capdem, " + lab, capsize=3)
+    ax.set_xlabel("η = 1 − 1/α")
+    ax.set_ylabel("valence Z_c / Z")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "study1_valence.png"), dpi=110)
+    plt.close(fig)
+    written.append("study1_valence.png")
+    # bond-force PDFs with the cascade fits (first seed of each frictionless alpha)
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    seen = set()
+    for k, case in enumerate(sorted(cases, key=lambda c: (c.alpha, c.seed))):
+        if case.mu != 0 or case.alpha in seen:
+            continue
+        seen.add(case.alpha)
+        with open(case.analysis) as f:
+            cv = json.load(f)["bond_forces"]["curves"]
+        pdf = np.array(cv["pdf_mean1"]["data"])
+        fit = np.array(cv["cascade_fit"]["data"]) if "cascade_fit" in cv else None
+        col = "C%d" % (len(seen) - 1)
+        good = pdf[:, 1] > 0
+        ax.semilogy(pdf[good, 0], pdf[good, 1], "o", ms=3, color=col, label="α = %g" % case.alpha)
+        if fit is not None:
+            ax.semilogy(fit[:, 0], fit[:, 1], "-", color=col, lw=1)
+    ax.set_xlabel("bond force / mean bond force")
+    ax.set_ylabel("PDF")
+    ax.set_title("bond forces and cascade fits (seed 1 of each α)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "study1_bond_forces.png"), dpi=110)
+    plt.close(fig)
+    written.append("study1_bond_forces.png")
+    # finite size: Phi of the ball and of the core against N^(-1/3), every N of OUT
+    by_alpha = {}
+    for g in agg_all or []:
+        if g["mu"] == 0:
+            by_alpha.setdefault(g["alpha"], []).append(g)
+    by_alpha = {a: gs for a, gs in by_alpha.items() if len({g["n"] for g in gs}) >= 2}
+    if by_alpha:
+        fig, ax = plt.subplots(figsize=(5.5, 4))
+        for k, (a, gs) in enumerate(sorted(by_alpha.items())):
+            gs = sorted(gs, key=lambda g: g["n"])
+            x = np.array([g["n"] ** (-1.0 / 3.0) for g in gs])
+            col = "C%d" % k
+            for key, mfc, name in (("phi_container", None, "ball"), ("phi_core_1L", "none", "core 1 L")):
+                y = np.array([g[key] for g in gs])
+                e = np.array([g[key + "_se"] or 0.0 for g in gs])
+                ax.errorbar(x, y, e, fmt="o", mfc=mfc, color=col, capsize=3, label="α = %g, %s" % (a, name))
+            ax.axhline(phi_fit(eta_of(a)), color=col, ls="--", lw=0.8)
+            for r in finite_size(gs):
+                xx = np.linspace(0, x.max(), 50)
+                ax.plot(xx, r["phi_inf"] + r["slope"] * xx, ":", color=col, lw=1)
+            ax.axvline(PAPER1["n_particles"] ** (-1.0 / 3.0), color="gray", lw=0.8)
+            for g in gs:
+                ax.annotate("%d%s" % (g["n"], " ci" if g["ci"] else ""), (g["n"] ** (-1.0 / 3.0), g["phi_container"]),
+                            textcoords="offset points", xytext=(3, -10), fontsize=7)
+        ax.set_xlabel("N^(-1/3) (grey line: the paper's N = 8385)")
+        ax.set_ylabel("packing fraction Φ")
+        ax.set_title("finite size (dashed: seed 001 fit; dotted: line through the ball's Φ)", fontsize=9)
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "study1_phi_finite_size.png"), dpi=110)
+        plt.close(fig)
+        written.append("study1_phi_finite_size.png")
+    print("figures: %s (%s)" % (outdir, ", ".join(written)))
+
+
+# -------------------------------------------------------------------- smoke check
+
+def check_bands(rows):
+    """The CI smoke test's assertions (docs/validation.md, "Smoke test")."""
+    ok = True
+    for r in rows:
+        iso = r["Z_c_isostatic"]
+        lo_z, hi_z = 0.97 * iso, 1.09 * iso
+        fit = phi_fit(r["eta"])
+        tests = [
+            ("Z_c with wall contacts %.3f in [%.3f, %.3f] (0.97 .. 1.09 x isostatic %.3f)"
+             % (r["Z_c_walls"], lo_z, hi_z, iso), lo_z <= r["Z_c_walls"] <= hi_z),
+            ("Phi core (1 L from the ball) %.4f within 0.06 of the paper's fit %.4f"
+             % (r["phi_core_1L"], fit), r["phi_core_1L"] is not None and abs(r["phi_core_1L"] - fit) <= 0.06),
+            ("Phi of the ball %.4f below Phi of the core %.4f (wall depletion)"
+             % (r["phi_container"], r["phi_core_1L"]), r["phi_container"] < r["phi_core_1L"]),
+            ("ball pressure / p = %.4f within 1 %%" % r["pressure_over_p"], abs(r["pressure_over_p"] - 1) < 0.01),
+        ]
+        for text, good in tests:
+            print("%s %s: %s" % ("PASS" if good else "FAIL", r["case"], text))
+            ok = ok and good
+    return ok
+
+
+# --------------------------------------------------------------------------- main
+
+def finished_cases_in(out):
+    """Every case folder under OUT/study1 whose run is done and analysed."""
+    found = []
+    for name in sorted(os.listdir(out)):
+        m = re.fullmatch(r"a([0-9p]+)_mu([0-9p]+)_n(\d+)_s(\d+)(_ci)?", name)
+        if not m:
+            continue
+        c = Case(float(m.group(1).replace("p", ".")), float(m.group(2).replace("p", ".")), int(m.group(4)),
+                 int(m.group(3)), out, bool(m.group(5)))
+        if c.name == name and os.path.exists(c.analysis) and os.path.exists(c.packing_m1) \
+                and lock_holder(c) is None:
+            found.append(c)
+    return found
+
+
+def parse_list(s, typ=float):
+    return [typ(x) for x in s.split(",") if x.strip()] if s else []
+
+
+def study1(args):
+    capdem = os.path.join(os.path.abspath(args.build), "capdem")
+    if not os.access(capdem, os.X_OK):
+        sys.exit("validate.py: %s not found; build first (README)" % capdem)
+    out = os.path.join(os.path.abspath(args.out), "study1")
+    os.makedirs(out, exist_ok=True)
+    alphas, seeds = parse_list(args.alphas), parse_list(args.seeds, int)
+    for a in alphas + parse_list(args.friction_alphas):
+        if a not in STUDY1_SHAPES:
+            sys.exit("validate.py: alpha %g is not one of study 1's (%s)"
+                     % (a, ", ".join("%g" % x for x in STUDY1_SHAPES)))
+    cases = [Case(a, 0.0, s, args.n, out, args.ci) for a in alphas for s in seeds]
+    cases += [Case(a, args.friction_mu, s, args.n, out, args.ci)
+              for a in parse_list(args.friction_alphas) for s in seeds]
+    if args.fresh:
+        for c in cases:
+            if lock_holder(c) is None and os.path.isdir(c.dir):
+                shutil.rmtree(c.dir)
+    print("study 1: %d cases, N = %d, %d thread(s) per run, %d job(s), output %s" % (
+        len(cases), args.n, args.threads, args.jobs, out), flush=True)
+    t_all = time.time()
+
+    def one(c):
+        holder = lock_holder(c)
+        if holder is not None and args.wait:
+            say("  %s: being run by process %d (%s); waiting for it" % (c.name, holder, peek(c.h5)))
+            wait_for(c, holder)
+            holder = None
+        if holder is not None:
+            say("  %s: being run by process %d (%s); skipped" % (c.name, holder, peek(c.h5)))
+            return False
+        done = run_state(c.h5)
+        done = done is not None and done[2] == PHASE_DONE
+        while not done and not args.no_run:
+            res = advance(c, args, capdem)
+            done = res == "done"
+            if res != "capped":
+                break
+        if done:
+            return analyse(c, capdem, force=args.reanalyse)
+        if args.no_run:
+            st = run_state(c.h5)
+            say("  %s: %s" % (c.name, "not started" if st is None else
+                              "stopped at step %d in phase %d (resumable)" % (st[1], st[2])))
+        return False
+
+    if args.jobs > 1:
+        with ThreadPoolExecutor(args.jobs) as ex:
+            finished = list(ex.map(one, cases))
+    else:
+        finished = [one(c) for c in cases]
+    done_cases = [c for c, f in zip(cases, finished) if f]
+    pending = [c.name for c, f in zip(cases, finished) if not f]
+    print("study 1: %d of %d cases finished (%.1f s this invocation)%s" % (
+        len(done_cases), len(cases), time.time() - t_all, ("; pending: " + ", ".join(pending)) if pending else ""))
+    rows = [metrics(c) for c in done_cases]
+    for r in rows:
+        print("  %-22s %8d steps  %7.1f s wall (%d segment(s))  N_p* %d" % (
+            r["case"], r["step"], r["run_wall_s"], r["run_segments"], r["n_particles_in_contact"]))
+    agg = aggregate(rows)
+    every = [metrics(c) for c in finished_cases_in(out)]  # results.json: every finished case of OUT
+    agg_all = aggregate(every)
+    write_results(out, every, agg_all)
+    if agg:
+        print_table(agg)
+        if args.markdown:
+            print()
+            print(markdown(agg))
+    if args.figures and done_cases:
+        figures(args.figures, done_cases, agg, args.n, agg_all)
+    if args.check:
+        if pending:
+            print("FAIL: cases not finished: " + ", ".join(pending))
+            return 1
+        return 0 if check_bands(rows) else 1
+    return 0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="study", required=True)
+    p1 = sub.add_parser("study1", help="hexapods under radial compaction (seed 001)")
+    p1.add_argument("--build", default="build", help="build folder holding capdem")
+    p1.add_argument("--out", default="runs/validation", help="output folder (runs under OUT/study1)")
+    p1.add_argument("--alphas", default="3,9,1,1.5,2,5,7", help="frictionless aspect ratios, in run order")
+    p1.add_argument("--seeds", default="1,2")
+    p1.add_argument("--n", type=int, default=1000, help="particles per run")
+    p1.add_argument("--friction-alphas", default="3,9", help="aspect ratios repeated at --friction-mu ('' for none)")
+    p1.add_argument("--friction-mu", type=float, default=0.4)
+    p1.add_argument("--threads", type=int, default=2, help="OpenMP threads of each capdem run")
+    p1.add_argument("--jobs", type=int, default=1, help="runs at a time")
+    p1.add_argument("--steps", type=int, default=5000000, help="first step cap (the presets')")
+    p1.add_argument("--max-steps", type=int, default=20000000, help="largest cap a resume may set")
+    p1.add_argument("--no-run", action="store_true", help="only collect finished cases")
+    p1.add_argument("--wait", action="store_true",
+                    help="wait for a case another process is running (a capdem left by a killed driver) "
+                         "instead of skipping it, so that one simulation runs at a time")
+    p1.add_argument("--reanalyse", action="store_true", help="run capdem analyze again on finished cases")
+    p1.add_argument("--fresh", action="store_true", help="delete the selected cases' folders first")
+    p1.add_argument("--figures", help="write the PNG figures into this folder")
+    p1.add_argument("--markdown", action="store_true", help="also print the table as Markdown")
+    p1.add_argument("--check", action="store_true", help="assert the smoke test's bands (exit 1 if not)")
+    p1.add_argument("--ci", action="store_true",
+                    help="the CI presets' relaxation check (energy steady to 1e-3 every 2000 steps, not 1e-4 "
+                         "every 5000); case folders get a _ci suffix")
+    for name, what in (("study2", "2D crosses, deposit and compress (seed 000)"),
+                       ("study3", "3D stars in a cylinder, deposit and compress (seed 000)"),
+                       ("study4", "spheres in the 2D box and the cylinder (seed 000, Mueth)")):
+        p = sub.add_parser(name, help=what)
+        p.add_argument("--build", default="build", help="build folder holding capdem")
+        p.add_argument("--out", default="runs/validation", help="output folder (runs under OUT/%s)" % name)
+        if name != "study4":
+            p.add_argument("--psis", default="", help="sphericities of Table S1 (default: the issue's four)")
+        p.add_argument("--seeds", default="1,2")
+        p.add_argument("--n", type=int, default=0, help="particles per run (default: the paper's count rule)")
+        p.add_argument("--width-l", type=float, default=0,
+                       help="box width / cylinder diameter in L (default: the study's; smaller only for tests)")
+        p.add_argument("--threads", type=int, default=2)
+        p.add_argument("--steps", type=int, default=5000000)
+        p.add_argument("--max-steps", type=int, default=40000000)
+        p.add_argument("--plan", action="store_true", help="print the cases (count, size, dt) and stop")
+        p.add_argument("--no-run", action="store_true")
+        p.add_argument("--reanalyse", action="store_true")
+        p.add_argument("--figures", help="write the PNG figures into this folder")
+    args = ap.parse_args()
+    if args.study == "study1":
+        return study1(args)
+    sys.dont_write_bytecode = True  # no host/__pycache__ in the worktree
+    import validate_deposit
+    return validate_deposit.run_study(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,390 @@
+"""Studies 2-4 of docs/validation.md (seed 000): deposit and compress.
+
+Used by host/validate.py (`validate.py study2|study3|study4 ...`); the run,
+resume, lock and timing machinery is study 1's (validate.advance), only the
+configs, the references and the figures differ.
+
+  study2  2D crosses in a box of width 30 L, psi 0.995, 0.754, 0.585, 0.473
+  study3  3D stars (hexapods) in a cylinder of diameter 6 L, psi 0.995, 0.702, 0.526, 0.419
+  study4  spheres, 2D box of width 30 d_p and cylinder of diameter 10 d_p (seed 000's references)
+
+The aspect ratio of each psi is seed 000's Table S1.  The count follows the
+paper's rule (compressed packing at least twice as high as the box is wide,
+or as the cylinder's diameter) with an upper estimate of the packing
+fraction (PHI_GUESS below), so that the rule holds; each run's H/W is
+reported and checked afterwards.
+"""
+import json
+import math
+import os
+import string
+import subprocess
+
+import numpy as np
+
+import validate as v1
+
+REPO = v1.REPO
+ARM_D = v1.ARM_D
+DENSITY, KN, ETA_N = 1000.0, 1.0e5, 0.2
+
+# Table S1 of seed 000: sphericity -> aspect ratio L / d_p.
+STUDIES = {
+    "study2": {"dim": 2, "shape": "cross", "domain": "box", "size_L": 30.0,
+               "psis": [(0.995, 1.1), (0.754, 3.0), (0.585, 6.0), (0.473, 11.0)],
+               "template": "configs/validation/study2/deposit_2d.yaml"},
+    "study3": {"dim": 3, "shape": "hexapod", "domain": "cylinder", "size_L": 6.0,
+               "psis": [(0.995, 1.1), (0.702, 3.0), (0.526, 6.0), (0.419, 11.0)],
+               "template": "configs/validation/study3/deposit_cylinder.yaml"},
+    "study4": {"cases": [("2d", {"dim": 2, "shape": "sphere", "domain": "box", "size_L": 30.0,
+                                 "template": "configs/validation/study2/deposit_2d.yaml"}),
+                         ("3d", {"dim": 3, "shape": "sphere", "domain": "cylinder", "size_L": 10.0,
+                                 "template": "configs/validation/study3/deposit_cylinder.yaml"})]},
+}
+
+# Mueth, Jaeger, Nagel, PRE 57 (1998) 3164, fit of eq. (1) of seed 000 to
+# their 3D glass-sphere packings: a = 3.0, b = 0.75, beta = 1.5 (the values
+# are from Mueth et al., not from the seed's text).
+MUETH = {"a": 3.0, "b": 0.75, "beta": 1.5}
+
+
+def k_paper_2d(psi):
+    """Seed 000, Fig. 6a: linear fit to the 2D tail exponents."""
+    return 0.18 * (1.0 - psi) + 1.43
+
+
+def k_paper_3d(psi):
+    """Seed 000: k = 1.38 +- 0.14 for psi >= 0.7, else the fit -2.03 (1 - psi)^2.43 + 1.29."""
+    return 1.38 if psi >= 0.7 else -2.03 * (1.0 - psi) ** 2.43 + 1.29
+
+
+def rdf_peaks_paper(alpha):
+    """Seed 000 eq. (11) in units of L: D_1 = sqrt(d^2 + ((L + d)/2)^2), D_2 = 2 D_1, D_3 = 3 D_1."""
+    L, d = alpha, 1.0
+    d1 = math.sqrt(d * d + ((L + d) / 2.0) ** 2) / L
+    return [d1, 2 * d1, 3 * d1]
+
+
+def polydispersity(dim, psi):
+    """Seed 000 (section II): 2D 0.3 for psi > 0.88, 0.15 for 0.88 >= psi (the
+    paper states 0.15 down to 0.75 and nothing below: SPEC's 0.15 is kept);
+    3D 0.2 (stated for psi > 0.86; SPEC's 0.2 below)."""
+    if dim == 2:
+        return 0.3 if psi > 0.88 else 0.15
+    return 0.2
+
+
+def phi_guess(dim, shape, alpha):
+    """Upper estimate of the compressed packing fraction, for the count rule:
+    2D: 0.84, random close packing of polydisperse discs (seed 000 Fig. S1:
+    crosses of lower psi pack looser); 3D stars: seed 001's frictionless fit
+    at eta = 1 - 1/alpha (friction only lowers it); spheres 0.64."""
+    if dim == 2:
+        return 0.84
+    if shape == "sphere":
+        return 0.64
+    return v1.phi_fit(v1.eta_of(alpha))
+
+
+def shape_props(capdem, shape, alpha):
+    args = [capdem, "shape", shape, "--diameter", "%g" % ARM_D, "--density", "%g" % DENSITY, "--json"]
+    if shape != "sphere":
+        args[3:3] = ["--aspect", "%g" % alpha]
+    return json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
+
+
+def area_2d(shape, alpha, n=1500):
+    """Area of the particle's cut in its plane (union of capsules), on a grid [m^2]."""
+    L, r = alpha * ARM_D, 0.5 * ARM_D
+    h = 0.5 * L - r  # half-length of the axis
+    x = (np.arange(n) + 0.5) / n * L - 0.5 * L
+    X, Y = np.meshgrid(x, x)
+    if shape == "sphere":
+        inside = X ** 2 + Y ** 2 <= r * r
+    else:
+        a1 = (np.clip(X, -h, h) - X) ** 2 + Y ** 2 <= r * r
+        a2 = (np.clip(Y, -h, h) - Y) ** 2 + X ** 2 <= r * r
+        inside = a1 | a2
+    return inside.mean() * L * L
+
+
+class DepositCase(v1.Case):
+    def __init__(self, study, tag, spec, psi, alpha, seed, n, out, capdem, size_l=None):
+        self.study, self.spec, self.psi, self.capdem = study, spec, psi, capdem
+        self.alpha, self.mu, self.seed, self.ci = alpha, 0.5, seed, False
+        self.dim, self.shape = spec["dim"], spec["shape"]
+        self.poly = 0.2 if self.shape == "sphere" else polydispersity(self.dim, psi)
+        props = shape_props(capdem, self.shape, alpha)
+        self.L = props["tip_length"]
+        self.volume, self.mass = props["volume"], props["mass"]
+        self.size = (size_l or spec["size_L"]) * self.L  # W or D [m]
+        es2, es3 = 1 + self.poly ** 2 / 3.0, 1 + self.poly ** 2
+        phi = phi_guess(self.dim, self.shape, alpha)
+        if self.dim == 2:
+            self.area = area_2d(self.shape, alpha)
+            n_rule = 2 * self.size ** 2 * phi / (self.area * es2)
+        else:
+            n_rule = 2 * self.size * math.pi * self.size ** 2 / 4 * phi / (self.volume * es3)
+        self.n_rule, self.phi_guess = int(math.ceil(n_rule)), phi
+        self.n = n if n else self.n_rule
+        name = "%s_%s_n%d_s%d" % (tag, ("psi%s" % ("%g" % psi).replace(".", "p")) if psi else "ref", self.n, seed)
+        v1.Case.__init__(self, alpha, 0.5, seed, self.n, out)
+        self.name = name
+        self.dir = os.path.join(out, name)
+        for k in ("config", "h5", "log", "timing", "analysis", "packing_m1", "lock"):
+            setattr(self, k, os.path.join(self.dir, os.path.basename(getattr(self, k))))
+
+    def lattice_rows(self):
+        """Height of the lattice that holds N sites (src/setup.c, lattice_sites)."""
+        R = 0.5 * self.L * (1 + self.poly)
+        a = 1.5 * 2 * R
+        if self.dim == 2:
+            per_row = max(1, int(math.floor(self.size / a)))
+        else:
+            rc = 0.5 * self.size
+            m = max(1, int(math.floor(self.size / a)))
+            off = -rc + 0.5 * (self.size - (m - 1) * a)
+            per_row = sum(1 for i in range(m) for k in range(m)
+                          if math.hypot(off + a * i, off + a * k) <= rc - R)
+            per_row = max(per_row, 1)
+        rows = int(math.ceil(self.n / per_row))
+        return rows, a
+
+    def dt(self):
+        m_min = self.mass * (1 - self.poly) ** 3
+        mij = 0.5 * m_min
+        tcol = math.pi / math.sqrt((KN / 2) / mij * (1 - ETA_N ** 2))
+        dt = tcol / 20
+        e = math.floor(math.log10(dt))
+        return math.floor(dt / 10 ** (e - 1)) * 10 ** (e - 1)  # two digits, rounded down
+
+    def write_config(self, steps):
+        rows, a = self.lattice_rows()
+        height = (rows + 1) * a
+        fields = dict(name=self.name, seed=self.seed, dt="%.2g" % self.dt(), steps=steps, shape=self.shape,
+                      aspect="" if self.shape == "sphere" else "aspect: %g," % self.alpha, n=self.n,
+                      poly="%g" % self.poly, height="%.6g" % height)
+        if self.dim == 2:
+            fields.update(width="%.6g" % self.size, thickness="%.6g" % self.L)
+        else:
+            fields.update(diameter="%.6g" % self.size)
+        with open(os.path.join(REPO, self.spec["template"])) as f:
+            text = string.Template(f.read()).substitute(fields)
+        os.makedirs(self.dir, exist_ok=True)
+        with open(self.config, "w") as f:
+            f.write(text)
+
+
+def make_cases(args, capdem, out):
+    seeds = v1.parse_list(args.seeds, int)
+    cases = []
+    if args.study in ("study2", "study3"):
+        spec = STUDIES[args.study]
+        psis = v1.parse_list(args.psis) if args.psis else [p for p, _ in spec["psis"]]
+        table = dict(spec["psis"])
+        for psi in psis:
+            if psi not in table:
+                raise SystemExit("validate.py: psi %g is not one of %s's (%s)"
+                                 % (psi, args.study, ", ".join("%g" % p for p in table)))
+            for s in seeds:
+                cases.append(DepositCase(args.study, "cross2d" if spec["dim"] == 2 else "star3d", spec, psi,
+                                         table[psi], s, args.n, out, capdem, args.width_l))
+    else:
+        for tag, spec in STUDIES["study4"]["cases"]:
+            for s in seeds:
+                cases.append(DepositCase("study4", "sphere" + tag, spec, None, 1.0, s, args.n, out, capdem,
+                                         args.width_l))
+    return cases
+
+
+def analyse(case, capdem, force=False):
+    if os.path.exists(case.analysis) and not force:
+        with open(case.analysis) as f:
+            d = json.load(f)
+        st = v1.run_state(case.h5)
+        if st and d.get("step") == st[1]:
+            return True
+    r = subprocess.run([capdem, "analyze", "run.h5", "--json", "--quiet"], cwd=case.dir, capture_output=True,
+                       text=True)
+    if r.returncode != 0:
+        v1.say("  %s: capdem analyze failed (%d): %s" % (case.name, r.returncode, r.stderr.strip()))
+        return False
+    with open(case.analysis, "w") as f:
+        f.write(r.stdout)
+    return True
+
+
+def pdf_type(pdf):
+    """'A' when P(f) has its maximum at 0.5 <= f <= 1.5 and rises to it from the
+    first bin (a peak near f = 1, seed 000 Fig. 1), else 'B'."""
+    f, p = pdf[:, 0], pdf[:, 1]
+    sel = f <= 3.0
+    k = int(np.argmax(p[sel]))
+    return "A" if 0.5 <= f[sel][k] <= 1.5 and p[sel][k] > 1.1 * p[0] else "B"
+
+
+def rdf_peaks(rdf, count=3, window=0.15):
+    """First maxima of G(r) in r/L: G smoothed by a 5-bin running mean, a peak
+    is the largest value within +-window (in L) and above 1.05.  A reading of
+    capdem analyze's G(r) table, not a measure of capdem analyze (which has
+    no peak finder)."""
+    r, g = rdf[:, 0], rdf[:, 1]
+    gs = np.convolve(g, np.ones(5) / 5, mode="same")
+    peaks = []
+    for i in range(len(gs)):
+        near = np.abs(r - r[i]) <= window
+        if gs[i] > 1.05 and gs[i] >= gs[near].max():
+            peaks.append(float(r[i]))
+        if len(peaks) == count:
+            break
+    return peaks
+
+
+def metrics(case):
+    with open(case.analysis) as f:
+        d = json.load(f)
+    nf, st = d["normal_forces"], d["stress"]
+    pdf = np.array(nf["curves"]["pdf"]["data"])
+    row = {"study": case.study, "case": case.name, "psi": case.psi, "alpha": case.alpha, "seed": case.seed,
+           "n": case.n, "n_rule": case.n_rule, "phi_guess": case.phi_guess, "step": d["step"],
+           "k": nf.get("k"), "k_lo": nf.get("k_lo"), "k_hi": nf.get("k_hi"), "k_wls": nf.get("k_wls"),
+           "mueth_a": nf.get("mueth_a"), "mueth_b": nf.get("mueth_b"), "mueth_beta": nf.get("mueth_beta"),
+           "pf_type": pdf_type(pdf), "stress_tail_k": st.get("tail_k"),
+           "phi_container": d["packing"].get("phi_container"),
+           "height_over_width": d["packing"]["container_height"] / case.size}
+    if "rdf" in d:
+        row["rdf_peaks"] = rdf_peaks(np.array(d["rdf"]["curves"]["rdf"]["data"]))
+    timing = []
+    if os.path.exists(case.timing):
+        with open(case.timing) as f:
+            timing = json.load(f)
+    row["run_wall_s"] = round(sum(t["wall_s"] for t in timing), 1)
+    return row
+
+
+def aggregate(rows):
+    groups = {}
+    for r in rows:
+        groups.setdefault((r["study"], r["case"].rsplit("_s", 1)[0]), []).append(r)
+    out = []
+    for (study, key), rs in sorted(groups.items()):
+        g = {"study": study, "key": key, "psi": rs[0]["psi"], "alpha": rs[0]["alpha"], "n": rs[0]["n"],
+             "n_rule": rs[0]["n_rule"], "seeds": sorted(r["seed"] for r in rs),
+             "types": "".join(r["pf_type"] for r in rs)}
+        for k in ("k", "k_wls", "mueth_a", "mueth_b", "mueth_beta", "stress_tail_k", "phi_container",
+                  "height_over_width", "run_wall_s"):
+            vals = np.array([r[k] for r in rs if r.get(k) is not None], dtype=float)
+            g[k] = float(vals.mean()) if len(vals) else None
+            g[k + "_se"] = float(vals.std(ddof=1) / math.sqrt(len(vals))) if len(vals) >= 2 else None
+        peaks = [r["rdf_peaks"] for r in rs if r.get("rdf_peaks")]
+        if peaks:
+            m = min(len(p) for p in peaks)
+            arr = np.array([p[:m] for p in peaks])
+            g["rdf_peaks"] = arr.mean(axis=0).tolist()
+            g["rdf_peaks_se"] = (arr.std(axis=0, ddof=1) / math.sqrt(len(arr))).tolist() if len(arr) >= 2 else None
+        if study == "study2":
+            g["k_paper"] = k_paper_2d(g["psi"])
+            g["rdf_peaks_paper"] = rdf_peaks_paper(g["alpha"]) if g["psi"] < 0.9 else [1.0, 1.91]
+        elif study == "study3":
+            g["k_paper"] = k_paper_3d(g["psi"])
+        out.append(g)
+    return out
+
+
+def print_table(agg):
+    for g in agg:
+        line = "%-24s N %5d (rule %5d)  seeds %-6s  k %s (paper %s)  k_wls %s  P(f) type %s  H/W %s" % (
+            g["key"], g["n"], g["n_rule"], ",".join(map(str, g["seeds"])), v1.pm(g, "k", 2),
+            v1.ref(g.get("k_paper")), v1.pm(g, "k_wls", 2), g["types"], v1.pm(g, "height_over_width", 2))
+        if g.get("rdf_peaks"):
+            line += "  G(r) peaks %s (paper %s)" % (
+                ", ".join("%.2f" % p for p in g["rdf_peaks"]),
+                ", ".join("%.2f" % p for p in g.get("rdf_peaks_paper", [])))
+        if g["study"] == "study4":
+            line += "  Mueth a, b, beta = %s, %s, %s (Mueth 1998: 3.0, 0.75, 1.5)" % (
+                v1.pm(g, "mueth_a", 2), v1.pm(g, "mueth_b", 2), v1.pm(g, "mueth_beta", 2))
+        print(line)
+
+
+def figures(outdir, cases, agg, study):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    os.makedirs(outdir, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    seen = set()
+    for c in sorted(cases, key=lambda c: (-(c.psi or 1), c.seed)):
+        key = c.name.rsplit("_s", 1)[0]
+        if key in seen:
+            continue
+        seen.add(key)
+        with open(c.analysis) as f:
+            pdf = np.array(json.load(f)["normal_forces"]["curves"]["pdf"]["data"])
+        good = pdf[:, 1] > 0
+        ax.semilogy(pdf[good, 0], pdf[good, 1], "o-", ms=3, lw=0.8, label=key)
+    f = np.linspace(0, 6, 200)
+    ax.semilogy(f, MUETH["a"] * (1 - MUETH["b"] * np.exp(-f ** 2)) * np.exp(-MUETH["beta"] * f), "k--",
+                label="Mueth et al. 1998")
+    ax.set_xlabel("f = F_n / <F_n>")
+    ax.set_ylabel("P(f)")
+    ax.set_ylim(1e-4, 3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "%s_pf.png" % study), dpi=110)
+    plt.close(fig)
+    written = ["%s_pf.png" % study]
+    if study in ("study2", "study3"):
+        fig, ax = plt.subplots(figsize=(5.5, 4))
+        ps = np.linspace(0.4, 1.0, 100)
+        ax.plot(ps, [k_paper_2d(p) if study == "study2" else k_paper_3d(p) for p in ps], "k--",
+                label="seed 000 fit")
+        gs = [g for g in agg if g["study"] == study and g.get("k") is not None]
+        ax.errorbar([g["psi"] for g in gs], [g["k"] for g in gs], [g["k_se"] or 0 for g in gs], fmt="o",
+                    capsize=3, label="capdem, k (maximum likelihood)")
+        ax.errorbar([g["psi"] for g in gs], [g["k_wls"] for g in gs], [g["k_wls_se"] or 0 for g in gs], fmt="s",
+                    mfc="none", capsize=3, label="capdem, k (least squares, as the paper)")
+        ax.set_xlabel("sphericity ψ")
+        ax.set_ylabel("tail exponent k")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, "%s_k.png" % study), dpi=110)
+        plt.close(fig)
+        written.append("%s_k.png" % study)
+    print("figures: %s (%s)" % (outdir, ", ".join(written)))
+
+
+def run_study(args):
+    capdem = os.path.join(os.path.abspath(args.build), "capdem")
+    if not os.access(capdem, os.X_OK):
+        raise SystemExit("validate.py: %s not found; build first (README)" % capdem)
+    out = os.path.join(os.path.abspath(args.out), args.study)
+    os.makedirs(out, exist_ok=True)
+    cases = make_cases(args, capdem, out)
+    print("%s: %d cases, output %s" % (args.study, len(cases), out))
+    for c in cases:
+        rows, a = c.lattice_rows()
+        print("  %-26s alpha %-4g N %5d (rule %5d, phi guess %.3f)  %s %.4g m  height %.4g m  dt %.2g s  poly %g"
+              % (c.name, c.alpha, c.n, c.n_rule, c.phi_guess, "W" if c.dim == 2 else "D", c.size, (rows + 1) * a,
+                 c.dt(), c.poly))
+    if args.plan:
+        return 0
+    finished = []
+    for c in cases:
+        done = v1.run_state(c.h5)
+        done = done is not None and done[2] == v1.PHASE_DONE
+        while not done and not args.no_run:
+            res = v1.advance(c, args, capdem)
+            done = res == "done"
+            if res != "capped":
+                break
+        if done and analyse(c, capdem, args.reanalyse):
+            finished.append(c)
+    rows = [metrics(c) for c in finished]
+    agg = aggregate(rows)
+    with open(os.path.join(out, "results.json"), "w") as f:
+        json.dump({"generated": v1.now(), "runs": rows, "cases": agg}, f, indent=1)
+    print("%s: %d of %d cases finished" % (args.study, len(finished), len(cases)))
+    print_table(agg)
+    if args.figures and finished:
+        figures(args.figures, finished, agg, args.study)
+    return 0
