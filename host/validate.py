@@ -66,9 +66,9 @@ ARM_D = 0.005  # arm diameter [m] (SPEC 3)
 PHASE_DONE = 7
 
 # alpha -> (shape, dt): the time steps of configs/protocols/radial_hexapods_a*.yaml
-STUDY1_SHAPES = {1.0: ("sphere", 4.0e-6), 1.5: ("hexapod", 9.0e-6), 2.0: ("hexapod", 1.0e-5),
-                 3.0: ("hexapod", 1.0e-5), 5.0: ("hexapod", 1.0e-5), 7.0: ("hexapod", 1.0e-5),
-                 9.0: ("hexapod", 1.0e-5)}
+STUDY1_SHAPES = {1.0: ("sphere", 4.0e-6), 1.5: ("hexapod", 6.5e-6), 2.0: ("hexapod", 8.5e-6),
+                 3.0: ("hexapod", 1.0e-5), 5.0: ("hexapod", 1.5e-5), 7.0: ("hexapod", 2.0e-5),
+                 9.0: ("hexapod", 2.0e-5)}
 
 # Seed 001 (Tran et al. 2024), as its text states them (figures are not in
 # the extracted text; only the numbers the text gives are used).
