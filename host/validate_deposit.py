@@ -134,22 +134,6 @@ class DepositCase(v1.Case):
         for k in ("config", "h5", "log", "timing", "analysis", "packing_m1", "lock"):
             setattr(self, k, os.path.join(self.dir, os.path.basename(getattr(self, k))))
 
-    def lattice_rows(self):
-        """Height of the lattice that holds N sites (src/setup.c, lattice_sites)."""
-        R = 0.5 * self.L * (1 + self.poly)
-        a = 1.5 * 2 * R
-        if self.dim == 2:
-            per_row = max(1, int(math.floor(self.size / a)))
-        else:
-            rc = 0.5 * self.size
-            m = max(1, int(math.floor(self.size / a)))
-            off = -rc + 0.5 * (self.size - (m - 1) * a)
-            per_row = sum(1 for i in range(m) for k in range(m)
-                          if math.hypot(off + a * i, off + a * k) <= rc - R)
-            per_row = max(per_row, 1)
-        rows = int(math.ceil(self.n / per_row))
-        return rows, a
-
     def dt(self):
         m_min = self.mass * (1 - self.poly) ** 3
         mij = 0.5 * m_min
@@ -159,11 +143,9 @@ class DepositCase(v1.Case):
         return math.floor(dt / 10 ** (e - 1)) * 10 ** (e - 1)  # two digits, rounded down
 
     def write_config(self, steps):
-        rows, a = self.lattice_rows()
-        height = (rows + 1) * a
         fields = dict(name=self.name, seed=self.seed, dt="%.2g" % self.dt(), steps=steps, shape=self.shape,
                       aspect="" if self.shape == "sphere" else "aspect: %g," % self.alpha, n=self.n,
-                      poly="%g" % self.poly, height="%.6g" % height)
+                      poly="%g" % self.poly)
         if self.dim == 2:
             fields.update(width="%.6g" % self.size, thickness="%.6g" % self.L)
         else:
@@ -361,11 +343,9 @@ def run_study(args):
     os.makedirs(out, exist_ok=True)
     cases = make_cases(args, capdem, out)
     print("%s: %d cases, output %s" % (args.study, len(cases), out))
-    for c in cases:
-        rows, a = c.lattice_rows()
-        print("  %-26s alpha %-4g N %5d (rule %5d, phi guess %.3f)  %s %.4g m  height %.4g m  dt %.2g s  poly %g"
-              % (c.name, c.alpha, c.n, c.n_rule, c.phi_guess, "W" if c.dim == 2 else "D", c.size, (rows + 1) * a,
-                 c.dt(), c.poly))
+    for c in cases:  # the domain height is capdem's lattice fit (domain.height left out)
+        print("  %-26s alpha %-4g N %5d (rule %5d, phi guess %.3f)  %s %.4g m  dt %.2g s  poly %g"
+              % (c.name, c.alpha, c.n, c.n_rule, c.phi_guess, "W" if c.dim == 2 else "D", c.size, c.dt(), c.poly))
     if args.plan:
         return 0
     finished = []
