@@ -1,0 +1,162 @@
+#!/usr/bin/python3
+"""capdem against LAMMPS on the same work, same machine, same cores, same N.
+
+    /usr/bin/python3 bench/lammps/compare.py [--build build] [--cases spheres:1000,hexapods_a3:1000]
+        [--threads 2] [--steps 1000] [--repeat 3] [--work build/bench-work] [--reuse]
+
+For each case:N, in one invocation:
+  spheres      capdem-bench writes the initial lattice deposit (seed, N) and
+               settles it under 50 g; LAMMPS reads the same initial state
+               (capdem_to_lammps.py) and settles it for the same number of
+               steps with the same law (lammps_law.py), walls, gravity and
+               dt.  Each code then times `--steps` steps `--repeat` times on
+               its own settled packing, still under 50 g.
+  hexapods_aX  capdem-bench settles N hexapods; LAMMPS reads that settled
+               packing as rigid clusters of glued spheres (fix rigid/small
+               molecule, spheres <= d/2 apart along each arm), steps 500
+               untimed steps to let the clusters find their contacts, then
+               is timed the same way.  Settling the clusters from scratch in
+               LAMMPS would cost ~10 x the timed segment and time nothing new.
+capdem runs with --threads T (OpenMP), LAMMPS with `mpirun -np T` (the
+Debian package has no OPENMP package; MPI is its parallel mode here).  Only
+the stepping is timed: capdem-bench's timed segment, LAMMPS's "Loop time of"
+of each timed `run`.  Throughput counts particles (a hexapod is one particle
+in both codes, 13 or 49 LAMMPS atoms).  Prints one JSON line per case and
+a table; the ratio is capdem / LAMMPS of the medians of the repeats.
+
+Installs LAMMPS (Debian package `lammps`) with apt-get if `lmp` is missing.
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import lammps_law  # noqa: E402
+import capdem_to_lammps  # noqa: E402
+
+MATERIAL = dict(kn=1e5, kt=5e4, eta_n=0.2, eta_t=0.2, mu=0.5)  # SPEC 3; walls frictionless
+SETTLE = {"spheres": 30000, "hexapods_a3": 15000, "hexapods_a9": 15000}
+
+
+def ensure_lammps():
+    if shutil.which("lmp"):
+        return
+    print("compare: lmp not found; installing Debian's lammps package", file=sys.stderr)
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    sudo = [] if os.geteuid() == 0 else ["sudo"]
+    subprocess.run(sudo + ["apt-get", "update"], check=True, env=env)
+    subprocess.run(sudo + ["apt-get", "install", "-y", "--no-install-recommends", "lammps", "openmpi-bin"], check=True, env=env)
+
+
+def lammps_version():
+    out = subprocess.run(["lmp", "-h"], capture_output=True, text=True).stdout
+    m = re.search(r"Large-scale Atomic/Molecular Massively Parallel Simulator - (.*)", out)
+    return m.group(1).strip() if m else "unknown"
+
+
+def capdem_bench(args, extra):
+    cmd = [os.path.join(args.build, "capdem-bench"), "--threads", str(args.threads)] + extra
+    env = dict(os.environ, OMP_WAIT_POLICY="PASSIVE")
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if p.returncode:
+        raise SystemExit("compare: %s failed (%d): %s" % (" ".join(cmd), p.returncode, p.stderr))
+    return [json.loads(l) for l in p.stdout.splitlines() if l.startswith("{")]
+
+
+def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None, nrepeat=None):
+    c = lammps_law.lammps_constants(**MATERIAL)
+    var = {
+        "astyle": "hybrid sphere molecular" if meta["rigid"] else "sphere",
+        "data": data, "rigid": int(meta["rigid"]),
+        "model": lammps_law.pair_coeff_args(c), "wallmodel": lammps_law.pair_coeff_args(c, mu=0.0),
+        "W": meta["width"], "H": meta["height"], "T": meta["thickness"], "dt": meta["dt"], "g": 490.5,
+        "skin": 0.1 * meta["min_diameter"],  # capdem's automatic skin
+        "commcut": meta["max_body_extent"] + 0.1 * meta["min_diameter"] + 1e-4,
+        "nsettle": nsettle, "dumpc": int(contacts is not None), "contacts": contacts or "none",
+        "nwarm": nwarm, "nsteps": nsteps or args.steps, "nrepeat": nrepeat or args.repeat,
+    }
+    cmd = ["mpirun", "--allow-run-as-root", "-np", str(args.threads), "lmp", "-in", os.path.join(HERE, "in.capdem.lmp"),
+           "-log", log, "-screen", "none"]
+    for k, v in var.items():
+        cmd += ["-var", k, str(v)]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode:
+        raise SystemExit("compare: LAMMPS failed (%d), see %s: %s" % (p.returncode, log, p.stdout[-2000:] + p.stderr[-2000:]))
+    loops = re.findall(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms", open(log).read())
+    timed = [(float(t), int(s)) for t, _, s, _ in loops if int(s) == var["nsteps"]][-var["nrepeat"]:]
+    return timed, cmd
+
+
+def one_case(args, case, n):
+    w = os.path.join(args.work, "%s_%d" % (case, n))
+    seed = ["--seed", str(args.seed)]
+    settled = w + "_capdem.h5"
+    common = ["--case", case, "--n", str(n), "--friction-limit", "total", "--gravity", "490.5"] + seed
+    if args.reuse and os.path.exists(settled):
+        capdem = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps),
+                                     "--repeat", str(args.repeat)])
+    else:
+        capdem = capdem_bench(args, common + ["--settle-steps", str(SETTLE[case]), "--steps", str(args.steps),
+                                              "--repeat", str(args.repeat), "--save-settled", settled])
+    if case == "spheres":
+        init = w + "_init.h5"
+        capdem_bench(args, common + ["--settle-steps", "0", "--repeat", "0", "--save-settled", init])
+        src, nsettle, nwarm = init, SETTLE[case], 20
+    else:
+        src, nsettle, nwarm = settled, 0, 500
+    data = w + ".data"
+    meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(src), data)
+    timed, cmd = run_lammps(args, data, meta, w + ".lammps.log", nsettle, nwarm)
+    c_rate = statistics.median(r["particle_steps_per_s"] for r in capdem)
+    l_rates = [n * s / t for t, s in timed]
+    l_rate = statistics.median(l_rates)
+    return {
+        "case": case, "N": n, "threads": args.threads, "steps": args.steps, "repeat": args.repeat,
+        "capdem_particle_steps_per_s": c_rate, "capdem_repeats": [r["particle_steps_per_s"] for r in capdem],
+        "capdem_contacts_per_particle": capdem[-1]["contacts_per_particle"],
+        "lammps_particle_steps_per_s": l_rate, "lammps_repeats": l_rates,
+        "lammps_atoms": meta["atoms"], "lammps_atom_steps_per_s": l_rate * meta["spheres_per_particle"],
+        "ratio_capdem_over_lammps": c_rate / l_rate,
+        "lammps_settled_from": "capdem's initial lattice" if case == "spheres" else "capdem's settled packing",
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--cases", default="spheres:1000,hexapods_a3:1000,hexapods_a9:1000")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--steps", type=int, default=1000)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--seed", type=int, default=5)
+    ap.add_argument("--work", default="build/bench-work")
+    ap.add_argument("--reuse", action="store_true", help="time capdem on a settled packing left by an earlier run")
+    args = ap.parse_args()
+    ensure_lammps()
+    os.makedirs(args.work, exist_ok=True)
+    version = lammps_version()
+    rows = []
+    for item in args.cases.split(","):
+        case, n = item.split(":")
+        if case not in SETTLE:
+            raise SystemExit("compare: case %s: expected one of %s (crosses2d has no LAMMPS twin)" % (case, ", ".join(SETTLE)))
+        r = one_case(args, case, int(float(n)))
+        r["lammps_version"] = version
+        print(json.dumps(r), flush=True)
+        rows.append(r)
+    print("\n| case | N | threads | capdem p-steps/s | LAMMPS p-steps/s | capdem / LAMMPS |")
+    print("|---|---|---|---|---|---|")
+    for r in rows:
+        print("| %s | %d | %d | %.3g | %.3g | %.2f |" % (r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"],
+                                                     r["lammps_particle_steps_per_s"], r["ratio_capdem_over_lammps"]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
