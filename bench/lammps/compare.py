@@ -69,7 +69,9 @@ def capdem_bench(args, extra):
     return [json.loads(l) for l in p.stdout.splitlines() if l.startswith("{")]
 
 
-def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None, nrepeat=None):
+def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None, nrepeat=None, write_data=None):
+    """Runs in.capdem.lmp; returns [(loop seconds, steps)] of the timed runs
+    and the mean contacts per atom at the end (compute contact/atom)."""
     c = lammps_law.lammps_constants(**MATERIAL)
     var = {
         "astyle": "hybrid sphere molecular" if meta["rigid"] else "sphere",
@@ -79,7 +81,9 @@ def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None
         "skin": 0.1 * meta["min_diameter"],  # capdem's automatic skin
         "commcut": meta["max_body_extent"] + 0.1 * meta["min_diameter"] + 1e-4,
         "nsettle": nsettle, "dumpc": int(contacts is not None), "contacts": contacts or "none",
-        "nwarm": nwarm, "nsteps": nsteps or args.steps, "nrepeat": nrepeat or args.repeat,
+        "writedata": int(write_data is not None), "settled": write_data or "none",
+        "nwarm": nwarm, "nsteps": args.steps if nsteps is None else nsteps,
+        "nrepeat": args.repeat if nrepeat is None else nrepeat,
     }
     cmd = ["mpirun", "--allow-run-as-root", "-np", str(args.threads), "lmp", "-in", os.path.join(HERE, "in.capdem.lmp"),
            "-log", log, "-screen", "none"]
@@ -88,42 +92,55 @@ def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode:
         raise SystemExit("compare: LAMMPS failed (%d), see %s: %s" % (p.returncode, log, p.stdout[-2000:] + p.stderr[-2000:]))
-    loops = re.findall(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms", open(log).read())
-    timed = [(float(t), int(s)) for t, _, s, _ in loops if int(s) == var["nsteps"]][-var["nrepeat"]:]
-    return timed, cmd
+    text = open(log).read()
+    loops = re.findall(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms", text)
+    timed = [(float(t), int(s)) for t, _, s, _ in loops if int(s) == var["nsteps"]][-var["nrepeat"]:] if var["nrepeat"] else []
+    rows = re.findall(r"^\s+\d+\s+\d+\s+[0-9.eE+-]+\s+([0-9.eE+-]+)\s*$", text, re.M)
+    return timed, (float(rows[-1]) if rows else None)
 
 
 def one_case(args, case, n):
+    """Settles once, then alternates capdem and LAMMPS timed segments
+    (--repeat pairs): a load that drifts on the shared machine hits both
+    codes of a pair alike, and each pair gives one ratio."""
     w = os.path.join(args.work, "%s_%d" % (case, n))
-    seed = ["--seed", str(args.seed)]
     settled = w + "_capdem.h5"
-    common = ["--case", case, "--n", str(n), "--friction-limit", "total", "--gravity", "490.5"] + seed
-    if args.reuse and os.path.exists(settled):
-        capdem = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps),
-                                     "--repeat", str(args.repeat)])
-    else:
-        capdem = capdem_bench(args, common + ["--settle-steps", str(SETTLE[case]), "--steps", str(args.steps),
-                                              "--repeat", str(args.repeat), "--save-settled", settled])
+    common = ["--case", case, "--n", str(n), "--friction-limit", "total", "--gravity", "490.5", "--seed", str(args.seed)]
+    if not (args.reuse and os.path.exists(settled)):
+        capdem_bench(args, common + ["--settle-steps", str(SETTLE[case]), "--repeat", "0", "--save-settled", settled])
     if case == "spheres":
-        init = w + "_init.h5"
-        capdem_bench(args, common + ["--settle-steps", "0", "--repeat", "0", "--save-settled", init])
-        src, nsettle, nwarm = init, SETTLE[case], 20
+        # LAMMPS settles the same initial state itself and times its own packing
+        init, data = w + "_init.h5", w + "_lammps_settled.data"
+        if not (args.reuse and os.path.exists(data)):
+            capdem_bench(args, common + ["--settle-steps", "0", "--repeat", "0", "--save-settled", init])
+            meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(init), w + "_init.data")
+            run_lammps(args, w + "_init.data", meta, w + "_settle.lammps.log", SETTLE[case], 0, nrepeat=0,
+                       write_data=data)
+        meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(init if os.path.exists(init) else settled), os.devnull)
+        nwarm = 200  # write_data keeps no tangential history: let the springs build up again
     else:
-        src, nsettle, nwarm = settled, 0, 500
-    data = w + ".data"
-    meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(src), data)
-    timed, cmd = run_lammps(args, data, meta, w + ".lammps.log", nsettle, nwarm)
-    c_rate = statistics.median(r["particle_steps_per_s"] for r in capdem)
-    l_rates = [n * s / t for t, s in timed]
-    l_rate = statistics.median(l_rates)
+        # LAMMPS times capdem's settled packing as glued-sphere clusters
+        data = w + ".data"
+        meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(settled), data)
+        nwarm = 200
+    capdem, lammps, ratios, z_lammps = [], [], [], None
+    for r in range(args.repeat):
+        c = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps), "--repeat", "1"])[0]
+        timed, z_lammps = run_lammps(args, data, meta, w + ".lammps.log", 0, nwarm, nrepeat=1)
+        l_rate = n * timed[0][1] / timed[0][0]
+        capdem.append(c)
+        lammps.append(l_rate)
+        ratios.append(c["particle_steps_per_s"] / l_rate)
+    c_rates = [c["particle_steps_per_s"] for c in capdem]
     return {
-        "case": case, "N": n, "threads": args.threads, "steps": args.steps, "repeat": args.repeat,
-        "capdem_particle_steps_per_s": c_rate, "capdem_repeats": [r["particle_steps_per_s"] for r in capdem],
+        "case": case, "N": n, "threads": args.threads, "steps": args.steps, "pairs": args.repeat,
+        "capdem_particle_steps_per_s": statistics.median(c_rates), "capdem_repeats": c_rates,
         "capdem_contacts_per_particle": capdem[-1]["contacts_per_particle"],
-        "lammps_particle_steps_per_s": l_rate, "lammps_repeats": l_rates,
-        "lammps_atoms": meta["atoms"], "lammps_atom_steps_per_s": l_rate * meta["spheres_per_particle"],
-        "ratio_capdem_over_lammps": c_rate / l_rate,
-        "lammps_settled_from": "capdem's initial lattice" if case == "spheres" else "capdem's settled packing",
+        "lammps_particle_steps_per_s": statistics.median(lammps), "lammps_repeats": lammps,
+        "lammps_contacts_per_atom": z_lammps if case == "spheres" else None,
+        "lammps_atoms": meta["atoms"], "lammps_atom_steps_per_s": statistics.median(lammps) * meta["spheres_per_particle"],
+        "ratio_capdem_over_lammps": statistics.median(ratios), "ratios": ratios,
+        "lammps_packing": "its own, settled from capdem's initial lattice" if case == "spheres" else "capdem's settled packing",
     }
 
 
@@ -150,11 +167,12 @@ def main():
         r["lammps_version"] = version
         print(json.dumps(r), flush=True)
         rows.append(r)
-    print("\n| case | N | threads | capdem p-steps/s | LAMMPS p-steps/s | capdem / LAMMPS |")
+    print("\n| case | N | threads | capdem p-steps/s | LAMMPS p-steps/s | capdem / LAMMPS (median, range over pairs) |")
     print("|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %d | %d | %.3g | %.3g | %.2f |" % (r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"],
-                                                     r["lammps_particle_steps_per_s"], r["ratio_capdem_over_lammps"]))
+        print("| %s | %d | %d | %.3g | %.3g | %.2f (%.2f-%.2f) |" % (
+            r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], r["lammps_particle_steps_per_s"],
+            r["ratio_capdem_over_lammps"], min(r["ratios"]), max(r["ratios"])))
     return 0
 
 
