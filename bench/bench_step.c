@@ -14,7 +14,8 @@
  * packing stays as dense as it settled; G = 9.81 unloads it, and a packing
  * settled under 50 g then springs up and loses most of its contacts), then M steps are timed R times
  * and one JSON line is printed per repeat: case, N, backend, device,
- * threads, steps, wall seconds, particle-steps/s, contact-updates/s (active
+ * threads, steps, wall seconds (and the process's CPU seconds over the same
+ * segment: less sensitive to other jobs on a shared machine), particle-steps/s, contact-updates/s (active
  * contacts x steps / s), contacts per particle and bytes per particle of the
  * state.  Only the stepping is timed: set-up, settling, sync and output are
  * not.
@@ -43,12 +44,13 @@
 #include "io_h5.h"
 #include "bench_cases.h"
 
-static double now(void)
+static double clock_s(clockid_t which)
 {
     struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
+    clock_gettime(which, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
+static double now(void) { return clock_s(CLOCK_MONOTONIC); }
 
 /* Copies every column and scalar of src into dst, whose columns are
  * allocated (its pair columns grow as needed). */
@@ -206,17 +208,17 @@ int main(int argc, char **argv)
             if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
             cd_sim_observe(&sim, &o);
             double contacts = o.n_contacts + o.n_wall_contacts;
-            double t = now();
+            double t = now(), c = clock_s(CLOCK_PROCESS_CPUTIME_ID);
             if (cd_sim_step(&sim, steps, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
-            double wall = now() - t;
+            double wall = now() - t, cpu = clock_s(CLOCK_PROCESS_CPUTIME_ID) - c;
             /* (a sync, untimed, for the pair count of the report) */
             if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
             printf("{\"case\": \"%s\", \"N\": %ld, \"backend\": \"%s\", \"device\": \"%s\", \"threads\": %d, "
-                   "\"steps\": %ld, \"wall_s\": %.6g, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
+                   "\"steps\": %ld, \"wall_s\": %.6g, \"cpu_s\": %.6g, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
                    "\"contacts_per_particle\": %.3f, \"pairs_in_list\": %zu, \"bytes_per_particle\": %.0f, "
                    "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"dt\": %g}\n",
                    case_label, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
-                   round_threads[k], steps, wall, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
+                   round_threads[k], steps, wall, cpu, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
                    sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.p.dt);
             fflush(stdout);
         }

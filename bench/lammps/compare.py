@@ -1,10 +1,13 @@
 #!/usr/bin/python3
 """capdem against LAMMPS on the same work, same machine, same cores, same N.
 
-    /usr/bin/python3 bench/lammps/compare.py [--build build] [--cases spheres:1000,hexapods_a3:1000]
+    /usr/bin/python3 bench/lammps/compare.py [--build build] [--cases spheres:1000,hexapods_a3:1000:100]
         [--threads 2] [--steps 1000] [--repeat 3] [--work build/bench-work] [--reuse]
 
-For each case:N, in one invocation:
+For each case:N[:LAMMPS_STEPS], in one invocation (LAMMPS_STEPS: the
+length of LAMMPS's timed segments, default --steps; shorter ones for the
+hexapods keep the two segments of a pair about as long, so that they see the
+same load):
   spheres      capdem-bench writes the initial lattice deposit (seed, N) and
                settles it under 50 g; LAMMPS reads the same initial state
                (capdem_to_lammps.py) and settles it for the same number of
@@ -22,7 +25,12 @@ Debian package has no OPENMP package; MPI is its parallel mode here).  Only
 the stepping is timed: capdem-bench's timed segment, LAMMPS's "Loop time of"
 of each timed `run`.  Throughput counts particles (a hexapod is one particle
 in both codes, 13 or 49 LAMMPS atoms).  Prints one JSON line per case and
-a table; the ratio is capdem / LAMMPS of the medians of the repeats.
+a table; the ratio is capdem / LAMMPS of wall-clock throughput, taken per
+pair of segments (median and range over pairs).  The JSON lines also give
+the ratio of particle-steps per CPU second (capdem: the process's CPU time;
+LAMMPS: loop time x "% CPU use" x ranks), which other jobs on a shared
+machine disturb much less; with 2 ranks LAMMPS's CPU time includes MPI's
+busy waiting, so that ratio is clean with --threads 1 only.
 
 Installs LAMMPS (Debian package `lammps`) with apt-get if `lmp` is missing.
 """
@@ -93,13 +101,16 @@ def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None
     if p.returncode:
         raise SystemExit("compare: LAMMPS failed (%d), see %s: %s" % (p.returncode, log, p.stdout[-2000:] + p.stderr[-2000:]))
     text = open(log).read()
-    loops = re.findall(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms", text)
-    timed = [(float(t), int(s)) for t, _, s, _ in loops if int(s) == var["nsteps"]][-var["nrepeat"]:] if var["nrepeat"] else []
+    loops = re.findall(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms\s+"
+                       r"(?:Performance:[^\n]*\n)?\s*([0-9.]+)% CPU use", text)
+    # (loop wall seconds, steps, CPU seconds of all ranks = wall x CPU use x ranks)
+    timed = [(float(t), int(s), float(t) * float(pct) / 100 * int(np_)) for t, np_, s, _, pct in loops
+             if int(s) == var["nsteps"]][-var["nrepeat"]:] if var["nrepeat"] else []
     rows = re.findall(r"^\s+\d+\s+\d+\s+[0-9.eE+-]+\s+([0-9.eE+-]+)\s*$", text, re.M)
     return timed, (float(rows[-1]) if rows else None)
 
 
-def one_case(args, case, n):
+def one_case(args, case, n, lammps_steps):
     """Settles once, then alternates capdem and LAMMPS timed segments
     (--repeat pairs): a load that drifts on the shared machine hits both
     codes of a pair alike, and each pair gives one ratio."""
@@ -123,23 +134,27 @@ def one_case(args, case, n):
         data = w + ".data"
         meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(settled), data)
         nwarm = 200
-    capdem, lammps, ratios, z_lammps = [], [], [], None
+    capdem, lammps, ratios, cpu_ratios, z_lammps = [], [], [], [], None
     for r in range(args.repeat):
         c = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps), "--repeat", "1"])[0]
-        timed, z_lammps = run_lammps(args, data, meta, w + ".lammps.log", 0, nwarm, nrepeat=1)
+        timed, z_lammps = run_lammps(args, data, meta, w + ".lammps.log", 0, nwarm, nsteps=lammps_steps, nrepeat=1)
         l_rate = n * timed[0][1] / timed[0][0]
         capdem.append(c)
         lammps.append(l_rate)
         ratios.append(c["particle_steps_per_s"] / l_rate)
+        # per CPU second: n steps / cpu_s, both codes
+        cpu_ratios.append((n * c["steps"] / c["cpu_s"]) / (n * timed[0][1] / timed[0][2]))
     c_rates = [c["particle_steps_per_s"] for c in capdem]
     return {
-        "case": case, "N": n, "threads": args.threads, "steps": args.steps, "pairs": args.repeat,
+        "case": case, "N": n, "threads": args.threads, "steps": args.steps, "lammps_steps": lammps_steps,
+        "pairs": args.repeat,
         "capdem_particle_steps_per_s": statistics.median(c_rates), "capdem_repeats": c_rates,
         "capdem_contacts_per_particle": capdem[-1]["contacts_per_particle"],
         "lammps_particle_steps_per_s": statistics.median(lammps), "lammps_repeats": lammps,
         "lammps_contacts_per_atom": z_lammps if case == "spheres" else None,
         "lammps_atoms": meta["atoms"], "lammps_atom_steps_per_s": statistics.median(lammps) * meta["spheres_per_particle"],
         "ratio_capdem_over_lammps": statistics.median(ratios), "ratios": ratios,
+        "cpu_ratio_capdem_over_lammps": statistics.median(cpu_ratios), "cpu_ratios": cpu_ratios,
         "lammps_packing": "its own, settled from capdem's initial lattice" if case == "spheres" else "capdem's settled packing",
     }
 
@@ -160,19 +175,21 @@ def main():
     version = lammps_version()
     rows = []
     for item in args.cases.split(","):
-        case, n = item.split(":")
+        case, n, *ls = item.split(":")
         if case not in SETTLE:
             raise SystemExit("compare: case %s: expected one of %s (crosses2d has no LAMMPS twin)" % (case, ", ".join(SETTLE)))
-        r = one_case(args, case, int(float(n)))
+        r = one_case(args, case, int(float(n)), int(ls[0]) if ls else args.steps)
         r["lammps_version"] = version
         print(json.dumps(r), flush=True)
         rows.append(r)
-    print("\n| case | N | threads | capdem p-steps/s | LAMMPS p-steps/s | capdem / LAMMPS (median, range over pairs) |")
-    print("|---|---|---|---|---|---|")
+    print("\n| case | N | threads | capdem p-steps/s | LAMMPS p-steps/s | capdem / LAMMPS wall (median, range) "
+          "| capdem / LAMMPS per CPU s (median, range) |")
+    print("|---|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %d | %d | %.3g | %.3g | %.2f (%.2f-%.2f) |" % (
+        print("| %s | %d | %d | %.3g | %.3g | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) |" % (
             r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], r["lammps_particle_steps_per_s"],
-            r["ratio_capdem_over_lammps"], min(r["ratios"]), max(r["ratios"])))
+            r["ratio_capdem_over_lammps"], min(r["ratios"]), max(r["ratios"]),
+            r["cpu_ratio_capdem_over_lammps"], min(r["cpu_ratios"]), max(r["cpu_ratios"])))
     return 0
 
 
