@@ -4,6 +4,7 @@
  *                [--settle-steps S] [--relax-steps X] [--gravity G] [--steps M] [--repeat R]
  *                [--backend omp|opencl|omp:2,omp:1,...] [--device cpu|gpu|auto] [--seed K]
  *                [--friction-limit elastic|total] [--save-settled F.h5] [--load-settled F.h5]
+ *                [--tile KX,KZ]
  *
  * A case (bench_cases.c) is a shape, a size distribution, a dimension and a
  * time step, with the SPEC 3 material.  N particles are deposited from a
@@ -25,7 +26,9 @@
  * bench/lammps/ read; --load-settled F starts from such a file instead of
  * settling (its config gives the case and N), so that an expensive settle is
  * done once and the timing later.  --repeat 0 with --save-settled only
- * settles.
+ * settles.  --tile KX,KZ (with --load-settled) places KX x KZ copies of the
+ * loaded packing side by side (bench_tile.c) and relaxes them for
+ * --relax-steps before timing: a large packing without a tall settle.
  *
  * --backend takes a comma-separated list (an entry "omp:1" runs that round
  * with 1 thread, so thread counts are compared on one packing): the packing is settled on the
@@ -43,6 +46,7 @@
 #include "sim.h"
 #include "io_h5.h"
 #include "bench_cases.h"
+#include "bench_tile.h"
 
 static double clock_s(clockid_t which)
 {
@@ -100,6 +104,7 @@ int main(int argc, char **argv)
 {
     const char *case_name = "hexapods_a3", *friction_limit = "elastic";
     const char *save_path = NULL, *load_path = NULL;
+    int tile_x = 1, tile_z = 1;
     long n = 10000, settle = -1, relax = 0, steps = 500, repeat = 3;
     unsigned seed = 5;
     double gravity = 490.5; /* [m/s^2] after settling: the settling load */
@@ -121,6 +126,10 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--friction-limit")) friction_limit = argv[i + 1];
         else if (!strcmp(argv[i], "--save-settled")) save_path = argv[i + 1];
         else if (!strcmp(argv[i], "--load-settled")) load_path = argv[i + 1];
+        else if (!strcmp(argv[i], "--tile")) {
+            if (sscanf(argv[i + 1], "%d,%d", &tile_x, &tile_z) != 2 || tile_x < 1 || tile_z < 1)
+                return fail("--tile: expected KX,KZ (copies along x and z, each >= 1)", 2);
+        }
         else { fprintf(stderr, "capdem-bench: unknown option %s\n", argv[i]); return 2; }
     }
     if (n < 1 || steps < 1 || repeat < 0 || relax < 0 || threads < 1) return fail("--n, --steps, --threads must be >= 1", 2);
@@ -136,6 +145,21 @@ int main(int argc, char **argv)
         free(text);
         if (rc || cd_sim_setup(&sim, &cfg, err, sizeof err) || cd_h5_read_snapshot(load_path, -1, &sim.s, err, sizeof err))
             return fail(err, 2);
+        if (tile_x * tile_z > 1) {
+            static cd_sim big;
+            static char tiled[4096];
+            cd_config big_cfg;
+            double w = sim.cfg.box_width, t = sim.cfg.box_thickness;
+            if (cd_bench_tile_config(cfg.source_text, tile_x, tile_z, tiled, sizeof tiled))
+                return fail("--tile: the loaded file is not a capdem-bench case", 2);
+            if (cd_config_parse(tiled, load_path, &big_cfg, err, sizeof err) || cd_sim_setup(&big, &big_cfg, err, sizeof err))
+                return fail(err, 2);
+            if (cd_bench_tile_state(&big.s, &sim.s, tile_x, tile_z, w, t)) return fail("--tile: counts do not match", 2);
+            cd_sim_free(&sim);
+            cd_config_free(&cfg);
+            sim = big; /* the tiled simulation replaces the loaded one */
+            cfg = big_cfg;
+        }
         n = (long)sim.s.n_particles;
         const char *tag = strstr(cfg.source_text, "# case: ");
         if (tag && sscanf(tag + 8, "%63s", yaml) == 1) case_name = yaml;
@@ -169,7 +193,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "capdem-bench: --backend: expected omp, opencl or a list of them\n");
         return 2;
     }
-    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path ? 0 : 1, err, sizeof err))
+    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 ? 0 : 1, err, sizeof err))
         return fail(err, 2);
     double t0 = now();
     if (!load_path && cd_sim_step(&sim, settle, err, sizeof err)) return fail(err, 3);

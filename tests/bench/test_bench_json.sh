@@ -48,6 +48,11 @@ test ! -s "$dir/save.jsonl" || { echo "--repeat 0 printed a timing"; exit 1; }
 check hexapods_a3 60 10 "$dir/load.jsonl"
 test "$(wc -l < "$dir/load.jsonl")" -eq 2
 
+# --tile: 2 x 1 copies of the loaded packing, relaxed, then timed
+"$bench" --load-settled "$dir/settled.h5" --tile 2,1 --relax-steps 50 --steps 10 --repeat 1 --threads 1 \
+  > "$dir/tile.jsonl" 2> /dev/null
+check hexapods_a3 120 10 "$dir/tile.jsonl"
+
 # bad input: exit status 2 and a message naming the cases
 if "$bench" --case tetrahedra --n 10 2> "$dir/bad.err"; then echo "accepted an unknown case"; exit 1; fi
 grep -q "hexapods_a9" "$dir/bad.err"
