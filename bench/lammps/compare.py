@@ -93,7 +93,9 @@ def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None
         "nwarm": nwarm, "nsteps": args.steps if nsteps is None else nsteps,
         "nrepeat": args.repeat if nrepeat is None else nrepeat,
     }
-    cmd = ["mpirun", "--allow-run-as-root", "-np", str(args.threads), "lmp", "-in", os.path.join(HERE, "in.capdem.lmp"),
+    # ranks yield the core while they wait (as capdem runs with OMP_WAIT_POLICY=PASSIVE): on a
+    # shared, oversubscribed machine a spinning rank starves the one it waits for
+    cmd = ["mpirun", "--allow-run-as-root", "--mca", "mpi_yield_when_idle", "1", "-np", str(args.threads), "lmp", "-in", os.path.join(HERE, "in.capdem.lmp"),
            "-log", log, "-screen", "none"]
     for k, v in var.items():
         cmd += ["-var", k, str(v)]
