@@ -18,6 +18,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 
 def main():
@@ -32,7 +33,10 @@ def main():
             if not line.startswith("{"):
                 continue
             r = json.loads(line)
-            label = "%s, %d thread%s" % (r["case"], r["threads"], "" if r["threads"] == 1 else "s")
+            if r["backend"] == "omp":
+                label = "%s, %d thread%s" % (r["case"], r["threads"], "" if r["threads"] == 1 else "s")
+            else:  # the OpenCL runtime chooses its own worker threads
+                label = r["case"]
             series[r["backend"]][label].append((r["N"], r["wall_s"] / r["steps"]))
     backends = sorted(series)
     fig, axes = plt.subplots(1, len(backends), figsize=(5.5 * len(backends), 4.2), squeeze=False, sharey=True)
@@ -53,6 +57,8 @@ def main():
         ax.set_xlabel("particles N")
         ax.set_title("backend %s" % backend + (" (PoCL, CPU)" if backend == "opencl" else " (host OpenMP)"))
         ax.grid(True, which="both", alpha=0.3)
+        ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+        ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.legend(fontsize=8)
     axes[0][0].set_ylabel("wall time per step [ms]")
     fig.suptitle(a.title, fontsize=10)
