@@ -1,18 +1,34 @@
 /* Throughput of the time step on a settled packing.
  *
- *   capdem-bench [--shape hexapod] [--aspect 3] [--n 10000] [--threads T]
+ *   capdem-bench [--case spheres|crosses2d|hexapods_a3|hexapods_a9] [--n 10000] [--threads T]
  *                [--settle-steps S] [--relax-steps X] [--gravity G] [--steps M] [--repeat R]
- *                [--backend omp|opencl|omp,opencl] [--device cpu|gpu|auto]
+ *                [--backend omp|opencl|omp:2,omp:1,...] [--device cpu|gpu|auto] [--seed K]
+ *                [--friction-limit elastic|total] [--save-settled F.h5] [--load-settled F.h5]
+ *                [--tile KX,KZ]
  *
- * Deposits N particles from a lattice into a box of square cross-section
- * (10 particle sizes wide per 1000 particles), settles them for S steps
- * under a strengthened gravity (50 g, which shortens the fall without
- * changing the contact law), lets the packing relax for X steps under G
- * (default 9.81 m/s^2, default X 0; G = 490.5 keeps the packing as dense as
- * it settled), then times M steps R times and prints one
- * JSON line per repeat: case, N, backend, threads, steps, wall seconds,
- * particle-steps/s, contact-updates/s (active contacts x steps / s),
- * contacts per particle and bytes per particle of the state.
+ * A case (bench_cases.c) is a shape, a size distribution, a dimension and a
+ * time step, with the SPEC 3 material.  N particles are deposited from a
+ * lattice into a box of square cross-section (columns about 4x as tall as
+ * wide), settled for S steps (default: the case's) under a strengthened
+ * gravity (50 g, which shortens the fall without changing the contact law),
+ * relaxed for X steps under G (default X 0, default G = 490.5 m/s^2: the
+ * packing stays as dense as it settled; G = 9.81 unloads it, and a packing
+ * settled under 50 g then springs up and loses most of its contacts), then M steps are timed R times
+ * and one JSON line is printed per repeat: case, N, backend, device,
+ * threads, steps, wall seconds (and the process's CPU seconds over the same
+ * segment: less sensitive to other jobs on a shared machine), particle-steps/s, contact-updates/s (active
+ * contacts x steps / s), contacts per particle and bytes per particle of the
+ * state.  Only the stepping is timed: set-up, settling, sync and output are
+ * not.
+ *
+ * --save-settled F writes the settled (and relaxed) packing to F, a run file
+ * (docs/output.md) that `capdem analyze`, `capdem run --resume` and
+ * bench/lammps/ read; --load-settled F starts from such a file instead of
+ * settling (its config gives the case and N), so that an expensive settle is
+ * done once and the timing later.  --repeat 0 with --save-settled only
+ * settles.  --tile KX,KZ (with --load-settled) places KX x KZ copies of the
+ * loaded packing side by side (bench_tile.c) and relaxes them for
+ * --relax-steps before timing: a large packing without a tall settle.
  *
  * --backend takes a comma-separated list (an entry "omp:1" runs that round
  * with 1 thread, so thread counts are compared on one packing): the packing is settled on the
@@ -28,13 +44,17 @@
 #include <time.h>
 #include <omp.h>
 #include "sim.h"
+#include "io_h5.h"
+#include "bench_cases.h"
+#include "bench_tile.h"
 
-static double now(void)
+static double clock_s(clockid_t which)
 {
     struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
+    clock_gettime(which, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
+static double now(void) { return clock_s(CLOCK_MONOTONIC); }
 
 /* Copies every column and scalar of src into dst, whose columns are
  * allocated (its pair columns grow as needed). */
@@ -64,17 +84,35 @@ static size_t state_bytes(const cd_sim *sim)
     return b;
 }
 
+static int fail(const char *what, int status)
+{
+    fprintf(stderr, "capdem-bench: %s\n", what);
+    return status;
+}
+
+/* Writes the synced state of sim to path as a one-snapshot run file. */
+static int save_settled(const char *path, cd_sim *sim, const cd_config *cfg, char *err, size_t len)
+{
+    cd_output *o = cd_output_create(path, cfg, sim->shapes, sim->n_shapes, NULL, 0, err, len);
+    if (!o) return -1;
+    int rc = cd_output_snapshot(o, &sim->s);
+    if (rc) snprintf(err, len, "%s: %s", path, cd_output_error(o));
+    return cd_output_close(o) || rc ? -1 : 0;
+}
+
 int main(int argc, char **argv)
 {
-    const char *shape = "hexapod";
-    double aspect = 3;
-    long n = 10000, settle = 15000, relax = 0, steps = 500, repeat = 3;
-    double gravity = 9.81; /* [m/s^2] after settling */
+    const char *case_name = "hexapods_a3", *friction_limit = "elastic";
+    const char *save_path = NULL, *load_path = NULL;
+    int tile_x = 1, tile_z = 1;
+    long n = 10000, settle = -1, relax = 0, steps = 500, repeat = 3;
+    unsigned seed = 5;
+    double gravity = 490.5; /* [m/s^2] after settling: the settling load */
     int threads = omp_get_max_threads();
     const char *backends = "omp", *device = "auto";
-    for (int i = 1; i + 1 < argc; i += 2) {
-        if (!strcmp(argv[i], "--shape")) shape = argv[i + 1];
-        else if (!strcmp(argv[i], "--aspect")) aspect = atof(argv[i + 1]);
+    for (int i = 1; i < argc; i += 2) {
+        if (i + 1 >= argc) { fprintf(stderr, "capdem-bench: %s needs a value\n", argv[i]); return 2; }
+        if (!strcmp(argv[i], "--case")) case_name = argv[i + 1];
         else if (!strcmp(argv[i], "--n")) n = atol(argv[i + 1]);
         else if (!strcmp(argv[i], "--threads")) threads = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--settle-steps")) settle = atol(argv[i + 1]);
@@ -84,31 +122,61 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--repeat")) repeat = atol(argv[i + 1]);
         else if (!strcmp(argv[i], "--backend")) backends = argv[i + 1];
         else if (!strcmp(argv[i], "--device")) device = argv[i + 1];
+        else if (!strcmp(argv[i], "--seed")) seed = (unsigned)atol(argv[i + 1]);
+        else if (!strcmp(argv[i], "--friction-limit")) friction_limit = argv[i + 1];
+        else if (!strcmp(argv[i], "--save-settled")) save_path = argv[i + 1];
+        else if (!strcmp(argv[i], "--load-settled")) load_path = argv[i + 1];
+        else if (!strcmp(argv[i], "--tile")) {
+            if (sscanf(argv[i + 1], "%d,%d", &tile_x, &tile_z) != 2 || tile_x < 1 || tile_z < 1)
+                return fail("--tile: expected KX,KZ (copies along x and z, each >= 1)", 2);
+        }
         else { fprintf(stderr, "capdem-bench: unknown option %s\n", argv[i]); return 2; }
     }
+    if (n < 1 || steps < 1 || repeat < 0 || relax < 0 || threads < 1) return fail("--n, --steps, --threads must be >= 1", 2);
     omp_set_num_threads(threads);
-    double d = 0.005, L = aspect * d;                /* arm diameter, tip length [m] */
-    double size = (strcmp(shape, "sphere") ? L : d) * 1.2 * 1.1; /* lattice spacing [m] */
-    double width = size * ceil(cbrt((double)n / 4.0)); /* columns about 4x as tall as wide */
-    /* the lattice keeps clear of the walls: a layer holds (width/size - 1)^2
-     * sites, not (width/size)^2 */
-    double per_layer = (width / size - 1) * (width / size - 1);
-    double height = size * ((double)n / per_layer + 3);
-    char yaml[2048];
-    snprintf(yaml, sizeof yaml,
-             "run: {dt: 1.0e-5, steps: 0, seed: 5}\n"
-             "physics: {gravity: [0, -490.5, 0]}\n"
-             "particles: [{shape: %s, aspect: %g, diameter: %g, count: %ld, polydispersity: 0.2}]\n"
-             "domain: {type: box, width: %g, thickness: %g, height: %g}\n"
-             "init: {placement: lattice, clearance: 1.1, speed: 0.25}\n",
-             shape, !strcmp(shape, "sphere") ? 1.0 : aspect, d, n, width, width, height * 1.01);
+    char yaml[2048], err[2048];
     cd_config cfg;
-    char err[2048];
     static cd_sim sim;
-    if (cd_config_parse(yaml, "bench", &cfg, err, sizeof err) || cd_sim_setup(&sim, &cfg, err, sizeof err)) {
-        fprintf(stderr, "capdem-bench: %s\n", err);
-        return 2;
+    if (load_path) {
+        /* the case and N come from the config echoed in the file */
+        char *text = cd_h5_read_config_text(load_path, err, sizeof err);
+        if (!text) return fail(err, 2);
+        int rc = cd_config_parse(text, load_path, &cfg, err, sizeof err);
+        free(text);
+        if (rc || cd_sim_setup(&sim, &cfg, err, sizeof err) || cd_h5_read_snapshot(load_path, -1, &sim.s, err, sizeof err))
+            return fail(err, 2);
+        if (tile_x * tile_z > 1) {
+            static cd_sim big;
+            static char tiled[4096];
+            cd_config big_cfg;
+            double w = sim.cfg.box_width, t = sim.cfg.box_thickness;
+            if (cd_bench_tile_config(cfg.source_text, tile_x, tile_z, tiled, sizeof tiled))
+                return fail("--tile: the loaded file is not a capdem-bench case", 2);
+            if (cd_config_parse(tiled, load_path, &big_cfg, err, sizeof err) || cd_sim_setup(&big, &big_cfg, err, sizeof err))
+                return fail(err, 2);
+            if (cd_bench_tile_state(&big.s, &sim.s, tile_x, tile_z, w, t)) return fail("--tile: counts do not match", 2);
+            cd_sim_free(&sim);
+            cd_config_free(&cfg);
+            sim = big; /* the tiled simulation replaces the loaded one */
+            cfg = big_cfg;
+        }
+        n = (long)sim.s.n_particles;
+        const char *tag = strstr(cfg.source_text, "# case: ");
+        if (tag && sscanf(tag + 8, "%63s", yaml) == 1) case_name = yaml;
+    } else {
+        const cd_bench_case *bc = cd_bench_case_find(case_name);
+        if (!bc) {
+            fprintf(stderr, "capdem-bench: --case %s: expected one of %s\n", case_name, cd_bench_case_names());
+            return 2;
+        }
+        if (settle < 0) settle = bc->settle_steps;
+        int k = snprintf(yaml, sizeof yaml, "# case: %s\n", bc->name);
+        if (cd_bench_case_yaml(bc, n, seed, friction_limit, yaml + k, sizeof yaml - (size_t)k) < 0)
+            return fail("case config too long", 2);
+        if (cd_config_parse(yaml, "bench", &cfg, err, sizeof err) || cd_sim_setup(&sim, &cfg, err, sizeof err))
+            return fail(err, 2);
     }
+    const char *case_label = case_name;
     char list[256], *save = NULL, *names[8];
     int n_backends = 0;
     snprintf(list, sizeof list, "%s", backends);
@@ -125,19 +193,16 @@ int main(int argc, char **argv)
         fprintf(stderr, "capdem-bench: --backend: expected omp, opencl or a list of them\n");
         return 2;
     }
-    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, 1, err, sizeof err)) {
-        fprintf(stderr, "capdem-bench: %s\n", err);
-        return 2;
-    }
+    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 ? 0 : 1, err, sizeof err))
+        return fail(err, 2);
     double t0 = now();
-    if (cd_sim_step(&sim, settle, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
+    if (!load_path && cd_sim_step(&sim, settle, err, sizeof err)) return fail(err, 3);
     double t_settle = now() - t0;
     sim.p.gravity = cd_v3(0, -gravity, 0);
-    if (relax > 0 && cd_sim_step(&sim, relax, err, sizeof err)) {
-        fprintf(stderr, "capdem-bench: %s\n", err);
-        return 3;
-    }
-    if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
+    if (relax > 0 && cd_sim_step(&sim, relax, err, sizeof err)) return fail(err, 3);
+    if (cd_sim_sync(&sim, err, sizeof err)) return fail(err, 3);
+    if (save_path && save_settled(save_path, &sim, &cfg, err, sizeof err)) return fail(err, 1);
+    if (repeat == 0) n_backends = 0;
     /* With several backends each starts from a copy of this state. */
     static cd_state settled;
     if (n_backends > 1 &&
@@ -159,24 +224,26 @@ int main(int argc, char **argv)
                 fprintf(stderr, "capdem-bench: %s\n", err);
                 return 2;
             }
+        } else if (load_path && cd_sim_step(&sim, 20, err, sizeof err)) {
+            return fail(err, 3); /* warm-up of a loaded packing: first list build */
         }
         for (long r = 0; r < repeat; r++) {
             cd_observables o;
             if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
             cd_sim_observe(&sim, &o);
             double contacts = o.n_contacts + o.n_wall_contacts;
-            double t = now();
+            double t = now(), c = clock_s(CLOCK_PROCESS_CPUTIME_ID);
             if (cd_sim_step(&sim, steps, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
-            double wall = now() - t;
+            double wall = now() - t, cpu = clock_s(CLOCK_PROCESS_CPUTIME_ID) - c;
             /* (a sync, untimed, for the pair count of the report) */
             if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
-            printf("{\"case\": \"%s_a%g\", \"N\": %ld, \"backend\": \"%s\", \"device\": \"%s\", \"threads\": %d, "
-                   "\"steps\": %ld, \"wall_s\": %.4f, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
+            printf("{\"case\": \"%s\", \"N\": %ld, \"backend\": \"%s\", \"device\": \"%s\", \"threads\": %d, "
+                   "\"steps\": %ld, \"wall_s\": %.6g, \"cpu_s\": %.6g, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
                    "\"contacts_per_particle\": %.3f, \"pairs_in_list\": %zu, \"bytes_per_particle\": %.0f, "
-                   "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld}\n",
-                   shape, aspect, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
-                   round_threads[k], steps, wall, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
-                   sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds);
+                   "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"dt\": %g}\n",
+                   case_label, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
+                   round_threads[k], steps, wall, cpu, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
+                   sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.p.dt);
             fflush(stdout);
         }
     }

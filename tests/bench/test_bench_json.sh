@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# capdem-bench (bench/bench_step.c, docs/performance.md): every case prints
+# JSON lines with every key of issue 7 and sane values; a settled packing
+# saved with --save-settled loads back with --load-settled (same case and N);
+# capdem_to_lammps.py turns it into a LAMMPS data file with the glued-sphere
+# count of a hexapod (13 at alpha 3).  Tiny cases: a few seconds on 2 cores.
+#   test_bench_json.sh CAPDEM_BENCH SOURCE_DIR
+set -euo pipefail
+bench=$1
+src=$2
+py=/usr/bin/python3
+dir=$(mktemp -d bench-test.XXXXXX)
+trap 'rm -rf "$dir"' EXIT
+
+check() { # CASE N STEPS FILE: every line of FILE is a valid report of CASE
+  "$py" - "$@" <<'PY'
+import json, sys
+case, n, steps, path = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+keys = ["case", "N", "backend", "device", "threads", "steps", "wall_s", "particle_steps_per_s",
+        "contact_updates_per_s", "contacts_per_particle", "bytes_per_particle"]
+lines = [l for l in open(path) if l.strip()]
+assert lines, "no JSON line"
+for l in lines:
+    r = json.loads(l)
+    missing = [k for k in keys if k not in r]
+    assert not missing, "missing keys %s in %s" % (missing, l)
+    assert r["case"] == case and r["N"] == n and r["steps"] == steps, l
+    assert r["backend"] and r["device"] and r["threads"] >= 1, l
+    assert r["wall_s"] > 0, l
+    rate = r["N"] * r["steps"] / r["wall_s"]
+    assert abs(r["particle_steps_per_s"] - rate) <= 2e-3 * rate + 1e-3 * r["N"] / r["wall_s"], l
+    assert r["contact_updates_per_s"] >= 0 and 0 <= r["contacts_per_particle"] < 40, l
+    assert 100 < r["bytes_per_particle"] < 1e5, l
+print("ok", case, len(lines), "lines")
+PY
+}
+
+for case in spheres crosses2d hexapods_a3 hexapods_a9; do
+  "$bench" --case "$case" --n 40 --settle-steps 300 --steps 20 --repeat 2 --threads 1 > "$dir/$case.jsonl" 2> "$dir/$case.err"
+  check "$case" 40 20 "$dir/$case.jsonl"
+done
+
+# save, then load: same case and N, thread rounds on one packing
+"$bench" --case hexapods_a3 --n 60 --settle-steps 500 --repeat 0 --threads 1 --save-settled "$dir/settled.h5" \
+  > "$dir/save.jsonl" 2> /dev/null
+test ! -s "$dir/save.jsonl" || { echo "--repeat 0 printed a timing"; exit 1; }
+"$bench" --load-settled "$dir/settled.h5" --steps 10 --repeat 1 --backend omp:1,omp:2 > "$dir/load.jsonl" 2> /dev/null
+check hexapods_a3 60 10 "$dir/load.jsonl"
+test "$(wc -l < "$dir/load.jsonl")" -eq 2
+
+# --tile: 2 x 1 copies of the loaded packing, relaxed, then timed
+"$bench" --load-settled "$dir/settled.h5" --tile 2,1 --relax-steps 50 --steps 10 --repeat 1 --threads 1 \
+  > "$dir/tile.jsonl" 2> /dev/null
+check hexapods_a3 120 10 "$dir/tile.jsonl"
+
+# bad input: exit status 2 and a message naming the cases
+if "$bench" --case tetrahedra --n 10 2> "$dir/bad.err"; then echo "accepted an unknown case"; exit 1; fi
+grep -q "hexapods_a9" "$dir/bad.err"
+
+# the settled packing as LAMMPS glued-sphere clusters
+"$py" "$src/bench/lammps/capdem_to_lammps.py" "$dir/settled.h5" "$dir/settled.data" > "$dir/meta.json"
+"$py" - "$dir/meta.json" "$dir/settled.data" <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert m["particles"] == 60 and m["rigid"] and m["atoms"] == 13 * 60, m
+head = open(sys.argv[2]).read()
+assert "780 atoms" in head and "Atoms # hybrid" in head and "Velocities" in head
+print("ok converter", m["atoms"], "spheres")
+PY
+echo "capdem-bench: all checks passed"
