@@ -56,23 +56,6 @@ static double clock_s(clockid_t which)
 }
 static double now(void) { return clock_s(CLOCK_MONOTONIC); }
 
-/* Copies every column and scalar of src into dst, whose columns are
- * allocated (its pair columns grow as needed). */
-static int state_copy_into(cd_state *dst, const cd_state *src)
-{
-    if (cd_state_reserve_pairs(dst, src->n_pairs)) return -1;
-    cd_state keep = *dst;
-    *dst = *src; /* counts, walls, time, step and any other scalar */
-    dst->cap_pairs = keep.cap_pairs;
-    for (size_t f = 0; f < cd_n_fields; f++) {
-        void **slot = cd_field_ptr(dst, &cd_fields[f]);
-        *slot = *cd_field_ptr(&keep, &cd_fields[f]);
-        size_t bytes = cd_state_rows(src, cd_fields[f].group) * cd_fields[f].elem_size;
-        memcpy(*slot, *cd_field_ptr((cd_state *)src, &cd_fields[f]), bytes);
-    }
-    return 0;
-}
-
 static size_t state_bytes(const cd_sim *sim)
 {
     size_t b = 0;
@@ -204,10 +187,8 @@ int main(int argc, char **argv)
     if (save_path && save_settled(save_path, &sim, &cfg, err, sizeof err)) return fail(err, 1);
     if (repeat == 0) n_backends = 0;
     /* With several backends each starts from a copy of this state. */
-    static cd_state settled;
-    if (n_backends > 1 &&
-        (cd_state_alloc(&settled, sim.s.n_particles, sim.s.n_prims, sim.s.n_walls, sim.s.n_pairs + 1) ||
-         state_copy_into(&settled, &sim.s))) {
+    static cd_state settled; /* zeroed: cd_state_copy allocates it */
+    if (n_backends > 1 && cd_state_copy(&settled, &sim.s)) {
         fprintf(stderr, "capdem-bench: out of memory\n");
         return 3;
     }
@@ -218,7 +199,7 @@ int main(int argc, char **argv)
             /* hand the settled state over through the host, as a resumed run
              * does, and warm up (first list build, lazy kernel compilation) */
             sim.backend->stop(&sim);
-            if (state_copy_into(&sim.s, &settled)) { fprintf(stderr, "capdem-bench: out of memory\n"); return 3; }
+            if (cd_state_copy(&sim.s, &settled)) { fprintf(stderr, "capdem-bench: out of memory\n"); return 3; }
             if (cd_sim_use_backend(&sim, names[k], device, err, sizeof err) || cd_sim_start(&sim, 0, err, sizeof err) ||
                 cd_sim_step(&sim, 20, err, sizeof err)) {
                 fprintf(stderr, "capdem-bench: %s\n", err);
