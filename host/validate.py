@@ -584,20 +584,24 @@ def figures(outdir, cases, agg, n, agg_all=None):
     fig.savefig(os.path.join(outdir, "study1_phi.png"), dpi=110)
     plt.close(fig)
     written.append("study1_phi.png")
-    # interlocking
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    paper_points(ax, PAPER1["lambda"], "seed 001 text (α = 1, 9)")
-    for mu, (m, c, lab) in styles.items():
-        x, y, e = series("lambda", mu)
-        if len(x):
-            ax.errorbar(x, y, e, fmt=m, color=c, label="capdem, " + lab, capsize=3)
-    ax.set_xlabel("η = 1 − 1/α")
-    ax.set_ylabel("interlocking λ = 1 − <l>/L")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "study1_lambda.png"), dpi=110)
-    plt.close(fig)
-    written.append("study1_lambda.png")
+    # interlocking and valence: one capdem series per friction against the paper's points
+    def eta_figure(key, paper, paper_label, ylabel, fname):
+        fig, ax = plt.subplots(figsize=(5.5, 4))
+        paper_points(ax, paper, paper_label)
+        for mu, (m, c, lab) in styles.items():
+            x, y, e = series(key, mu)
+            if len(x):
+                ax.errorbar(x, y, e, fmt=m, color=c, label="capdem, " + lab, capsize=3)
+        ax.set_xlabel("η = 1 − 1/α")
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, fname), dpi=110)
+        plt.close(fig)
+        written.append(fname)
+
+    eta_figure("lambda", PAPER1["lambda"], "seed 001 text (α = 1, 9)", "interlocking λ = 1 − <l>/L", "study1_lambda.png")
+    eta_figure("valence", PAPER1["valence"], "seed 001 text", "valence Z_c / Z", "study1_valence.png")
     # coordination
     fig, ax = plt.subplots(figsize=(5.5, 4))
     paper_points(ax, PAPER1["Z_c"], "seed 001 Z_c (text)")
@@ -618,20 +622,6 @@ def figures(outdir, cases, agg, n, agg_all=None):
     fig.savefig(os.path.join(outdir, "study1_coordination.png"), dpi=110)
     plt.close(fig)
     written.append("study1_coordination.png")
-    # valence
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    paper_points(ax, PAPER1["valence"], "seed 001 text")
-    for mu, (m, c, lab) in styles.items():
-        x, y, e = series("valence", mu)
-        if len(x):
-            ax.errorbar(x, y, e, fmt=m, color=c, label="capdem, " + lab, capsize=3)
-    ax.set_xlabel("η = 1 − 1/α")
-    ax.set_ylabel("valence Z_c / Z")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "study1_valence.png"), dpi=110)
-    plt.close(fig)
-    written.append("study1_valence.png")
     # bond-force PDFs with the cascade fits (first seed of each frictionless alpha)
     fig, ax = plt.subplots(figsize=(5.5, 4))
     seen = set()
