@@ -26,7 +26,7 @@ import validate as v1
 
 REPO = v1.REPO
 ARM_D = v1.ARM_D
-DENSITY, KN, ETA_N = 1000.0, 1.0e5, 0.2
+DENSITY = 1000.0  # [kg/m^3], the templates' material.density
 
 # Table S1 of seed 000: sphericity -> aspect ratio L / d_p.
 STUDIES = {
@@ -116,7 +116,7 @@ class DepositCase(v1.Case):
         self.poly = 0.2 if self.shape == "sphere" else polydispersity(self.dim, psi)
         props = shape_props(capdem, self.shape, alpha)
         self.L = props["tip_length"]
-        self.volume, self.mass = props["volume"], props["mass"]
+        self.volume = props["volume"]
         self.size = (size_l or spec["size_L"]) * self.L  # W or D [m]
         es2, es3 = 1 + self.poly ** 2 / 3.0, 1 + self.poly ** 2
         phi = phi_guess(self.dim, self.shape, alpha)
@@ -134,16 +134,8 @@ class DepositCase(v1.Case):
         for k in ("config", "h5", "log", "timing", "analysis", "packing_m1", "lock"):
             setattr(self, k, os.path.join(self.dir, os.path.basename(getattr(self, k))))
 
-    def dt(self):
-        m_min = self.mass * (1 - self.poly) ** 3
-        mij = 0.5 * m_min
-        tcol = math.pi / math.sqrt((KN / 2) / mij * (1 - ETA_N ** 2))
-        dt = tcol / 20
-        e = math.floor(math.log10(dt))
-        return math.floor(dt / 10 ** (e - 1)) * 10 ** (e - 1)  # two digits, rounded down
-
     def write_config(self, steps):
-        fields = dict(name=self.name, seed=self.seed, dt="%.2g" % self.dt(), steps=steps, shape=self.shape,
+        fields = dict(name=self.name, seed=self.seed, steps=steps, shape=self.shape,
                       aspect="" if self.shape == "sphere" else "aspect: %g," % self.alpha, n=self.n,
                       poly="%g" % self.poly)
         if self.dim == 2:
@@ -343,9 +335,9 @@ def run_study(args):
     os.makedirs(out, exist_ok=True)
     cases = make_cases(args, capdem, out)
     print("%s: %d cases, output %s" % (args.study, len(cases), out))
-    for c in cases:  # the domain height is capdem's lattice fit (domain.height left out)
-        print("  %-26s alpha %-4g N %5d (rule %5d, phi guess %.3f)  %s %.4g m  dt %.2g s  poly %g"
-              % (c.name, c.alpha, c.n, c.n_rule, c.phi_guess, "W" if c.dim == 2 else "D", c.size, c.dt(), c.poly))
+    for c in cases:  # capdem picks the height (lattice fit) and dt (run.steps_per_collision: 20)
+        print("  %-26s alpha %-4g N %5d (rule %5d, phi guess %.3f)  %s %.4g m  poly %g"
+              % (c.name, c.alpha, c.n, c.n_rule, c.phi_guess, "W" if c.dim == 2 else "D", c.size, c.poly))
     if args.plan:
         return 0
     finished = []

@@ -35,6 +35,7 @@ typedef struct {
     char output[CD_PATH_MAX];      /* HDF5 output path ("" = <name>.h5 next to cwd) */
     long long snapshot_every;      /* steps between snapshots */
     long long thermo_every;        /* steps between time-series rows */
+    double steps_per_collision;    /* > 0: dt = t_col / steps_per_collision (run.dt not given) */
     int force_dt;                  /* 1: run even when dt > t_col/5 */
 
     /* physics */

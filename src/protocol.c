@@ -55,13 +55,6 @@ int cd_protocol_check(const cd_config *c, char *err, size_t errlen)
     return 0;
 }
 
-static double total_mass(const cd_sim *sim)
-{
-    double m = 0;
-    for (size_t q = 0; q < sim->s.n_particles; q++) m += sim->s.mass[q];
-    return m;
-}
-
 /* Pressure on the ball [Pa]: given, or p L / kn = pressure_ratio (seed 001). */
 static double ball_pressure(const cd_sim *sim)
 {
@@ -188,7 +181,13 @@ long long cd_protocol_steps_until_control(const cd_sim *sim)
     case CD_PHASE_COMPACT: return 1; /* the driven wall responds to the load every step */
     case CD_PHASE_BASE:
         return sim->cfg.check_every - (sim->s.step % sim->cfg.check_every);
-    case CD_PHASE_PROBE: return 1; /* the pressure is averaged every step of the window's second half */
+    case CD_PHASE_PROBE: {
+        /* the pressure is averaged every step of the window's second half;
+         * the ball is fixed, so nothing needs the load before that */
+        long long elapsed = sim->s.step - (long long)sim->s.control[CTL_PROBE_STEP];
+        long long half = (sim->cfg.probe_steps + 1) / 2;
+        return elapsed < half ? half - elapsed : 1;
+    }
     default: return 1LL << 40;
     }
 }
@@ -218,7 +217,7 @@ static double driven_wall_energy(const cd_sim *sim)
 {
     const cd_wall *w = &sim->s.walls[(int)sim->s.control[CTL_WALL]];
     int deposit = !strcmp(sim->cfg.protocol, "deposit_compress");
-    double m = deposit && sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : total_mass(sim);
+    double m = deposit && sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : sim->total_mass;
     double v2 = deposit ? cd_v3_norm2(w->velocity) : w->radial_velocity * w->radial_velocity;
     return 0.5 * m * v2;
 }
@@ -371,7 +370,7 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
         break;
     case CD_PHASE_HOLD: {
         /* load control: m_p x'' = (load - F) along the outward direction */
-        double m = sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : total_mass(sim);
+        double m = sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : sim->total_mass;
         double a = (load - sim->cfg.piston_force) / m; /* [m/s^2], positive outwards */
         s->walls[w].velocity = cd_v3_axpy(s->walls[w].velocity, -a * dt, s->walls[w].normal);
         if (relaxed(sim, err, errlen, &done)) return -1;
@@ -384,7 +383,7 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
     case CD_PHASE_COMPACT: {
         /* m_w R'' = sum f_i - p 4 pi R^2, m_w the total particle mass */
         double R = s->walls[w].radius;
-        double a = (load - ball_pressure(sim) * 4 * CD_PI * R * R) / total_mass(sim);
+        double a = (load - ball_pressure(sim) * 4 * CD_PI * R * R) / sim->total_mass;
         s->walls[w].radial_velocity += a * dt;
         if (relaxed(sim, err, errlen, &done)) return -1;
         if (done) {
@@ -460,10 +459,8 @@ static double container_volume(const cd_sim *sim)
 void cd_protocol_observables(const cd_sim *sim, const cd_observables *o, double *v)
 {
     const cd_state *s = &sim->s;
-    double solid = 0; /* [m^3] */
-    for (size_t q = 0; q < s->n_particles; q++) solid += sim->shapes[s->shape[q]].volume * pow(s->scale[q], 3);
     double V = container_volume(sim);
-    v[0] = V > 0 ? solid / V : 0;
+    v[0] = V > 0 ? sim->solid_volume / V : 0;
     v[1] = s->n_particles ? 2 * o->n_contacts / (double)s->n_particles : 0;
     v[2] = s->control[CTL_PHASE];
     v[3] = s->control[CTL_LOAD];

@@ -215,7 +215,9 @@ static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
     double *h = !strcmp(c->domain, "box") ? &c->box_height : !strcmp(c->domain, "cylinder") ? &c->cyl_height : NULL;
     if (!h || *h > 0) return 0;
     double R = largest_bounding_radius(sim), a = c->clearance * 2 * R; /* [m] */
-    size_t N = sim->s.n_particles, row_max = 1u << 20;
+    double wx = !strcmp(c->domain, "box") ? c->box_width : c->cyl_diameter;    /* [m] */
+    double wz = !strcmp(c->domain, "box") ? c->box_thickness : c->cyl_diameter; /* [m] */
+    size_t N = sim->s.n_particles, row_max = (size_t)(floor(wx / a) + 1) * (size_t)(floor(wz / a) + 1);
     cd_vec3 *sites = malloc(row_max * sizeof(cd_vec3));
     if (!sites) return -1;
     *h = a * (1 + 1e-9); /* one row */
@@ -260,9 +262,11 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
     return 0;
 }
 
+/* The collision time of the lightest pair [s]; run.steps_per_collision
+ * sets dt from it, otherwise dt is checked against it. */
 static int check_time_step(cd_sim *sim, char *err, size_t errlen)
 {
-    const cd_config *c = &sim->cfg;
+    cd_config *c = &sim->cfg;
     const cd_state *s = &sim->s;
     /* The two lightest particles give the shortest collision. */
     double m1 = INFINITY, m2 = INFINITY;
@@ -272,6 +276,7 @@ static int check_time_step(cd_sim *sim, char *err, size_t errlen)
     }
     double m_eff = s->n_particles > 1 ? cd_law_effective_mass(m1, m2) : m1;
     sim->collision_time = cd_law_collision_time(c->kn, m_eff, c->eta_n);
+    if (c->steps_per_collision > 0) c->dt = sim->collision_time / c->steps_per_collision;
     if (c->dt > sim->collision_time / 5 && !c->force_dt) {
         snprintf(err, errlen, "%s: run.dt = %g s: expected at most t_col/5 = %g s (collision time %g s of the lightest pair); "
                  "lower dt or set run.force_dt: true", c->source_path, c->dt, sim->collision_time / 5, sim->collision_time);
@@ -332,6 +337,8 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
             s->shape[q] = k;
             s->scale[q] = f;
             s->mass[q] = sh->mass * f * f * f;
+            sim->total_mass += s->mass[q];
+            sim->solid_volume += sh->volume * f * f * f;
             s->inertia[q] = cd_v3(sh->principal[0] * pow(f, 5), sh->principal[1] * pow(f, 5), sh->principal[2] * pow(f, 5));
             s->prim_first[q] = (cd_int)prim;
             s->prim_count[q] = sh->n_prims;

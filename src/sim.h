@@ -48,6 +48,8 @@ typedef struct cd_sim {
     int n_shapes;
     cd_neighbors nb;
     double collision_time;    /* smallest pair collision time [s] */
+    double total_mass;        /* sum of the particle masses [kg] (fixed at set-up) */
+    double solid_volume;      /* sum of the particle volumes [m^3] (fixed at set-up) */
     int threads;              /* OpenMP threads in use */
     const cd_backend *backend;/* runs the steps; omp unless chosen otherwise */
     void *backend_data;       /* the backend's own state (device buffers) */

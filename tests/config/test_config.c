@@ -424,6 +424,14 @@ static void test_count_and_height_rules(void **state)
     cd_config_free(&c);
 }
 
+static void test_dt_and_steps_per_collision_together_are_refused(void **state)
+{
+    (void)state;
+    expect_error(PARTICLES "run:\n  dt: 1.0e-6\n  steps_per_collision: 20\n", "run.steps_per_collision = 20",
+                 "cannot be given together with run.dt");
+    expect_error(PARTICLES "run:\n  steps_per_collision: 4\n", "run.steps_per_collision = 4", ">= 5");
+}
+
 static void test_box_without_width_is_refused(void **state)
 {
     (void)state;
@@ -528,6 +536,7 @@ int main(void)
         cmocka_unit_test(test_missing_file_is_refused),
         cmocka_unit_test(test_print_keys_lists_every_key),
         cmocka_unit_test(test_count_and_height_rules),
+        cmocka_unit_test(test_dt_and_steps_per_collision_together_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -126,6 +126,31 @@ static void test_fill_ratio_picks_count_and_lattice_picks_height(void **state)
     cd_config_free(&cfg);
 }
 
+/* run.steps_per_collision: dt = t_col / n with t_col the collision time
+ * of the lightest pair, here two equal spheres of mass m = rho pi d^3 / 6:
+ * t_col = pi / sqrt((kn/2)/(m/2) (1 - eta^2)), the damped oscillator of
+ * SPEC 3, computed here from the closed form. */
+static void test_steps_per_collision_sets_dt(void **state)
+{
+    (void)state;
+    const double d = 0.005, rho = 1000, kn = 1e5, eta = 0.2, n = 20; /* [m], [kg/m^3], [N/m], [1], [1] */
+    char yaml[512];
+    snprintf(yaml, sizeof yaml,
+             "run: {steps_per_collision: %g}\nmaterial: {density: %g, kn: %g, damping_normal: %g}\n"
+             "particles: [{shape: sphere, diameter: %g, count: 2}]\n", n, rho, kn, eta, d);
+    static cd_sim sim;
+    cd_config cfg;
+    char err[2048];
+    if (cd_config_parse(yaml, "spc.yaml", &cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
+    double m = rho * CD_PI * d * d * d / 6;                             /* [kg] */
+    double t_col = CD_PI / sqrt(0.5 * kn / (0.5 * m) * (1 - eta * eta)); /* [s] */
+    print_message("dt %.9g s, t_col / %g = %.9g s\n", sim.p.dt, n, t_col / n);
+    assert_true(fabs(sim.p.dt / (t_col / n) - 1) < 1e-12);
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+}
+
 /* protocol.piston_start = packing: when the settling ends, the piston is
  * moved from the top of the domain to one particle size (largest bounding
  * diameter x (1 + p)) above the highest point of any particle. */
@@ -321,6 +346,7 @@ int main(void)
         cmocka_unit_test(test_piston_reaches_and_holds_target_force),
         cmocka_unit_test(test_deposit_resumed_equals_uninterrupted),
         cmocka_unit_test(test_fill_ratio_picks_count_and_lattice_picks_height),
+        cmocka_unit_test(test_steps_per_collision_sets_dt),
         cmocka_unit_test(test_piston_starts_one_particle_size_above_the_packing),
         cmocka_unit_test(test_cylinder_deposit_has_no_angular_momentum_about_the_axis),
         cmocka_unit_test(test_bulk_modulus_linear_and_resumable),
