@@ -64,6 +64,7 @@ typedef struct {
     /* initial placement */
     char placement[16];            /* lattice | random */
     double clearance;              /* lattice spacing / particle size [1] */
+    double lattice_gap;            /* > 0: lattice spacing = particle size + this [m] (init.clearance not given) */
     double init_speed;             /* velocity components uniform in (-v, v) [m/s] */
 
     /* neighbour list */

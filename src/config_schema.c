@@ -138,8 +138,10 @@ const cd_key cd_config_keys[] = {
     /* initial placement */
     {"init.placement", CD_KT_ENUM, "-", "lattice", CFG_SIZED(placement), .choices = "lattice|random",
      .label = "placement", .meaning = "lattice: particles on a grid; random: random positions without overlap"},
-    {"init.clearance", CD_KT_REAL, "1", "1.5", CFG(clearance), GE(1),
+    {"init.clearance", CD_KT_REAL, "1", "1.5", CFG(clearance), GE(1), .conflicts = "gap",
      .label = "lattice clearance", .meaning = "lattice spacing over particle size"},
+    {"init.gap", CD_KT_REAL, "m", NULL, CFG(lattice_gap), GT(0), .conflicts = "clearance",
+     .label = "lattice gap", .meaning = "instead of init.clearance: lattice spacing = particle size + this gap (seed 000: 1.5 d_p)"},
     {"init.speed", CD_KT_REAL, "m/s", "0.25", CFG(init_speed), GE(0),
      .label = "initial speed", .meaning = "each velocity component is uniform in (-v, v)"},
 

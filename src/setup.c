@@ -205,6 +205,14 @@ static void resolve_fill_count(cd_sim *sim)
     c->species[0].count = (long)ceil(c->fill_ratio * width * section * c->fill_fraction / v);
 }
 
+/* Lattice spacing [m] for particles of largest bounding radius R [m]:
+ * init.gap (seed 000's "space of 1.5 d_p between each particle") or
+ * init.clearance x the particle size. */
+static double lattice_spacing(const cd_config *c, double R)
+{
+    return c->lattice_gap > 0 ? 2 * R + c->lattice_gap : c->clearance * 2 * R;
+}
+
 /* domain.height omitted (seed 000): the lowest box or cylinder whose
  * lattice of spacing a holds every particle, i.e. rows x a with rows =
  * ceil(N / sites per row).  Rows are centred, so a height of exactly
@@ -214,7 +222,7 @@ static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
     cd_config *c = &sim->cfg;
     double *h = !strcmp(c->domain, "box") ? &c->box_height : !strcmp(c->domain, "cylinder") ? &c->cyl_height : NULL;
     if (!h || *h > 0) return 0;
-    double R = largest_bounding_radius(sim), a = c->clearance * 2 * R; /* [m] */
+    double R = largest_bounding_radius(sim), a = lattice_spacing(c, R); /* [m] */
     double wx = !strcmp(c->domain, "box") ? c->box_width : c->cyl_diameter;    /* [m] */
     double wz = !strcmp(c->domain, "box") ? c->box_thickness : c->cyl_diameter; /* [m] */
     size_t N = sim->s.n_particles, row_max = (size_t)(floor(wx / a) + 1) * (size_t)(floor(wz / a) + 1);
@@ -238,7 +246,7 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
     const cd_config *c = &sim->cfg;
     cd_state *s = &sim->s;
     double R = largest_bounding_radius(sim); /* [m] */
-    double a = c->clearance * 2 * R;          /* lattice spacing [m] */
+    double a = lattice_spacing(c, R);         /* [m] */
     size_t N = s->n_particles;
     cd_vec3 *sites = malloc((N + 1) * sizeof(cd_vec3));
     if (!sites) return -1;
@@ -246,8 +254,8 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
     if (got < N) {
         char dom[256];
         describe_domain(c, dom, sizeof dom);
-        snprintf(err, errlen, "%s: particles: %zu particles of size %g m (init.clearance %g) do not fit: %s holds only %zu %s sites; "
-                 "enlarge the domain or lower the counts", c->source_path, N, 2 * R, c->clearance, dom, got, c->placement);
+        snprintf(err, errlen, "%s: particles: %zu particles of size %g m (lattice spacing %g m) do not fit: %s holds only %zu %s sites; "
+                 "enlarge the domain or lower the counts", c->source_path, N, 2 * R, a, dom, got, c->placement);
         free(sites);
         return -1;
     }

@@ -424,12 +424,15 @@ static void test_count_and_height_rules(void **state)
     cd_config_free(&c);
 }
 
-static void test_dt_and_steps_per_collision_together_are_refused(void **state)
+static void test_alternative_keys_together_are_refused(void **state)
 {
     (void)state;
     expect_error(PARTICLES "run:\n  dt: 1.0e-6\n  steps_per_collision: 20\n", "run.steps_per_collision = 20",
                  "cannot be given together with run.dt");
     expect_error(PARTICLES "run:\n  steps_per_collision: 4\n", "run.steps_per_collision = 4", ">= 5");
+    expect_error(PARTICLES "init:\n  clearance: 1.5\n  gap: 0.0075\n", "init.gap = 0.0075",
+                 "cannot be given together with init.clearance");
+    expect_error(PARTICLES "init:\n  gap: 0\n", "init.gap = 0", "> 0");
 }
 
 static void test_box_without_width_is_refused(void **state)
@@ -498,7 +501,7 @@ static void test_print_keys_lists_every_key(void **state)
         "particles[].aspect", "particles[].diameter", "particles[].segments", "particles[].count",
         "particles[].polydispersity", "domain.type", "domain.width", "domain.thickness", "domain.height",
         "domain.diameter", "domain.radius", "domain.walls[].point", "domain.walls[].normal",
-        "domain.walls[].velocity", "init.placement", "init.clearance", "init.speed", "neighbor.skin"};
+        "domain.walls[].velocity", "init.placement", "init.clearance", "init.gap", "init.speed", "neighbor.skin"};
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
         assert_contains(text, keys[i]);
     assert_contains(text, "N/m");
@@ -536,7 +539,7 @@ int main(void)
         cmocka_unit_test(test_missing_file_is_refused),
         cmocka_unit_test(test_print_keys_lists_every_key),
         cmocka_unit_test(test_count_and_height_rules),
-        cmocka_unit_test(test_dt_and_steps_per_collision_together_are_refused),
+        cmocka_unit_test(test_alternative_keys_together_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

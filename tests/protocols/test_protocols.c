@@ -90,21 +90,22 @@ static void test_deposit_resumed_equals_uninterrupted(void **state)
 /* protocol.fill_ratio with the count left out (seed 000's rule): N =
  * ceil(2 W (W T) phi / <v>) with <v> = (pi d^3 / 6)(1 + p^2), the mean
  * volume of spheres whose diameter is uniform in [(1 - p) d, (1 + p) d];
- * and domain.height left out: rows x a for a lattice of spacing
- * a = clearance x the largest diameter, floor(W / a) x floor(T / a) sites
- * per row.  Both computed here from the closed forms. */
-static void test_fill_ratio_picks_count_and_lattice_picks_height(void **state)
+ * and domain.height left out: rows x a for a lattice of spacing a,
+ * floor(W / a) x floor(T / a) sites per row.  The spacing is
+ * init.clearance x the largest diameter, or with init.gap (seed 000's
+ * "space of 1.5 d_p between each particle") the largest diameter + gap.
+ * Both computed here from the closed forms. */
+static void check_fill_and_height(const char *init_key, double init_value, double a_expected)
 {
-    (void)state;
-    const double W = 0.1, T = 0.02, d = 0.005, p = 0.2, phi = 0.5, fill = 2, clearance = 1.5; /* [m] and [1] */
+    const double W = 0.1, T = 0.02, d = 0.005, p = 0.2, phi = 0.5, fill = 2; /* [m] and [1] */
     char yaml[1024];
     snprintf(yaml, sizeof yaml,
              "particles: [{shape: sphere, diameter: %g, polydispersity: %g}]\n"
              "domain: {type: box, width: %g, thickness: %g}\n"
-             "init: {placement: lattice, clearance: %g}\n"
+             "init: {placement: lattice, %s: %g}\n"
              "run: {dt: 1.0e-6}\n"
              "protocol: {type: deposit_compress, fill_ratio: %g, fill_fraction: %g}\n",
-             d, p, W, T, clearance, fill, phi);
+             d, p, W, T, init_key, init_value, fill, phi);
     static cd_sim sim;
     cd_config cfg;
     char err[2048];
@@ -112,18 +113,25 @@ static void test_fill_ratio_picks_count_and_lattice_picks_height(void **state)
     if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
     double v_mean = CD_PI * d * d * d / 6 * (1 + p * p); /* [m^3] */
     size_t n_expected = (size_t)ceil(fill * W * (W * T) * phi / v_mean);
-    double a = clearance * d * (1 + p);                  /* [m] */
-    size_t per_row = (size_t)floor(W / a) * (size_t)floor(T / a);
-    double h_expected = (double)((n_expected + per_row - 1) / per_row) * a;
-    print_message("N = %zu (expected %zu), height %.6g m (expected %.6g m)\n", sim.s.n_particles, n_expected,
-                  sim.cfg.box_height, h_expected);
+    size_t per_row = (size_t)floor(W / a_expected) * (size_t)floor(T / a_expected);
+    double h_expected = (double)((n_expected + per_row - 1) / per_row) * a_expected;
+    print_message("%s %g: N = %zu (expected %zu), height %.6g m (expected %.6g m)\n", init_key, init_value,
+                  sim.s.n_particles, n_expected, sim.cfg.box_height, h_expected);
     assert_int_equal(sim.s.n_particles, n_expected);
     assert_true(fabs(sim.cfg.box_height - h_expected) < 1e-6 * h_expected);
     double top = 0;
     for (size_t q = 0; q < sim.s.n_particles; q++) top = fmax(top, sim.s.position[q].y + 0.5 * d * sim.s.scale[q]);
-    assert_true(top <= sim.cfg.box_height && top > sim.cfg.box_height - a); /* the top row is used */
+    assert_true(top <= sim.cfg.box_height && top > sim.cfg.box_height - a_expected); /* the top row is used */
     cd_sim_free(&sim);
     cd_config_free(&cfg);
+}
+
+static void test_fill_ratio_picks_count_and_lattice_picks_height(void **state)
+{
+    (void)state;
+    const double d_max = 0.005 * (1 + 0.2); /* largest diameter [m] */
+    check_fill_and_height("clearance", 1.5, 1.5 * d_max);
+    check_fill_and_height("gap", 0.0075, d_max + 0.0075);
 }
 
 /* run.steps_per_collision: dt = t_col / n with t_col the collision time
