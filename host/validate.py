@@ -373,6 +373,20 @@ def analyse(case, capdem, force=False):
 
 # ----------------------------------------------------------------------- results
 
+def inner_contact_density(pk):
+    """Contacts per volume within half the ball radius over the ball's mean,
+    from capdem analyze's contact-density profile (counts per radial bin):
+    seed 001 (Fig. 3b) finds n_c nearly constant from one particle size out
+    of the centre to the wall, so a homogeneous packing gives about 1; a
+    hollow shell of particles jammed at the wall (the ball swept them up
+    faster than they could fill the inside) gives about 0."""
+    rows = pk["curves"]["contact_density"]["data"]
+    R = (3.0 * pk["container_volume"] / (4.0 * math.pi)) ** (1.0 / 3.0)  # ball radius [m]
+    total = sum(r[2] for r in rows)
+    inner = sum(r[2] for r in rows if r[0] < 0.5 * R)
+    return inner / total / 0.125 if total > 0 else None
+
+
 def metrics(case):
     """The numbers of one finished case, straight from capdem analyze."""
     with open(case.analysis) as f:
@@ -388,6 +402,7 @@ def metrics(case):
             timing = json.load(f)
     p_applied = 1.0e-5 * 1.0e5 / d["sample"]["L"]
     return {
+        "nc_inner": inner_contact_density(pk),
         "alpha": case.alpha, "eta": eta_of(case.alpha), "mu": case.mu, "seed": case.seed, "n": case.n, "ci": case.ci,
         "case": case.name, "step": d["step"], "time_s": d["time"],
         "n_particles_in_contact": npc, "n_rattlers": net["n_rattlers"],
@@ -413,7 +428,7 @@ def metrics(case):
 
 
 AGG_KEYS = ["phi_container", "phi_core_1L", "phi_core_3L", "lambda", "Z", "Z_c", "Z_c_walls", "Z_c_isostatic",
-            "valence", "cascade_beta", "k_tail", "n_particles_in_contact", "n_rattlers", "pressure_over_p",
+            "valence", "cascade_beta", "k_tail", "nc_inner", "n_particles_in_contact", "n_rattlers", "pressure_over_p",
             "step", "run_wall_s"]
 
 
@@ -501,18 +516,19 @@ def ref(v, digits=2):
 def markdown(agg):
     lines = []
     lines.append("| α | η | μ | N | seeds | Φ ball (paper fit; text) | Φ core 1 L | λ (paper) | Z (paper) "
-                 "| Z_c (paper) | Z_c with wall contacts / isostatic | valence (paper) | cascade β (paper) |")
-    lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+                 "| Z_c (paper) | Z_c with wall contacts / isostatic | valence (paper) | cascade β (paper) | n_c inner / mean |")
+    lines.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for g in agg:
         fric = g["mu"] > 0  # the paper's fit and the isostatic count are frictionless references
-        lines.append("| %g | %.3f | %g | %d | %s | %s (%s; %s) | %s | %s (%s) | %s (%s) | %s (%s) | %s / %s | %s (%s) | %s (%s) |" % (
+        lines.append("| %g | %.3f | %g | %d | %s | %s (%s; %s) | %s | %s (%s) | %s (%s) | %s (%s) | %s / %s | %s (%s) | %s (%s) | %s |" % (
             g["alpha"], g["eta"], g["mu"], g["n"], ",".join(str(s) for s in g["seeds"]),
             pm(g, "phi_container"), "—" if fric else "%.3f" % g["phi_fit_paper"],
             "—" if fric else ref(g["phi_text_paper"]),
             pm(g, "phi_core_1L"), pm(g, "lambda"), ref(g["lambda_paper"], 1), pm(g, "Z", 2), ref(g["Z_paper"], 1),
             pm(g, "Z_c", 2), ref(g["Z_c_paper"], 0), pm(g, "Z_c_walls", 2),
             "—" if fric else "%.2f" % g["Z_c_isostatic"],
-            pm(g, "valence", 2), ref(g["valence_paper"]), pm(g, "cascade_beta", 2), ref(g["beta_paper"])))
+            pm(g, "valence", 2), ref(g["valence_paper"]), pm(g, "cascade_beta", 2), ref(g["beta_paper"]),
+            pm(g, "nc_inner", 2)))
     return "\n".join(lines)
 
 
@@ -698,6 +714,8 @@ def check_bands(rows):
             ("Phi of the ball %.4f below Phi of the core %.4f (wall depletion)"
              % (r["phi_container"], r["phi_core_1L"]), r["phi_container"] < r["phi_core_1L"]),
             ("ball pressure / p = %.4f within 1 %%" % r["pressure_over_p"], abs(r["pressure_over_p"] - 1) < 0.01),
+            ("contact density within R/2 over the mean %.2f above 0.5 (no hollow shell)" % (r["nc_inner"] or 0),
+             r["nc_inner"] is not None and r["nc_inner"] > 0.5),
         ]
         for text, good in tests:
             print("%s %s: %s" % ("PASS" if good else "FAIL", r["case"], text))
