@@ -109,9 +109,21 @@ def now():
 
 # --------------------------------------------------------------------------- runs
 
+START_RADIUS_FACTOR = 1.5  # starting ball radius over that of the expected packing (docs/validation.md)
+
+
+def particle_volume(capdem, alpha):
+    """Volume of one study-1 particle [m^3], from `capdem shape`."""
+    shape = STUDY1_SHAPES[alpha][0]
+    cmd = [capdem, "shape", shape, "--diameter", "%g" % ARM_D, "--json"]
+    if shape != "sphere":
+        cmd[3:3] = ["--aspect", "%g" % alpha]
+    return json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout)["volume"]
+
+
 class Case:
-    def __init__(self, alpha, mu, seed, n, out, ci=False):
-        self.alpha, self.mu, self.seed, self.n, self.ci = alpha, mu, seed, n, ci
+    def __init__(self, alpha, mu, seed, n, out, ci=False, capdem=None):
+        self.alpha, self.mu, self.seed, self.n, self.ci, self.capdem = alpha, mu, seed, n, ci, capdem
         self.name = "a%s_mu%s_n%d_s%d%s" % (fmt_alpha(alpha), fmt_mu(mu), n, seed, "_ci" if ci else "")
         self.dir = os.path.join(out, self.name)
         self.config = os.path.join(self.dir, "config.yaml")
@@ -125,7 +137,11 @@ class Case:
     def write_config(self, steps):
         shape, dt = STUDY1_SHAPES[self.alpha]
         L = self.alpha * ARM_D
-        radius = 9.5 * L * (self.n / 1000.0) ** (1.0 / 3.0)
+        # Start: 1.5 x the radius at which the particles would fill the ball to
+        # seed 001's fit Phi(eta) (solid fraction Phi / 3.4), placed at random
+        # with only their arms kept apart (init.exclusion: shape).
+        v = particle_volume(self.capdem, self.alpha)
+        radius = START_RADIUS_FACTOR * (3.0 * self.n * v / (4.0 * math.pi * phi_fit(eta_of(self.alpha)))) ** (1.0 / 3.0)
         with open(TEMPLATE1) as f:
             text = string.Template(f.read()).substitute(
                 name=self.name, seed=self.seed, dt="%.3g" % dt, steps=steps, mu="%g" % self.mu,
@@ -755,8 +771,8 @@ def study1(args):
         if a not in STUDY1_SHAPES:
             sys.exit("validate.py: alpha %g is not one of study 1's (%s)"
                      % (a, ", ".join("%g" % x for x in STUDY1_SHAPES)))
-    cases = [Case(a, 0.0, s, args.n, out, args.ci) for a in alphas for s in seeds]
-    cases += [Case(a, args.friction_mu, s, args.n, out, args.ci)
+    cases = [Case(a, 0.0, s, args.n, out, args.ci, capdem) for a in alphas for s in seeds]
+    cases += [Case(a, args.friction_mu, s, args.n, out, args.ci, capdem)
               for a in parse_list(args.friction_alphas) for s in seeds]
     if args.fresh:
         for c in cases:

@@ -63,6 +63,7 @@ typedef struct {
 
     /* initial placement */
     char placement[16];            /* lattice | random */
+    char exclusion[16];            /* random placement: bounding_sphere | shape */
     double clearance;              /* lattice spacing / particle size [1] */
     double lattice_gap;            /* > 0: lattice spacing = particle size + this [m] (init.clearance not given) */
     double init_speed;             /* velocity components uniform in (-v, v) [m/s] */

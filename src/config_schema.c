@@ -138,6 +138,8 @@ const cd_key cd_config_keys[] = {
     /* initial placement */
     {"init.placement", CD_KT_ENUM, "-", "lattice", CFG_SIZED(placement), .choices = "lattice|random",
      .label = "placement", .meaning = "lattice: particles on a grid; random: random positions without overlap"},
+    {"init.exclusion", CD_KT_ENUM, "-", "bounding_sphere", CFG_SIZED(exclusion), .choices = "bounding_sphere|shape",
+     .label = "random exclusion", .meaning = "random placement keeps apart bounding_sphere: the bounding spheres; shape: only the arms (denser starts)"},
     {"init.clearance", CD_KT_REAL, "1", "1.5", CFG(clearance), GE(1), .conflicts = "gap",
      .label = "lattice clearance", .meaning = "lattice spacing over particle size"},
     {"init.gap", CD_KT_REAL, "m", NULL, CFG(lattice_gap), GT(0), .conflicts = "clearance",

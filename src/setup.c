@@ -10,6 +10,7 @@
 #include "rng.h"
 #include "protocol.h"
 #include "../kernels/rigid.h"
+#include "../kernels/segseg.h"
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -140,11 +141,11 @@ static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out
     return count;
 }
 
-/* Random non-overlapping bounding spheres in the domain (rejection with a
- * bounded number of tries per particle). */
-static size_t random_sites(const cd_config *c, cd_rng *r, double R, cd_vec3 *out, size_t max)
+/* Box around the domain in which random positions are drawn [m]; without
+ * a domain, a cube that holds max bounding spheres of radius R at a
+ * quarter of their own volume each. */
+static void sampling_box(const cd_config *c, double R, size_t max, double lo[3], double hi[3])
 {
-    double lo[3], hi[3];
     if (!strcmp(c->domain, "box")) {
         lo[0] = 0; hi[0] = c->box_width; lo[1] = 0; hi[1] = c->box_height; lo[2] = 0; hi[2] = c->box_thickness;
     } else if (!strcmp(c->domain, "cylinder")) {
@@ -155,14 +156,87 @@ static size_t random_sites(const cd_config *c, cd_rng *r, double R, cd_vec3 *out
         double side = 2 * R * cbrt(4.0 * (double)max) + 2 * R;
         for (int k = 0; k < 3; k++) { lo[k] = -0.5 * side; hi[k] = 0.5 * side; }
     }
+}
+
+static cd_vec3 random_point(const cd_config *c, cd_rng *r, const double lo[3], const double hi[3])
+{
+    cd_vec3 p = cd_v3(cd_rng_range(r, lo[0], hi[0]), cd_rng_range(r, lo[1], hi[1]), cd_rng_range(r, lo[2], hi[2]));
+    if (c->dimension == 2) p.z = 0.5 * (lo[2] + hi[2]);
+    return p;
+}
+
+/* Random non-overlapping bounding spheres in the domain (rejection with a
+ * bounded number of tries per particle). */
+static size_t random_sites(const cd_config *c, cd_rng *r, double R, cd_vec3 *out, size_t max)
+{
+    double lo[3], hi[3];
+    sampling_box(c, R, max, lo, hi);
     size_t count = 0;
     for (size_t tries = 0; count < max && tries < 2000 * max; tries++) {
-        cd_vec3 p = cd_v3(cd_rng_range(r, lo[0], hi[0]), cd_rng_range(r, lo[1], hi[1]), cd_rng_range(r, lo[2], hi[2]));
-        if (c->dimension == 2) p.z = 0.5 * (lo[2] + hi[2]);
+        cd_vec3 p = random_point(c, r, lo, hi);
         if (!inside_domain(c, p, R)) continue;
         int ok = 1;
         for (size_t k = 0; k < count && ok; k++) ok = cd_v3_norm2(cd_v3_sub(p, out[k])) >= 4 * R * R;
         if (ok) out[count++] = p;
+    }
+    return count;
+}
+
+/* Do particles i and j overlap at the positions and orientations in s?
+ * Exact for spherocylinder arms: some pair of axes closer than the sum of
+ * their radii. */
+static int shapes_overlap(const cd_state *s, size_t i, size_t j)
+{
+    for (cd_int u = s->prim_first[i]; u < s->prim_first[i] + s->prim_count[i]; u++) {
+        cd_vec3 p0 = cd_rigid_to_world(s->position[i], s->orientation[i], s->prim_a_body[u]);
+        cd_vec3 p1 = cd_rigid_to_world(s->position[i], s->orientation[i], s->prim_b_body[u]);
+        for (cd_int w = s->prim_first[j]; w < s->prim_first[j] + s->prim_count[j]; w++) {
+            cd_vec3 q0 = cd_rigid_to_world(s->position[j], s->orientation[j], s->prim_a_body[w]);
+            cd_vec3 q1 = cd_rigid_to_world(s->position[j], s->orientation[j], s->prim_b_body[w]);
+            double a, b, reach = s->prim_radius[u] + s->prim_radius[w]; /* [1], [1], [m] */
+            cd_segseg_closest(p0, p1, q0, q1, &a, &b);
+            cd_vec3 d = cd_v3_sub(cd_v3_add(q0, cd_v3_scale(cd_v3_sub(q1, q0), b)),
+                                  cd_v3_add(p0, cd_v3_scale(cd_v3_sub(p1, p0), a)));
+            if (cd_v3_norm2(d) < reach * reach) return 1;
+        }
+    }
+    return 0;
+}
+
+/* Every arm of particle q inside the domain (both axis ends at least the
+ * arm radius from every wall; the domains are convex, so the whole arm is). */
+static int arms_inside_domain(const cd_config *c, const cd_state *s, size_t q)
+{
+    for (cd_int u = s->prim_first[q]; u < s->prim_first[q] + s->prim_count[q]; u++)
+        if (!inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_a_body[u]), s->prim_radius[u]) ||
+            !inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_b_body[u]), s->prim_radius[u]))
+            return 0;
+    return 1;
+}
+
+/* init.exclusion = shape: random positions and orientations such that no
+ * two particles' arms overlap (their bounding spheres may), so that long
+ * arms can start interleaved, much denser than bounding spheres allow.
+ * Writes position and orientation of every particle placed; returns the
+ * number placed (rejection with a bounded number of tries per particle). */
+static size_t random_shape_placement(const cd_sim *sim, cd_state *s, cd_rng *r, double R, size_t max)
+{
+    const cd_config *c = &sim->cfg;
+    double lo[3], hi[3];
+    sampling_box(c, R, max, lo, hi);
+    size_t count = 0;
+    for (size_t tries = 0; count < max && tries < 2000 * max; tries++) {
+        s->position[count] = random_point(c, r, lo, hi);
+        s->orientation[count] = random_orientation(r, c->dimension);
+        if (!arms_inside_domain(c, s, count)) continue;
+        double Ri = sim->shapes[s->shape[count]].bounding_radius * s->scale[count]; /* [m] */
+        int ok = 1;
+        for (size_t k = 0; k < count && ok; k++) {
+            double Rk = sim->shapes[s->shape[k]].bounding_radius * s->scale[k]; /* [m] */
+            if (cd_v3_norm2(cd_v3_sub(s->position[count], s->position[k])) < (Ri + Rk) * (Ri + Rk))
+                ok = !shapes_overlap(s, count, k);
+        }
+        if (ok) count++;
     }
     return count;
 }
@@ -247,26 +321,33 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
     cd_state *s = &sim->s;
     double R = largest_bounding_radius(sim); /* [m] */
     double a = lattice_spacing(c, R);         /* [m] */
-    size_t N = s->n_particles;
-    cd_vec3 *sites = malloc((N + 1) * sizeof(cd_vec3));
-    if (!sites) return -1;
-    size_t got = !strcmp(c->placement, "random") ? random_sites(c, rng, R, sites, N) : lattice_sites(c, a, R, sites, N);
-    if (got < N) {
-        char dom[256];
-        describe_domain(c, dom, sizeof dom);
-        snprintf(err, errlen, "%s: particles: %zu particles of size %g m (lattice spacing %g m) do not fit: %s holds only %zu %s sites; "
-                 "enlarge the domain or lower the counts", c->source_path, N, 2 * R, a, dom, got, c->placement);
+    size_t N = s->n_particles, got;
+    int random = !strcmp(c->placement, "random"), by_shape = random && !strcmp(c->exclusion, "shape");
+    if (by_shape) {
+        got = random_shape_placement(sim, s, rng, R, N);
+    } else {
+        cd_vec3 *sites = malloc((N + 1) * sizeof(cd_vec3));
+        if (!sites) return -1;
+        got = random ? random_sites(c, rng, R, sites, N) : lattice_sites(c, a, R, sites, N);
+        for (size_t q = 0; q < got; q++) s->position[q] = sites[q];
         free(sites);
+    }
+    if (got < N) {
+        char dom[256], how[96];
+        describe_domain(c, dom, sizeof dom);
+        if (by_shape) snprintf(how, sizeof how, "random places without overlapping arms");
+        else if (random) snprintf(how, sizeof how, "random places for bounding spheres of %g m", 2 * R);
+        else snprintf(how, sizeof how, "lattice sites (size %g m, spacing %g m)", 2 * R, a);
+        snprintf(err, errlen, "%s: particles: %zu particles do not fit: %s holds only %zu %s; "
+                 "enlarge the domain or lower the counts", c->source_path, N, dom, got, how);
         return -1;
     }
     for (size_t q = 0; q < N; q++) {
-        s->position[q] = sites[q];
-        s->orientation[q] = random_orientation(rng, c->dimension);
-        double v = c->init_speed;
+        if (!by_shape) s->orientation[q] = random_orientation(rng, c->dimension); /* drawn with the place otherwise */
+        double v = c->init_speed; /* [m/s] */
         s->velocity[q] = cd_v3(cd_rng_range(rng, -v, v), cd_rng_range(rng, -v, v), c->dimension == 2 ? 0 : cd_rng_range(rng, -v, v));
         s->angmom[q] = cd_v3_zero();
     }
-    free(sites);
     return 0;
 }
 

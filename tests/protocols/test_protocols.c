@@ -134,6 +134,51 @@ static void test_fill_ratio_picks_count_and_lattice_picks_height(void **state)
     check_fill_and_height("gap", 0.0075, d_max + 0.0075);
 }
 
+/* init.exclusion = shape: 300 hexapods of alpha 9 in a ball whose volume
+ * is 0.64 of the sum of their bounding spheres' (a fill of 1.55, four
+ * times the 0.38 at which random sequential addition of spheres jams), so
+ * only interleaved arms fit.  Checked by the contact kernels, not by the
+ * placement's own test: the first force evaluation finds no particle-particle
+ * and no particle-wall contact.  Bounding-sphere exclusion cannot place
+ * them and says so. */
+static void test_random_shape_exclusion_places_dense_without_overlap(void **state)
+{
+    (void)state;
+    const double R_ball = 0.13, d = 0.005, alpha = 9; /* [m], [m], [1] */
+    const int N = 300;
+    char yaml[1024];
+    const char *fmt = "physics: {gravity: [0, 0, 0]}\n"
+                      "run: {dt: 2.0e-5}\n"
+                      "particles: [{shape: hexapod, aspect: %g, diameter: %g, count: %d}]\n"
+                      "domain: {type: ball, radius: %g}\n"
+                      "init: {placement: random, exclusion: %s}\n";
+    snprintf(yaml, sizeof yaml, fmt, alpha, d, N, R_ball, "shape");
+    static cd_sim sim;
+    cd_config cfg;
+    char err[2048];
+    if (cd_config_parse(yaml, "shape.yaml", &cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_use_backend(&sim, cdt_backend(), NULL, err, sizeof err)) fail_msg("%s", err);
+    double Rb = sim.shapes[0].bounding_radius; /* [m] */
+    double fill = N * pow(Rb / R_ball, 3);
+    assert_int_equal(cd_sim_initial_forces(&sim), 0);
+    cd_observables o;
+    cd_sim_observe(&sim, &o);
+    print_message("bounding-sphere fill %.3f, contacts %g, wall contacts %g\n", fill, o.n_contacts, o.n_wall_contacts);
+    assert_true(fill > 1.5);
+    assert_true(o.n_contacts == 0 && o.n_wall_contacts == 0);
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+
+    snprintf(yaml, sizeof yaml, fmt, alpha, d, N, R_ball, "bounding_sphere");
+    if (cd_config_parse(yaml, "sphere.yaml", &cfg, err, sizeof err)) fail_msg("%s", err);
+    assert_int_not_equal(cd_sim_setup(&sim, &cfg, err, sizeof err), 0);
+    print_message("%s\n", err);
+    assert_non_null(strstr(err, "do not fit"));
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+}
+
 /* run.steps_per_collision: dt = t_col / n with t_col the collision time
  * of the lightest pair, here two equal spheres of mass m = rho pi d^3 / 6:
  * t_col = pi / sqrt((kn/2)/(m/2) (1 - eta^2)), the damped oscillator of
@@ -355,6 +400,7 @@ int main(void)
         cmocka_unit_test(test_deposit_resumed_equals_uninterrupted),
         cmocka_unit_test(test_fill_ratio_picks_count_and_lattice_picks_height),
         cmocka_unit_test(test_steps_per_collision_sets_dt),
+        cmocka_unit_test(test_random_shape_exclusion_places_dense_without_overlap),
         cmocka_unit_test(test_piston_starts_one_particle_size_above_the_packing),
         cmocka_unit_test(test_cylinder_deposit_has_no_angular_momentum_about_the_axis),
         cmocka_unit_test(test_bulk_modulus_linear_and_resumable),
