@@ -678,6 +678,28 @@ def figures(outdir, cases, agg, n, agg_all=None):
     fig.savefig(os.path.join(outdir, "study1_bond_forces.png"), dpi=110)
     plt.close(fig)
     written.append("study1_bond_forces.png")
+    # contact density against the distance from the ball centre (seed 1 of each case):
+    # flat for a homogeneous packing (seed 001 Fig. 3b), zero inside for a hollow shell
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    firsts = {}
+    for case in sorted(cases, key=lambda c: (c.mu, c.alpha, c.seed)):
+        firsts.setdefault((case.mu, case.alpha), case)
+    for k, case in enumerate(firsts.values()):
+        with open(case.analysis) as f:
+            pk = json.load(f)["packing"]
+        rows = np.array(pk["curves"]["contact_density"]["data"])
+        R = (3.0 * pk["container_volume"] / (4.0 * math.pi)) ** (1.0 / 3.0)
+        ax.plot(rows[:, 0] / R, rows[:, 1] / pk["contact_density_mean"], "-o", ms=3, lw=1,
+                ls="-" if case.mu == 0 else "--", label="α = %g, μ = %g" % (case.alpha, case.mu))
+    ax.axvline(0.5, color="0.6", lw=0.8)
+    ax.set_xlabel("r / R (ball radius)")
+    ax.set_ylabel("contact density / mean")
+    ax.set_title("contact density profiles (seed 1), N = %d" % n)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "study1_contact_density.png"), dpi=110)
+    plt.close(fig)
+    written.append("study1_contact_density.png")
     # finite size: Phi of the ball and of the core against N^(-1/3), every N of OUT
     by_alpha = {}
     for g in agg_all or []:
