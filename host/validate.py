@@ -689,7 +689,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
             pk = json.load(f)["packing"]
         rows = np.array(pk["curves"]["contact_density"]["data"])
         R = (3.0 * pk["container_volume"] / (4.0 * math.pi)) ** (1.0 / 3.0)
-        ax.plot(rows[:, 0] / R, rows[:, 1] / pk["contact_density_mean"], "-o", ms=3, lw=1,
+        ax.plot(rows[:, 0] / R, rows[:, 1] / pk["contact_density_mean"], marker="o", ms=3, lw=1,
                 ls="-" if case.mu == 0 else "--", label="α = %g, μ = %g" % (case.alpha, case.mu))
     ax.axvline(0.5, color="0.6", lw=0.8)
     ax.set_xlabel("r / R (ball radius)")
