@@ -597,6 +597,13 @@ def figures(outdir, cases, agg, n, agg_all=None):
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "k*", ms=10, label=label)
 
     written = []
+
+    def save(fig, fname):
+        fig.tight_layout()
+        fig.savefig(os.path.join(outdir, fname), dpi=110)
+        plt.close(fig)
+        written.append(fname)
+
     # packing fraction
     fig, ax = plt.subplots(figsize=(5.5, 4))
     ax.plot(et, phi_fit(et), "k--", label="seed 001 fit 0.62 + 0.85η² − 1.5η³")
@@ -612,10 +619,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
     ax.set_ylabel("packing fraction Φ")
     ax.set_title("Study 1: Φ(η), N = %d (paper: 8385)" % n)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "study1_phi.png"), dpi=110)
-    plt.close(fig)
-    written.append("study1_phi.png")
+    save(fig, "study1_phi.png")
     # interlocking and valence: one capdem series per friction against the paper's points
     def eta_figure(key, paper, paper_label, ylabel, fname):
         fig, ax = plt.subplots(figsize=(5.5, 4))
@@ -627,10 +631,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
         ax.set_xlabel("η = 1 − 1/α")
         ax.set_ylabel(ylabel)
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, fname), dpi=110)
-        plt.close(fig)
-        written.append(fname)
+        save(fig, fname)
 
     eta_figure("lambda", PAPER1["lambda"], "seed 001 text (α = 1, 9)", "interlocking λ = 1 − <l>/L", "study1_lambda.png")
     eta_figure("valence", PAPER1["valence"], "seed 001 text", "valence Z_c / Z", "study1_valence.png")
@@ -650,10 +651,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
     ax.set_xlabel("η = 1 − 1/α")
     ax.set_ylabel("coordination")
     ax.legend(fontsize=6.5, loc="center left", bbox_to_anchor=(0.04, 0.55))
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "study1_coordination.png"), dpi=110)
-    plt.close(fig)
-    written.append("study1_coordination.png")
+    save(fig, "study1_coordination.png")
     # bond-force PDFs with the cascade fits (first seed of each frictionless alpha)
     fig, ax = plt.subplots(figsize=(5.5, 4))
     seen = set()
@@ -674,10 +672,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
     ax.set_ylabel("PDF")
     ax.set_title("bond forces and cascade fits (seed 1 of each α)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "study1_bond_forces.png"), dpi=110)
-    plt.close(fig)
-    written.append("study1_bond_forces.png")
+    save(fig, "study1_bond_forces.png")
     # contact density against the distance from the ball centre (seed 1 of each case):
     # flat for a homogeneous packing (seed 001 Fig. 3b), zero inside for a hollow shell
     fig, ax = plt.subplots(figsize=(5.5, 4))
@@ -696,10 +691,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
     ax.set_ylabel("contact density / mean")
     ax.set_title("contact density profiles (seed 1), N = %d" % n)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "study1_contact_density.png"), dpi=110)
-    plt.close(fig)
-    written.append("study1_contact_density.png")
+    save(fig, "study1_contact_density.png")
     # finite size: Phi of the ball and of the core against N^(-1/3), every N of OUT
     by_alpha = {}
     for g in agg_all or []:
@@ -728,10 +720,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
         ax.set_ylabel("packing fraction Φ")
         ax.set_title("finite size (dashed: seed 001 fit; dotted: line through the ball's Φ)", fontsize=9)
         ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(os.path.join(outdir, "study1_phi_finite_size.png"), dpi=110)
-        plt.close(fig)
-        written.append("study1_phi_finite_size.png")
+        save(fig, "study1_phi_finite_size.png")
     print("figures: %s (%s)" % (outdir, ", ".join(written)))
 
 
