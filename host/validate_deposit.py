@@ -76,11 +76,13 @@ def polydispersity(dim, psi):
 
 def phi_guess(dim, shape, alpha):
     """Upper estimate of the compressed packing fraction, for the count rule:
-    2D: 0.84, random close packing of polydisperse discs (seed 000 Fig. S1:
-    crosses of lower psi pack looser); 3D stars: seed 001's frictionless fit
-    at eta = 1 - 1/alpha (friction only lowers it); spheres 0.64."""
+    2D: 0.91, the hexagonal packing of equal discs (0.907) rounded up
+    (0.84, random close packing, was too low: capdem's polydisperse discs of
+    study 4 reached 0.909 and only H/W = 1.85; crosses of lower psi pack
+    looser, seed 000 Fig. S1); 3D stars: seed 001's frictionless fit at
+    eta = 1 - 1/alpha (friction only lowers it); spheres 0.64."""
     if dim == 2:
-        return 0.84
+        return 0.91
     if shape == "sphere":
         return 0.64
     return v1.phi_fit(v1.eta_of(alpha))
