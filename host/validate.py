@@ -112,13 +112,13 @@ def now():
 START_RADIUS_FACTOR = 1.5  # starting ball radius over that of the expected packing (docs/validation.md)
 
 
-def particle_volume(capdem, alpha):
-    """Volume of one study-1 particle [m^3], from `capdem shape`."""
-    shape = STUDY1_SHAPES[alpha][0]
-    cmd = [capdem, "shape", shape, "--diameter", "%g" % ARM_D, "--json"]
+def shape_props(capdem, shape, alpha, density=1000.0):
+    """`capdem shape ... --json` of a shape of arm diameter ARM_D (volume [m^3],
+    tip_length [m], mass [kg], ...): capdem's own mass properties."""
+    cmd = [capdem, "shape", shape, "--diameter", "%g" % ARM_D, "--density", "%g" % density, "--json"]
     if shape != "sphere":
         cmd[3:3] = ["--aspect", "%g" % alpha]
-    return json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout)["volume"]
+    return json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout)
 
 
 class Case:
@@ -140,7 +140,7 @@ class Case:
         # Start: 1.5 x the radius at which the particles would fill the ball to
         # seed 001's fit Phi(eta) (solid fraction Phi / 3.4), placed at random
         # with only their arms kept apart (init.exclusion: shape).
-        v = particle_volume(self.capdem, self.alpha)
+        v = shape_props(self.capdem, shape, self.alpha)["volume"]
         radius = START_RADIUS_FACTOR * (3.0 * self.n * v / (4.0 * math.pi * phi_fit(eta_of(self.alpha)))) ** (1.0 / 3.0)
         with open(TEMPLATE1) as f:
             text = string.Template(f.read()).substitute(
@@ -153,30 +153,30 @@ class Case:
             f.write(text)
 
 
-def run_state(h5path):
-    """(complete snapshots, last step, last phase) of a run file, or None."""
+def run_state(h5path, locking=True):
+    """(complete snapshots, last step, last phase) of a run file, or None.
+    locking=False reads a file another process is writing (only committed
+    snapshots count) and stays silent when it cannot."""
     if not os.path.exists(h5path):
         return None
     try:
-        with h5py.File(h5path, "r") as f:
+        with h5py.File(h5path, "r", locking=locking) as f:
             n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]), len(f["walls/control"]))
             if n == 0:
                 return (0, 0, -1)
             return (n, int(f["walls/step"][n - 1]), int(round(float(f["walls/control"][n - 1][0]))))
-    except (OSError, KeyError) as e:
-        print("  %s: unreadable (%s)" % (h5path, e), flush=True)
+    except (OSError, KeyError, TypeError, ValueError) as e:
+        if locking:
+            print("  %s: unreadable (%s)" % (h5path, e), flush=True)
         return None
 
 
 def peek(h5path):
-    """Progress of a run file another process is writing (HDF5 file locking off;
-    only committed snapshots are read)."""
-    try:
-        with h5py.File(h5path, "r", locking=False) as f:
-            n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]))
-            return "last snapshot at step %d" % int(f["walls/step"][n - 1]) if n else "no snapshot yet"
-    except (OSError, KeyError, TypeError, ValueError) as e:
-        return "run file not readable now: %s" % e
+    """Progress of a run file another process is writing."""
+    st = run_state(h5path, locking=False)
+    if st is None:
+        return "run file not readable now"
+    return "last snapshot at step %d" % st[1] if st[0] else "no snapshot yet"
 
 
 def lock_holder(case):
@@ -220,7 +220,7 @@ def wait_for(case, pid):
         start = lock_text.split()[1]
     except (OSError, IndexError):
         lock_text, start = "", None
-    st0 = run_state_unlocked(case.h5)
+    st0 = run_state(case.h5, locking=False)
     cpu = None
     while lock_holder(case) is not None:
         c = cpu_seconds(pid)
@@ -237,16 +237,6 @@ def wait_for(case, pid):
                              "note": "run by a driver that was stopped; waited for by process %d; wall time "
                                      "from the lock file, up to 5 s late; first step after %s" % (
                                          os.getpid(), st0[1] if st0 else "?")})
-
-
-def run_state_unlocked(h5path):
-    """run_state of a file another process is writing (HDF5 file locking off)."""
-    try:
-        with h5py.File(h5path, "r", locking=False) as f:
-            n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]), len(f["walls/control"]))
-            return (n, int(f["walls/step"][n - 1]), int(round(float(f["walls/control"][n - 1][0])))) if n else None
-    except (OSError, KeyError, TypeError, ValueError):
-        return None
 
 
 def record_timing(case, entry):
@@ -389,6 +379,11 @@ def analyse(case, capdem, force=False):
 
 # ----------------------------------------------------------------------- results
 
+def ball_radius(pk):
+    """Ball radius [m] from capdem analyze's container volume."""
+    return (3.0 * pk["container_volume"] / (4.0 * math.pi)) ** (1.0 / 3.0)
+
+
 def inner_contact_density(pk):
     """Contacts per volume within half the ball radius over the ball's mean,
     from capdem analyze's contact-density profile (counts per radial bin):
@@ -397,7 +392,7 @@ def inner_contact_density(pk):
     hollow shell of particles jammed at the wall (the ball swept them up
     faster than they could fill the inside) gives about 0."""
     rows = pk["curves"]["contact_density"]["data"]
-    R = (3.0 * pk["container_volume"] / (4.0 * math.pi)) ** (1.0 / 3.0)  # ball radius [m]
+    R = ball_radius(pk)
     total = sum(r[2] for r in rows)
     inner = sum(r[2] for r in rows if r[0] < 0.5 * R)
     return inner / total / 0.125 if total > 0 else None
@@ -683,7 +678,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
         with open(case.analysis) as f:
             pk = json.load(f)["packing"]
         rows = np.array(pk["curves"]["contact_density"]["data"])
-        R = (3.0 * pk["container_volume"] / (4.0 * math.pi)) ** (1.0 / 3.0)
+        R = ball_radius(pk)
         ax.plot(rows[:, 0] / R, rows[:, 1] / pk["contact_density_mean"], marker="o", ms=3, lw=1,
                 ls="-" if case.mu == 0 else "--", label="α = %g, μ = %g" % (case.alpha, case.mu))
     ax.axvline(0.5, color="0.6", lw=0.8)

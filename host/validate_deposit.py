@@ -88,13 +88,6 @@ def phi_guess(dim, shape, alpha):
     return v1.phi_fit(v1.eta_of(alpha))
 
 
-def shape_props(capdem, shape, alpha):
-    args = [capdem, "shape", shape, "--diameter", "%g" % ARM_D, "--density", "%g" % DENSITY, "--json"]
-    if shape != "sphere":
-        args[3:3] = ["--aspect", "%g" % alpha]
-    return json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)
-
-
 def area_2d(shape, alpha, n=1500):
     """Area of the particle's cut in its plane (union of capsules), on a grid [m^2]."""
     L, r = alpha * ARM_D, 0.5 * ARM_D
@@ -116,7 +109,7 @@ class DepositCase(v1.Case):
         self.alpha, self.mu, self.seed, self.ci = alpha, 0.5, seed, False
         self.dim, self.shape = spec["dim"], spec["shape"]
         self.poly = 0.2 if self.shape == "sphere" else polydispersity(self.dim, psi)
-        props = shape_props(capdem, self.shape, alpha)
+        props = v1.shape_props(capdem, self.shape, alpha, DENSITY)
         self.L = props["tip_length"]
         self.volume = props["volume"]
         self.size = (size_l or spec["size_L"]) * self.L  # W or D [m]

@@ -204,6 +204,18 @@ static void test_steps_per_collision_sets_dt(void **state)
     cd_config_free(&cfg);
 }
 
+/* A CI preset set up on the test backend, its protocol begun and its
+ * initial forces computed: ready to step. */
+static void start_preset(cd_sim *sim, cd_config *cfg, const char *name)
+{
+    char err[2048];
+    if (cd_config_load(preset(name), cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_setup(sim, cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_sim_use_backend(sim, cdt_backend(), NULL, err, sizeof err)) fail_msg("%s", err);
+    cd_protocol_begin(sim);
+    if (cd_sim_start(sim, 1, err, sizeof err)) fail_msg("%s", err);
+}
+
 /* protocol.piston_start = packing: when the settling ends, the piston is
  * moved from the top of the domain to one particle size (largest bounding
  * diameter x (1 + p)) above the highest point of any particle. */
@@ -213,11 +225,7 @@ static void test_piston_starts_one_particle_size_above_the_packing(void **state)
     static cd_sim sim;
     cd_config cfg;
     char err[2048];
-    if (cd_config_load(preset("deposit_2d_crosses"), &cfg, err, sizeof err)) fail_msg("%s", err);
-    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
-    if (cd_sim_use_backend(&sim, cdt_backend(), NULL, err, sizeof err)) fail_msg("%s", err);
-    cd_protocol_begin(&sim);
-    if (cd_sim_start(&sim, 1, err, sizeof err)) fail_msg("%s", err);
+    start_preset(&sim, &cfg, "deposit_2d_crosses");
     int w = (int)sim.s.control[2];
     double parked = sim.s.walls[w].point.y;
     while ((int)sim.s.control[0] == CD_PHASE_SETTLE) {
@@ -249,12 +257,7 @@ static void test_cylinder_deposit_has_no_angular_momentum_about_the_axis(void **
     (void)state;
     static cd_sim sim;
     cd_config cfg;
-    char err[2048];
-    if (cd_config_load(preset("deposit_cylinder_D6L"), &cfg, err, sizeof err)) fail_msg("%s", err);
-    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
-    if (cd_sim_use_backend(&sim, cdt_backend(), NULL, err, sizeof err)) fail_msg("%s", err);
-    cd_protocol_begin(&sim);
-    if (cd_sim_start(&sim, 1, err, sizeof err)) fail_msg("%s", err);
+    start_preset(&sim, &cfg, "deposit_cylinder_D6L");
     for (int pass = 0; pass < 2; pass++) {
         if (pass) cdt_step(&sim, 20000);
         double L = 0, scale = 0;
