@@ -100,12 +100,17 @@ CD_INLINE void cd_item_wall_forces(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_w
         cd_long row = (cd_long)i * n_walls + w;
         cd_wall wall = walls[w]; /* private copy: the wall functions take private pointers */
         cd_contact_geom g;
-        cd_wall_contact(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, &g);
-        if (!(g.overlap > 0)) {
-            c.wallc_active[row] = 0;
-            c.wallc_shear[row] = cd_v3_zero();
-            c.wallc_overlap[row] = 0;
-            c.wallc_fn[row] = 0;
+        int apart = cd_wall_clearly_apart(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
+        if (!apart) cd_wall_contact(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, &g);
+        if (apart || !(g.overlap > 0)) {
+            /* An inactive row holds zeros (the load sums read every row);
+             * it is written only when it changes, to spare the bandwidth. */
+            if (c.wallc_active[row]) {
+                c.wallc_active[row] = 0;
+                c.wallc_shear[row] = cd_v3_zero();
+                c.wallc_overlap[row] = 0;
+                c.wallc_fn[row] = 0;
+            }
             continue;
         }
         cd_vec3 vi = cd_rigid_point_velocity(c.position[pi], c.velocity[pi], c.angvel[pi], g.point);

@@ -221,6 +221,51 @@ static void test_moving_wall_velocity_at_contact(void **state)
 }
 
 /* An unknown wall type never produces a contact. */
+/* The force kernel's pre-test (cd_wall_clearly_apart) may say "apart" only
+ * where cd_wall_contact finds no overlap, and must say it for primitives
+ * well inside: 200,000 random rods and spheres (deterministic LCG) in and
+ * around a plane, a tilted cylinder and a sphere, plus the exact touching
+ * positions.  No tolerance: one disagreement would change forces. */
+static double lcg_unit(uint64_t *x)
+{
+    *x = *x * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*x >> 11) / 9007199254740992.0; /* [0, 1) */
+}
+static void test_clearly_apart_never_hides_a_contact(void **state)
+{
+    double c = sqrt(0.5);
+    cd_wall walls[3] = {plane(cd_v3(0, 0, 0.1), cd_v3(0, c, c)), cylinder(cd_v3(0, 0, 0), cd_v3(c, 0, c), 1.0),
+                        sphere(cd_v3(0.2, 0, 0), 1.0)};
+    uint64_t x = 12345;
+    long apart = 0, contacts = 0;
+    (void)state;
+    for (int k = 0; k < 200000; k++) {
+        cd_wall *w = &walls[k % 3];
+        cd_vec3 a = cd_v3(2.4 * lcg_unit(&x) - 1.2, 2.4 * lcg_unit(&x) - 1.2, 2.4 * lcg_unit(&x) - 1.2);
+        cd_vec3 d = cd_v3(lcg_unit(&x) - 0.5, lcg_unit(&x) - 0.5, lcg_unit(&x) - 0.5);
+        cd_vec3 b = (k / 3) % 2 ? cd_v3_add(a, cd_v3_scale(d, 0.6)) : a; /* rod or sphere */
+        double r = 0.2 * lcg_unit(&x);
+        cd_contact_geom g;
+        cd_wall_contact(w, a, b, r, SIN2DEG, &g);
+        if (cd_wall_clearly_apart(w, a, b, r)) {
+            apart++;
+            assert_false(g.overlap > 0);
+        }
+        contacts += g.overlap > 0;
+    }
+    assert_true(apart > 50000 && contacts > 20000); /* both branches exercised */
+    /* touching exactly (overlap 0) and just overlapping, radius-0.3 spheres */
+    cd_wall cyl = cylinder(cd_v3(0, 0, 0), cd_v3(0, 0, 1), 2.0);
+    cd_contact_geom g;
+    assert_true(cd_wall_clearly_apart(&cyl, cd_v3(1.6, 0, 0), cd_v3(1.6, 0, 0), 0.3));
+    cd_wall_contact(&cyl, cd_v3(1.7, 0, 0), cd_v3(1.7, 0, 0), 0.3, SIN2DEG, &g);
+    assert_false(cd_wall_clearly_apart(&cyl, cd_v3(1.7, 0, 0), cd_v3(1.7, 0, 0), 0.3));
+    assert_false(g.overlap > 1e-15);
+    cd_wall floor = plane(cd_v3(0, 0, 0), cd_v3(0, 0, 1));
+    assert_true(cd_wall_clearly_apart(&floor, cd_v3(0, 0, 0.3), cd_v3(1, 0, 0.5), 0.3));
+    assert_false(cd_wall_clearly_apart(&floor, cd_v3(0, 0, 0.3), cd_v3(1, 0, 0.5), 0.3 + 1e-12));
+}
+
 static void test_unknown_wall_type_gives_no_contact(void **state)
 {
     cd_wall w = plane(cd_v3(0, 0, 0), cd_v3(0, 0, 1));
@@ -242,6 +287,7 @@ int main(void)
         cmocka_unit_test(test_cylinder_with_tilted_axis),
         cmocka_unit_test(test_sphere_wall_contacts),
         cmocka_unit_test(test_moving_wall_velocity_at_contact),
+        cmocka_unit_test(test_clearly_apart_never_hides_a_contact),
         cmocka_unit_test(test_unknown_wall_type_gives_no_contact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
