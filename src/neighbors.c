@@ -1,5 +1,5 @@
-/* Broad phase: cell lists over the bounding spheres of primitives feeding a
- * Verlet list of primitive pairs with a skin.  The list is rebuilt only when
+/* Broad phase: cell lists over the bounding spheres of particles, then of
+ * their primitives, feeding a Verlet list of primitive pairs with a skin.  The list is rebuilt only when
  * some primitive end has moved more than half the skin since the last build
  * (every point of a segment moves at most as far as its farthest end, so no
  * pair can come into contact unseen).  Contact history is carried over by
@@ -10,6 +10,17 @@
 #include <math.h>
 #include "sim.h"
 #include "../kernels/broadphase.h"
+
+/* Particles per block of the build: each block fills its own row buffer,
+ * and the buffers are copied into the list in block order, so the rows
+ * come out in one fixed order whatever the threads. */
+#define CD_NB_BLOCK 64
+
+struct cd_nb_block {
+    cd_prim_id *rows; /* candidate j of the block's primitives, row after row */
+    size_t n, cap;
+};
+
 
 void cd_neighbors_init(cd_neighbors *nb, double skin)
 {
@@ -23,9 +34,12 @@ void cd_neighbors_free(cd_neighbors *nb)
     free(nb->gather_start);
     free(nb->gather_rows);
     free(nb->cell_start);
-    free(nb->cell_prims);
-    free(nb->prim_cell);
+    free(nb->cell_parts);
+    free(nb->part_cell);
+    free(nb->part_bound);
     free(nb->pair_count);
+    for (size_t b = 0; b < nb->n_blocks; b++) free(nb->blocks[b].rows);
+    free(nb->blocks);
     memset(nb, 0, sizeof(*nb));
 }
 
@@ -39,23 +53,6 @@ int cd_neighbors_needed(cd_sim *sim)
     for (size_t i = 0; i < s->n_prims; i++)
         moved = moved || cd_bp_moved(s->prim_a[i], s->prim_a_ref[i], s->prim_b[i], s->prim_b_ref[i], limit2);
     return moved;
-}
-
-/* The grid of the primitives' bounding-sphere centres (kernels/broadphase.h). */
-static void make_grid(const cd_state *s, double skin, cd_grid *g)
-{
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double rmax = 0;
-    for (size_t i = 0; i < s->n_prims; i++) cd_bp_bounds_add(lo, hi, &rmax, s->prim_a[i], s->prim_b[i], s->prim_radius[i]);
-    cd_grid_make(g, lo, hi, rmax, skin, (cd_long)s->n_prims);
-}
-
-/* Candidates j > i of primitive i, ascending, into out (if not NULL). */
-static cd_int scan_prim(const cd_state *s, const cd_grid *g, const cd_int *cell_start, const cd_int *cell_prims,
-                        size_t i, double skin, cd_prim_id *out)
-{
-    return cd_bp_scan_prim(s->prim_a, s->prim_b, s->prim_radius, s->prim_particle, g, cell_start, cell_prims,
-                           (cd_prim_id)i, skin, out, CD_BP_UNBOUNDED);
 }
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -96,43 +93,165 @@ static int build_gather(cd_sim *sim)
     return 0;
 }
 
+/* Appends j to block b's rows (grows the buffer by half). */
+static int block_push(struct cd_nb_block *b, cd_prim_id j)
+{
+    if (b->n == b->cap && grow((void **)&b->rows, &b->cap, b->n + 1, sizeof(cd_prim_id))) return -1;
+    b->rows[b->n++] = j;
+    return 0;
+}
+
+/* Bounding sphere of each particle about its centre of mass [m]: the
+ * largest reach of its primitives' bounding spheres, widened by 1e-9 of
+ * itself so that it holds every primitive sphere despite rounding (the
+ * particle test below must never drop a pair the primitive test keeps). */
+static double particle_bounds(const cd_state *s, double *bound, double lo[3], double hi[3])
+{
+    double rmax = 0;
+    for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
+    for (size_t p = 0; p < s->n_particles; p++) {
+        cd_vec3 x = s->position[p];
+        double r = 0;
+        for (cd_int i = s->prim_first[p]; i < s->prim_first[p] + s->prim_count[p]; i++) {
+            double reach = cd_v3_norm(cd_v3_sub(cd_bp_centre(s->prim_a[i], s->prim_b[i]), x)) +
+                           cd_bp_bound(s->prim_a[i], s->prim_b[i], s->prim_radius[i]);
+            if (reach > r) r = reach;
+        }
+        bound[p] = r * (1 + 1e-9);
+        if (bound[p] > rmax) rmax = bound[p];
+        double v[3] = {x.x, x.y, x.z};
+        for (int k = 0; k < 3; k++) {
+            if (v[k] < lo[k]) lo[k] = v[k];
+            if (v[k] > hi[k]) hi[k] = v[k];
+        }
+    }
+    return rmax;
+}
+
+/* Particles q > p whose bounding spheres come within the skin of p's, in
+ * ascending order, into *list (grown as needed); returns how many. */
+static long particle_candidates(const cd_state *s, const cd_neighbors *nb, const cd_grid *g, size_t p,
+                                cd_int **list, size_t *cap)
+{
+    cd_vec3 x = s->position[p];
+    double reach0 = nb->part_bound[p] + nb->skin;
+    cd_long cx = cd_grid_coord(g, x.x, 0), cy = cd_grid_coord(g, x.y, 1), cz = cd_grid_coord(g, x.z, 2);
+    size_t n = 0;
+    for (cd_long z = cz - 1; z <= cz + 1; z++) {
+        if (z < 0 || z >= g->dim[2]) continue;
+        for (cd_long y = cy - 1; y <= cy + 1; y++) {
+            if (y < 0 || y >= g->dim[1]) continue;
+            for (cd_long xx = cx - 1; xx <= cx + 1; xx++) {
+                if (xx < 0 || xx >= g->dim[0]) continue;
+                cd_long cell = (z * g->dim[1] + y) * g->dim[0] + xx;
+                for (cd_int k = nb->cell_start[cell]; k < nb->cell_start[cell + 1]; k++) {
+                    cd_int q = nb->cell_parts[k];
+                    if ((size_t)q <= p) continue;
+                    double reach = reach0 + nb->part_bound[q];
+                    if (cd_v3_norm2(cd_v3_sub(s->position[q], x)) > reach * reach) continue;
+                    if (n == *cap && grow((void **)list, cap, n + 1, sizeof(cd_int))) return -1;
+                    cd_int m = (cd_int)n++; /* insertion keeps the list ascending */
+                    while (m > 0 && (*list)[m - 1] > q) {
+                        (*list)[m] = (*list)[m - 1];
+                        m--;
+                    }
+                    (*list)[m] = q;
+                }
+            }
+        }
+    }
+    return (long)n;
+}
+
+/* Rows of the primitives of particles [p0, p1) into block b: for each
+ * primitive i, the primitives j of the candidate particles (ascending, so
+ * the row is sorted by j) that pass the primitive test cd_bp_is_candidate;
+ * count[i + 1] = the row's length. */
+static int fill_block(const cd_state *s, const cd_neighbors *nb, const cd_grid *g, size_t p0, size_t p1,
+                      struct cd_nb_block *b, cd_int **list, size_t *cap)
+{
+    b->n = 0;
+    for (size_t p = p0; p < p1; p++) {
+        long nq = particle_candidates(s, nb, g, p, list, cap);
+        if (nq < 0) return -1;
+        for (cd_int i = s->prim_first[p]; i < s->prim_first[p] + s->prim_count[p]; i++) {
+            size_t before = b->n;
+            for (long k = 0; k < nq; k++) {
+                cd_int q = (*list)[k];
+                for (cd_int j = s->prim_first[q]; j < s->prim_first[q] + s->prim_count[q]; j++)
+                    if (cd_bp_is_candidate(s->prim_a[i], s->prim_b[i], s->prim_radius[i], s->prim_a[j], s->prim_b[j],
+                                           s->prim_radius[j], nb->skin) &&
+                        block_push(b, (cd_prim_id)j))
+                        return -1;
+            }
+            nb->pair_count[i + 1] = (cd_int)(b->n - before);
+        }
+    }
+    return 0;
+}
+
+/* The candidate pairs (i, j), i < j, of primitives of different particles
+ * whose axes come within r_i + r_j + skin, sorted by i then j.  The scan
+ * runs over particles (a grid of particle centres, particle bounding
+ * spheres first): the three arms of a hexapod share one centre, and a
+ * scan over primitives met each neighbour nine times.  The pairs are the
+ * same set as the primitive test alone gives (the particle sphere holds
+ * its primitives' spheres), in the same order.  One pass: each block of
+ * CD_NB_BLOCK particles writes its rows into its own buffer. */
 int cd_neighbors_build(cd_sim *sim)
 {
     cd_state *s = &sim->s;
     cd_neighbors *nb = &sim->nb;
-    size_t P = s->n_prims;
-    double skin = nb->skin;
-    cd_grid g;
-    make_grid(s, skin, &g);
-    size_t ncell = (size_t)(g.dim[0] * g.dim[1] * g.dim[2]);
-
-    free(nb->cell_start);
-    nb->cell_start = calloc(ncell + 1, sizeof(cd_int));
-    if (!nb->prim_cell) {
-        nb->prim_cell = malloc((P + 1) * sizeof(cd_int));
-        nb->cell_prims = malloc((P + 1) * sizeof(cd_int));
+    size_t P = s->n_prims, N = s->n_particles;
+    size_t nblocks = (N + CD_NB_BLOCK - 1) / CD_NB_BLOCK;
+    if (!nb->part_cell) {
+        nb->part_cell = malloc((N + 1) * sizeof(cd_int));
+        nb->cell_parts = malloc((N + 1) * sizeof(cd_int));
+        nb->part_bound = malloc((N + 1) * sizeof(double));
         nb->pair_count = malloc((P + 2) * sizeof(cd_int));
     }
-    if (!nb->cell_start || !nb->prim_cell || !nb->cell_prims || !nb->pair_count) return -1;
+    if (nb->n_blocks != nblocks) { /* first build (the particle count is fixed) */
+        for (size_t b = 0; b < nb->n_blocks; b++) free(nb->blocks[b].rows);
+        free(nb->blocks);
+        nb->blocks = calloc(nblocks + 1, sizeof(struct cd_nb_block));
+        nb->n_blocks = nblocks;
+    }
+    if (!nb->part_cell || !nb->cell_parts || !nb->part_bound || !nb->pair_count || !nb->blocks) return -1;
 
-    /* Counting sort of primitives into cells, stable in primitive order. */
-    for (size_t i = 0; i < P; i++) {
-        nb->prim_cell[i] = (cd_int)cd_grid_cell_of(&g, cd_bp_centre(s->prim_a[i], s->prim_b[i]));
-        nb->cell_start[nb->prim_cell[i] + 1]++;
+    /* Grid of particle centres; counting sort into cells, stable in particle order. */
+    double lo[3], hi[3];
+    double rmax = particle_bounds(s, nb->part_bound, lo, hi);
+    cd_grid g;
+    cd_grid_make(&g, lo, hi, rmax, nb->skin, (cd_long)N);
+    size_t ncell = (size_t)(g.dim[0] * g.dim[1] * g.dim[2]);
+    free(nb->cell_start);
+    nb->cell_start = calloc(ncell + 1, sizeof(cd_int));
+    cd_int *cursor = malloc((ncell + 1) * sizeof(cd_int));
+    if (!nb->cell_start || !cursor) { free(cursor); return -1; }
+    for (size_t p = 0; p < N; p++) {
+        nb->part_cell[p] = (cd_int)cd_grid_cell_of(&g, s->position[p]);
+        nb->cell_start[nb->part_cell[p] + 1]++;
     }
     for (size_t c = 0; c < ncell; c++) nb->cell_start[c + 1] += nb->cell_start[c];
-    {
-        cd_int *cursor = malloc((ncell + 1) * sizeof(cd_int));
-        if (!cursor) return -1;
-        memcpy(cursor, nb->cell_start, (ncell + 1) * sizeof(cd_int));
-        for (size_t i = 0; i < P; i++) nb->cell_prims[cursor[nb->prim_cell[i]]++] = (cd_int)i;
-        free(cursor);
-    }
+    memcpy(cursor, nb->cell_start, (ncell + 1) * sizeof(cd_int));
+    for (size_t p = 0; p < N; p++) nb->cell_parts[cursor[nb->part_cell[p]]++] = (cd_int)p;
+    free(cursor);
 
-    /* Pass 1: count candidates per primitive; prefix sum gives row offsets. */
+    /* The rows, block by block. */
+    int failed = 0;
+#pragma omp parallel if (CD_PARALLEL(P)) reduction(|| : failed)
+    {
+        cd_int *list = NULL;
+        size_t cap = 0;
+#pragma omp for schedule(dynamic, 1)
+        for (size_t b = 0; b < nblocks; b++) {
+            size_t p1 = (b + 1) * CD_NB_BLOCK < N ? (b + 1) * CD_NB_BLOCK : N;
+            if (!failed) failed = fill_block(s, nb, &g, b * CD_NB_BLOCK, p1, &nb->blocks[b], &list, &cap) != 0;
+        }
+        free(list);
+    }
+    if (failed) return -1;
     cd_int *count = nb->pair_count;
-#pragma omp parallel for schedule(dynamic, 256) if (CD_PARALLEL(P))
-    for (size_t i = 0; i < P; i++) count[i + 1] = scan_prim(s, &g, nb->cell_start, nb->cell_prims, i, skin, NULL);
     count[0] = 0;
     for (size_t i = 0; i < P; i++) count[i + 1] += count[i];
     size_t n_new = (size_t)count[P];
@@ -150,17 +269,21 @@ int cd_neighbors_build(cd_sim *sim)
     if (cd_state_reserve_pairs(s, n_new + n_new / 4 + 16)) { free(old_keys); free(old_shear); free(old_active); return -1; }
     s->n_pairs = n_new;
 
-    /* Pass 2: fill rows (sorted by i, then j) and carry history over. */
-#pragma omp parallel for schedule(dynamic, 256) if (CD_PARALLEL(P))
-    for (size_t i = 0; i < P; i++) {
-        cd_int first = count[i];
-        cd_int n = scan_prim(s, &g, nb->cell_start, nb->cell_prims, i, skin, s->pair_prim_j + first);
-        for (cd_int k = first; k < first + n; k++) {
-            s->pair_prim_i[k] = (cd_prim_id)i;
-            long o = cd_bp_find_key(old_keys, (cd_long)n_old, cd_bp_pair_key((cd_prim_id)i, s->pair_prim_j[k]));
-            s->pair_active[k] = o >= 0 ? old_active[o] : 0;
-            s->pair_shear[k] = o >= 0 ? old_shear[o] : cd_v3_zero();
-        }
+    /* Copy each block's rows into place and carry the history over. */
+#pragma omp parallel for schedule(dynamic, 1) if (CD_PARALLEL(P))
+    for (size_t b = 0; b < nblocks; b++) {
+        size_t p1 = (b + 1) * CD_NB_BLOCK < N ? (b + 1) * CD_NB_BLOCK : N;
+        cd_int i0 = s->prim_first[b * CD_NB_BLOCK], i1 = s->prim_first[p1 - 1] + s->prim_count[p1 - 1];
+        const cd_prim_id *rows = nb->blocks[b].rows;
+        for (cd_int i = i0; i < i1; i++)
+            for (cd_int k = count[i]; k < count[i + 1]; k++) {
+                cd_prim_id j = rows[k - count[i0]];
+                s->pair_prim_i[k] = (cd_prim_id)i;
+                s->pair_prim_j[k] = j;
+                long o = cd_bp_find_key(old_keys, (cd_long)n_old, cd_bp_pair_key((cd_prim_id)i, j));
+                s->pair_active[k] = o >= 0 ? old_active[o] : 0;
+                s->pair_shear[k] = o >= 0 ? old_shear[o] : cd_v3_zero();
+            }
     }
     free(old_keys);
     free(old_shear);

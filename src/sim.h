@@ -35,9 +35,12 @@ typedef struct {
     cd_int *gather_start;     /* n_particles + 1 */
     cd_pair_id *gather_rows;  /* 2 n_pairs */
     size_t gather_cap;
-    /* scratch */
-    cd_int *cell_start, *cell_prims, *prim_cell, *pair_count;
-    size_t cell_cap;
+    /* scratch: particles binned by cell (CSR), per-particle bounding radii,
+     * per-primitive row counts, and one row buffer per block of particles */
+    cd_int *cell_start, *cell_parts, *part_cell, *pair_count;
+    double *part_bound;
+    struct cd_nb_block *blocks;
+    size_t n_blocks;
 } cd_neighbors;
 
 typedef struct cd_sim {
