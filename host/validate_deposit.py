@@ -74,15 +74,28 @@ def polydispersity(dim, psi):
     return 0.2
 
 
+# 2D crosses: area fractions capdem measured in a box of 10 L (250 crosses,
+# the study-2 protocol; 2026-11-22): alpha 3 0.75 (the CI twin of
+# deposit_2d_crosses), alpha 6 0.60 (compressed), alpha 11 0.40 (settled
+# 0.36, less the 10 % the piston took off the height at alpha 6).  The
+# count uses 1.2 x these (walls take a larger share of a 10 L box than of
+# 30 L), capped at 0.91.  seed 000 Fig. S1 gives the trend (a figure only).
+PHI_2D_CROSSES = {3: 0.75, 6: 0.60, 11: 0.40}
+
+
 def phi_guess(dim, shape, alpha):
     """Upper estimate of the compressed packing fraction, for the count rule:
-    2D: 0.91, the hexagonal packing of equal discs (0.907) rounded up
-    (0.84, random close packing, was too low: capdem's polydisperse discs of
-    study 4 reached 0.909 and only H/W = 1.85; crosses of lower psi pack
-    looser, seed 000 Fig. S1); 3D stars: seed 001's frictionless fit at
-    eta = 1 - 1/alpha (friction only lowers it); spheres 0.64."""
+    2D discs and near-discs (alpha 1.1): 0.91, the hexagonal packing of
+    equal discs (0.907) rounded up (0.84, random close packing, was too
+    low: capdem's polydisperse discs of study 4 reached 0.909 and only
+    H/W = 1.85); thinner crosses pack looser (seed 000 Fig. S1): 1.2 x
+    capdem's pilot values (PHI_2D_CROSSES), which halves the count at
+    alpha = 11 where 0.91 gave H/W near 4; 3D stars: seed 001's
+    frictionless fit at eta = 1 - 1/alpha (friction only lowers it);
+    spheres 0.64."""
     if dim == 2:
-        return 0.91
+        measured = PHI_2D_CROSSES.get(alpha) if shape == "cross" else None
+        return min(0.91, round(1.2 * measured, 3)) if measured else 0.91
     if shape == "sphere":
         return 0.64
     return v1.phi_fit(v1.eta_of(alpha))
