@@ -890,6 +890,7 @@ def main():
         p.add_argument("--no-run", action="store_true")
         p.add_argument("--reanalyse", action="store_true")
         p.add_argument("--figures", help="write the PNG figures into this folder")
+        p.add_argument("--markdown", action="store_true", help="also print the table as Markdown")
     args = ap.parse_args()
     if args.study == "study1":
         return study1(args)

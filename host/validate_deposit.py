@@ -254,7 +254,7 @@ def aggregate(rows):
              "n_rule": rs[0]["n_rule"], "seeds": sorted(r["seed"] for r in rs),
              "types": "".join(r["pf_type"] for r in rs)}
         for k in ("k", "k_wls", "mueth_a", "mueth_b", "mueth_beta", "stress_tail_k", "phi_container",
-                  "height_over_width", "run_wall_s"):
+                  "height_over_width", "run_wall_s", "step"):
             vals = np.array([r[k] for r in rs if r.get(k) is not None], dtype=float)
             g[k] = float(vals.mean()) if len(vals) else None
             g[k + "_se"] = float(vals.std(ddof=1) / math.sqrt(len(vals))) if len(vals) >= 2 else None
@@ -269,6 +269,8 @@ def aggregate(rows):
             g["rdf_peaks_paper"] = rdf_peaks_paper(g["alpha"]) if g["psi"] < 0.9 else [1.0, 1.91]
         elif study == "study3":
             g["k_paper"] = k_paper_3d(g["psi"])
+        elif study == "study4":  # seed 000: its 2D fit at psi = 1; Murphy et al.'s 3D spheres
+            g["k_paper"] = k_paper_2d(1.0) if key.startswith("sphere2d") else 1.4
         out.append(g)
     return out
 
@@ -286,6 +288,35 @@ def print_table(agg):
             line += "  Mueth a, b, beta = %s, %s, %s (Mueth 1998: 3.0, 0.75, 1.5)" % (
                 v1.pm(g, "mueth_a", 2), v1.pm(g, "mueth_b", 2), v1.pm(g, "mueth_beta", 2))
         print(line)
+
+
+def markdown(agg):
+    """The table of docs/validation.md for one study (mean +- standard error
+    over seeds; one seed: its value)."""
+    cols = ["ψ (α)", "N", "seeds", "H / W", "Φ", "k, max. likelihood", "k, least squares", "seed 000 k",
+            "P(f) type", "P(i) tail k"]
+    study = agg[0]["study"] if agg else ""
+    if study == "study2" or study == "study4":
+        cols += ["G(r) peaks / L (seed 000)"]
+    if study == "study4":
+        cols += ["Mueth a, b, β (Mueth: 3.0, 0.75, 1.5)"]
+    cols += ["steps (mean)", "wall per run"]
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for g in sorted(agg, key=lambda g: -(g["psi"] or 0)):
+        shape = ("%.3f (%g)" % (g["psi"], g["alpha"])) if g["psi"] else g["key"].split("_")[0]
+        cells = [shape, "%d" % g["n"], ",".join(map(str, g["seeds"])), v1.pm(g, "height_over_width", 2),
+                 v1.pm(g, "phi_container", 3), v1.pm(g, "k", 2), v1.pm(g, "k_wls", 2), v1.ref(g.get("k_paper")),
+                 ", ".join(g["types"]), v1.pm(g, "stress_tail_k", 2)]
+        if study in ("study2", "study4"):
+            peaks = g.get("rdf_peaks") or []
+            cells.append("%s (%s)" % (", ".join("%.2f" % p for p in peaks) or "—",
+                                      ", ".join("%.2f" % p for p in g.get("rdf_peaks_paper", [])) or "—"))
+        if study == "study4":
+            cells.append("%s; %s; %s" % (v1.pm(g, "mueth_a", 2), v1.pm(g, "mueth_b", 2), v1.pm(g, "mueth_beta", 2)))
+        cells += ["%.0f" % g["step"] if g.get("step") else "—",
+                  "%.0f s" % g["run_wall_s"] if g.get("run_wall_s") else "—"]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def figures(outdir, cases, agg, study):
@@ -365,6 +396,8 @@ def run_study(args):
         json.dump({"generated": v1.now(), "runs": rows, "cases": agg}, f, indent=1)
     print("%s: %d of %d cases finished" % (args.study, len(finished), len(cases)))
     print_table(agg)
+    if args.markdown:
+        print(markdown(agg))
     if args.figures and finished:
         figures(args.figures, finished, agg, args.study)
     return 0
