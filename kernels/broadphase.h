@@ -1,7 +1,8 @@
 /* Broad phase of the Verlet list (docs/architecture.md; used by
  * src/neighbors.c on the host and kernels/cl/neighbors.cl on a device):
- * a uniform grid over the primitives' bounding-sphere centres, the exact
- * candidate test, the scan of one primitive's neighbour cells, the pair key
+ * a uniform grid over the particles' centres with their bounding spheres,
+ * the exact candidate test of two primitives, the scan of one primitive's
+ * neighbour cells, the pair key
  * and its binary search (history carry-over), and the skin criterion.
  * Written once so that both backends build the same list of pairs.
  * Device-safe: C11 and OpenCL C 1.2. */
@@ -27,21 +28,37 @@ CD_INLINE cd_vec3 cd_bp_centre(cd_vec3 a, cd_vec3 b) { return cd_v3_scale(cd_v3_
 /* Radius of a primitive's bounding sphere about cd_bp_centre [m]. */
 CD_INLINE cd_real cd_bp_bound(cd_vec3 a, cd_vec3 b, cd_real r) { return CD_R(0.5) * cd_v3_norm(cd_v3_sub(b, a)) + r; }
 
-/* Adds a primitive to the running box of centres lo/hi [m] and the largest
- * bounding radius rmax [m].  Minimum and maximum are exact, so any order of
- * additions (threads, work-groups) gives the same box. */
-CD_INLINE void cd_bp_bounds_add(cd_real *lo, cd_real *hi, cd_real *rmax, cd_vec3 a, cd_vec3 b, cd_real r)
+/* Bounding radius of a particle about its centre of mass x [m]: the
+ * largest reach |centre_i - x| + bound_i of its primitives first ..
+ * first + count - 1, widened by 1e-9 of itself so that it holds every
+ * primitive's sphere despite rounding (the particle test must never drop a
+ * pair that the primitive test keeps). */
+CD_INLINE cd_real cd_bp_particle_bound(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBAL cd_vec3 *prim_b,
+                                       const CD_GLOBAL cd_real *prim_radius, cd_int first, cd_int count, cd_vec3 x)
 {
-    cd_vec3 c = cd_bp_centre(a, b);
+    cd_real r = 0;
+    for (cd_int i = first; i < first + count; i++) {
+        cd_real reach = cd_v3_norm(cd_v3_sub(cd_bp_centre(prim_a[i], prim_b[i]), x)) +
+                        cd_bp_bound(prim_a[i], prim_b[i], prim_radius[i]);
+        if (reach > r) r = reach;
+    }
+    return r * CD_R(1.000000001);
+}
+
+/* Adds a particle (centre x [m], bounding radius bound [m]) to the running
+ * box of centres lo/hi [m] and the largest bound rmax [m].  Minimum and
+ * maximum are exact, so any order of additions (threads, work-groups)
+ * gives the same box. */
+CD_INLINE void cd_bp_bounds_add(cd_real *lo, cd_real *hi, cd_real *rmax, cd_vec3 x, cd_real bound)
+{
     cd_real v[3];
-    v[0] = c.x;
-    v[1] = c.y;
-    v[2] = c.z;
+    v[0] = x.x;
+    v[1] = x.y;
+    v[2] = x.z;
     for (int k = 0; k < 3; k++) {
         if (v[k] < lo[k]) lo[k] = v[k];
         if (v[k] > hi[k]) hi[k] = v[k];
     }
-    cd_real bound = cd_bp_bound(a, b, r);
     if (bound > *rmax) *rmax = bound;
 }
 
@@ -95,23 +112,29 @@ CD_INLINE int cd_bp_is_candidate(cd_vec3 ai, cd_vec3 bi, cd_real ri, cd_vec3 aj,
 /* Writes of cd_bp_scan_prim without a bound. */
 #define CD_BP_UNBOUNDED 0x7fffffff
 
-/* Visits the candidates j > i of primitive i (other particles only) in the
- * 27 cells around its centre; writes them to out (unless out is 0) in
+/* Visits the candidates j > i of primitive i of particle p: the particles
+ * q > p in the 27 cells around p's centre whose bounding spheres
+ * (part_bound [m]) come within the skin, then each primitive j of q that
+ * passes cd_bp_is_candidate; writes them to out (unless out is 0) in
  * ascending order and returns how many there are.  At most cap are written:
  * a return value above cap means out is incomplete (a device fills fixed
  * slots in one pass and re-scans the rare primitive that overflows its
- * slot).  cell_start/cell_prims: primitives binned by cell (CSR, any order
- * inside a cell: the insertion below sorts the row). */
+ * slot).  cell_start/cell_parts: particles binned by cell (CSR, any order
+ * inside a cell: the insertion below sorts the row).  The host builds the
+ * same rows particle by particle (src/neighbors.c). */
 CD_INLINE cd_int cd_bp_scan_prim(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBAL cd_vec3 *prim_b,
                                  const CD_GLOBAL cd_real *prim_radius, const CD_GLOBAL cd_particle_id *prim_particle,
+                                 const CD_GLOBAL cd_vec3 *position, const CD_GLOBAL cd_int *prim_first,
+                                 const CD_GLOBAL cd_int *prim_count, const CD_GLOBAL cd_real *part_bound,
                                  const cd_grid *g, const CD_GLOBAL cd_int *cell_start,
-                                 const CD_GLOBAL cd_int *cell_prims, cd_prim_id i, cd_real skin,
+                                 const CD_GLOBAL cd_int *cell_parts, cd_prim_id i, cd_real skin,
                                  CD_GLOBAL cd_prim_id *out, cd_int cap)
 {
     cd_vec3 ai = prim_a[i], bi = prim_b[i];
     cd_real ri = prim_radius[i];
-    cd_particle_id pi = prim_particle[i];
-    cd_vec3 c = cd_bp_centre(ai, bi);
+    cd_particle_id p = prim_particle[i];
+    cd_vec3 c = position[p];
+    cd_real reach0 = part_bound[p] + skin; /* [m] */
     cd_long cx = cd_grid_coord(g, c.x, 0), cy = cd_grid_coord(g, c.y, 1), cz = cd_grid_coord(g, c.z, 2);
     cd_int n = 0;
     for (cd_long z = cz - 1; z <= cz + 1; z++) {
@@ -122,19 +145,23 @@ CD_INLINE cd_int cd_bp_scan_prim(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBA
                 if (x < 0 || x >= g->dim[0]) continue;
                 cd_long cell = (z * g->dim[1] + y) * g->dim[0] + x;
                 for (cd_int k = cell_start[cell]; k < cell_start[cell + 1]; k++) {
-                    cd_prim_id j = cell_prims[k];
-                    if (j <= i || prim_particle[j] == pi) continue;
-                    if (!cd_bp_is_candidate(ai, bi, ri, prim_a[j], prim_b[j], prim_radius[j], skin)) continue;
-                    if (out && n < cap) {
-                        /* insertion keeps the row sorted by j */
-                        cd_int m = n;
-                        while (m > 0 && out[m - 1] > j) {
-                            out[m] = out[m - 1];
-                            m--;
+                    cd_particle_id q = cell_parts[k];
+                    if (q <= p) continue;
+                    cd_real reach = reach0 + part_bound[q];
+                    if (cd_v3_norm2(cd_v3_sub(position[q], c)) > reach * reach) continue;
+                    for (cd_prim_id j = prim_first[q]; j < prim_first[q] + prim_count[q]; j++) {
+                        if (!cd_bp_is_candidate(ai, bi, ri, prim_a[j], prim_b[j], prim_radius[j], skin)) continue;
+                        if (out && n < cap) {
+                            /* insertion keeps the row sorted by j */
+                            cd_int m = n;
+                            while (m > 0 && out[m - 1] > j) {
+                                out[m] = out[m - 1];
+                                m--;
+                            }
+                            out[m] = j;
                         }
-                        out[m] = j;
+                        n++;
                     }
-                    n++;
                 }
             }
         }

@@ -68,7 +68,7 @@ typedef struct cd_cl {
 
     /* neighbour-list workspace */
     cl_mem partial, grid;       /* bounds per chunk (7 reals), the cd_grid */
-    cl_mem prim_cell, cell_count, cell_start, cell_cursor, cell_prims;
+    cl_mem part_cell, part_bound, cell_count, cell_start, cell_cursor, cell_parts;
     size_t cell_cap;            /* cells the grid may have: 8 n_prims + 64 */
     cl_mem pair_count, pair_offset, block_sum;
     cl_mem cand;                /* candidates per primitive, slot entries each */

@@ -135,11 +135,12 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
     cl->partial = cd_cl_buffer(cl, 7 * CD_CL_MAX_BLOCKS * sizeof(cd_real), "allocating the neighbour list");
     cl->grid = cd_cl_buffer(cl, sizeof(cd_grid), "allocating the neighbour list");
-    /* The grid has at most 8 P + 64 cells (cd_grid_make), so the cell
-     * arrays never grow and the host never needs the cell count. */
+    /* The grid has at most 8 N + 64 <= 8 P + 64 cells (cd_grid_make), so
+     * the cell arrays never grow and the host never needs the cell count. */
     cl->cell_cap = 8 * P + 64;
-    cl->prim_cell = cd_cl_buffer(cl, P * sizeof(cd_int), "allocating the cell lists");
-    cl->cell_prims = cd_cl_buffer(cl, P * sizeof(cd_int), "allocating the cell lists");
+    cl->part_cell = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the cell lists");
+    cl->cell_parts = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the cell lists");
+    cl->part_bound = cd_cl_buffer(cl, N * sizeof(cd_real), "allocating the cell lists");
     cl->cell_count = cd_cl_buffer(cl, cl->cell_cap * sizeof(cd_int), "allocating the cell lists");
     cl->cell_cursor = cd_cl_buffer(cl, cl->cell_cap * sizeof(cd_int), "allocating the cell lists");
     cl->cell_start = cd_cl_buffer(cl, (cl->cell_cap + 1) * sizeof(cd_int), "allocating the cell lists");
@@ -221,8 +222,8 @@ void cd_cl_buffers_release(cd_cl *cl)
         release(&cl->hist[h].keys);
         cl->hist[h].cap = 0;
     }
-    cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->partial, &cl->grid, &cl->prim_cell,
-                       &cl->cell_count, &cl->cell_start, &cl->cell_cursor, &cl->cell_prims, &cl->pair_count,
+    cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->partial, &cl->grid, &cl->part_cell,
+                       &cl->part_bound, &cl->cell_count, &cl->cell_start, &cl->cell_cursor, &cl->cell_parts, &cl->pair_count,
                        &cl->pair_offset, &cl->block_sum, &cl->cand, &cl->gather_count, &cl->gather_start,
                        &cl->gather_cursor, &cl->gather_rows};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);

@@ -18,40 +18,41 @@ static int copy(cd_cl *cl, cl_mem src, cl_mem dst, size_t bytes)
     return cd_cl_check(cl, rc, "copying a buffer") ? -1 : 0;
 }
 
-/* Grid and cell lists (CSR cell_start / cell_prims). */
-static void bin_prims(cd_cl *cl, cd_int P, cd_real skin)
+/* Particle bounds, grid and cell lists (CSR cell_start / cell_parts). */
+static void bin_particles(cd_cl *cl, cd_int N, cd_real skin)
 {
-    cd_int parts = (P + 63) / 64;
+    cd_int parts = (N + 63) / 64;
     if (parts > CD_CL_MAX_BLOCKS) parts = CD_CL_MAX_BLOCKS;
-    cd_int chunk = (P + parts - 1) / parts, cell_cap = (cd_int)cl->cell_cap;
-    parts = (P + chunk - 1) / chunk;
-    cd_cl_arg(cl, CD_CLK_BOUNDS, F, sizeof P, &P);
+    cd_int chunk = (N + parts - 1) / parts, cell_cap = (cd_int)cl->cell_cap;
+    parts = (N + chunk - 1) / chunk;
+    cd_cl_arg(cl, CD_CLK_BOUNDS, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_BOUNDS, F + 1, sizeof chunk, &chunk);
     cd_cl_arg(cl, CD_CLK_BOUNDS, F + 2, sizeof cl->partial, &cl->partial);
+    cd_cl_arg(cl, CD_CLK_BOUNDS, F + 3, sizeof cl->part_bound, &cl->part_bound);
     cd_cl_run(cl, CD_CLK_BOUNDS, (size_t)parts);
     cd_cl_arg(cl, CD_CLK_GRID, 0, sizeof cl->partial, &cl->partial);
     cd_cl_arg(cl, CD_CLK_GRID, 1, sizeof parts, &parts);
     cd_cl_arg(cl, CD_CLK_GRID, 2, sizeof skin, &skin);
-    cd_cl_arg(cl, CD_CLK_GRID, 3, sizeof P, &P);
+    cd_cl_arg(cl, CD_CLK_GRID, 3, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_GRID, 4, sizeof cl->grid, &cl->grid);
     cd_cl_run(cl, CD_CLK_GRID, 1);
 
     /* The scan runs over every cell the grid may have: the empty tail
      * costs little and spares reading the grid back. */
     cd_cl_fill_int(cl, cl->cell_count, 0, 0, cl->cell_cap);
-    cd_cl_arg(cl, CD_CLK_BIN, F, sizeof P, &P);
+    cd_cl_arg(cl, CD_CLK_BIN, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_BIN, F + 1, sizeof cl->grid, &cl->grid);
-    cd_cl_arg(cl, CD_CLK_BIN, F + 2, sizeof cl->prim_cell, &cl->prim_cell);
+    cd_cl_arg(cl, CD_CLK_BIN, F + 2, sizeof cl->part_cell, &cl->part_cell);
     cd_cl_arg(cl, CD_CLK_BIN, F + 3, sizeof cl->cell_count, &cl->cell_count);
     cd_cl_arg(cl, CD_CLK_BIN, F + 4, sizeof cell_cap, &cell_cap);
-    cd_cl_run(cl, CD_CLK_BIN, (size_t)P);
+    cd_cl_run(cl, CD_CLK_BIN, (size_t)N);
     cd_cl_scan(cl, cl->cell_count, cl->cell_cap, cl->cell_start);
     copy(cl, cl->cell_start, cl->cell_cursor, cl->cell_cap * sizeof(cd_int));
-    cd_cl_arg(cl, CD_CLK_CELL_FILL, 0, sizeof P, &P);
-    cd_cl_arg(cl, CD_CLK_CELL_FILL, 1, sizeof cl->prim_cell, &cl->prim_cell);
+    cd_cl_arg(cl, CD_CLK_CELL_FILL, 0, sizeof N, &N);
+    cd_cl_arg(cl, CD_CLK_CELL_FILL, 1, sizeof cl->part_cell, &cl->part_cell);
     cd_cl_arg(cl, CD_CLK_CELL_FILL, 2, sizeof cl->cell_cursor, &cl->cell_cursor);
-    cd_cl_arg(cl, CD_CLK_CELL_FILL, 3, sizeof cl->cell_prims, &cl->cell_prims);
-    cd_cl_run(cl, CD_CLK_CELL_FILL, (size_t)P);
+    cd_cl_arg(cl, CD_CLK_CELL_FILL, 3, sizeof cl->cell_parts, &cl->cell_parts);
+    cd_cl_run(cl, CD_CLK_CELL_FILL, (size_t)N);
 }
 
 /* Twice the candidate slots, after one overflowed (a primitive in contact
@@ -71,8 +72,9 @@ static void scan_args(cd_cl *cl, enum cd_cl_kernel k, cd_int P, cd_real skin)
     cd_cl_arg(cl, k, F, sizeof P, &P);
     cd_cl_arg(cl, k, F + 1, sizeof cl->grid, &cl->grid);
     cd_cl_arg(cl, k, F + 2, sizeof cl->cell_start, &cl->cell_start);
-    cd_cl_arg(cl, k, F + 3, sizeof cl->cell_prims, &cl->cell_prims);
+    cd_cl_arg(cl, k, F + 3, sizeof cl->cell_parts, &cl->cell_parts);
     cd_cl_arg(cl, k, F + 4, sizeof skin, &skin);
+    cd_cl_arg(cl, k, F + 5, sizeof cl->part_bound, &cl->part_bound);
 }
 
 /* Per-particle lists of pair rows in ascending order (CSR gather_start /
@@ -102,15 +104,15 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
     cd_real skin = sim->nb.skin; /* [m] */
     cd_int n_new = 0, overflow = 0;
     if (P > 0) {
-        bin_prims(cl, P, skin);
+        bin_particles(cl, N, skin);
         /* the skin flag (these ends become the references) and the overflow */
         cd_cl_fill_int(cl, cl->flags, 0, 0, 1);
         cd_cl_fill_int(cl, cl->flags, 0, 2, 1);
         scan_args(cl, CD_CLK_PAIR_COLLECT, P, skin);
-        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 5, sizeof cl->pair_count, &cl->pair_count);
-        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 6, sizeof cl->cand, &cl->cand);
-        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 7, sizeof cl->slot, &cl->slot);
-        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 8, sizeof cl->flags, &cl->flags);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 6, sizeof cl->pair_count, &cl->pair_count);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 7, sizeof cl->cand, &cl->cand);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 8, sizeof cl->slot, &cl->slot);
+        cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 9, sizeof cl->flags, &cl->flags);
         cd_cl_run(cl, CD_CLK_PAIR_COLLECT, (size_t)P);
         cd_cl_scan(cl, cl->pair_count, (size_t)P, cl->pair_offset);
         /* the one wait of a rebuild: how many pairs (to size the buffers),
@@ -140,8 +142,8 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
         cd_cl_run(cl, CD_CLK_PAIR_PLACE, (size_t)P);
     } else if (n_new > 0) {
         scan_args(cl, CD_CLK_PAIR_FILL, P, skin);
-        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 5, sizeof cl->pair_offset, &cl->pair_offset);
-        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 6, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
+        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 6, sizeof cl->pair_offset, &cl->pair_offset);
+        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 7, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
         cd_cl_run(cl, CD_CLK_PAIR_FILL, (size_t)P);
         grow_slots(cl, (size_t)P);
     }

@@ -101,35 +101,24 @@ static int block_push(struct cd_nb_block *b, cd_prim_id j)
     return 0;
 }
 
-/* Bounding sphere of each particle about its centre of mass [m]: the
- * largest reach of its primitives' bounding spheres, widened by 1e-9 of
- * itself so that it holds every primitive sphere despite rounding (the
- * particle test below must never drop a pair the primitive test keeps). */
+/* Bounding sphere of each particle about its centre of mass [m]
+ * (cd_bp_particle_bound), the box of the centres and the largest bound. */
 static double particle_bounds(const cd_state *s, double *bound, double lo[3], double hi[3])
 {
     double rmax = 0;
     for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
     for (size_t p = 0; p < s->n_particles; p++) {
-        cd_vec3 x = s->position[p];
-        double r = 0;
-        for (cd_int i = s->prim_first[p]; i < s->prim_first[p] + s->prim_count[p]; i++) {
-            double reach = cd_v3_norm(cd_v3_sub(cd_bp_centre(s->prim_a[i], s->prim_b[i]), x)) +
-                           cd_bp_bound(s->prim_a[i], s->prim_b[i], s->prim_radius[i]);
-            if (reach > r) r = reach;
-        }
-        bound[p] = r * (1 + 1e-9);
-        if (bound[p] > rmax) rmax = bound[p];
-        double v[3] = {x.x, x.y, x.z};
-        for (int k = 0; k < 3; k++) {
-            if (v[k] < lo[k]) lo[k] = v[k];
-            if (v[k] > hi[k]) hi[k] = v[k];
-        }
+        bound[p] = cd_bp_particle_bound(s->prim_a, s->prim_b, s->prim_radius, s->prim_first[p], s->prim_count[p],
+                                        s->position[p]);
+        cd_bp_bounds_add(lo, hi, &rmax, s->position[p], bound[p]);
     }
     return rmax;
 }
 
 /* Particles q > p whose bounding spheres come within the skin of p's, in
- * ascending order, into *list (grown as needed); returns how many. */
+ * ascending order, into *list (grown as needed); returns how many.  (The
+ * device's cd_bp_scan_prim makes the same scan once per primitive; here
+ * the three arms of a hexapod share it.) */
 static long particle_candidates(const cd_state *s, const cd_neighbors *nb, const cd_grid *g, size_t p,
                                 cd_int **list, size_t *cap)
 {

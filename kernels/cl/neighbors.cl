@@ -1,5 +1,5 @@
 /* The Verlet list built on the device (docs/opencl.md, "Neighbour list"):
- * the same grid, candidate test and sorted rows as src/neighbors.c
+ * the same grid of particles, candidate test and sorted rows as src/neighbors.c
  * (kernels/broadphase.h), history carried by binary search of the new
  * (prim_i, prim_j) keys in the old sorted keys, and the per-particle gather
  * lists.  Integer atomics only fill counting sorts; every list that an
@@ -9,11 +9,12 @@
 #include "../broadphase.h"
 #include "../cols.h"
 
-/* Box of the bounding-sphere centres and largest bounding radius of the
- * chunk [g chunk, (g+1) chunk) of primitives: 7 reals per work-item. */
+/* Bounding radius of each particle of the chunk [g chunk, (g+1) chunk)
+ * into part_bound, and the box of their centres and largest bound: 7
+ * reals per work-item. */
 __kernel void cd_cl_bounds(
 #include "col_params.h"
-    cd_int n_prims, cd_int chunk, __global cd_real *partial)
+    cd_int n_particles, cd_int chunk, __global cd_real *partial, __global cd_real *part_bound)
 {
 #include "col_bind.h"
     cd_int g = (cd_int)get_global_id(0);
@@ -22,9 +23,13 @@ __kernel void cd_cl_bounds(
         lo[k] = (cd_real)INFINITY;
         hi[k] = -(cd_real)INFINITY;
     }
-    cd_int end = (g + 1) * chunk < n_prims ? (g + 1) * chunk : n_prims;
-    for (cd_int i = g * chunk; i < end; i++)
-        cd_bp_bounds_add(lo, hi, &rmax, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
+    cd_int end = (g + 1) * chunk < n_particles ? (g + 1) * chunk : n_particles;
+    for (cd_int p = g * chunk; p < end; p++) {
+        cd_real b = cd_bp_particle_bound(c.prim_a, c.prim_b, c.prim_radius, c.prim_first[p], c.prim_count[p],
+                                         c.position[p]);
+        part_bound[p] = b;
+        cd_bp_bounds_add(lo, hi, &rmax, c.position[p], b);
+    }
     for (int k = 0; k < 3; k++) {
         partial[7 * g + k] = lo[k];
         partial[7 * g + 3 + k] = hi[k];
@@ -34,7 +39,7 @@ __kernel void cd_cl_bounds(
 
 /* One work-item: merges the partial boxes (minimum and maximum are exact)
  * and makes the grid. */
-__kernel void cd_cl_grid(__global const cd_real *partial, cd_int n_parts, cd_real skin, cd_int n_prims,
+__kernel void cd_cl_grid(__global const cd_real *partial, cd_int n_parts, cd_real skin, cd_int n_particles,
                          __global cd_grid *grid)
 {
     cd_real lo[3], hi[3], rmax = 0;
@@ -50,37 +55,37 @@ __kernel void cd_cl_grid(__global const cd_real *partial, cd_int n_parts, cd_rea
         if (partial[7 * g + 6] > rmax) rmax = partial[7 * g + 6];
     }
     cd_grid gr;
-    cd_grid_make(&gr, lo, hi, rmax, skin, n_prims);
+    cd_grid_make(&gr, lo, hi, rmax, skin, n_particles);
     grid[0] = gr;
 }
 
-/* Cell of primitive i; counts the primitives per cell.  cell_cap bounds
- * the index even for a non-finite position (a run blowing up before its
- * check), so that no write leaves the buffers. */
+/* Cell of particle q (its centre); counts the particles per cell.
+ * cell_cap bounds the index even for a non-finite position (a run blowing
+ * up before its check), so that no write leaves the buffers. */
 __kernel void cd_cl_bin(
 #include "col_params.h"
-    cd_int n_prims, __global const cd_grid *grid, __global cd_int *prim_cell, __global cd_int *cell_count,
+    cd_int n_particles, __global const cd_grid *grid, __global cd_int *part_cell, __global cd_int *cell_count,
     cd_int cell_cap)
 {
 #include "col_bind.h"
-    cd_int i = (cd_int)get_global_id(0);
-    if (i >= n_prims) return;
+    cd_int q = (cd_int)get_global_id(0);
+    if (q >= n_particles) return;
     cd_grid g = grid[0];
-    cd_long idx = cd_grid_cell_of(&g, cd_bp_centre(c.prim_a[i], c.prim_b[i]));
+    cd_long idx = cd_grid_cell_of(&g, c.position[q]);
     cd_int cell = idx >= 0 && idx < cell_cap ? (cd_int)idx : 0;
-    prim_cell[i] = cell;
+    part_cell[q] = cell;
     atomic_inc(&cell_count[cell]);
 }
 
-/* Places primitive i in its cell's slice of cell_prims (cursor starts as
+/* Places particle q in its cell's slice of cell_parts (cursor starts as
  * cell_start).  The order inside a cell varies from run to run, but
  * cd_bp_scan_prim sorts each row, so the list does not. */
-__kernel void cd_cl_cell_fill(cd_int n_prims, __global const cd_int *prim_cell, __global cd_int *cursor,
-                              __global cd_int *cell_prims)
+__kernel void cd_cl_cell_fill(cd_int n_particles, __global const cd_int *part_cell, __global cd_int *cursor,
+                              __global cd_int *cell_parts)
 {
-    cd_int i = (cd_int)get_global_id(0);
-    if (i >= n_prims) return;
-    cell_prims[atomic_inc(&cursor[prim_cell[i]])] = i;
+    cd_int q = (cd_int)get_global_id(0);
+    if (q >= n_particles) return;
+    cell_parts[atomic_inc(&cursor[part_cell[q]])] = q;
 }
 
 /* One pass over the candidates of primitive i: their number, and the
@@ -91,15 +96,16 @@ __kernel void cd_cl_cell_fill(cd_int n_prims, __global const cd_int *prim_cell, 
 __kernel void cd_cl_pair_collect(
 #include "col_params.h"
     cd_int n_prims, __global const cd_grid *grid, __global const cd_int *cell_start,
-    __global const cd_int *cell_prims, cd_real skin, __global cd_int *pair_count, __global cd_prim_id *cand,
-    cd_int slot, __global cd_int *flags)
+    __global const cd_int *cell_parts, cd_real skin, __global const cd_real *part_bound, __global cd_int *pair_count,
+    __global cd_prim_id *cand, cd_int slot, __global cd_int *flags)
 {
 #include "col_bind.h"
     cd_int i = (cd_int)get_global_id(0);
     if (i >= n_prims) return;
     cd_grid g = grid[0];
-    cd_int n = cd_bp_scan_prim(c.prim_a, c.prim_b, c.prim_radius, c.prim_particle, &g, cell_start, cell_prims, i, skin,
-                               cand + (cd_long)i * slot, slot);
+    cd_int n = cd_bp_scan_prim(c.prim_a, c.prim_b, c.prim_radius, c.prim_particle, c.position, c.prim_first,
+                               c.prim_count, part_bound, &g, cell_start, cell_parts, i, skin, cand + (cd_long)i * slot,
+                               slot);
     pair_count[i] = n;
     if (n > slot) flags[2] = 1;
 }
@@ -129,15 +135,17 @@ __kernel void cd_cl_pair_place(
 __kernel void cd_cl_pair_fill(
 #include "col_params.h"
     cd_int n_prims, __global const cd_grid *grid, __global const cd_int *cell_start,
-    __global const cd_int *cell_prims, cd_real skin, __global const cd_int *pair_offset, __global cd_ulong *keys)
+    __global const cd_int *cell_parts, cd_real skin, __global const cd_real *part_bound,
+    __global const cd_int *pair_offset, __global cd_ulong *keys)
 {
 #include "col_bind.h"
     cd_int i = (cd_int)get_global_id(0);
     if (i >= n_prims) return;
     cd_grid g = grid[0];
     cd_int first = pair_offset[i];
-    cd_int n = cd_bp_scan_prim(c.prim_a, c.prim_b, c.prim_radius, c.prim_particle, &g, cell_start, cell_prims, i,
-                               skin, c.pair_prim_j + first, CD_BP_UNBOUNDED);
+    cd_int n = cd_bp_scan_prim(c.prim_a, c.prim_b, c.prim_radius, c.prim_particle, c.position, c.prim_first,
+                               c.prim_count, part_bound, &g, cell_start, cell_parts, i, skin, c.pair_prim_j + first,
+                               CD_BP_UNBOUNDED);
     for (cd_int k = first; k < first + n; k++) {
         c.pair_prim_i[k] = i;
         keys[k] = cd_bp_pair_key(i, c.pair_prim_j[k]);
