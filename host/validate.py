@@ -524,6 +524,24 @@ def ref(v, digits=2):
     return "—" if v is None else ("%%.%df" % digits) % v
 
 
+def markdown_into(spec, table, default_marker):
+    """Replaces the lines between <!-- MARKER:begin --> and <!-- MARKER:end -->
+    of FILE (spec FILE or FILE:MARKER) with the table, so that docs tables are
+    regenerated, not copied by hand."""
+    path, _, marker = spec.partition(":")
+    marker = marker or default_marker
+    begin, end = "<!-- %s:begin -->" % marker, "<!-- %s:end -->" % marker
+    with open(path) as f:
+        text = f.read()
+    if begin not in text or end not in text:
+        raise SystemExit("validate.py: %s has no %s ... %s" % (path, begin, end))
+    head, rest = text.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    with open(path, "w") as f:
+        f.write(head + begin + "\n" + table + "\n" + end + tail)
+    print("table written into %s (%s)" % (path, marker))
+
+
 def markdown(agg):
     lines = []
     lines.append("| α | η | μ | N | seeds | Φ ball (paper fit; text) | Φ core 1 L | λ (paper) | Z (paper) "
@@ -834,6 +852,8 @@ def study1(args):
         if args.markdown:
             print()
             print(markdown(agg))
+        if args.markdown_into:
+            markdown_into(args.markdown_into, markdown(agg), "study1-table")
     if args.figures and done_cases:
         figures(args.figures, done_cases, agg, args.n, agg_all)
     if args.check:
@@ -867,6 +887,8 @@ def main():
     p1.add_argument("--fresh", action="store_true", help="delete the selected cases' folders first")
     p1.add_argument("--figures", help="write the PNG figures into this folder")
     p1.add_argument("--markdown", action="store_true", help="also print the table as Markdown")
+    p1.add_argument("--markdown-into", metavar="FILE[:MARKER]",
+                    help="write the table between <!-- MARKER:begin/end --> of FILE (default marker: STUDY-table)")
     p1.add_argument("--check", action="store_true", help="assert the smoke test's bands (exit 1 if not)")
     p1.add_argument("--ci", action="store_true",
                     help="the CI presets' relaxation check (energy steady to 1e-3 every 2000 steps, not 1e-4 "
@@ -891,6 +913,8 @@ def main():
         p.add_argument("--reanalyse", action="store_true")
         p.add_argument("--figures", help="write the PNG figures into this folder")
         p.add_argument("--markdown", action="store_true", help="also print the table as Markdown")
+        p.add_argument("--markdown-into", metavar="FILE[:MARKER]",
+                       help="write the table between <!-- MARKER:begin/end --> of FILE (default marker: STUDY-table)")
     args = ap.parse_args()
     if args.study == "study1":
         return study1(args)

@@ -398,6 +398,8 @@ def run_study(args):
     print_table(agg)
     if args.markdown:
         print(markdown(agg))
+    if args.markdown_into and agg:
+        v1.markdown_into(args.markdown_into, markdown(agg), args.study + "-table")
     if args.figures and finished:
         figures(args.figures, finished, agg, args.study)
     return 0
