@@ -37,6 +37,7 @@ typedef struct {
     long long thermo_every;        /* steps between time-series rows */
     double steps_per_collision;    /* > 0: dt = t_col / steps_per_collision (run.dt not given) */
     int force_dt;                  /* 1: run even when dt > t_col/5 */
+    double max_overlap;            /* stop when an overlap exceeds this fraction of the arm diameter [1] */
 
     /* physics */
     int dimension;                 /* 3, or 2 (x-y plane motion only) */

@@ -54,6 +54,8 @@ const cd_key cd_config_keys[] = {
      .label = "time-series interval, steps", .meaning = "steps between rows of the time series"},
     {"run.force_dt", CD_KT_BOOL, "-", "false", CFG(force_dt),
      .label = "force the time step", .meaning = "run even when dt > t_col/5"},
+    {"run.max_overlap", CD_KT_REAL, "1", "0.5", CFG(max_overlap), GT(0), LE(2),
+     .label = "overlap limit", .meaning = "stop (exit 3) when an overlap exceeds this fraction of the arm diameter"},
 
     /* physics */
     {"physics.dimension", CD_KT_INT, "-", "3", CFG_SIZED(dimension), GE(2), LE(3),

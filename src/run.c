@@ -13,10 +13,6 @@
 #include "io_h5.h"
 #include "protocol.h"
 
-/* Overlaps beyond this fraction of the arm diameter are not a packing any
- * more but a numerical failure (dt too large, stiffness too low). */
-#define CD_MAX_OVERLAP_RATIO 0.5
-
 enum { OBS_KT, OBS_KR, OBS_KC, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
 
 static int observable_table(const cd_sim *sim, cd_observable_info *info)
@@ -212,10 +208,14 @@ int cd_run(const cd_run_options *opt)
                 break;
             }
             cd_sim_observe(&sim, &o);
-            if (o.max_overlap_ratio > CD_MAX_OVERLAP_RATIO) {
+            /* Overlaps beyond run.max_overlap (default half the arm
+             * diameter) are taken for a numerical failure (dt too large,
+             * stiffness too low) or a load the stiffness cannot carry. */
+            if (o.max_overlap_ratio > cfg.max_overlap) {
                 fprintf(stderr, "\ncapdem: run stopped at step %lld (t = %.9g s): an overlap reached %.3g of the arm diameter "
-                        "(limit %.2g); the time step %g s or the stiffness is unsuitable. %s keeps the snapshots written so far\n",
-                        sim.s.step, sim.s.time, o.max_overlap_ratio, CD_MAX_OVERLAP_RATIO, sim.p.dt, cfg.output);
+                        "(limit run.max_overlap = %.2g); the time step %g s, the stiffness or the load is unsuitable. "
+                        "%s keeps the snapshots written so far\n",
+                        sim.s.step, sim.s.time, o.max_overlap_ratio, cfg.max_overlap, sim.p.dt, cfg.output);
                 status = 3;
                 break;
             }

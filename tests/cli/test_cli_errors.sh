@@ -35,6 +35,28 @@ expect_refusal restitution_above_one 'material\.restitution' < <(printf '%s\nmat
 expect_refusal dt_above_fifth_of_collision_time 'run\.dt' < <(printf '%s\nrun: {dt: 1.0e-4}\n' "$base")
 expect_refusal particles_do_not_fit 'particles.*do not fit' < <(printf 'particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 500}]\ndomain: {type: box, width: 0.05, height: 0.05, thickness: 0.05}\n')
 
+# A sphere on springs far too soft for its weight (kn 0.5 N/m: static overlap
+# m g / (kn/2) = 0.51 d) overlaps the floor beyond half its diameter: exit 3
+# with the limit named; with run.max_overlap 2 the same run ends normally.
+soft='particles: [{shape: sphere, diameter: 0.005, count: 1}]
+domain: {type: box, width: 0.02, height: 0.02, thickness: 0.02}
+material: {kn: 0.5, kt: 0.25}
+init: {speed: 0}'
+printf '%s\nrun: {dt: 1.0e-4, steps: 3000, thermo_every: 10, output: %s}\n' "$soft" "$work/soft.h5" > "$work/soft.yaml"
+"$capdem" run "$work/soft.yaml" --quiet 2> "$work/err"
+rc=$?
+if [ $rc -eq 3 ] && grep -q "run.max_overlap = 0.5" "$work/err" && h5dump -H "$work/soft.h5" > /dev/null 2>&1; then
+  pass=$((pass+1))
+else
+  echo "FAIL overlap limit: exit status $rc, expected 3 naming run.max_overlap, file readable"; cat "$work/err"; fails=$((fails+1))
+fi
+printf '%s\nrun: {dt: 1.0e-4, steps: 3000, thermo_every: 10, max_overlap: 2, output: %s}\n' "$soft" "$work/soft2.h5" > "$work/soft2.yaml"
+if "$capdem" run "$work/soft2.yaml" --quiet 2> "$work/err"; then
+  pass=$((pass+1))
+else
+  echo "FAIL overlap limit 2: the run stopped"; cat "$work/err"; fails=$((fails+1))
+fi
+
 # dt above t_col/5 runs when forced (with a warning)
 printf '%s\nrun: {dt: 1.0e-4, steps: 10, force_dt: true, output: %s}\n' "$base" "$work/forced.h5" > "$work/forced.yaml"
 if "$capdem" run "$work/forced.yaml" --quiet 2> "$work/err" && grep -q warning "$work/err"; then
