@@ -89,6 +89,12 @@ int cd_an_geometry_setup(const cd_an_snapshot *s, double margin_side_L, double m
         if (y > g->top_particles) g->top_particles = y;
     }
     box_extents(s, g);
+    /* A 2D box has no front and back walls (docs/motion.md): its slab is
+     * [0, domain.thickness]. */
+    if (s->cfg_ok && s->cfg.dimension == 2 && !strcmp(s->cfg.domain, "box") && isinf(g->lo[2]) && isinf(g->hi[2])) {
+        g->lo[2] = 0;
+        g->hi[2] = s->cfg.box_thickness;
+    }
     g->top_wall = g->hi[1];
     g->kind = container_kind(s, g);
     double L = g->L;

@@ -16,17 +16,20 @@
 #include "rng.h"
 
 /* A snapshot of n point-like spheres (one zero-length primitive of radius
- * rad each, tip length L = 1 m) in the box [0,W] x [0,H] x [0,T] (six plane
- * walls); dimension 2 or 3.  Positions are set by the caller. */
+ * rad each, tip length L = 1 m) in the box [0,W] x [0,H] x [0,T]: six plane
+ * walls in 3D, four in 2D (no front and back, as capdem's 2D box; the slab
+ * is domain.thickness); dimension 2 or 3.  Positions are set by the caller. */
 static void box_snapshot(cd_an_snapshot *s, size_t n, double W, double H, double T, int dim, double rad)
 {
+    int n_walls = dim == 2 ? 4 : 6;
     memset(s, 0, sizeof(*s));
-    assert_int_equal(cd_an_snapshot_alloc(s, n, n, 0, 0, 6), 0);
+    assert_int_equal(cd_an_snapshot_alloc(s, n, n, 0, 0, n_walls), 0);
     snprintf(s->path, sizeof s->path, "synthetic");
     cd_config_defaults(&s->cfg);
     s->cfg_ok = 1;
     snprintf(s->cfg.domain, sizeof s->cfg.domain, "box");
     s->cfg.dimension = dim;
+    s->cfg.box_thickness = T;
     s->n_shapes = 1;
     s->shapes = calloc(1, sizeof(cd_an_shape));
     snprintf(s->shapes[0].kind, sizeof s->shapes[0].kind, "sphere");
@@ -37,7 +40,7 @@ static void box_snapshot(cd_an_snapshot *s, size_t n, double W, double H, double
     s->shapes[0].arms[0][6] = rad;
     const double pt[6][3] = {{0, 0, 0}, {0, H, 0}, {0, 0, 0}, {W, 0, 0}, {0, 0, 0}, {0, 0, T}};
     const double nm[6][3] = {{0, 1, 0}, {0, -1, 0}, {1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1}};
-    for (int w = 0; w < 6; w++) {
+    for (int w = 0; w < n_walls; w++) {
         s->walls[w].type = CD_WALL_PLANE;
         s->walls[w].point = cd_v3(pt[w][0], pt[w][1], pt[w][2]);
         s->walls[w].normal = cd_v3(nm[w][0], nm[w][1], nm[w][2]);
