@@ -1,8 +1,8 @@
 """Studies 2-4 of docs/validation.md (seed 000): deposit and compress.
 
 Used by host/validate.py (`validate.py study2|study3|study4 ...`); the run,
-resume, lock and timing machinery is study 1's (validate.advance), only the
-configs, the references and the figures differ.
+resume, lock and timing machinery is validate_runs.py's (shared with study
+1), only the configs, the references and the figures differ.
 
   study2  2D crosses in a box of width 30 L, psi 0.995, 0.754, 0.585, 0.473
   study3  3D stars (hexapods) in a cylinder of diameter 6 L, psi 0.995, 0.702, 0.526, 0.419
@@ -22,10 +22,11 @@ import subprocess
 
 import numpy as np
 
-import validate as v1
+import validate_runs as vr
+from validate_study1 import eta_of, phi_fit
 
-REPO = v1.REPO
-ARM_D = v1.ARM_D
+REPO = vr.REPO
+ARM_D = vr.ARM_D
 DENSITY = 1000.0  # [kg/m^3], the templates' material.density
 
 # Table S1 of seed 000: sphericity -> aspect ratio L / d_p.
@@ -98,7 +99,7 @@ def phi_guess(dim, shape, alpha):
         return min(0.91, round(1.2 * measured, 3)) if measured else 0.91
     if shape == "sphere":
         return 0.64
-    return v1.phi_fit(v1.eta_of(alpha))
+    return phi_fit(eta_of(alpha))
 
 
 def area_2d(shape, alpha, n=1500):
@@ -116,13 +117,13 @@ def area_2d(shape, alpha, n=1500):
     return inside.mean() * L * L
 
 
-class DepositCase(v1.Case):
+class DepositCase(vr.RunCase):
     def __init__(self, study, tag, spec, psi, alpha, seed, n, out, capdem, size_l=None):
         self.study, self.spec, self.psi, self.capdem = study, spec, psi, capdem
-        self.alpha, self.mu, self.seed, self.ci = alpha, 0.5, seed, False
+        self.alpha, self.mu, self.ci = alpha, 0.5, False  # SPEC 3 friction
         self.dim, self.shape = spec["dim"], spec["shape"]
         self.poly = 0.2 if self.shape == "sphere" else polydispersity(self.dim, psi)
-        props = v1.shape_props(capdem, self.shape, alpha, DENSITY)
+        props = vr.shape_props(capdem, self.shape, alpha, DENSITY)
         self.L = props["tip_length"]
         self.volume = props["volume"]
         self.size = (size_l or spec["size_L"]) * self.L  # W or D [m]
@@ -136,11 +137,7 @@ class DepositCase(v1.Case):
         self.n_rule, self.phi_guess = int(math.ceil(n_rule)), phi
         self.n = n if n else self.n_rule
         name = "%s_%s_n%d_s%d" % (tag, ("psi%s" % ("%g" % psi).replace(".", "p")) if psi else "ref", self.n, seed)
-        v1.Case.__init__(self, alpha, 0.5, seed, self.n, out)
-        self.name = name
-        self.dir = os.path.join(out, name)
-        for k in ("config", "h5", "log", "timing", "analysis", "packing_m1", "lock"):
-            setattr(self, k, os.path.join(self.dir, os.path.basename(getattr(self, k))))
+        vr.RunCase.__init__(self, name, out, seed)
 
     def write_config(self, steps):
         fields = dict(name=self.name, seed=self.seed, steps=steps, shape=self.shape,
@@ -158,11 +155,11 @@ class DepositCase(v1.Case):
 
 
 def make_cases(args, capdem, out):
-    seeds = v1.parse_list(args.seeds, int)
+    seeds = vr.parse_list(args.seeds, int)
     cases = []
     if args.study in ("study2", "study3"):
         spec = STUDIES[args.study]
-        psis = v1.parse_list(args.psis) if args.psis else [p for p, _ in spec["psis"]]
+        psis = vr.parse_list(args.psis) if args.psis else [p for p, _ in spec["psis"]]
         table = dict(spec["psis"])
         for psi in psis:
             if psi not in table:
@@ -183,13 +180,13 @@ def analyse(case, capdem, force=False):
     if os.path.exists(case.analysis) and not force:
         with open(case.analysis) as f:
             d = json.load(f)
-        st = v1.run_state(case.h5)
+        st = vr.run_state(case.h5)
         if st and d.get("step") == st[1]:
             return True
     r = subprocess.run([capdem, "analyze", "run.h5", "--json", "--quiet"], cwd=case.dir, capture_output=True,
                        text=True)
     if r.returncode != 0:
-        v1.say("  %s: capdem analyze failed (%d): %s" % (case.name, r.returncode, r.stderr.strip()))
+        vr.say("  %s: capdem analyze failed (%d): %s" % (case.name, r.returncode, r.stderr.strip()))
         return False
     with open(case.analysis, "w") as f:
         f.write(r.stdout)
@@ -278,15 +275,15 @@ def aggregate(rows):
 def print_table(agg):
     for g in agg:
         line = "%-24s N %5d (rule %5d)  seeds %-6s  k %s (paper %s)  k_wls %s  P(f) type %s  H/W %s" % (
-            g["key"], g["n"], g["n_rule"], ",".join(map(str, g["seeds"])), v1.pm(g, "k", 2),
-            v1.ref(g.get("k_paper")), v1.pm(g, "k_wls", 2), g["types"], v1.pm(g, "height_over_width", 2))
+            g["key"], g["n"], g["n_rule"], ",".join(map(str, g["seeds"])), vr.pm(g, "k", 2),
+            vr.ref(g.get("k_paper")), vr.pm(g, "k_wls", 2), g["types"], vr.pm(g, "height_over_width", 2))
         if g.get("rdf_peaks"):
             line += "  G(r) peaks %s (paper %s)" % (
                 ", ".join("%.2f" % p for p in g["rdf_peaks"]),
                 ", ".join("%.2f" % p for p in g.get("rdf_peaks_paper", [])))
         if g["study"] == "study4":
             line += "  Mueth a, b, beta = %s, %s, %s (Mueth 1998: 3.0, 0.75, 1.5)" % (
-                v1.pm(g, "mueth_a", 2), v1.pm(g, "mueth_b", 2), v1.pm(g, "mueth_beta", 2))
+                vr.pm(g, "mueth_a", 2), vr.pm(g, "mueth_b", 2), vr.pm(g, "mueth_beta", 2))
         print(line)
 
 
@@ -304,15 +301,15 @@ def markdown(agg):
     lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for g in sorted(agg, key=lambda g: -(g["psi"] or 0)):
         shape = ("%.3f (%g)" % (g["psi"], g["alpha"])) if g["psi"] else g["key"].split("_")[0]
-        cells = [shape, "%d" % g["n"], ",".join(map(str, g["seeds"])), v1.pm(g, "height_over_width", 2),
-                 v1.pm(g, "phi_container", 3), v1.pm(g, "k", 2), v1.pm(g, "k_wls", 2), v1.ref(g.get("k_paper")),
-                 ", ".join(g["types"]), v1.pm(g, "stress_tail_k", 2)]
+        cells = [shape, "%d" % g["n"], ",".join(map(str, g["seeds"])), vr.pm(g, "height_over_width", 2),
+                 vr.pm(g, "phi_container", 3), vr.pm(g, "k", 2), vr.pm(g, "k_wls", 2), vr.ref(g.get("k_paper")),
+                 ", ".join(g["types"]), vr.pm(g, "stress_tail_k", 2)]
         if study in ("study2", "study4"):
             peaks = g.get("rdf_peaks") or []
             cells.append("%s (%s)" % (", ".join("%.2f" % p for p in peaks) or "—",
                                       ", ".join("%.2f" % p for p in g.get("rdf_peaks_paper", [])) or "—"))
         if study == "study4":
-            cells.append("%s; %s; %s" % (v1.pm(g, "mueth_a", 2), v1.pm(g, "mueth_b", 2), v1.pm(g, "mueth_beta", 2)))
+            cells.append("%s; %s; %s" % (vr.pm(g, "mueth_a", 2), vr.pm(g, "mueth_b", 2), vr.pm(g, "mueth_beta", 2)))
         cells += ["%.0f" % g["step"] if g.get("step") else "—",
                   "%.0f s" % g["run_wall_s"] if g.get("run_wall_s") else "—"]
         lines.append("| " + " | ".join(cells) + " |")
@@ -371,7 +368,6 @@ def run_study(args):
     if not os.access(capdem, os.X_OK):
         raise SystemExit("validate.py: %s not found; build first (README)" % capdem)
     out = os.path.join(os.path.abspath(args.out), args.study)
-    os.makedirs(out, exist_ok=True)
     cases = make_cases(args, capdem, out)
     print("%s: %d cases, output %s" % (args.study, len(cases), out))
     for c in cases:  # capdem picks the height (lattice fit) and dt (run.steps_per_collision: 20)
@@ -379,12 +375,13 @@ def run_study(args):
               % (c.name, c.alpha, c.n, c.n_rule, c.phi_guess, "W" if c.dim == 2 else "D", c.size, c.poly))
     if args.plan:
         return 0
+    os.makedirs(out, exist_ok=True)
     finished = []
     for c in cases:
-        done = v1.run_state(c.h5)
-        done = done is not None and done[2] == v1.PHASE_DONE
+        done = vr.run_state(c.h5)
+        done = done is not None and done[2] == vr.PHASE_DONE
         while not done and not args.no_run:
-            res = v1.advance(c, args, capdem)
+            res = vr.advance(c, args, capdem)
             done = res == "done"
             if res != "capped":
                 break
@@ -393,13 +390,13 @@ def run_study(args):
     rows = [metrics(c) for c in finished]
     agg = aggregate(rows)
     with open(os.path.join(out, "results.json"), "w") as f:
-        json.dump({"generated": v1.now(), "runs": rows, "cases": agg}, f, indent=1)
+        json.dump({"generated": vr.now(), "runs": rows, "cases": agg}, f, indent=1)
     print("%s: %d of %d cases finished" % (args.study, len(finished), len(cases)))
     print_table(agg)
     if args.markdown:
         print(markdown(agg))
     if args.markdown_into and agg:
-        v1.markdown_into(args.markdown_into, markdown(agg), args.study + "-table")
+        vr.markdown_into(args.markdown_into, markdown(agg), args.study + "-table")
     if args.figures and finished:
         figures(args.figures, finished, agg, args.study)
     return 0
