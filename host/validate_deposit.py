@@ -378,6 +378,10 @@ def run_study(args):
     os.makedirs(out, exist_ok=True)
     finished = []
     for c in cases:
+        holder = vr.lock_holder(c)
+        if holder is not None:  # another driver's: report, do not open the file it writes
+            vr.say("  %s: being run by process %d (%s)" % (c.name, holder, vr.peek(c.h5)))
+            continue
         done = vr.run_state(c.h5)
         done = done is not None and done[2] == vr.PHASE_DONE
         while not done and not args.no_run:
