@@ -222,13 +222,18 @@ def rdf_peaks(rdf, count=3, window=0.15):
 def metrics(case):
     with open(case.analysis) as f:
         d = json.load(f)
-    nf, st = d["normal_forces"], d["stress"]
+    nf, st, bf = d["normal_forces"], d["stress"], d["bond_forces"]
     pdf = np.array(nf["curves"]["pdf"]["data"])
     row = {"study": case.study, "case": case.name, "psi": case.psi, "alpha": case.alpha, "seed": case.seed,
            "n": case.n, "n_rule": case.n_rule, "phi_guess": case.phi_guess, "step": d["step"],
            "k": nf.get("k"), "k_lo": nf.get("k_lo"), "k_hi": nf.get("k_hi"), "k_wls": nf.get("k_wls"),
            "mueth_a": nf.get("mueth_a"), "mueth_b": nf.get("mueth_b"), "mueth_beta": nf.get("mueth_beta"),
            "pf_type": pdf_type(pdf), "stress_tail_k": st.get("tail_k"),
+           # the same test on the forces between particles (capdem's bond forces: the vector sum
+           # of a touching pair's spherocylinder contacts, over its own mean), and how many
+           # spherocylinder contacts make one particle contact
+           "pair_type": pdf_type(np.array(bf["curves"]["pdf_mean1"]["data"])),
+           "contacts_per_pair": nf["n_contacts"] / bf["n_bonds"],
            "phi_container": d["packing"].get("phi_container"),
            "height_over_width": d["packing"]["container_height"] / case.size}
     if "rdf" in d:
@@ -249,9 +254,9 @@ def aggregate(rows):
     for (study, key), rs in sorted(groups.items()):
         g = {"study": study, "key": key, "psi": rs[0]["psi"], "alpha": rs[0]["alpha"], "n": rs[0]["n"],
              "n_rule": rs[0]["n_rule"], "seeds": sorted(r["seed"] for r in rs),
-             "types": "".join(r["pf_type"] for r in rs)}
+             "types": "".join(r["pf_type"] for r in rs), "pair_types": "".join(r["pair_type"] for r in rs)}
         for k in ("k", "k_wls", "mueth_a", "mueth_b", "mueth_beta", "stress_tail_k", "phi_container",
-                  "height_over_width", "run_wall_s", "step"):
+                  "height_over_width", "run_wall_s", "step", "contacts_per_pair"):
             vals = np.array([r[k] for r in rs if r.get(k) is not None], dtype=float)
             g[k] = float(vals.mean()) if len(vals) else None
             g[k + "_se"] = float(vals.std(ddof=1) / math.sqrt(len(vals))) if len(vals) >= 2 else None
@@ -274,9 +279,10 @@ def aggregate(rows):
 
 def print_table(agg):
     for g in agg:
-        line = "%-24s N %5d (rule %5d)  seeds %-6s  k %s (paper %s)  k_wls %s  P(f) type %s  H/W %s" % (
+        line = "%-24s N %5d (rule %5d)  seeds %-6s  k %s (paper %s)  k_wls %s  P(f) type %s (particle pairs %s)  H/W %s" % (
             g["key"], g["n"], g["n_rule"], ",".join(map(str, g["seeds"])), vr.pm(g, "k", 2),
-            vr.ref(g.get("k_paper")), vr.pm(g, "k_wls", 2), g["types"], vr.pm(g, "height_over_width", 2))
+            vr.ref(g.get("k_paper")), vr.pm(g, "k_wls", 2), g["types"], g["pair_types"],
+            vr.pm(g, "height_over_width", 2))
         if g.get("rdf_peaks"):
             line += "  G(r) peaks %s (paper %s)" % (
                 ", ".join("%.2f" % p for p in g["rdf_peaks"]),
@@ -291,7 +297,7 @@ def markdown(agg):
     """The table of docs/validation.md for one study (mean +- standard error
     over seeds; one seed: its value)."""
     cols = ["ψ (α)", "N", "seeds", "H / W", "Φ", "k, max. likelihood", "k, least squares", "seed 000 k",
-            "P(f) type", "P(i) tail k"]
+            "P(f) type", "type, particle pairs", "contacts / touching pair", "P(i) tail k"]
     study = agg[0]["study"] if agg else ""
     if study == "study2" or study == "study4":
         cols += ["G(r) peaks / L (seed 000)"]
@@ -303,7 +309,8 @@ def markdown(agg):
         shape = ("%.3f (%g)" % (g["psi"], g["alpha"])) if g["psi"] else g["key"].split("_")[0]
         cells = [shape, "%d" % g["n"], ",".join(map(str, g["seeds"])), vr.pm(g, "height_over_width", 2),
                  vr.pm(g, "phi_container", 3), vr.pm(g, "k", 2), vr.pm(g, "k_wls", 2), vr.ref(g.get("k_paper")),
-                 ", ".join(g["types"]), vr.pm(g, "stress_tail_k", 2)]
+                 ", ".join(g["types"]), ", ".join(g["pair_types"]), vr.pm(g, "contacts_per_pair", 2),
+                 vr.pm(g, "stress_tail_k", 2)]
         if study in ("study2", "study4"):
             peaks = g.get("rdf_peaks") or []
             cells.append("%s (%s)" % (", ".join("%.2f" % p for p in peaks) or "—",
