@@ -8,7 +8,8 @@ usage:
                           [--threads 2] [--jobs 1] [--max-steps 20000000]
                           [--no-run] [--wait] [--figures DIR] [--markdown] [--check] [--ci] [--fresh]
   host/validate.py study2|study3|study4 [--build build] [--out runs/validation] [--psis ...] [--seeds 1,2]
-                          [--n N] [--plan] [--no-run] [--figures DIR]     (host/validate_deposit.py)
+                          [--n N] [--plan] [--no-run] [--figures DIR] [--records DIR]
+                          (host/validate_deposit.py)
 
 
 Study 1 is host/validate_study1.py, studies 2-4 host/validate_deposit.py;
@@ -70,6 +71,9 @@ def main():
         p.add_argument("--no-run", action="store_true")
         p.add_argument("--reanalyse", action="store_true")
         p.add_argument("--figures", help="write the PNG figures into this folder")
+        p.add_argument("--records", default="",
+                       help="folder of the runs' records (docs/validation_runs): each finished run's table row "
+                            "is written there, and a case whose run folder is not in --out is read from it")
         p.add_argument("--markdown", action="store_true", help="also print the table as Markdown")
         p.add_argument("--markdown-into", metavar="FILE[:MARKER]",
                        help="write the table between <!-- MARKER:begin/end --> of FILE (default marker: STUDY-table)")

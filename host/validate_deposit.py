@@ -243,6 +243,55 @@ def metrics(case):
         with open(case.timing) as f:
             timing = json.load(f)
     row["run_wall_s"] = round(sum(t["wall_s"] for t in timing), 1)
+    row["run_cpu_s"] = round(sum(t["cpu_s"] or 0 for t in timing), 1)
+    row["capdem"] = timing[-1].get("capdem") if timing else None
+    row["git"] = timing[-1].get("git") if timing else None
+    row["pdf"] = pdf.tolist()  # P(f) of the normal forces, for the figures
+    return row
+
+
+# A record is one finished run's row of the tables (metrics() above: every
+# number of the study's table, its P(f) for the figures, the run time and
+# the capdem commit), kept as one small JSON file per run in a folder of the
+# repository (--records).  The run folders are large and live outside the
+# repository, on a machine that a session may lose; the records are what the
+# tables and figures of docs/validation.md are regenerated from, so that a
+# study whose runs take longer than one session accumulates across sessions.
+RECORD_VERSION = 1
+
+
+def record_path(records, case):
+    return os.path.join(records, case.study, case.name + ".json")
+
+
+def write_record(records, case, row):
+    path = record_path(records, case)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(case.config) as f:
+        config = f.read()
+    with open(path, "w") as f:
+        json.dump({"record_version": RECORD_VERSION, "written": vr.now(), "row": row, "config": config}, f,
+                  indent=1)
+        f.write("\n")
+
+
+def read_record(records, case):
+    """The row of a case's record, or None when there is none.  A record of
+    another format, or one whose case differs from what the driver would run
+    now (count, aspect ratio, seed), is refused with the reason."""
+    path = record_path(records, case)
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        rec = json.load(f)
+    if rec.get("record_version") != RECORD_VERSION:
+        raise SystemExit("validate.py: %s: record_version %r, this driver reads %d"
+                         % (path, rec.get("record_version"), RECORD_VERSION))
+    row = rec["row"]
+    for key, want in (("n", case.n), ("alpha", case.alpha), ("seed", case.seed), ("psi", case.psi)):
+        if row.get(key) != want:
+            raise SystemExit("validate.py: %s: %s is %r, the case has %r (a record of another set-up: move it)"
+                             % (path, key, row.get(key), want))
     return row
 
 
@@ -323,20 +372,19 @@ def markdown(agg):
     return "\n".join(lines)
 
 
-def figures(outdir, cases, agg, study):
+def figures(outdir, rows, agg, study):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     os.makedirs(outdir, exist_ok=True)
     fig, ax = plt.subplots(figsize=(5.5, 4))
     seen = set()
-    for c in sorted(cases, key=lambda c: (-(c.psi or 1), c.seed)):
-        key = c.name.rsplit("_s", 1)[0]
+    for r in sorted(rows, key=lambda r: (-(r["psi"] or 1), r["seed"])):
+        key = r["case"].rsplit("_s", 1)[0]
         if key in seen:
             continue
         seen.add(key)
-        with open(c.analysis) as f:
-            pdf = np.array(json.load(f)["normal_forces"]["curves"]["pdf"]["data"])
+        pdf = np.array(r["pdf"])
         good = pdf[:, 1] > 0
         ax.semilogy(pdf[good, 0], pdf[good, 1], "o-", ms=3, lw=0.8, label=key)
     f = np.linspace(0, 6, 200)
@@ -399,15 +447,28 @@ def run_study(args):
         if done and analyse(c, capdem, args.reanalyse):
             finished.append(c)
     rows = [metrics(c) for c in finished]
+    recorded = []
+    if args.records:
+        for c, row in zip(finished, rows):
+            write_record(args.records, c, row)
+        for c in cases:
+            if c not in finished:
+                row = read_record(args.records, c)
+                if row is not None:
+                    recorded.append(row)
+        if recorded:
+            print("%s: %d cases from their records in %s (run folders not here)"
+                  % (args.study, len(recorded), args.records))
+    rows += recorded
     agg = aggregate(rows)
     with open(os.path.join(out, "results.json"), "w") as f:
         json.dump({"generated": vr.now(), "runs": rows, "cases": agg}, f, indent=1)
-    print("%s: %d of %d cases finished" % (args.study, len(finished), len(cases)))
+    print("%s: %d of %d cases finished" % (args.study, len(rows), len(cases)))
     print_table(agg)
     if args.markdown:
         print(markdown(agg))
     if args.markdown_into and agg:
         vr.markdown_into(args.markdown_into, markdown(agg), args.study + "-table")
-    if args.figures and finished:
-        figures(args.figures, finished, agg, args.study)
+    if args.figures and rows:
+        figures(args.figures, rows, agg, args.study)
     return 0

@@ -2,8 +2,9 @@
 # The deposit-and-compress driver of studies 2-4 (host/validate.py study2,
 # docs/validation.md) end to end at toy size: 30 alpha-3 crosses in a box of
 # 5 L run to the end of the protocol, are analysed, land in results.json and
-# in a Markdown table between markers; a second invocation finds the case
-# done and runs nothing (resumability).
+# in a Markdown table between markers and in the run's record; a second
+# invocation finds the case done and runs nothing (resumability); with the
+# run folder gone, the table is regenerated from the record alone.
 # usage: test_deposit_driver.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build=$1 src=$2
@@ -11,7 +12,7 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 drive() {
     /usr/bin/python3 "$src/host/validate.py" study2 --build "$build" --out "$out" --psis 0.754 --seeds 9 \
-        --n 30 --width-l 5 --threads 1 "$@"
+        --n 30 --width-l 5 --threads 1 --records "$out/records" "$@"
 }
 log=$(drive)
 echo "$log"
@@ -38,4 +39,20 @@ grep -q "^| 0.754 (3) | 30 | 9 |" "$doc" || { cat "$doc"; echo "FAIL: no table r
 grep -q "^old$" "$doc" && { echo "FAIL: the old table was kept"; exit 1; }
 log=$(drive)
 grep -q "starting\|resuming" <<<"$log" && { echo "$log"; echo "FAIL: a finished case ran again"; exit 1; }
-echo "PASS: run, analysis, table, no second run"
+record="$out/records/study2/cross2d_psi0p754_n30_s9.json"
+[ -s "$record" ] || { echo "FAIL: no record $record"; exit 1; }
+row_before=$(grep "^| 0.754 (3) | 30 | 9 |" "$doc")
+# the run folder is lost (a new machine): the table comes back from the record, the same row
+rm -rf "$out/study2/cross2d_psi0p754_n30_s9"
+printf 'before\n<!-- study2-table:begin -->\nold\n<!-- study2-table:end -->\nafter\n' >"$doc"
+log=$(drive --no-run --markdown-into "$doc" --figures "$out/figures")
+echo "$log"
+grep -q "1 cases from their records" <<<"$log" || { echo "FAIL: the record was not read"; exit 1; }
+[ "$(grep "^| 0.754 (3) | 30 | 9 |" "$doc")" = "$row_before" ] ||
+    { cat "$doc"; echo "FAIL: the row from the record differs from the run's"; exit 1; }
+[ -s "$out/figures/study2_pf.png" ] || { echo "FAIL: no P(f) figure from the record"; exit 1; }
+# a record of another set-up (here: another count) is refused, not mixed into the table
+sed -i 's/"n": 30,/"n": 31,/' "$record"
+if drive --no-run >/dev/null 2>"$out/err"; then echo "FAIL: a record of another count was accepted"; exit 1; fi
+grep -q "a record of another set-up" "$out/err" || { cat "$out/err"; echo "FAIL: no reason given"; exit 1; }
+echo "PASS: run, analysis, table, record, no second run"
