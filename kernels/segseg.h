@@ -199,7 +199,9 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
     return sd < CD_R(0) ? cd_v3_neg(n) : n;
 }
 
-/* Contact geometry of two spherocylinders (SPEC 2).
+/* Contact geometry of two spherocylinders (SPEC 2): cd_segseg_contact, or
+ * cd_segseg_contact_at when the closest-point parameters s, t [1] of
+ * cd_segseg_closest are at hand.
  * Inputs: axis ends p0, p1 and radius ri of primitive i, q0, q1 and rj of
  * primitive j [m]; sin_parallel [1] = sine of the parallel cut-off angle
  * (SPEC default: sin(2 degrees)); <= 0 disables the parallel rule.
@@ -217,15 +219,14 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
  * overlapping section, half-way between the two axes (for exactly parallel
  * axes c = A + n D/2).  D, overlap and n stay those of the closest points so
  * that the force stays continuous; g->parallel = 1. */
-CD_INLINE void cd_segseg_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
-                                 cd_real sin_parallel, cd_contact_geom *g)
+CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
+                                    cd_real s, cd_real t, cd_real sin_parallel, cd_contact_geom *g)
 {
-    cd_real s, t, D;
+    cd_real D;
     cd_vec3 a, b, n;
     cd_vec3 d1 = cd_v3_sub(p1, p0);
     cd_vec3 d2 = cd_v3_sub(q1, q0);
 
-    cd_segseg_closest(p0, p1, q0, q1, &s, &t);
     a = cd_v3_axpy(p0, s, d1);
     b = cd_v3_axpy(q0, t, d2);
     n = cd_v3(0, 0, 1);
@@ -264,6 +265,33 @@ CD_INLINE void cd_segseg_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0,
             }
         }
     }
+}
+
+/* cd_segseg_contact_at at the closest points of cd_segseg_closest. */
+CD_INLINE void cd_segseg_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
+                                 cd_real sin_parallel, cd_contact_geom *g)
+{
+    cd_real s, t;
+    cd_segseg_closest(p0, p1, q0, q1, &s, &t);
+    cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, s, t, sin_parallel, g);
+}
+
+/* Square-root-free pre-test of the force kernel: 1 when the spherocylinders
+ * (axis ends p0, p1, q0, q1 [m], radii ri, rj [m]) are apart at their
+ * closest points P(s), Q(t) of cd_segseg_closest by more than 1e-9 of
+ * ri + rj in squared distance, i.e. |Q(t) - P(s)|^2 > (ri + rj)^2 (1 + 1e-9).
+ * Then cd_segseg_contact_at gives overlap < 0 (its D, a square root of the
+ * same sum, is within a few 1e-16 of it), so skipping it changes no result;
+ * it spares the square root, the divisions and the parallel rule of the
+ * separated rows, most rows of a Verlet list with a skin. */
+CD_INLINE int cd_segseg_clearly_apart(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
+                                      cd_real s, cd_real t)
+{
+    cd_vec3 a = cd_v3_axpy(p0, s, cd_v3_sub(p1, p0));
+    cd_vec3 b = cd_v3_axpy(q0, t, cd_v3_sub(q1, q0));
+    cd_vec3 ab = cd_v3_sub(b, a);
+    cd_real reach = ri + rj; /* [m] */
+    return cd_v3_dot(ab, ab) > reach * reach * CD_R(1.000000001);
 }
 
 CD_DEVICE_END

@@ -62,15 +62,24 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
 {
     cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
     cd_particle_id pi = c.prim_particle[i], pj = c.prim_particle[j];
+    cd_vec3 ai = c.prim_a[i], bi = c.prim_b[i], aj = c.prim_a[j], bj = c.prim_b[j];
+    cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
     cd_contact_geom g;
-    cd_segseg_contact(c.prim_a[i], c.prim_b[i], c.prim_radius[i], c.prim_a[j], c.prim_b[j], c.prim_radius[j],
-                      sin_parallel, &g);
-    if (!(g.overlap > 0)) {
-        /* Separated: the contact and its history end. */
-        c.pair_active[k] = 0;
-        c.pair_shear[k] = cd_v3_zero();
-        c.pair_fn[k] = 0;
-        c.pair_overlap[k] = 0;
+    cd_real s, t;
+    cd_segseg_closest(ai, bi, aj, bj, &s, &t);
+    int apart = cd_segseg_clearly_apart(ai, bi, ri, aj, bj, rj, s, t);
+    if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, &g);
+    if (apart || !(g.overlap > 0)) {
+        /* Separated: the contact and its history end.  An inactive row is
+         * read by nobody but its own next step and the history carry-over
+         * (every reader checks pair_active), so it is written only when it
+         * changes, to spare the bandwidth. */
+        if (c.pair_active[k]) {
+            c.pair_active[k] = 0;
+            c.pair_shear[k] = cd_v3_zero();
+            c.pair_fn[k] = 0;
+            c.pair_overlap[k] = 0;
+        }
         return;
     }
     cd_vec3 vi = cd_rigid_point_velocity(c.position[pi], c.velocity[pi], c.angvel[pi], g.point);

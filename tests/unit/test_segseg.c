@@ -273,6 +273,56 @@ static void test_contact_is_finite_with_unit_normal_from_i_to_j(void **state)
     }
 }
 
+/* The force kernel's pre-test (cd_segseg_clearly_apart) may say "apart"
+ * only where cd_segseg_contact_at finds no overlap, and it must say it for
+ * every pair separated by more than its margin (1e-9 of the squared
+ * reach), or it would spare nothing.  Radii are set around each pair's own
+ * distance D: just touching (sum 1 + 1e-12 of D), just apart (1 - 1e-12,
+ * inside the margin: either answer is right, the contact must still be
+ * found separated) and clearly apart (1 - 1e-6). */
+static void test_clearly_apart_never_hides_a_contact(void **state)
+{
+    int kind, i, spared = 0, clear = 0;
+    double sp = sin(2.0 * CD_PI / 180.0);
+    (void)state;
+    rng_state = 9191;
+    for (kind = 0; kind < CASE_COUNT; kind++) {
+        for (i = 0; i < 500; i++) {
+            cd_vec3 p0, p1, q0, q1;
+            double s, t;
+            cd_contact_geom g;
+            make_case(kind, &p0, &p1, &q0, &q1);
+            cd_segseg_closest(p0, p1, q0, q1, &s, &t);
+            double D = len(cd_v3_lerp(p0, p1, s), cd_v3_lerp(q0, q1, t));
+            if (!(D > 1e-9)) continue; /* touching axes: no radius makes them apart */
+            const double factor[3] = {1 + 1e-12, 1 - 1e-12, 1 - 1e-6};
+            for (int f = 0; f < 3; f++) {
+                double ri = 0.3 * D * factor[f], rj = 0.7 * D * factor[f];
+                int apart = cd_segseg_clearly_apart(p0, p1, ri, q0, q1, rj, s, t);
+                cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, s, t, sp, &g);
+                if (apart) {
+                    spared++;
+                    assert_true(g.overlap < 0);
+                }
+                if (f == 0) assert_false(apart);
+                if (f == 2) {
+                    clear++;
+                    assert_true(apart);
+                }
+            }
+            /* the split call gives the same geometry as the whole one */
+            cd_contact_geom h;
+            cd_segseg_contact(p0, p1, 0.1, q0, q1, 0.2, sp, &h);
+            cd_segseg_contact_at(p0, p1, 0.1, q0, q1, 0.2, s, t, sp, &g);
+            assert_true(g.distance == h.distance && g.overlap == h.overlap && g.parallel == h.parallel);
+            assert_memory_equal(&g.normal, &h.normal, sizeof g.normal);
+            assert_memory_equal(&g.point, &h.point, sizeof g.point);
+        }
+    }
+    assert_true(clear > 1000);
+    print_message("  %d radius choices found apart (%d of them 1e-6 of D apart, all found)\n", spared, clear);
+}
+
 /* Exchanging i and j keeps D, the overlap and the contact point, and flips
  * the normal (random pairs of every kind, parallel rule on). */
 static void test_swapping_i_and_j_flips_normal_keeps_distance_and_point(void **state)
@@ -547,6 +597,7 @@ int main(void)
         cmocka_unit_test(test_hand_computed_contacts),
         cmocka_unit_test(test_touching_axes_give_deterministic_unit_normal),
         cmocka_unit_test(test_extreme_scales_stay_finite),
+        cmocka_unit_test(test_clearly_apart_never_hides_a_contact),
         cmocka_unit_test(test_headers_compile_as_opencl_c_1_2),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
