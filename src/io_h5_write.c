@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "capdem_commit.h" /* CAPDEM_COMMIT, generated at build time (src/git_commit.cmake) */
+
 #ifndef CAPDEM_VERSION
 #define CAPDEM_VERSION "unknown"
 #endif
@@ -181,6 +183,7 @@ static int write_h5md(cd_output *o)
     if (!rc) rc = cdh5_attr_str(o, ga, "/h5md/author", "name", author);
     if (!rc) rc = cdh5_attr_str(o, gc, "/h5md/creator", "name", "capdem");
     if (!rc) rc = cdh5_attr_str(o, gc, "/h5md/creator", "version", CAPDEM_VERSION);
+    if (!rc) rc = cdh5_attr_str(o, gc, "/h5md/creator", "commit", CAPDEM_COMMIT);
     cdh5_close_id(&g);
     cdh5_close_id(&ga);
     cdh5_close_id(&gc);

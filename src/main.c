@@ -7,6 +7,7 @@
 #include "config.h"
 #include "export.h"
 #include "analyze.h"
+#include "capdem_commit.h" /* CAPDEM_COMMIT, generated at build time (src/git_commit.cmake) */
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -118,7 +119,7 @@ static int cmd_run(int argc, char **argv)
 
 static void print_version(void)
 {
-    printf("capdem %s\n", CAPDEM_VERSION);
+    printf("capdem %s (commit %s)\n", CAPDEM_VERSION, CAPDEM_COMMIT);
     printf("omp backend: offload variant '%s'", CAPDEM_OFFLOAD_VARIANT);
 #ifdef _OPENMP
     printf(", OpenMP %d, %d host thread(s), %d offload device(s)\n", _OPENMP, omp_get_max_threads(), omp_get_num_devices());

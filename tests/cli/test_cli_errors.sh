@@ -73,6 +73,18 @@ else
   echo "FAIL good run"; cat "$work/err"; fails=$((fails+1))
 fi
 
+# the run file names the commit capdem was built from, the one --version
+# prints; in a git checkout it is the checkout's HEAD (with -dirty when
+# tracked files differ from it)
+commit=$("$capdem" --version | sed -n 's/^capdem .* (commit \(.*\))$/\1/p')
+in_file=$(h5dump -a /h5md/creator/commit "$work/good.h5" 2>/dev/null | sed -n 's/^ *(0): "\(.*\)"$/\1/p')
+head=$(git -C "$2" rev-parse --short=7 HEAD 2>/dev/null || echo unknown)
+if [ -n "$commit" ] && [ "$commit" = "$in_file" ] && [ "${commit%-dirty}" = "$head" ]; then
+  pass=$((pass+1))
+else
+  echo "FAIL commit: --version '$commit', run file '$in_file', checkout '$head'"; fails=$((fails+1))
+fi
+
 # shape JSON has the documented keys
 ok=1
 "$capdem" shape hexapod --aspect 3 --diameter 0.005 --density 1000 --json > "$work/shape.json" || ok=0
