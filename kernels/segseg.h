@@ -199,6 +199,25 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
     return sd < CD_R(0) ? cd_v3_neg(n) : n;
 }
 
+/* Weight [1] of the parallel rule's contact point for axes at an angle
+ * whose squared sine is sin2_angle, with the cut-off sin_parallel [1]
+ * (SPEC 2): 1 below the cut-off (the paper's parallel contact point), 0 at
+ * or above twice it (the closest points), linear in the sine between.
+ * Without the band the point jumps by up to half an arm's length when the
+ * angle crosses the cut-off: a torque that is not the gradient of any
+ * energy, which kept pairs of 2D crosses at the cut-off spinning at
+ * 10-18 rad/s in a compressed packing, and the packing from relaxing
+ * (docs/contacts.md).  sin_parallel <= 0: the rule is off (weight 0). */
+CD_INLINE cd_real cd_parallel_weight(cd_real sin2_angle, cd_real sin_parallel)
+{
+    cd_real sp2 = sin_parallel * sin_parallel;
+    if (!(sin_parallel > CD_R(0)) || sin2_angle >= CD_R(4) * sp2)
+        return CD_R(0);
+    if (sin2_angle < sp2)
+        return CD_R(1);
+    return CD_R(2) - sqrt(sin2_angle) / sin_parallel;
+}
+
 /* Contact geometry of two spherocylinders (SPEC 2): cd_segseg_contact, or
  * cd_segseg_contact_at when the closest-point parameters s, t [1] of
  * cd_segseg_closest are at hand.
@@ -211,14 +230,18 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
  * Closest points a = P(s), b = Q(t) from cd_segseg_closest; D = |b - a|,
  * n = (b - a)/D, c = (a + b)/2.
  * D = 0 (axes touch): n from cd_segseg_touch_normal (deterministic unit).
- * Parallel rule: both segments of non-zero length, sin(angle) < sin_parallel
- * and each segment's projection onto the other's axis overlaps it.  Let
+ * Parallel rule: both segments of non-zero length, sin(angle) <
+ * 2 sin_parallel and each segment's projection onto the other's axis
+ * overlaps it.  Let
  * [lo_i, hi_i] = [0,1] intersected with the parameters on axis i of q0, q1
  * projected onto axis i, A = P((lo_i + hi_i)/2) the middle of that section
  * on axis i, and B the same on axis j.  Then c = (A + B)/2: the middle of the
  * overlapping section, half-way between the two axes (for exactly parallel
- * axes c = A + n D/2).  D, overlap and n stay those of the closest points so
- * that the force stays continuous; g->parallel = 1. */
+ * axes c = A + n D/2): the contact point below the cut-off (g->parallel = 1),
+ * blended with the closest points' middle by cd_parallel_weight between
+ * the cut-off and twice it, so that the point moves continuously with the
+ * angle.  D, overlap and n stay those of the closest points so that the
+ * force stays continuous. */
 CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
                                     cd_real s, cd_real t, cd_real sin_parallel, cd_contact_geom *g)
 {
@@ -245,7 +268,9 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
         cd_real aa = cd_v3_dot(d1, d1);
         cd_real ee = cd_v3_dot(d2, d2);
         cd_vec3 m = cd_v3_cross(d1, d2);
-        if (aa > CD_R(0) && ee > CD_R(0) && cd_v3_dot(m, m) < sin_parallel * sin_parallel * aa * ee) {
+        cd_real wpar = aa > CD_R(0) && ee > CD_R(0) ? cd_parallel_weight(cd_v3_dot(m, m) / (aa * ee), sin_parallel)
+                                                    : CD_R(0);
+        if (wpar > CD_R(0)) {
             /* section of axis i covered by j, and of axis j covered by i */
             cd_real u0 = cd_v3_dot(cd_v3_sub(q0, p0), d1) / aa;
             cd_real u1 = cd_v3_dot(cd_v3_sub(q1, p0), d1) / aa;
@@ -260,8 +285,9 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
             if (loi <= hii && loj <= hij) {
                 cd_vec3 A = cd_v3_axpy(p0, CD_R(0.5) * (loi + hii), d1);
                 cd_vec3 B = cd_v3_axpy(q0, CD_R(0.5) * (loj + hij), d2);
-                g->point = cd_v3_scale(cd_v3_add(A, B), CD_R(0.5));
-                g->parallel = 1;
+                cd_vec3 mid = cd_v3_scale(cd_v3_add(A, B), CD_R(0.5));
+                g->parallel = wpar == CD_R(1);
+                g->point = g->parallel ? mid : cd_v3_lerp(g->point, mid, wpar);
             }
         }
     }

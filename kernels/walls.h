@@ -32,7 +32,10 @@
  * Parallel rule.  With u the unit axis and n the normal at x, when
  * |dot(u, n)| < sin_parallel (the axis lies within the cut-off angle of the
  * wall's tangent plane at x) and the segment has non-zero length, the
- * contact point is taken at the segment's middle m instead of at x:
+ * contact point is taken at the segment's middle m instead of at x (between
+ * the cut-off and twice it the two points, and on curved walls the two
+ * normals, are blended by cd_parallel_weight, so that they move
+ * continuously with the angle):
  *   plane:            c = m - w->normal (d(m) + overlap/2), the foot of m on
  *                     the plane pushed overlap/2 into the wall; n unchanged.
  *   cylinder, sphere: c = foot(m) + e_m (R + overlap/2) with e_m the outward
@@ -61,15 +64,17 @@
 
 CD_DEVICE_BEGIN
 
-/* Is the segment a->b within the cut-off angle of the plane with unit
- * normal nrm?  |dot(b - a, nrm)| < sin_parallel |b - a|, zero length never
- * (SPEC 2, parallel rule; lengths in [m], result 0/1). */
-CD_INLINE int cd_wall_is_parallel(cd_vec3 a, cd_vec3 b, cd_vec3 nrm, cd_real sin_parallel)
+/* Weight [1] of the parallel rule for the segment a->b [m] against the
+ * plane with unit normal nrm: cd_parallel_weight of the squared sine of
+ * the angle between them, dot(b - a, nrm)^2 / |b - a|^2 (1 within the
+ * cut-off angle, 0 beyond twice it); 0 for a zero-length segment
+ * (SPEC 2, parallel rule). */
+CD_INLINE cd_real cd_wall_parallel_weight(cd_vec3 a, cd_vec3 b, cd_vec3 nrm, cd_real sin_parallel)
 {
     cd_vec3 ab = cd_v3_sub(b, a);
     cd_real l2 = cd_v3_dot(ab, ab);
     cd_real un = cd_v3_dot(ab, nrm);
-    return sin_parallel > CD_R(0) && l2 > CD_R(0) && un * un < sin_parallel * sin_parallel * l2;
+    return l2 > CD_R(0) ? cd_parallel_weight(un * un / l2, sin_parallel) : CD_R(0);
 }
 
 /* Plane wall (SPEC 2, walls): w->point on the plane, w->normal unit, into the
@@ -87,14 +92,14 @@ CD_INLINE void cd_wall_plane_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_
     g->distance = D;
     g->overlap = delta;
     g->normal = cd_v3_neg(nw);
-    g->parallel = 0;
-    if (cd_wall_is_parallel(a, b, nw, sin_parallel)) {
+    g->point = cd_v3_axpy(x, -CD_R(0.5) * (D + r), nw);
+    cd_real wpar = cd_wall_parallel_weight(a, b, nw, sin_parallel);
+    g->parallel = wpar == CD_R(1);
+    if (wpar > CD_R(0)) {
         cd_vec3 m = cd_v3_scale(cd_v3_add(a, b), CD_R(0.5));
         cd_real dm = cd_v3_dot(cd_v3_sub(m, w->point), nw);
-        g->point = cd_v3_axpy(m, -(dm + CD_R(0.5) * delta), nw);
-        g->parallel = 1;
-    } else {
-        g->point = cd_v3_axpy(x, -CD_R(0.5) * (D + r), nw);
+        cd_vec3 pm = cd_v3_axpy(m, -(dm + CD_R(0.5) * delta), nw);
+        g->point = g->parallel ? pm : cd_v3_lerp(g->point, pm, wpar);
     }
 }
 
@@ -135,16 +140,25 @@ CD_INLINE void cd_wall_curved_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd
     g->normal = n;
     g->parallel = 0;
     g->point = cd_v3_axpy(x, CD_R(0.5) * (D + r), n);
-    if (cd_wall_is_parallel(a, b, n, sin_parallel)) {
+    cd_real wpar = cd_wall_parallel_weight(a, b, n, sin_parallel);
+    if (wpar > CD_R(0)) {
         cd_vec3 m = cd_v3_scale(cd_v3_add(a, b), CD_R(0.5));
         cd_vec3 rm = cd_wall_radial(w, m);
         cd_vec3 em = n;
         cd_real rhom = cd_segseg_normalize(rm, &em);
         if (rhom > CD_R(0)) {
             cd_vec3 foot = cd_v3_sub(m, rm);
-            g->point = cd_v3_axpy(foot, R + CD_R(0.5) * delta, em);
-            g->normal = em;
-            g->parallel = 1;
+            cd_vec3 pm = cd_v3_axpy(foot, R + CD_R(0.5) * delta, em);
+            g->parallel = wpar == CD_R(1);
+            if (g->parallel) {
+                g->point = pm;
+                g->normal = em;
+            } else { /* between the cut-off and twice it: point and normal blended */
+                cd_vec3 nb = n;
+                g->point = cd_v3_lerp(g->point, pm, wpar);
+                cd_segseg_normalize(cd_v3_lerp(n, em, wpar), &nb);
+                g->normal = nb;
+            }
         }
     }
 }

@@ -323,6 +323,40 @@ static void test_clearly_apart_never_hides_a_contact(void **state)
     print_message("  %d radius choices found apart (%d of them 1e-6 of D apart, all found)\n", spared, clear);
 }
 
+/* The contact point moves continuously with the angle between the axes
+ * (docs/contacts.md): a unit segment turned about one end from 1.5 to 4.5
+ * degrees against a parallel one 0.2 away (radii 0.15, overlapping).  Below
+ * the 2-degree cut-off the point is the middle of the overlap section,
+ * beyond 4 degrees the closest points' middle; in between it slides from
+ * one to the other, 0.5 apart, by at most 4 x the steepest slope (0.5 over
+ * sin 4 - sin 2, i.e. 14.3 per radian) between samples.  The rule without
+ * the band jumped by 0.5 at 2 degrees. */
+static void test_parallel_point_is_continuous_in_the_angle(void **state)
+{
+    double sp = sin(2.0 * CD_PI / 180.0), deg = CD_PI / 180.0, step = 3.0 * deg / 3000, worst = 0;
+    cd_vec3 p0 = cd_v3(0, 0, 0), p1 = cd_v3(1, 0, 0), q0 = cd_v3(0, 0.2, 0), last = cd_v3(0, 0, 0);
+    (void)state;
+    for (int k = 0; k <= 3000; k++) {
+        double th = 1.5 * deg + k * step;
+        cd_vec3 q1 = cd_v3_add(q0, cd_v3(cos(th), sin(th), 0));
+        cd_contact_geom g;
+        cd_segseg_contact(p0, p1, 0.15, q0, q1, 0.15, sp, &g);
+        assert_true(g.overlap > 0);
+        if (sin(th) < sp * (1 - 1e-12)) {
+            assert_int_equal(g.parallel, 1);
+            assert_true(fabs(g.point.x - 0.5) < 0.005); /* middle of the overlap section (0.498 at 2 deg) */
+        }
+        if (sin(th) > 2 * sp * (1 + 1e-12)) { /* beyond 4.002 degrees */
+            assert_int_equal(g.parallel, 0);
+            assert_true(len(g.point, cd_v3(0, 0.1, 0)) < 1e-12); /* middle of the closest points */
+        }
+        if (k > 0 && len(g.point, last) > worst) worst = len(g.point, last);
+        last = g.point;
+    }
+    print_message("  largest move of the point between samples %.3g (bound %.3g)\n", worst, 4 * 14.3 * step);
+    assert_true(worst < 4 * 14.3 * step);
+}
+
 /* Exchanging i and j keeps D, the overlap and the contact point, and flips
  * the normal (random pairs of every kind, parallel rule on). */
 static void test_swapping_i_and_j_flips_normal_keeps_distance_and_point(void **state)
@@ -598,6 +632,7 @@ int main(void)
         cmocka_unit_test(test_touching_axes_give_deterministic_unit_normal),
         cmocka_unit_test(test_extreme_scales_stay_finite),
         cmocka_unit_test(test_clearly_apart_never_hides_a_contact),
+        cmocka_unit_test(test_parallel_point_is_continuous_in_the_angle),
         cmocka_unit_test(test_headers_compile_as_opencl_c_1_2),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
