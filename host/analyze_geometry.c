@@ -32,7 +32,8 @@ void cd_an_wall_points(cd_an_snapshot *s)
     for (size_t c = 0; c < s->nw; c++) {
         int q = s->w_prim[c], w = s->w_wall[c];
         cd_contact_geom g;
-        cd_wall_contact(&s->walls[w], s->prim_a[q], s->prim_b[q], s->prim_radius[q], sin_par, &g);
+        cd_wall_contact_rule(&s->walls[w], s->prim_a[q], s->prim_b[q], s->prim_radius[q], sin_par,
+                             s->cfg.parallel_blend, &g);
         s->w_point[c] = g.point;
     }
 }

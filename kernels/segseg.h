@@ -201,17 +201,18 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
 
 /* Weight [1] of the parallel rule's contact point for axes at an angle
  * whose squared sine is sin2_angle, with the cut-off sin_parallel [1]
- * (SPEC 2): 1 below the cut-off (the paper's parallel contact point), 0 at
- * or above twice it (the closest points), linear in the sine between.
- * Without the band the point jumps by up to half an arm's length when the
- * angle crosses the cut-off: a torque that is not the gradient of any
- * energy, which kept pairs of 2D crosses at the cut-off spinning at
- * 10-18 rad/s in a compressed packing, and the packing from relaxing
- * (docs/contacts.md).  sin_parallel <= 0: the rule is off (weight 0). */
-CD_INLINE cd_real cd_parallel_weight(cd_real sin2_angle, cd_real sin_parallel)
+ * (SPEC 2): 1 below the cut-off (the paper's parallel contact point), else
+ * 0 (the closest points).  With blend (material.parallel_blend) the step
+ * becomes a ramp: 0 only at or above twice the cut-off's sine, linear in
+ * the sine between.  Without it the point jumps by up to half an arm's
+ * length when the angle crosses the cut-off: a torque that is not the
+ * gradient of any energy, which kept pairs of 2D crosses at the cut-off
+ * spinning at 10-18 rad/s in a compressed packing, and the packing from
+ * relaxing (docs/contacts.md).  sin_parallel <= 0: the rule is off. */
+CD_INLINE cd_real cd_parallel_weight(cd_real sin2_angle, cd_real sin_parallel, cd_int blend)
 {
     cd_real sp2 = sin_parallel * sin_parallel;
-    if (!(sin_parallel > CD_R(0)) || sin2_angle >= CD_R(4) * sp2)
+    if (!(sin_parallel > CD_R(0)) || sin2_angle >= (blend ? CD_R(4) : CD_R(1)) * sp2)
         return CD_R(0);
     if (sin2_angle < sp2)
         return CD_R(1);
@@ -231,19 +232,19 @@ CD_INLINE cd_real cd_parallel_weight(cd_real sin2_angle, cd_real sin_parallel)
  * n = (b - a)/D, c = (a + b)/2.
  * D = 0 (axes touch): n from cd_segseg_touch_normal (deterministic unit).
  * Parallel rule: both segments of non-zero length, sin(angle) <
- * 2 sin_parallel and each segment's projection onto the other's axis
- * overlaps it.  Let
+ * sin_parallel (2 sin_parallel with blend) and each segment's projection
+ * onto the other's axis overlaps it.  Let
  * [lo_i, hi_i] = [0,1] intersected with the parameters on axis i of q0, q1
  * projected onto axis i, A = P((lo_i + hi_i)/2) the middle of that section
  * on axis i, and B the same on axis j.  Then c = (A + B)/2: the middle of the
  * overlapping section, half-way between the two axes (for exactly parallel
  * axes c = A + n D/2): the contact point below the cut-off (g->parallel = 1),
- * blended with the closest points' middle by cd_parallel_weight between
- * the cut-off and twice it, so that the point moves continuously with the
- * angle.  D, overlap and n stay those of the closest points so that the
+ * with blend mixed with the closest points' middle by cd_parallel_weight
+ * between the cut-off and twice it, so that the point moves continuously
+ * with the angle.  D, overlap and n stay those of the closest points so that the
  * force stays continuous. */
 CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
-                                    cd_real s, cd_real t, cd_real sin_parallel, cd_contact_geom *g)
+                                    cd_real s, cd_real t, cd_real sin_parallel, cd_int blend, cd_contact_geom *g)
 {
     cd_real D;
     cd_vec3 a, b, n;
@@ -268,8 +269,9 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
         cd_real aa = cd_v3_dot(d1, d1);
         cd_real ee = cd_v3_dot(d2, d2);
         cd_vec3 m = cd_v3_cross(d1, d2);
-        cd_real wpar = aa > CD_R(0) && ee > CD_R(0) ? cd_parallel_weight(cd_v3_dot(m, m) / (aa * ee), sin_parallel)
-                                                    : CD_R(0);
+        cd_real wpar = aa > CD_R(0) && ee > CD_R(0)
+                           ? cd_parallel_weight(cd_v3_dot(m, m) / (aa * ee), sin_parallel, blend)
+                           : CD_R(0);
         if (wpar > CD_R(0)) {
             /* section of axis i covered by j, and of axis j covered by i */
             cd_real u0 = cd_v3_dot(cd_v3_sub(q0, p0), d1) / aa;
@@ -293,13 +295,14 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
     }
 }
 
-/* cd_segseg_contact_at at the closest points of cd_segseg_closest. */
+/* cd_segseg_contact_at at the closest points of cd_segseg_closest, with
+ * the paper's parallel rule (no blend). */
 CD_INLINE void cd_segseg_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
                                  cd_real sin_parallel, cd_contact_geom *g)
 {
     cd_real s, t;
     cd_segseg_closest(p0, p1, q0, q1, &s, &t);
-    cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, s, t, sin_parallel, g);
+    cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, s, t, sin_parallel, 0, g);
 }
 
 /* Square-root-free pre-test of the force kernel: 1 when the spherocylinders

@@ -57,8 +57,10 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
 }
 
 /* Pair row k of the Verlet list: narrow phase and contact law with history
- * (SPEC 2-3).  law: particle-particle law, dt [s], sin_parallel [1]. */
-CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel)
+ * (SPEC 2-3).  law: particle-particle law, dt [s], sin_parallel [1],
+ * parallel_blend 0/1 (material.parallel_blend). */
+CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
+                                  cd_int parallel_blend)
 {
     cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
     cd_particle_id pi = c.prim_particle[i], pj = c.prim_particle[j];
@@ -68,7 +70,7 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     cd_real s, t;
     cd_segseg_closest(ai, bi, aj, bj, &s, &t);
     int apart = cd_segseg_clearly_apart(ai, bi, ri, aj, bj, rj, s, t);
-    if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, &g);
+    if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, &g);
     if (apart || !(g.overlap > 0)) {
         /* Separated: the contact and its history end.  An inactive row is
          * read by nobody but its own next step and the history carry-over
@@ -102,7 +104,8 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
  * i n_walls .. i n_walls + n_walls - 1 of the wall-contact columns.
  * wall_law: particle-wall law (its mu is replaced by each wall's friction). */
 CD_INLINE void cd_item_wall_forces(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_wall *walls, cd_int n_walls,
-                                   cd_law_params wall_law, cd_real dt, cd_real sin_parallel)
+                                   cd_law_params wall_law, cd_real dt, cd_real sin_parallel,
+                                   cd_int parallel_blend)
 {
     cd_particle_id pi = c.prim_particle[i];
     for (cd_int w = 0; w < n_walls; w++) {
@@ -110,7 +113,8 @@ CD_INLINE void cd_item_wall_forces(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_w
         cd_wall wall = walls[w]; /* private copy: the wall functions take private pointers */
         cd_contact_geom g;
         int apart = cd_wall_clearly_apart(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
-        if (!apart) cd_wall_contact(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, &g);
+        if (!apart)
+            cd_wall_contact_rule(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, parallel_blend, &g);
         if (apart || !(g.overlap > 0)) {
             /* An inactive row holds zeros (the load sums read every row);
              * it is written only when it changes, to spare the bandwidth. */

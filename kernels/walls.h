@@ -32,10 +32,10 @@
  * Parallel rule.  With u the unit axis and n the normal at x, when
  * |dot(u, n)| < sin_parallel (the axis lies within the cut-off angle of the
  * wall's tangent plane at x) and the segment has non-zero length, the
- * contact point is taken at the segment's middle m instead of at x (between
- * the cut-off and twice it the two points, and on curved walls the two
- * normals, are blended by cd_parallel_weight, so that they move
- * continuously with the angle):
+ * contact point is taken at the segment's middle m instead of at x (with
+ * blend, between the cut-off and twice it the two points, and on curved
+ * walls the two normals, are mixed by cd_parallel_weight, so that they
+ * move continuously with the angle):
  *   plane:            c = m - w->normal (d(m) + overlap/2), the foot of m on
  *                     the plane pushed overlap/2 into the wall; n unchanged.
  *   cylinder, sphere: c = foot(m) + e_m (R + overlap/2) with e_m the outward
@@ -69,19 +69,19 @@ CD_DEVICE_BEGIN
  * the angle between them, dot(b - a, nrm)^2 / |b - a|^2 (1 within the
  * cut-off angle, 0 beyond twice it); 0 for a zero-length segment
  * (SPEC 2, parallel rule). */
-CD_INLINE cd_real cd_wall_parallel_weight(cd_vec3 a, cd_vec3 b, cd_vec3 nrm, cd_real sin_parallel)
+CD_INLINE cd_real cd_wall_parallel_weight(cd_vec3 a, cd_vec3 b, cd_vec3 nrm, cd_real sin_parallel, cd_int blend)
 {
     cd_vec3 ab = cd_v3_sub(b, a);
     cd_real l2 = cd_v3_dot(ab, ab);
     cd_real un = cd_v3_dot(ab, nrm);
-    return l2 > CD_R(0) ? cd_parallel_weight(un * un / l2, sin_parallel) : CD_R(0);
+    return l2 > CD_R(0) ? cd_parallel_weight(un * un / l2, sin_parallel, blend) : CD_R(0);
 }
 
 /* Plane wall (SPEC 2, walls): w->point on the plane, w->normal unit, into the
  * domain.  Segment a-b [m], radius r [m]; fills *g as described at the top
  * of this file. */
 CD_INLINE void cd_wall_plane_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r, cd_real sin_parallel,
-                                     cd_contact_geom *g)
+                                     cd_int blend, cd_contact_geom *g)
 {
     cd_vec3 nw = w->normal;
     cd_real da = cd_v3_dot(cd_v3_sub(a, w->point), nw); /* signed distances [m] */
@@ -93,7 +93,7 @@ CD_INLINE void cd_wall_plane_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_
     g->overlap = delta;
     g->normal = cd_v3_neg(nw);
     g->point = cd_v3_axpy(x, -CD_R(0.5) * (D + r), nw);
-    cd_real wpar = cd_wall_parallel_weight(a, b, nw, sin_parallel);
+    cd_real wpar = cd_wall_parallel_weight(a, b, nw, sin_parallel, blend);
     g->parallel = wpar == CD_R(1);
     if (wpar > CD_R(0)) {
         cd_vec3 m = cd_v3_scale(cd_v3_add(a, b), CD_R(0.5));
@@ -123,7 +123,7 @@ CD_INLINE cd_vec3 cd_wall_radial(const cd_wall *w, cd_vec3 x)
  * gets a deterministic normal: a perpendicular of the cylinder axis, or
  * (0, 0, -1) for the sphere. */
 CD_INLINE void cd_wall_curved_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r, cd_real sin_parallel,
-                                      cd_contact_geom *g)
+                                      cd_int blend, cd_contact_geom *g)
 {
     cd_vec3 ra = cd_wall_radial(w, a);
     cd_vec3 rb = cd_wall_radial(w, b);
@@ -140,7 +140,7 @@ CD_INLINE void cd_wall_curved_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd
     g->normal = n;
     g->parallel = 0;
     g->point = cd_v3_axpy(x, CD_R(0.5) * (D + r), n);
-    cd_real wpar = cd_wall_parallel_weight(a, b, n, sin_parallel);
+    cd_real wpar = cd_wall_parallel_weight(a, b, n, sin_parallel, blend);
     if (wpar > CD_R(0)) {
         cd_vec3 m = cd_v3_scale(cd_v3_add(a, b), CD_R(0.5));
         cd_vec3 rm = cd_wall_radial(w, m);
@@ -189,16 +189,17 @@ CD_INLINE int cd_wall_clearly_apart(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_r
 
 /* Contact geometry of a spherocylinder primitive (axis ends a, b [m],
  * radius r [m]) with wall *w (SPEC 2, walls).  sin_parallel [1]: sine of the
- * parallel cut-off angle, <= 0 disables the parallel rule.  The particle is
- * body i, the wall body j: g->normal points from the particle towards the
- * wall (see the top of this file). */
-CD_INLINE void cd_wall_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r, cd_real sin_parallel,
-                               cd_contact_geom *g)
+ * parallel cut-off angle, <= 0 disables the parallel rule; blend 1: its
+ * continuous form (cd_parallel_weight).  The particle is body i, the wall
+ * body j: g->normal points from the particle towards the wall (see the top
+ * of this file). */
+CD_INLINE void cd_wall_contact_rule(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r, cd_real sin_parallel,
+                                    cd_int blend, cd_contact_geom *g)
 {
     if (w->type == CD_WALL_PLANE) {
-        cd_wall_plane_contact(w, a, b, r, sin_parallel, g);
+        cd_wall_plane_contact(w, a, b, r, sin_parallel, blend, g);
     } else if (w->type == CD_WALL_CYLINDER || w->type == CD_WALL_SPHERE) {
-        cd_wall_curved_contact(w, a, b, r, sin_parallel, g);
+        cd_wall_curved_contact(w, a, b, r, sin_parallel, blend, g);
     } else {
         g->distance = CD_WALL_FAR;
         g->overlap = r - CD_WALL_FAR;
@@ -206,6 +207,13 @@ CD_INLINE void cd_wall_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r
         g->point = a;
         g->parallel = 0;
     }
+}
+
+/* cd_wall_contact_rule with the paper's parallel rule (no blend). */
+CD_INLINE void cd_wall_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r, cd_real sin_parallel,
+                               cd_contact_geom *g)
+{
+    cd_wall_contact_rule(w, a, b, r, sin_parallel, 0, g);
 }
 
 /* Velocity of the wall's surface material at a contact point [m/s]

@@ -30,12 +30,14 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 1, sizeof p->law, &p->law);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 2, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 3, sizeof p->sin_parallel, &p->sin_parallel);
+    cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 4, sizeof p->parallel_blend, &p->parallel_blend);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F, sizeof P, &P);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->walls, &cl->walls);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 2, sizeof W, &W);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 3, sizeof p->wall_law, &p->wall_law);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 4, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 5, sizeof p->sin_parallel, &p->sin_parallel);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 6, sizeof p->parallel_blend, &p->parallel_blend);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 1, sizeof cl->gather_start, &cl->gather_start);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof W, &W);

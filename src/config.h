@@ -49,6 +49,7 @@ typedef struct {
     double wall_friction;          /* mu_w [1] */
     int friction_limit_total;      /* 0: mu (kn/2) delta_n (seed 000); 1: mu F_n (seed 001, LAMMPS) */
     double parallel_angle_deg;     /* parallel-contact cut-off [deg] */
+    int parallel_blend;            /* 1: contact point blended up to twice the cut-off (docs/contacts.md) */
 
     /* particles */
     int n_species;

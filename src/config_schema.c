@@ -86,6 +86,10 @@ const cd_key cd_config_keys[] = {
      .meaning = "elastic: mu (k_n/2) delta_n (seed 000); total: mu F_n (seed 001, LAMMPS)"},
     {"material.parallel_angle", CD_KT_REAL, "deg", "2", CFG(parallel_angle_deg), GE(0), LT(45),
      .label = "parallel-contact angle", .meaning = "arms closer than this to parallel use the parallel-contact rule"},
+    {"material.parallel_blend", CD_KT_BOOL, "-", "false", CFG(parallel_blend),
+     .label = "continuous parallel rule",
+     .meaning = "true: from the cut-off to twice its sine the contact point slides from the parallel point to the "
+                "closest points instead of jumping (docs/contacts.md); false: seed 000's rule"},
 
     /* particles */
     {"particles", CD_KT_LIST, "-", NULL, CFG(species), ALWAYS, .min_items = 1, .max_items = CD_MAX_SPECIES,

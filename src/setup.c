@@ -454,6 +454,7 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
     sp->gravity = cd_v3(c->gravity[0], c->gravity[1], c->gravity[2]);
     sp->dimension = c->dimension;
     sp->sin_parallel = sin(c->parallel_angle_deg * CD_PI / 180);
+    sp->parallel_blend = c->parallel_blend;
     sp->law.kn = c->kn;
     sp->law.kt = c->kt;
     sp->law.eta_n = c->eta_n;

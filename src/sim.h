@@ -22,6 +22,7 @@ typedef struct {
     cd_law_params law;        /* particle-particle contact law */
     cd_law_params wall_law;   /* particle-wall contact law (mu = wall friction) */
     cd_real sin_parallel;     /* sine of the parallel-contact cut-off angle [1] */
+    cd_int parallel_blend;    /* 1: the continuous parallel rule (material.parallel_blend) */
     cd_int dimension;         /* 3, or 2: motion in the x-y plane only */
 } cd_step_params;
 

@@ -279,10 +279,11 @@ static void pair_forces(cd_sim *sim)
     cd_cols c = step_cols(sim);
     cd_law_params law = sim->p.law;
     cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
+    cd_int blend = sim->p.parallel_blend;
     size_t n = sim->s.n_pairs;
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, law))
-    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel);
+    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
 }
 
 /* One work item per primitive: its contacts with every wall.  The walls
@@ -294,10 +295,11 @@ static void wall_forces(cd_sim *sim)
     cd_int W = (cd_int)sim->s.n_walls;
     cd_law_params law = sim->p.wall_law;
     cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
+    cd_int blend = sim->p.parallel_blend;
     size_t n = sim->s.n_prims;
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, law) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
-    for (size_t i = 0; i < n; i++) cd_item_wall_forces(c, (cd_prim_id)i, walls, W, law, dt, sin_parallel);
+    for (size_t i = 0; i < n; i++) cd_item_wall_forces(c, (cd_prim_id)i, walls, W, law, dt, sin_parallel, blend);
 }
 
 /* One work item per particle: gravity plus its contacts in fixed order.

@@ -38,22 +38,22 @@ __kernel void cd_cl_prim_ends(
 /* Step 5: narrow phase and contact law of pair row k. */
 __kernel void cd_cl_pair_forces(
 #include "col_params.h"
-    cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel)
+    cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend)
 {
 #include "col_bind.h"
     cd_int k = (cd_int)get_global_id(0);
-    if (k < n_pairs) cd_item_pair_force(c, k, law, dt, sin_parallel);
+    if (k < n_pairs) cd_item_pair_force(c, k, law, dt, sin_parallel, parallel_blend);
 }
 
 /* Step 6: primitive i against every wall. */
 __kernel void cd_cl_wall_forces(
 #include "col_params.h"
     cd_int n_prims, __global const cd_wall *walls, cd_int n_walls, cd_law_params wall_law, cd_real dt,
-    cd_real sin_parallel)
+    cd_real sin_parallel, cd_int parallel_blend)
 {
 #include "col_bind.h"
     cd_int i = (cd_int)get_global_id(0);
-    if (i < n_prims) cd_item_wall_forces(c, i, walls, n_walls, wall_law, dt, sin_parallel);
+    if (i < n_prims) cd_item_wall_forces(c, i, walls, n_walls, wall_law, dt, sin_parallel, parallel_blend);
 }
 
 /* Steps 7-8: gather of particle q in fixed order, then (kick = 1) the

@@ -299,7 +299,7 @@ static void test_clearly_apart_never_hides_a_contact(void **state)
             for (int f = 0; f < 3; f++) {
                 double ri = 0.3 * D * factor[f], rj = 0.7 * D * factor[f];
                 int apart = cd_segseg_clearly_apart(p0, p1, ri, q0, q1, rj, s, t);
-                cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, s, t, sp, &g);
+                cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, s, t, sp, 0, &g);
                 if (apart) {
                     spared++;
                     assert_true(g.overlap < 0);
@@ -313,7 +313,7 @@ static void test_clearly_apart_never_hides_a_contact(void **state)
             /* the split call gives the same geometry as the whole one */
             cd_contact_geom h;
             cd_segseg_contact(p0, p1, 0.1, q0, q1, 0.2, sp, &h);
-            cd_segseg_contact_at(p0, p1, 0.1, q0, q1, 0.2, s, t, sp, &g);
+            cd_segseg_contact_at(p0, p1, 0.1, q0, q1, 0.2, s, t, sp, 0, &g);
             assert_true(g.distance == h.distance && g.overlap == h.overlap && g.parallel == h.parallel);
             assert_memory_equal(&g.normal, &h.normal, sizeof g.normal);
             assert_memory_equal(&g.point, &h.point, sizeof g.point);
@@ -323,8 +323,9 @@ static void test_clearly_apart_never_hides_a_contact(void **state)
     print_message("  %d radius choices found apart (%d of them 1e-6 of D apart, all found)\n", spared, clear);
 }
 
-/* The contact point moves continuously with the angle between the axes
- * (docs/contacts.md): a unit segment turned about one end from 1.5 to 4.5
+/* With material.parallel_blend the contact point moves continuously with
+ * the angle between the axes (docs/contacts.md): a unit segment turned
+ * about one end from 1.5 to 4.5
  * degrees against a parallel one 0.2 away (radii 0.15, overlapping).  Below
  * the 2-degree cut-off the point is the middle of the overlap section,
  * beyond 4 degrees the closest points' middle; in between it slides from
@@ -339,8 +340,12 @@ static void test_parallel_point_is_continuous_in_the_angle(void **state)
     for (int k = 0; k <= 3000; k++) {
         double th = 1.5 * deg + k * step;
         cd_vec3 q1 = cd_v3_add(q0, cd_v3(cos(th), sin(th), 0));
-        cd_contact_geom g;
-        cd_segseg_contact(p0, p1, 0.15, q0, q1, 0.15, sp, &g);
+        cd_contact_geom g, h;
+        double s, t;
+        cd_segseg_closest(p0, p1, q0, q1, &s, &t);
+        cd_segseg_contact_at(p0, p1, 0.15, q0, q1, 0.15, s, t, sp, 1, &g);
+        cd_segseg_contact(p0, p1, 0.15, q0, q1, 0.15, sp, &h); /* the paper's rule: a step at 2 degrees */
+        assert_int_equal(h.parallel, sin(th) < sp);
         assert_true(g.overlap > 0);
         if (sin(th) < sp * (1 - 1e-12)) {
             assert_int_equal(g.parallel, 1);

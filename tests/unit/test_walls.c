@@ -54,15 +54,20 @@ static void test_plane_tilted_segment_touches_with_lower_end(void **state)
     assert_true(dist(g.normal, cd_v3(0, 0, -1)) == 0.0);
     assert_true(dist(g.point, cd_v3(0, 0, -0.1)) < 1e-15);
     assert_int_equal(g.parallel, 0);
-    /* 5 degrees of tilt is above twice the cut-off: the end point */
+    /* 5 degrees of tilt is above twice the cut-off: the end point either way */
     cd_wall_contact(&w, cd_v3(0, 0, 0.4), cd_v3(2 * cos(5 * DEG), 0, 0.4 + 2 * sin(5 * DEG)), 0.5, SIN2DEG, &g);
     assert_int_equal(g.parallel, 0);
     assert_true(dist(g.point, cd_v3(0, 0, -0.05)) < 1e-15);
-    /* 3 degrees, between the cut-off and twice it: the end point's contact
-     * point (0, 0, -0.05) blended with the middle's, the foot of the middle
-     * (cos 3, 0, 0) pushed overlap/2 = 0.05 into the wall, with weight
-     * 2 - sin 3 / sin 2 */
+    /* 3 degrees, above the cut-off: seed 000's rule takes the end point;
+     * with material.parallel_blend (between the cut-off and twice it) the
+     * end point's contact point (0, 0, -0.05) is mixed with the middle's, the
+     * foot of the middle (cos 3, 0, 0) pushed overlap/2 = 0.05 into the
+     * wall, with weight 2 - sin 3 / sin 2 */
     cd_wall_contact(&w, cd_v3(0, 0, 0.4), cd_v3(2 * cos(3 * DEG), 0, 0.4 + 2 * sin(3 * DEG)), 0.5, SIN2DEG, &g);
+    assert_int_equal(g.parallel, 0);
+    assert_true(dist(g.point, cd_v3(0, 0, -0.05)) < 1e-15);
+    cd_wall_contact_rule(&w, cd_v3(0, 0, 0.4), cd_v3(2 * cos(3 * DEG), 0, 0.4 + 2 * sin(3 * DEG)), 0.5, SIN2DEG, 1,
+                         &g);
     double wpar = 2 - sin(3 * DEG) / SIN2DEG;
     assert_int_equal(g.parallel, 0);
     assert_true(dist(g.point, cd_v3(wpar * cos(3 * DEG), 0, -0.05)) < 1e-15);
