@@ -200,7 +200,9 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
 }
 
 /* Weight [1] of the parallel rule's contact point for axes at an angle
- * whose squared sine is sin2_angle, with the cut-off sin_parallel [1]
+ * whose squared sine is cross2 / norm2 (norm2 > 0; compared by products,
+ * so that the common case, far from the cut-off, costs no division), with
+ * the cut-off sin_parallel [1]
  * (SPEC 2): 1 below the cut-off (the paper's parallel contact point), else
  * 0 (the closest points).  With blend (material.parallel_blend) the step
  * becomes a ramp: 0 only at or above twice the cut-off's sine, linear in
@@ -209,14 +211,14 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
  * gradient of any energy, which kept pairs of 2D crosses at the cut-off
  * spinning at 10-18 rad/s in a compressed packing, and the packing from
  * relaxing (docs/contacts.md).  sin_parallel <= 0: the rule is off. */
-CD_INLINE cd_real cd_parallel_weight(cd_real sin2_angle, cd_real sin_parallel, cd_int blend)
+CD_INLINE cd_real cd_parallel_weight(cd_real cross2, cd_real norm2, cd_real sin_parallel, cd_int blend)
 {
     cd_real sp2 = sin_parallel * sin_parallel;
-    if (!(sin_parallel > CD_R(0)) || sin2_angle >= (blend ? CD_R(4) : CD_R(1)) * sp2)
+    if (!(sin_parallel > CD_R(0)) || !(cross2 < (blend ? CD_R(4) : CD_R(1)) * sp2 * norm2))
         return CD_R(0);
-    if (sin2_angle < sp2)
+    if (cross2 < sp2 * norm2)
         return CD_R(1);
-    return CD_R(2) - sqrt(sin2_angle) / sin_parallel;
+    return CD_R(2) - sqrt(cross2 / norm2) / sin_parallel;
 }
 
 /* Contact geometry of two spherocylinders (SPEC 2): cd_segseg_contact, or
@@ -269,9 +271,8 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
         cd_real aa = cd_v3_dot(d1, d1);
         cd_real ee = cd_v3_dot(d2, d2);
         cd_vec3 m = cd_v3_cross(d1, d2);
-        cd_real wpar = aa > CD_R(0) && ee > CD_R(0)
-                           ? cd_parallel_weight(cd_v3_dot(m, m) / (aa * ee), sin_parallel, blend)
-                           : CD_R(0);
+        cd_real wpar = aa > CD_R(0) && ee > CD_R(0) ? cd_parallel_weight(cd_v3_dot(m, m), aa * ee, sin_parallel, blend)
+                                                    : CD_R(0);
         if (wpar > CD_R(0)) {
             /* section of axis i covered by j, and of axis j covered by i */
             cd_real u0 = cd_v3_dot(cd_v3_sub(q0, p0), d1) / aa;

@@ -74,7 +74,7 @@ CD_INLINE cd_real cd_wall_parallel_weight(cd_vec3 a, cd_vec3 b, cd_vec3 nrm, cd_
     cd_vec3 ab = cd_v3_sub(b, a);
     cd_real l2 = cd_v3_dot(ab, ab);
     cd_real un = cd_v3_dot(ab, nrm);
-    return l2 > CD_R(0) ? cd_parallel_weight(un * un / l2, sin_parallel, blend) : CD_R(0);
+    return l2 > CD_R(0) ? cd_parallel_weight(un * un, l2, sin_parallel, blend) : CD_R(0);
 }
 
 /* Plane wall (SPEC 2, walls): w->point on the plane, w->normal unit, into the
