@@ -80,6 +80,7 @@ typedef struct {
     double piston_force;           /* deposit: target force on the piston [N] */
     double fill_ratio;             /* deposit: packing height / width that picks the count (0 = counts given) */
     double fill_fraction;          /* deposit: expected packing fraction for fill_ratio [1] (0 = not given) */
+    int piston_hold_position;      /* deposit: 1: the piston stops where the load was reached; 0: it carries the load (mass piston_mass) */
     int piston_from_top;           /* deposit: 1: the piston starts at the top; 0: just above the settled packing */
     double piston_mass;            /* deposit: piston mass while holding [kg] (0 = total particle mass) */
     double pressure;               /* ball: applied pressure [Pa] (0 = pressure_ratio kn / L) */

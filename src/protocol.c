@@ -369,10 +369,15 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
         }
         break;
     case CD_PHASE_HOLD: {
-        /* load control: m_p x'' = (load - F) along the outward direction */
-        double m = sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : sim->total_mass;
-        double a = (load - sim->cfg.piston_force) / m; /* [m/s^2], positive outwards */
-        s->walls[w].velocity = cd_v3_axpy(s->walls[w].velocity, -a * dt, s->walls[w].normal);
+        /* piston_hold load: m_p x'' = (load - F) along the outward direction;
+         * position: the piston stays where it stopped */
+        if (sim->cfg.piston_hold_position) {
+            s->walls[w].velocity = cd_v3_zero();
+        } else {
+            double m = sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : sim->total_mass;
+            double a = (load - sim->cfg.piston_force) / m; /* [m/s^2], positive outwards */
+            s->walls[w].velocity = cd_v3_axpy(s->walls[w].velocity, -a * dt, s->walls[w].normal);
+        }
         if (relaxed(sim, err, errlen, &done)) return -1;
         if (done) {
             enter(sim, CD_PHASE_DONE, log);

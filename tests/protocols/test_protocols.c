@@ -5,6 +5,7 @@
 #include "run.h"
 #include "io_h5.h"
 #include "protocol.h"
+#include <hdf5.h>
 
 static const char *preset(const char *name)
 {
@@ -64,6 +65,87 @@ static void test_piston_reaches_and_holds_target_force(void **state)
     }
     cd_sim_free(&sim);
     cd_config_free(&cfg);
+}
+
+/* Reads a whole observables series /observables/NAME/value of a run file
+ * into a malloc'ed array of doubles; *n gets the element count. */
+static double *read_series(const char *file, const char *name, size_t *n)
+{
+    char path[256];
+    snprintf(path, sizeof path, "/observables/%s/value", name);
+    hid_t f = H5Fopen(file, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(f >= 0);
+    hid_t d = H5Dopen2(f, path, H5P_DEFAULT);
+    assert_true(d >= 0);
+    hid_t sp = H5Dget_space(d);
+    *n = (size_t)H5Sget_simple_extent_npoints(sp);
+    double *v = malloc(*n * sizeof *v);
+    assert_non_null(v);
+    assert_true(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0);
+    H5Sclose(sp); H5Dclose(d); H5Fclose(f);
+    return v;
+}
+
+/* protocol.piston_hold = position: once the load is reached the piston stops
+ * and stays exactly where it stopped (every time-series row of the hold has
+ * the same piston position, bit for bit), and the run still ends by the
+ * relaxation criterion.  The CI twin of deposit_2d_crosses with that key. */
+static void test_piston_hold_position_keeps_the_piston_still(void **state)
+{
+    (void)state;
+    char yaml[4096], err[2048];
+    FILE *in = fopen(preset("deposit_2d_crosses"), "r");
+    assert_non_null(in);
+    size_t len = fread(yaml, 1, sizeof yaml - 1, in);
+    fclose(in);
+    yaml[len] = 0;
+    const char *key = "protocol: {type: deposit_compress,";
+    char *at = strstr(yaml, key);
+    assert_non_null(at);
+    char patched[4200];
+    snprintf(patched, sizeof patched, "%.*s%s piston_hold: position,%s", (int)(at - yaml), yaml, key, at + strlen(key));
+    FILE *out = fopen("proto_hold_position.yaml", "w");
+    assert_non_null(out);
+    fputs(patched, out);
+    fclose(out);
+    cd_run_options o = {.config_path = "proto_hold_position.yaml", .output_path = "proto_hold_position.h5", .steps = -1,
+                        .quiet = 1, .backend = cdt_backend()};
+    assert_int_equal(cd_run(&o), 0);
+
+    static cd_sim sim;
+    cd_config cfg;
+    if (cd_config_load("proto_hold_position.yaml", &cfg, err, sizeof err)) fail_msg("%s", err);
+    assert_int_equal(cfg.piston_hold_position, 1);
+    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
+    if (cd_h5_read_snapshot("proto_hold_position.h5", -1, &sim.s, err, sizeof err)) fail_msg("%s", err);
+    assert_int_equal((int)sim.s.control[0], CD_PHASE_DONE);
+    assert_true(sim.s.step < cfg.steps); /* the relaxation criterion ended the run */
+    int w = (int)sim.s.control[2];
+
+    size_t n_phase, n_pos;
+    double *phase = read_series("proto_hold_position.h5", "phase", &n_phase);
+    double *pos = read_series("proto_hold_position.h5", "wall_position", &n_pos);
+    size_t n_walls = n_pos / n_phase / 3;
+    assert_true(w < (int)n_walls);
+    size_t first = n_phase, held = 0;
+    for (size_t r = 0; r < n_phase; r++) {
+        if (phase[r] < CD_PHASE_HOLD) continue;
+        double y = pos[(r * n_walls + (size_t)w) * 3 + 1]; /* [m] */
+        if (first == n_phase) first = r;
+        assert_true(y == pos[(first * n_walls + (size_t)w) * 3 + 1]);
+        held++;
+    }
+    print_message("piston held at %.9f m for %zu rows, final load %.3f N (target %.1f N)\n",
+                  pos[(first * n_walls + (size_t)w) * 3 + 1], held, sim.s.control[4], cfg.piston_force);
+    assert_true(held >= 2);
+    assert_true(first > 0 && pos[((first - 1) * n_walls + (size_t)w) * 3 + 1] > pos[(first * n_walls + (size_t)w) * 3 + 1]);
+    assert_true(sim.s.walls[w].point.y == pos[(first * n_walls + (size_t)w) * 3 + 1]);
+    free(phase);
+    free(pos);
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+    unlink("proto_hold_position.yaml");
+    unlink("proto_hold_position.h5");
 }
 
 /* A deposit-and-compress run stopped in the compression phase and resumed
@@ -401,6 +483,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_piston_reaches_and_holds_target_force),
         cmocka_unit_test(test_deposit_resumed_equals_uninterrupted),
+        cmocka_unit_test(test_piston_hold_position_keeps_the_piston_still),
         cmocka_unit_test(test_fill_ratio_picks_count_and_lattice_picks_height),
         cmocka_unit_test(test_steps_per_collision_sets_dt),
         cmocka_unit_test(test_random_shape_exclusion_places_dense_without_overlap),
@@ -410,5 +493,6 @@ int main(void)
         cmocka_unit_test(test_radial_compaction_frictionless_hexapods_isostatic),
         cmocka_unit_test(test_radial_compaction_frictionless_spheres_isostatic),
     };
+    if (getenv("CDT_FILTER")) cmocka_set_test_filter(getenv("CDT_FILTER"));
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
