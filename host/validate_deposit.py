@@ -20,6 +20,7 @@ import os
 import string
 import subprocess
 
+import h5py
 import numpy as np
 
 import validate_runs as vr
@@ -219,6 +220,20 @@ def rdf_peaks(rdf, count=3, window=0.15):
     return peaks
 
 
+def end_state(case):
+    """The run's last time-series row: the load on the piston [N] (with
+    protocol.piston_hold = position it is what the relaxed packing exerts,
+    not the target) and the kinetic energy of the particles in contact over
+    the elastic energy (the relaxation test's ratio, the piston's share left
+    out)."""
+    with h5py.File(case.h5, "r") as f:
+        obs = f["observables"]
+        load = float(obs["wall_load/value"][-1])
+        ke = float(obs["kinetic_energy_in_contact/value"][-1])
+        eel = float(obs["elastic_energy/value"][-1])
+    return {"load_end": load, "ke_over_eel_end": ke / eel if eel > 0 else None}
+
+
 def metrics(case):
     with open(case.analysis) as f:
         d = json.load(f)
@@ -238,6 +253,7 @@ def metrics(case):
            "height_over_width": d["packing"]["container_height"] / case.size}
     if "rdf" in d:
         row["rdf_peaks"] = rdf_peaks(np.array(d["rdf"]["curves"]["rdf"]["data"]))
+    row.update(end_state(case))
     timing = []
     if os.path.exists(case.timing):
         with open(case.timing) as f:
@@ -305,7 +321,7 @@ def aggregate(rows):
              "n_rule": rs[0]["n_rule"], "seeds": sorted(r["seed"] for r in rs),
              "types": "".join(r["pf_type"] for r in rs), "pair_types": "".join(r["pair_type"] for r in rs)}
         for k in ("k", "k_wls", "mueth_a", "mueth_b", "mueth_beta", "stress_tail_k", "phi_container",
-                  "height_over_width", "run_wall_s", "step", "contacts_per_pair"):
+                  "height_over_width", "run_wall_s", "step", "contacts_per_pair", "load_end"):
             vals = np.array([r[k] for r in rs if r.get(k) is not None], dtype=float)
             g[k] = float(vals.mean()) if len(vals) else None
             g[k + "_se"] = float(vals.std(ddof=1) / math.sqrt(len(vals))) if len(vals) >= 2 else None
@@ -352,6 +368,8 @@ def markdown(agg):
         cols += ["G(r) peaks / L (seed 000)"]
     if study == "study4":
         cols += ["Mueth a, b, β (Mueth: 3.0, 0.75, 1.5)"]
+    if study == "study2":
+        cols += ["piston load at the end / N"]
     cols += ["steps (mean)", "wall per run"]
     lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for g in sorted(agg, key=lambda g: -(g["psi"] or 0)):
@@ -366,6 +384,8 @@ def markdown(agg):
                                       ", ".join("%.2f" % p for p in g.get("rdf_peaks_paper", [])) or "—"))
         if study == "study4":
             cells.append("%s; %s; %s" % (vr.pm(g, "mueth_a", 2), vr.pm(g, "mueth_b", 2), vr.pm(g, "mueth_beta", 2)))
+        if study == "study2":
+            cells.append(vr.pm(g, "load_end", 0))
         cells += ["%.0f" % g["step"] if g.get("step") else "—",
                   "%.0f s" % g["run_wall_s"] if g.get("run_wall_s") else "—"]
         lines.append("| " + " | ".join(cells) + " |")

@@ -29,8 +29,12 @@ assert row["pf_type"] in "AB" and row["pair_type"] in "AB"
 # a cross has two spherocylinders: a touching pair makes 1 to 4 contacts
 assert 1.0 <= row["contacts_per_pair"] <= 4.0, row["contacts_per_pair"]
 assert 0.0 < row["phi_container"] < 1.0, row["phi_container"]
-print("PASS results.json: k %.2f, type %s, %.2f contacts per pair" % (row["k"], row["pf_type"],
-                                                                    row["contacts_per_pair"]))
+# the template stops the piston (piston_hold: position): it ends with some load, and the
+# run's last time-series row is the step the relaxation test passed (ratio below 1e-6)
+assert row["load_end"] > 0, row["load_end"]
+assert row["ke_over_eel_end"] < 1e-6, row["ke_over_eel_end"]
+print("PASS results.json: k %.2f, type %s, %.2f contacts per pair, load %.1f N, KE/E_el %.2g at the end"
+      % (row["k"], row["pf_type"], row["contacts_per_pair"], row["load_end"], row["ke_over_eel_end"]))
 PY
 doc="$out/page.md"
 printf 'before\n<!-- study2-table:begin -->\nold\n<!-- study2-table:end -->\nafter\n' >"$doc"
