@@ -88,6 +88,7 @@ typedef struct {
     double relax_ratio;            /* stop when kinetic energy < relax_ratio x elastic energy [1] */
     double energy_tolerance;       /* ... and the elastic energy changed by less than this between checks [1] */
     long long check_every;         /* steps between convergence checks */
+    long long relax_sample;        /* steps between samples of the kinetic/elastic ratio between checks; 0: none */
     double strain_max, strain_min; /* bulk: largest and smallest volumetric strain dV/V [1] */
     long long probe_steps;         /* bulk: relaxation steps after each strain */
 } cd_config;

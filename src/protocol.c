@@ -19,6 +19,7 @@ enum {
     CTL_P_SUM,       /* bulk: sum of pressure samples over the second half of a window [Pa] */
     CTL_P_COUNT,     /* bulk: number of those samples */
     CTL_BASE_STEP,   /* bulk: step of the base state every probe starts from (a snapshot holds it) */
+    CTL_RATIO_MAX,   /* relax_sample > 0: largest kinetic / elastic energy sampled since the last check [1] */
     CTL_K_FIRST = 16 /* bulk: K of probe k in slot CTL_K_FIRST + k [Pa] */
 };
 #define CTL_MAX_PROBES (CD_CONTROL_SLOTS - CTL_K_FIRST)
@@ -70,6 +71,7 @@ static void enter(cd_sim *sim, int phase, FILE *log)
     sim->s.control[CTL_PHASE] = phase;
     sim->s.control[CTL_PHASE_TIME] = sim->s.time;
     sim->s.control[CTL_EEL_LAST] = -1;
+    sim->s.control[CTL_RATIO_MAX] = 0;
     if (log)
         fprintf(log, "\ncapdem: protocol phase %s at step %lld (t = %.6g s)\n", cd_protocol_phase_name(phase),
                 sim->s.step, sim->s.time);
@@ -179,8 +181,11 @@ long long cd_protocol_steps_until_control(const cd_sim *sim)
     case CD_PHASE_COMPRESS:
     case CD_PHASE_HOLD:
     case CD_PHASE_COMPACT: return 1; /* the driven wall responds to the load every step */
-    case CD_PHASE_BASE:
-        return sim->cfg.check_every - (sim->s.step % sim->cfg.check_every);
+    case CD_PHASE_BASE: {
+        long long n = sim->cfg.check_every - (sim->s.step % sim->cfg.check_every);
+        long long m = sim->cfg.relax_sample > 0 ? sim->cfg.relax_sample - (sim->s.step % sim->cfg.relax_sample) : n;
+        return n < m ? n : m;
+    }
     case CD_PHASE_PROBE: {
         /* the pressure is averaged every step of the window's second half;
          * the ball is fixed, so nothing needs the load before that */
@@ -225,17 +230,30 @@ static double driven_wall_energy(const cd_sim *sim)
 /* Relaxed: kinetic energy of the particles in contact below relax_ratio of
  * the elastic energy and the elastic energy steady since the last check
  * (checked every check_every steps).  Rattlers are left out: without gravity
- * and friction they can tumble in their cages indefinitely. */
+ * and friction they can tumble in their cages indefinitely.  With
+ * relax_sample > 0 the ratio is also sampled every relax_sample steps and a
+ * check passes only if the largest sample since the previous check (the
+ * check's own included) is below relax_ratio: a packing that still swings
+ * as a whole has kinetic energy near zero twice a period, and a check that
+ * falls there would otherwise pass it. */
 static int relaxed(cd_sim *sim, char *err, size_t errlen, int *done)
 {
     *done = 0;
-    if (sim->s.step % sim->cfg.check_every) return 0;
+    long long sample = sim->cfg.relax_sample;
+    int at_check = sim->s.step % sim->cfg.check_every == 0;
+    int at_sample = sample > 0 && sim->s.step % sample == 0;
+    if (!at_check && !at_sample) return 0;
     if (cd_sim_sync(sim, err, errlen)) return -1;
     cd_observables o;
     cd_sim_observe(sim, &o);
     double ke = o.kinetic_in_contact + driven_wall_energy(sim), eel = o.elastic, last = sim->s.control[CTL_EEL_LAST];
-    *done = eel > 0 && ke < sim->cfg.relax_ratio * eel && last > 0 && fabs(eel - last) < sim->cfg.energy_tolerance * eel;
+    double *worst = &sim->s.control[CTL_RATIO_MAX];
+    if (sample > 0) *worst = fmax(*worst, eel > 0 ? ke / eel : INFINITY);
+    if (!at_check) return 0;
+    int quiet = sample > 0 ? *worst < sim->cfg.relax_ratio : ke < sim->cfg.relax_ratio * eel;
+    *done = eel > 0 && quiet && last > 0 && fabs(eel - last) < sim->cfg.energy_tolerance * eel;
     sim->s.control[CTL_EEL_LAST] = eel;
+    *worst = 0;
     return 0;
 }
 
