@@ -51,8 +51,23 @@ MUETH = {"a": 3.0, "b": 0.75, "beta": 1.5}
 
 
 def k_paper_2d(psi):
-    """Seed 000, Fig. 6a: linear fit to the 2D tail exponents."""
+    """Seed 000, Fig. 6a's caption: linear fit to the 2D tail exponents (the
+    issue's reference).  It rises as psi falls (1.43 to 1.52 over the study's
+    psi), against the paper's own text (k_paper_2d_text)."""
     return 0.18 * (1.0 - psi) + 1.43
+
+
+# Seed 000's text: "In 2D packings, k decreases slightly with decreasing psi,
+# i.e. k = 1.42 for psi = 0.995 and k = 1.32 for psi = 0.47" (psi, k).
+K_TEXT_2D = ((0.995, 1.42), (0.47, 1.32))
+
+
+def k_paper_2d_text(psi):
+    """The straight line through seed 000's two 2D values in its text (the
+    caption's fit with the sign of its slope turned: 1.43 - 0.18 (1 - psi)
+    is within 0.02 of it)."""
+    (p1, k1), (p0, k0) = K_TEXT_2D
+    return k0 + (k1 - k0) * (psi - p0) / (p1 - p0)
 
 
 def k_paper_3d(psi):
@@ -345,6 +360,7 @@ def aggregate(rows):
             g["rdf_peaks_se"] = (arr.std(axis=0, ddof=1) / math.sqrt(len(arr))).tolist() if len(arr) >= 2 else None
         if study == "study2":
             g["k_paper"] = k_paper_2d(g["psi"])
+            g["k_paper_text"] = k_paper_2d_text(g["psi"])
             g["rdf_peaks_paper"] = rdf_peaks_paper(g["alpha"]) if g["psi"] < 0.9 else [1.0, 1.91]
         elif study == "study3":
             g["k_paper"] = k_paper_3d(g["psi"])
@@ -376,6 +392,8 @@ def markdown(agg):
     cols = ["ψ (α)", "N", "seeds", "H / W", "Φ", "k, max. likelihood", "k, least squares", "seed 000 k",
             "P(f) type", "type, particle pairs", "contacts / touching pair", "P(i) tail k"]
     study = agg[0]["study"] if agg else ""
+    if study == "study2":  # after "seed 000 k" (the caption's fit)
+        cols.insert(cols.index("seed 000 k") + 1, "seed 000 k, text")
     if study == "study2" or study == "study4":
         cols += ["G(r) peaks / L (seed 000)"]
     if study == "study4":
@@ -390,6 +408,8 @@ def markdown(agg):
                  vr.pm(g, "phi_container", 3), vr.pm(g, "k", 2), vr.pm(g, "k_wls", 2), vr.ref(g.get("k_paper")),
                  ", ".join(g["types"]), ", ".join(g["pair_types"]), vr.pm(g, "contacts_per_pair", 2),
                  vr.pm(g, "stress_tail_k", 2)]
+        if study == "study2":
+            cells.insert(cols.index("seed 000 k, text"), vr.ref(g.get("k_paper_text")))
         if study in ("study2", "study4"):
             peaks = g.get("rdf_peaks") or []
             cells.append("%s (%s)" % (", ".join("%.2f" % p for p in peaks) or "—",
@@ -435,7 +455,11 @@ def figures(outdir, rows, agg, study):
         fig, ax = plt.subplots(figsize=(5.5, 4))
         ps = np.linspace(0.4, 1.0, 100)
         ax.plot(ps, [k_paper_2d(p) if study == "study2" else k_paper_3d(p) for p in ps], "k--",
-                label="seed 000 fit")
+                label="seed 000 fit" + (" (Fig. 6a caption)" if study == "study2" else ""))
+        if study == "study2":
+            ax.plot(ps, [k_paper_2d_text(p) for p in ps], ":", color="grey",
+                    label="seed 000 text: k = 1.42 at 0.995, 1.32 at 0.47")
+            ax.plot(*zip(*K_TEXT_2D), "kx")
         gs = [g for g in agg if g["study"] == study and g.get("k") is not None]
         ax.errorbar([g["psi"] for g in gs], [g["k"] for g in gs], [g["k_se"] or 0 for g in gs], fmt="o",
                     capsize=3, label="capdem, k (maximum likelihood)")
