@@ -270,6 +270,11 @@ def metrics(case):
            "k": nf.get("k"), "k_lo": nf.get("k_lo"), "k_hi": nf.get("k_hi"), "k_wls": nf.get("k_wls"),
            "mueth_a": nf.get("mueth_a"), "mueth_b": nf.get("mueth_b"), "mueth_beta": nf.get("mueth_beta"),
            "pf_type": pdf_type(pdf), "stress_tail_k": st.get("tail_k"),
+           # P(i), the first stress invariant over its mean: the same type test, and its first bin
+           # (seed 000: a pronounced peak at i = 1 for 2D crosses above psi_crit that disappears
+           # below it "as lim_{i -> 0} P(i) increases with decreasing psi")
+           "stress_type": pdf_type(np.array(st["curves"]["pdf"]["data"])),
+           "stress_p0": float(st["curves"]["pdf"]["data"][0][1]),
            # the same test on the forces between particles (capdem's bond forces: the vector sum
            # of a touching pair's spherocylinder contacts, over its own mean), and how many
            # spherocylinder contacts make one particle contact
@@ -345,9 +350,10 @@ def aggregate(rows):
     for (study, key), rs in sorted(groups.items()):
         g = {"study": study, "key": key, "psi": rs[0]["psi"], "alpha": rs[0]["alpha"], "n": rs[0]["n"],
              "n_rule": rs[0]["n_rule"], "seeds": sorted(r["seed"] for r in rs),
-             "types": "".join(r["pf_type"] for r in rs), "pair_types": "".join(r["pair_type"] for r in rs)}
+             "types": "".join(r["pf_type"] for r in rs), "pair_types": "".join(r["pair_type"] for r in rs),
+             "stress_types": "".join(r.get("stress_type", "?") for r in rs)}
         for k in ("k", "k_wls", "mueth_a", "mueth_b", "mueth_beta", "stress_tail_k", "phi_container",
-                  "height_over_width", "run_wall_s", "step", "contacts_per_pair", "load_end",
+                  "height_over_width", "run_wall_s", "step", "contacts_per_pair", "load_end", "stress_p0",
                   "ke_over_eel_end_max"):
             vals = np.array([r[k] for r in rs if r.get(k) is not None], dtype=float)
             g[k] = float(vals.mean()) if len(vals) else None
@@ -392,8 +398,9 @@ def markdown(agg):
     cols = ["ψ (α)", "N", "seeds", "H / W", "Φ", "k, max. likelihood", "k, least squares", "seed 000 k",
             "P(f) type", "type, particle pairs", "contacts / touching pair", "P(i) tail k"]
     study = agg[0]["study"] if agg else ""
-    if study == "study2":  # after "seed 000 k" (the caption's fit)
+    if study == "study2":  # after "seed 000 k" (the caption's fit); P(i)'s type and first bin
         cols.insert(cols.index("seed 000 k") + 1, "seed 000 k, text")
+        cols += ["P(i) type", "P(i) first bin"]
     if study == "study2" or study == "study4":
         cols += ["G(r) peaks / L (seed 000)"]
     if study == "study4":
@@ -410,6 +417,7 @@ def markdown(agg):
                  vr.pm(g, "stress_tail_k", 2)]
         if study == "study2":
             cells.insert(cols.index("seed 000 k, text"), vr.ref(g.get("k_paper_text")))
+            cells += [", ".join(g["stress_types"]), vr.pm(g, "stress_p0", 2)]
         if study in ("study2", "study4"):
             peaks = g.get("rdf_peaks") or []
             cells.append("%s (%s)" % (", ".join("%.2f" % p for p in peaks) or "—",
