@@ -121,7 +121,9 @@ static void test_piston_hold_position_and_sampled_relaxation(void **state)
     char keys[160];
     snprintf(keys, sizeof keys, "protocol: {type: deposit_compress, piston_hold: position, relax_sample: %lld,", every);
     replace_once(yaml, sizeof yaml, "protocol: {type: deposit_compress,", keys);
-    replace_once(yaml, sizeof yaml, "relax_ratio: 1.0e-4", "relax_ratio: 3.0e-5");
+    char relax[48];
+    snprintf(relax, sizeof relax, "relax_ratio: %.17g", ratio);
+    replace_once(yaml, sizeof yaml, "relax_ratio: 1.0e-4", relax);
     replace_once(yaml, sizeof yaml, "thermo_every: 1000", "thermo_every: 500");
     FILE *out = fopen("proto_hold_position.yaml", "w");
     assert_non_null(out);
@@ -136,6 +138,7 @@ static void test_piston_hold_position_and_sampled_relaxation(void **state)
     if (cd_config_load("proto_hold_position.yaml", &cfg, err, sizeof err)) fail_msg("%s", err);
     assert_int_equal(cfg.piston_hold_position, 1);
     assert_true(cfg.relax_sample == every && cfg.thermo_every == every && cfg.check_every == check);
+    assert_true(cfg.relax_ratio == ratio);
     if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
     if (cd_h5_read_snapshot("proto_hold_position.h5", -1, &sim.s, err, sizeof err)) fail_msg("%s", err);
     assert_int_equal((int)sim.s.control[0], CD_PHASE_DONE);
