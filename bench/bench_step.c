@@ -60,6 +60,7 @@ static size_t state_bytes(const cd_sim *sim)
 {
     size_t b = 0;
     for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group == CD_GROUP_PAIR_OUT) continue; /* host-only output columns */
         size_t rows = cd_fields[f].group == CD_GROUP_PAIR ? sim->s.cap_pairs : cd_state_rows(&sim->s, cd_fields[f].group);
         b += rows * cd_fields[f].elem_size;
     }

@@ -9,9 +9,11 @@
 #define CD_COLS_H
 #include "defs.h"
 #include "geom_types.h"
+#include "field_groups.h"
 
+/* The device columns only (field_groups.h). */
 typedef struct {
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_GLOBAL ctype *name;
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_GLOBAL ctype *name;)
 #include "../src/fields.def"
 #undef CD_FIELD
 } cd_cols;

@@ -56,9 +56,32 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
     c.prim_b[i] = cd_rigid_to_world(c.position[p], c.orientation[p], c.prim_b_body[i]);
 }
 
+/* Contact geometry of pair row k (SPEC 2): closest points of the two axes
+ * and, from them, the contact point, normal and overlap.  Fills g always
+ * (the host's output pass, src/pair_output.c, needs the normal of every
+ * active row). */
+CD_INLINE void cd_pair_geometry(cd_cols c, cd_pair_id k, cd_real sin_parallel, cd_int parallel_blend,
+                                cd_contact_geom *g)
+{
+    cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
+    cd_vec3 ai = c.prim_a[i], bi = c.prim_b[i], aj = c.prim_a[j], bj = c.prim_b[j];
+    cd_real s, t;
+    cd_segseg_closest(ai, bi, aj, bj, &s, &t);
+    cd_segseg_contact_at(ai, bi, c.prim_radius[i], aj, bj, c.prim_radius[j], s, t, sin_parallel, parallel_blend, g);
+}
+
+/* Torque about a body's centre [m] of a force [N] acting at a point [m]. */
+CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force)
+{
+    return cd_v3_cross(cd_v3_sub(point, centre), force);
+}
+
 /* Pair row k of the Verlet list: narrow phase and contact law with history
  * (SPEC 2-3).  law: particle-particle law, dt [s], sin_parallel [1],
- * parallel_blend 0/1 (material.parallel_blend). */
+ * parallel_blend 0/1 (material.parallel_blend).  An active row keeps what
+ * the next step and the gather need: history, point, force on j, F_n and
+ * the overlap (the observables' elastic energy); the normal, F_t and the
+ * torques are derived on the host for output only (fields.def, PAIR_OUT). */
 CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
                                   cd_int parallel_blend)
 {
@@ -92,12 +115,9 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     c.pair_active[k] = 1;
     c.pair_shear[k] = shear;
     c.pair_point[k] = g.point;
-    c.pair_normal[k] = g.normal;
+    c.pair_force[k] = f.force_j;
     c.pair_overlap[k] = g.overlap;
     c.pair_fn[k] = f.fn;
-    c.pair_ft[k] = f.ft;
-    c.pair_torque_i[k] = cd_v3_cross(cd_v3_sub(g.point, c.position[pi]), cd_v3_neg(f.force_j));
-    c.pair_torque_j[k] = cd_v3_cross(cd_v3_sub(g.point, c.position[pj]), f.force_j);
 }
 
 /* Primitive i against every wall (SPEC 2, walls; SPEC 3): rows
@@ -139,15 +159,17 @@ CD_INLINE void cd_item_wall_forces(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_w
         c.wallc_overlap[row] = g.overlap;
         c.wallc_fn[row] = f.fn;
         c.wallc_force[row] = fi;
-        c.wallc_torque[row] = cd_v3_cross(cd_v3_sub(g.point, c.position[pi]), fi);
+        c.wallc_torque[row] = cd_contact_torque(g.point, c.position[pi], fi);
     }
 }
 
 /* Total force and torque of particle q: gravity [m/s^2] times its mass,
- * then its wall contacts primitive by primitive, then its pair rows
- * gather_rows[gather_start[q] .. gather_start[q+1]) in ascending row order,
- * so the sum has one fixed order on every backend.  dimension 2 keeps the
- * motion in the x-y plane. */
+ * then its wall contacts primitive by primitive, then its pair rows in
+ * ascending row order, so the sum has one fixed order on every backend.
+ * gather_rows[gather_start[q] .. gather_start[q+1]) hold 2 k + side for
+ * pair row k: side 1 when q owns the row's primitive j (it gets +F_j), 0
+ * when it owns primitive i (it gets -F_j), so the gather reads only the
+ * row's force and point.  dimension 2 keeps the motion in the x-y plane. */
 CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                               const CD_GLOBAL cd_pair_id *gather_rows, cd_int n_walls, cd_vec3 gravity,
                               cd_int dimension)
@@ -162,16 +184,17 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
             F = cd_v3_add(F, c.wallc_force[row]);
             T = cd_v3_add(T, c.wallc_torque[row]);
         }
+    cd_vec3 x = c.position[q];
     for (cd_int r = gather_start[q]; r < gather_start[q + 1]; r++) {
-        cd_pair_id k = gather_rows[r];
+        cd_pair_id e = gather_rows[r], k = e >> 1;
         if (!c.pair_active[k]) continue;
-        cd_vec3 fj = cd_v3_axpy(c.pair_ft[k], c.pair_fn[k], c.pair_normal[k]);
-        if (c.prim_particle[c.pair_prim_i[k]] == q) {
-            F = cd_v3_sub(F, fj);
-            T = cd_v3_add(T, c.pair_torque_i[k]);
-        } else {
+        cd_vec3 fj = c.pair_force[k];
+        if (e & 1) {
             F = cd_v3_add(F, fj);
-            T = cd_v3_add(T, c.pair_torque_j[k]);
+            T = cd_v3_add(T, cd_contact_torque(c.pair_point[k], x, fj));
+        } else {
+            F = cd_v3_sub(F, fj);
+            T = cd_v3_add(T, cd_contact_torque(c.pair_point[k], x, cd_v3_neg(fj)));
         }
     }
     if (dimension == 2) {

@@ -9,6 +9,7 @@
 #include <CL/cl.h>
 #include "sim.h"
 #include "../kernels/broadphase.h"
+#include "../kernels/field_groups.h"
 
 /* Kernels of the .cl files in kernels/cl.  Those marked "cols" in backend_cl_device.c
  * take the state's columns as their first CD_CL_N_FIELDS arguments. */
@@ -23,9 +24,10 @@ enum cd_cl_kernel {
 };
 
 /* Column indices: the order of src/fields.def, which is the order of
- * cd_fields[] and of the kernels' column parameters. */
+ * cd_fields[] and of the kernels' column parameters; the device columns
+ * only, which come first in cd_fields[] (kernels/field_groups.h). */
 enum {
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_CL_F_##name,
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_CL_F_##name,)
 #include "fields.def"
 #undef CD_FIELD
     CD_CL_N_FIELDS

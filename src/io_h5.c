@@ -267,7 +267,7 @@ static int truncate_snapshots(cd_output *o, long long resume_step)
     for (size_t k = 0; k < cd_n_fields; k++) {
         enum cdh5_store st = cdh5_store_of(&cd_fields[k]);
         if (st == CDH5_FIXED) continue;
-        hsize_t rows = st == CDH5_SERIES ? n : (hsize_t)(cd_fields[k].group == CD_GROUP_PAIR ? cend : wend);
+        hsize_t rows = st == CDH5_SERIES ? n : (hsize_t)(cd_group_pair_rows(cd_fields[k].group) ? cend : wend);
         if (cdh5_set_rows(o, o->cols[k].dset, cd_fields[k].name, rows)) return -1;
     }
     if (cdh5_set_rows(o, o->step, CDH5_SNAP_STEP, n) || cdh5_set_rows(o, o->time, CDH5_SNAP_TIME, n) ||

@@ -2,6 +2,7 @@
  * layout helpers shared with the writer (io_h5.c).  Layout: docs/output.md. */
 #include "io_h5.h"
 #include "io_h5_internal.h"
+#include "../kernels/vec3.h"
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,7 +18,7 @@ static const char *const fixed_columns[] = {
 
 enum cdh5_store cdh5_store_of(const cd_field_info *f)
 {
-    if (f->group == CD_GROUP_PAIR || f->group == CD_GROUP_WALLC) return CDH5_ROWS;
+    if (cd_group_pair_rows(f->group) || f->group == CD_GROUP_WALLC) return CDH5_ROWS;
     for (size_t i = 0; i < sizeof fixed_columns / sizeof fixed_columns[0]; i++)
         if (!strcmp(f->name, fixed_columns[i])) return CDH5_FIXED;
     return CDH5_SERIES;
@@ -28,7 +29,8 @@ const char *cdh5_group_path(enum cd_field_group g)
     switch (g) {
     case CD_GROUP_PARTICLE: return "/particles/all";
     case CD_GROUP_PRIM: return "/particles/prims";
-    case CD_GROUP_PAIR: return "/contacts";
+    case CD_GROUP_PAIR:
+    case CD_GROUP_PAIR_OUT: return "/contacts";
     case CD_GROUP_WALLC: return "/wall_contacts";
     default: return "/unknown";
     }
@@ -255,7 +257,11 @@ typedef struct {
     long long c0, c1, w0, w1;
     long long *windex;
     void *tmp;
+    int legacy_force;  /* the file predates /contacts/pair_force (rebuilt from F_n n + F_t) */
 } reader;
+
+/* Is field f the pair force, which files written before it existed lack? */
+static int is_pair_force(const cd_field_info *f) { return !strcmp(f->name, "pair_force"); }
 
 static int rfail(reader *r, const char *fmt, ...)
 {
@@ -314,13 +320,17 @@ static int check_snapshot(reader *r, long long k, const cd_state *s)
         char p[CDH5_PATH_LEN];
         if (cdh5_field_check(f, r->err, r->errlen)) return -1;
         cdh5_field_path(f, p, sizeof p);
+        if (is_pair_force(f) && !cdh5_exists(r->file, p)) {
+            r->legacy_force = 1;
+            continue;
+        }
         r->ds[i] = ropen(r, p);
         if (r->ds[i] < 0) return -1;
         long long n = cdh5_field_rows(r->ds[i], f, p, r->path, r->err, r->errlen);
         if (n < 0) return -1;
         enum cdh5_store st = cdh5_store_of(f);
         if (st == CDH5_ROWS) {
-            long long end = f->group == CD_GROUP_PAIR ? r->c1 : r->w1;
+            long long end = cd_group_pair_rows(f->group) ? r->c1 : r->w1;
             if (n < end) return rfail(r, "%s has %lld rows, snapshot %lld needs %lld", p, n, k, end);
             continue;
         }
@@ -357,13 +367,14 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
         char *col = *cd_field_ptr(s, f);
         hid_t mt = cdh5_mem_type(f);
         herr_t e = 0;
+        if (r->ds[i] < 0 && is_pair_force(f) && r->legacy_force) continue; /* rebuilt below */
         switch (cdh5_store_of(f)) {
         case CDH5_FIXED:
             if (cd_state_rows(s, f->group)) e = H5Dread(r->ds[i], mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, col);
             break;
         case CDH5_SERIES: e = cdh5_read_rows(r->ds[i], (hsize_t)k, 1, mt, col); break;
         case CDH5_ROWS:
-            if (f->group == CD_GROUP_PAIR) {
+            if (cd_group_pair_rows(f->group)) {
                 e = cdh5_read_rows(r->ds[i], (hsize_t)r->c0, (hsize_t)m, mt, col);
             } else {
                 memset(col, 0, cd_state_rows(s, f->group) * f->elem_size);
@@ -377,6 +388,10 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
         if (e < 0) return rfail(r, "cannot read column %s of snapshot %lld", f->name, k);
     }
     s->n_pairs = (size_t)m;
+    /* The force on j of a file that stored only its parts: F_n n + F_t,
+     * the law's expression (kernels/contact_law.h), so the same bits. */
+    if (r->legacy_force)
+        for (long long j = 0; j < m; j++) s->pair_force[j] = cd_v3_axpy(s->pair_ft[j], s->pair_fn[j], s->pair_normal[j]);
     cd_wall walls[CD_MAX_WALLS];
     memset(walls, 0, sizeof walls);
     hid_t wt = cdh5_wall_mem_type();
@@ -399,7 +414,7 @@ int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t 
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
     reader r = {path, err, errlen, H5I_INVALID_HID, NULL, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID,
-                H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, 0, 0, 0, 0, NULL, NULL};
+                H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, 0, 0, 0, 0, NULL, NULL, 0};
     int rc = -1;
     r.ds = malloc(cd_n_fields * sizeof *r.ds);
     if (!r.ds) {

@@ -3,6 +3,7 @@
  * the commit record.  Layout and crash behaviour: docs/output.md. */
 #include "io_h5.h"
 #include "io_h5_internal.h"
+#include "../kernels/vec3.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -76,7 +77,7 @@ static int create_col(cd_output *o, const cd_state *s, size_t k)
         return c->dset < 0 ? -1 : 0;
     }
     case CDH5_ROWS: {
-        hsize_t hint = f->group == CD_GROUP_PAIR ? 4 * o->n_prims : o->n_prims;
+        hsize_t hint = cd_group_pair_rows(f->group) ? 4 * o->n_prims : o->n_prims;
         hsize_t d[2] = {0, nc}, m[2] = {H5S_UNLIMITED, nc};
         hsize_t ch[2] = {clamp(hint, 256, CDH5_LARGE_CHUNK / f->elem_size), nc};
         c->dset = cdh5_make_dset(o, p, ft, 1 + vec, d, m, ch, f->unit);
@@ -130,11 +131,52 @@ int cdh5_layout_create(cd_output *o, const cd_state *s)
     return 0;
 }
 
+/* A file written before /contacts/pair_force existed (the contact force
+ * on j, fields.def) gets the column on reopening, every stored row rebuilt
+ * as F_n n + F_t (the law's expression, kernels/contact_law.h), so that a
+ * resumed run appends to it like to any other. */
+static int add_pair_force(cd_output *o, size_t k)
+{
+    static const char *const parts[3] = {"/contacts/pair_ft", "/contacts/pair_fn", "/contacts/pair_normal"};
+    hsize_t dims[3];
+    hid_t d[3];
+    for (int i = 0; i < 3; i++) d[i] = -1;
+    int rc = 0;
+    for (int i = 0; i < 3 && !rc; i++)
+        if ((d[i] = cdh5_open_dset(o, parts[i])) < 0) rc = -1;
+    long long rows = rc ? -1 : (cdh5_dims(d[1], dims) >= 1 ? (long long)dims[0] : -1);
+    if (!rc && rows < 0) rc = FAIL("%s: cannot read the length of %s", o->path, parts[1]);
+    cd_vec3 *ft = NULL, *nrm = NULL;
+    double *fn = NULL;
+    if (!rc) {
+        size_t m = rows > 0 ? (size_t)rows : 1;
+        ft = malloc(m * sizeof *ft);
+        nrm = malloc(m * sizeof *nrm);
+        fn = malloc(m * sizeof *fn);
+        if (!ft || !nrm || !fn) rc = FAIL("%s: out of memory", o->path);
+    }
+    if (!rc && rows > 0 &&
+        (cdh5_read_rows(d[0], 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, ft) < 0 ||
+         cdh5_read_rows(d[1], 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, fn) < 0 ||
+         cdh5_read_rows(d[2], 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, nrm) < 0))
+        rc = FAIL("%s: cannot read the contact forces to add /contacts/pair_force", o->path);
+    for (long long j = 0; !rc && j < rows; j++) ft[j] = cd_v3_axpy(ft[j], fn[j], nrm[j]);
+    if (!rc) rc = create_col(o, NULL, k);
+    if (!rc && rows > 0)
+        rc = cdh5_append(o, o->cols[k].dset, "pair_force", 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, ft);
+    for (int i = 0; i < 3; i++) cdh5_close_id(&d[i]);
+    free(ft);
+    free(nrm);
+    free(fn);
+    return rc;
+}
+
 /* Opens the layout of an existing file and learns its sizes. */
 int cdh5_layout_open(cd_output *o)
 {
     hsize_t dims[3];
-    long long rows[CD_GROUP_COUNT] = {-1, -1, -1, -1};
+    long long rows[CD_GROUP_COUNT];
+    for (int g = 0; g < CD_GROUP_COUNT; g++) rows[g] = -1;
     o->step = cdh5_open_dset(o, CDH5_SNAP_STEP);
     o->time = cdh5_open_dset(o, CDH5_SNAP_TIME);
     o->walls = cdh5_open_dset(o, CDH5_WALLS_VALUE);
@@ -157,6 +199,10 @@ int cdh5_layout_open(cd_output *o)
         if (cdh5_field_check(f, o->err, sizeof o->err)) return cdh5_report(o);
         cdh5_field_path(f, p, sizeof p);
         cdh5_col *c = &o->cols[k];
+        if (!strcmp(f->name, "pair_force") && !cdh5_exists(o->file, p)) {
+            if (add_pair_force(o, k)) return -1;
+            continue;
+        }
         c->dset = cdh5_open_dset(o, p);
         if (c->dset < 0) return -1;
         long long n = cdh5_field_rows(c->dset, f, p, o->path, o->err, sizeof o->err);
@@ -199,14 +245,15 @@ static int check_counts(cd_output *o, const cd_state *s)
     return 0;
 }
 
-/* Appends the active rows of one contact group (PAIR or WALLC). */
+/* Appends the active rows of one contact group (PAIR, with its PAIR_OUT
+ * columns, or WALLC). */
 static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g, const size_t *idx, size_t m,
                           void *tmp)
 {
     hsize_t at = g == CD_GROUP_PAIR ? o->c_rows : o->w_rows;
     for (size_t k = 0; k < cd_n_fields; k++) {
         const cd_field_info *f = &cd_fields[k];
-        if (f->group != g) continue;
+        if (f->group != g && !(g == CD_GROUP_PAIR && f->group == CD_GROUP_PAIR_OUT)) continue;
         const char *col = *cd_field_ptr((cd_state *)s, f);
         for (size_t r = 0; r < m; r++)
             memcpy((char *)tmp + r * f->elem_size, col + idx[r] * f->elem_size, f->elem_size);

@@ -5,6 +5,8 @@
  * pair can come into contact unseen).  Contact history is carried over by
  * matching the sorted (primitive i, primitive j) keys of the new list
  * against the old one.  Every result is independent of the thread count. */
+#include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
@@ -86,9 +88,10 @@ static int build_gather(cd_sim *sim)
     /* Filling in pair order keeps every particle's rows ascending. */
     cd_int *fill = nb->pair_count; /* reuse as cursor: sized n_prims+1 >= n_particles */
     memcpy(fill, nb->gather_start, s->n_particles * sizeof(cd_int));
+    /* Entries 2 k + side (kernels/step_items.h, cd_item_gather). */
     for (size_t k = 0; k < s->n_pairs; k++) {
-        nb->gather_rows[fill[s->prim_particle[s->pair_prim_i[k]]]++] = (cd_pair_id)k;
-        nb->gather_rows[fill[s->prim_particle[s->pair_prim_j[k]]]++] = (cd_pair_id)k;
+        nb->gather_rows[fill[s->prim_particle[s->pair_prim_i[k]]]++] = (cd_pair_id)(2 * k);
+        nb->gather_rows[fill[s->prim_particle[s->pair_prim_j[k]]]++] = (cd_pair_id)(2 * k + 1);
     }
     return 0;
 }
@@ -244,6 +247,11 @@ int cd_neighbors_build(cd_sim *sim)
     count[0] = 0;
     for (size_t i = 0; i < P; i++) count[i + 1] += count[i];
     size_t n_new = (size_t)count[P];
+    /* Gather entries are 2 k + 1 in a cd_int (cd_item_gather). */
+    if (n_new > (size_t)(INT32_MAX - 1) / 2) {
+        fprintf(stderr, "capdem: %zu pair rows exceed the neighbour list's limit of %d\n", n_new, (INT32_MAX - 1) / 2);
+        return -1;
+    }
 
     /* Keep the old keys and history for matching. */
     size_t n_old = s->n_pairs;

@@ -40,7 +40,9 @@ int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen)
 
 int cd_sim_sync(cd_sim *sim, char *err, size_t errlen)
 {
-    return sim->backend ? sim->backend->sync(sim, err, errlen) : 0;
+    if (sim->backend && sim->backend->sync(sim, err, errlen)) return -1;
+    cd_sim_derive_pair_output(sim);
+    return 0;
 }
 
 const cd_backend *cd_backend_find(const char *name)

@@ -7,6 +7,7 @@
 #include "config.h"
 #include "shapes.h"
 #include "../kernels/contact_law.h"
+#include "../kernels/cols.h"
 #include "backend.h"
 
 /* Loops over fewer rows than this run on one thread: a parallel region
@@ -31,8 +32,9 @@ typedef struct {
     double skin;              /* Verlet skin [m] */
     long long builds;         /* rebuilds so far */
     int force_rebuild;        /* 1: rebuild at the next step regardless of motion */
-    /* per-particle gather lists (CSR over pair rows): for particle p the rows
-     * gather_rows[gather_start[p] .. gather_start[p+1]) in ascending pair order */
+    /* per-particle gather lists (CSR over pair rows): for particle p the
+     * entries gather_rows[gather_start[p] .. gather_start[p+1]), 2 k + side
+     * for pair row k (side 1: p owns its primitive j), in ascending order */
     cd_int *gather_start;     /* n_particles + 1 */
     cd_pair_id *gather_rows;  /* 2 n_pairs */
     size_t gather_cap;
@@ -86,13 +88,23 @@ int cd_sim_initial_forces(cd_sim *sim);
 /* Advances n steps. Returns 0, or -1 when the run blew up (message in err). */
 int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen);
 
-/* Makes sim->s current (copies the device state back). */
+/* Makes sim->s current: copies the device state back and derives the
+ * output-only pair columns (cd_sim_derive_pair_output). */
 int cd_sim_sync(cd_sim *sim, char *err, size_t errlen);
 
 /* Sum of the normal forces the particles exert on wall w [N] at the last
  * force evaluation: the backend's reduction, or a sync and a host sum in a
  * fixed order. */
 int cd_sim_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen);
+
+/* The host columns of s as the per-item functions of kernels/step_items.h
+ * take them (the device columns of fields.def only). */
+cd_cols cd_sim_host_cols(cd_state *s);
+
+/* Fills the output-only pair columns (fields.def, PAIR_OUT: normal,
+ * tangential force, torques) of every row from the step's columns of the
+ * host state (src/pair_output.c).  cd_sim_sync calls it. */
+void cd_sim_derive_pair_output(cd_sim *sim);
 
 /* Checks the host state for non-finite values (a blown-up run). */
 int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen);

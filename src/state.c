@@ -6,6 +6,7 @@
 #define CD_GROUP_OF_PRIM CD_GROUP_PRIM
 #define CD_GROUP_OF_PAIR CD_GROUP_PAIR
 #define CD_GROUP_OF_WALLC CD_GROUP_WALLC
+#define CD_GROUP_OF_PAIR_OUT CD_GROUP_PAIR_OUT
 #define CD_KIND_OF_REAL CD_KIND_REAL
 #define CD_KIND_OF_INT CD_KIND_INT
 
@@ -27,7 +28,8 @@ size_t cd_state_rows(const cd_state *s, enum cd_field_group g)
     switch (g) {
     case CD_GROUP_PARTICLE: return s->n_particles;
     case CD_GROUP_PRIM: return s->n_prims;
-    case CD_GROUP_PAIR: return s->n_pairs;
+    case CD_GROUP_PAIR:
+    case CD_GROUP_PAIR_OUT: return s->n_pairs;
     case CD_GROUP_WALLC: return s->n_prims * s->n_walls;
     default: return 0;
     }
@@ -35,7 +37,7 @@ size_t cd_state_rows(const cd_state *s, enum cd_field_group g)
 
 static size_t group_capacity(const cd_state *s, enum cd_field_group g)
 {
-    return g == CD_GROUP_PAIR ? s->cap_pairs : cd_state_rows(s, g);
+    return cd_group_pair_rows(g) ? s->cap_pairs : cd_state_rows(s, g);
 }
 
 int cd_state_alloc(cd_state *s, size_t n_particles, size_t n_prims, size_t n_walls, size_t cap_pairs)
@@ -58,7 +60,7 @@ int cd_state_reserve_pairs(cd_state *s, size_t cap)
 {
     if (cap <= s->cap_pairs) return 0;
     for (size_t k = 0; k < cd_n_fields; k++) {
-        if (cd_fields[k].group != CD_GROUP_PAIR) continue;
+        if (!cd_group_pair_rows(cd_fields[k].group)) continue;
         void **slot = cd_field_ptr(s, &cd_fields[k]);
         void *p = realloc(*slot, cap * cd_fields[k].elem_size);
         if (!p) return -1;

@@ -6,7 +6,12 @@
 #include "../kernels/defs.h"
 #include "../kernels/geom_types.h"
 
-enum cd_field_group { CD_GROUP_PARTICLE, CD_GROUP_PRIM, CD_GROUP_PAIR, CD_GROUP_WALLC, CD_GROUP_COUNT };
+/* PAIR_OUT: output columns of the pair rows, derived on the host at sync
+ * (fields.def); same rows and capacity as PAIR. */
+enum cd_field_group { CD_GROUP_PARTICLE, CD_GROUP_PRIM, CD_GROUP_PAIR, CD_GROUP_WALLC, CD_GROUP_PAIR_OUT, CD_GROUP_COUNT };
+
+/* Do the columns of group g have one row per pair row (PAIR, PAIR_OUT)? */
+static inline int cd_group_pair_rows(enum cd_field_group g) { return g == CD_GROUP_PAIR || g == CD_GROUP_PAIR_OUT; }
 enum cd_field_kind { CD_KIND_REAL, CD_KIND_INT };
 
 #define CD_MAX_WALLS 8

@@ -54,11 +54,12 @@ static size_t cd_wide_min(void)
 /* Host-only loops (set-up work on the host columns). */
 #define CD_HOST_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
 
-/* The state's columns for the per-item functions of kernels/step_items.h. */
-static cd_cols cols_of(cd_state *s)
+/* The state's device columns for the per-item functions of
+ * kernels/step_items.h. */
+cd_cols cd_sim_host_cols(cd_state *s)
 {
     cd_cols c;
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) c.name = s->name;
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = s->name;)
 #include "fields.def"
 #undef CD_FIELD
     return c;
@@ -123,7 +124,7 @@ static void *off_devptr(void *p)
 /* Rows of a group held in memory: the pair columns at their capacity. */
 static size_t alloc_rows(const cd_state *s, enum cd_field_group g)
 {
-    return g == CD_GROUP_PAIR ? s->cap_pairs : cd_state_rows(s, g);
+    return cd_group_pair_rows(g) ? s->cap_pairs : cd_state_rows(s, g);
 }
 
 static void off_refresh_cols(cd_sim *sim, cd_off *o)
@@ -133,13 +134,14 @@ static void off_refresh_cols(cd_sim *sim, cd_off *o)
         void **slot = cd_field_ptr(&d, &cd_fields[f]);
         if (o->host[f]) *slot = off_devptr(o->host[f]);
     }
-    o->dev = cols_of(&d);
+    o->dev = cd_sim_host_cols(&d);
 }
 
-/* Maps field f at its current host address and size. */
+/* Maps field f at its current host address and size (none for the
+ * output-only columns, kernels/field_groups.h). */
 static void off_map_field(cd_sim *sim, cd_off *o, size_t f)
 {
-    void *p = *cd_field_ptr(&sim->s, &cd_fields[f]);
+    void *p = cd_fields[f].group == CD_GROUP_PAIR_OUT ? NULL : *cd_field_ptr(&sim->s, &cd_fields[f]);
     size_t bytes = alloc_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size;
     o->host[f] = p && bytes ? p : NULL;
     o->bytes[f] = o->host[f] ? bytes : 0;
@@ -258,7 +260,7 @@ static cd_cols step_cols(cd_sim *sim)
 #if CD_OFFLOAD
     if (sim->backend_data) return ((cd_off *)sim->backend_data)->dev;
 #endif
-    return cols_of(&sim->s);
+    return cd_sim_host_cols(&sim->s);
 }
 
 /* ---- the loops of a step ------------------------------------------------ */
@@ -379,7 +381,7 @@ void cd_sim_refresh(cd_sim *sim)
 {
     cd_state *s = &sim->s;
     for (size_t q = 0; q < s->n_particles; q++) s->angvel[q] = cd_rigid_angvel(s->orientation[q], s->angmom[q], s->inertia[q]);
-    cd_cols c = cols_of(s);
+    cd_cols c = cd_sim_host_cols(s);
     size_t n = s->n_prims;
     CD_HOST_FOR(n, firstprivate(c))
     for (size_t i = 0; i < n; i++) cd_item_prim_ends(c, (cd_prim_id)i);
@@ -398,7 +400,7 @@ static int report_bad(const cd_state *s, long bad, char *err, size_t errlen)
 int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
 {
     const cd_state *s = &sim->s;
-    cd_cols c = cols_of((cd_state *)s); /* read only */
+    cd_cols c = cd_sim_host_cols((cd_state *)s); /* read only */
     long bad = -1;
     size_t n = s->n_particles;
     CD_HOST_FOR(n, reduction(max : bad))
@@ -475,10 +477,12 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
 {
     (void)err; (void)errlen;
 #if CD_OFFLOAD
-    /* The only full copy back: every column, rows in use. */
-    if (sim->backend_data)
+    /* The only full copy back: every device column, rows in use. */
+    cd_off *o = sim->backend_data;
+    if (o)
         for (size_t f = 0; f < cd_n_fields; f++)
-            off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
+            if (o->host[f])
+                off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
                      cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
 #else
     (void)sim; /* the state lives in host memory */

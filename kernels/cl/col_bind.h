@@ -1,6 +1,6 @@
 /* Declares `cd_cols c` and points it at the column parameters of
  * col_params.h (no include guard: it expands at each use). */
 cd_cols c;
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) c.name = name;
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = name;)
 #include "../../src/fields.def"
 #undef CD_FIELD

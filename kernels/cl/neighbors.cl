@@ -190,8 +190,9 @@ __kernel void cd_cl_gather_count(
     atomic_inc(&count[c.prim_particle[c.pair_prim_j[k]]]);
 }
 
-/* Pass 2: row k into the slices of its two particles (cursor starts as
- * gather_start); pass 3 restores ascending order. */
+/* Pass 2: row k into the slices of its two particles as 2 k + side (side
+ * 1 for the particle of primitive j: step_items.h, cd_item_gather; cursor
+ * starts as gather_start); pass 3 restores ascending order. */
 __kernel void cd_cl_gather_fill(
 #include "col_params.h"
     cd_int n_pairs, __global cd_int *cursor, __global cd_pair_id *gather_rows)
@@ -199,8 +200,8 @@ __kernel void cd_cl_gather_fill(
 #include "col_bind.h"
     cd_int k = (cd_int)get_global_id(0);
     if (k >= n_pairs) return;
-    gather_rows[atomic_inc(&cursor[c.prim_particle[c.pair_prim_i[k]]])] = k;
-    gather_rows[atomic_inc(&cursor[c.prim_particle[c.pair_prim_j[k]]])] = k;
+    gather_rows[atomic_inc(&cursor[c.prim_particle[c.pair_prim_i[k]]])] = 2 * k;
+    gather_rows[atomic_inc(&cursor[c.prim_particle[c.pair_prim_j[k]]])] = 2 * k + 1;
 }
 
 /* Pass 3: particle q's rows in ascending order (insertion sort: a few tens
