@@ -47,6 +47,7 @@
 #include "io_h5.h"
 #include "bench_cases.h"
 #include "bench_tile.h"
+#include "bench_traffic.h"
 
 static double clock_s(clockid_t which)
 {
@@ -219,13 +220,25 @@ int main(int argc, char **argv)
             double wall = now() - t, cpu = clock_s(CLOCK_PROCESS_CPUTIME_ID) - c;
             /* (a sync, untimed, for the pair count of the report) */
             if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
+            cd_traffic tr[CD_TRAFFIC_KERNELS];
+            cd_bench_traffic(&sim, tr);
+            double moved = 0;
+            char kernels[768];
+            int at = 0;
+            for (int t = 0; t < CD_TRAFFIC_KERNELS; t++) {
+                moved += tr[t].read + tr[t].write;
+                at += snprintf(kernels + at, sizeof kernels - (size_t)at, "%s\"%s\": [%.0f, %.0f]", t ? ", " : "",
+                               tr[t].kernel, tr[t].read / (double)n, tr[t].write / (double)n);
+            }
             printf("{\"case\": \"%s\", \"N\": %ld, \"backend\": \"%s\", \"device\": \"%s\", \"threads\": %d, "
                    "\"steps\": %ld, \"wall_s\": %.6g, \"cpu_s\": %.6g, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
                    "\"contacts_per_particle\": %.3f, \"pairs_in_list\": %zu, \"bytes_per_particle\": %.0f, "
-                   "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"dt\": %g}\n",
+                   "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"dt\": %g, "
+                   "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}}\n",
                    case_label, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
                    round_threads[k], steps, wall, cpu, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
-                   sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.p.dt);
+                   sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.p.dt,
+                   moved / (double)n, kernels);
             fflush(stdout);
         }
     }

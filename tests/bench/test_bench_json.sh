@@ -17,7 +17,8 @@ check() { # CASE N STEPS FILE: every line of FILE is a valid report of CASE
 import json, sys
 case, n, steps, path = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
 keys = ["case", "N", "backend", "device", "threads", "steps", "wall_s", "particle_steps_per_s",
-        "contact_updates_per_s", "contacts_per_particle", "bytes_per_particle"]
+        "contact_updates_per_s", "contacts_per_particle", "bytes_per_particle",
+        "bytes_moved_per_particle_step", "kernel_bytes_read_written"]
 lines = [l for l in open(path) if l.strip()]
 assert lines, "no JSON line"
 for l in lines:
@@ -31,6 +32,13 @@ for l in lines:
     assert abs(r["particle_steps_per_s"] - rate) <= 2e-3 * rate + 1e-3 * r["N"] / r["wall_s"], l
     assert r["contact_updates_per_s"] >= 0 and 0 <= r["contacts_per_particle"] < 40, l
     assert 100 < r["bytes_per_particle"] < 1e5, l
+    # the traffic model: every loop of the step, read and written bytes per
+    # particle-step, adding up to the total (each rounded to 1 B)
+    kb = r["kernel_bytes_read_written"]
+    assert len(kb) >= 5 and all(len(v) == 2 and v[0] >= 0 and v[1] >= 0 for v in kb.values()), l
+    total = sum(v[0] + v[1] for v in kb.values())
+    assert abs(total - r["bytes_moved_per_particle_step"]) <= 2 * len(kb), l
+    assert 200 < r["bytes_moved_per_particle_step"] < 2e4, l
 print("ok", case, len(lines), "lines")
 PY
 }

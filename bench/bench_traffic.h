@@ -1,0 +1,19 @@
+/* Bytes moved per time step, kernel by kernel: see bench_traffic.c. */
+#ifndef CD_BENCH_TRAFFIC_H
+#define CD_BENCH_TRAFFIC_H
+#include "sim.h"
+
+enum { CD_TRAFFIC_KERNELS = 8 };
+
+typedef struct {
+    const char *kernel; /* the loop of src/step_omp.c (one OpenCL kernel or less) */
+    double read, write; /* bytes per step [B] */
+} cd_traffic;
+
+/* The bytes each loop of one time step reads and writes, counted from the
+ * code of kernels/step_items.h for the state's counts of particles,
+ * primitives, pair rows, contacts and wall contacts (sim->s synced).
+ * Fills out[CD_TRAFFIC_KERNELS]. */
+void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS]);
+
+#endif
