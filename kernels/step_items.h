@@ -14,6 +14,7 @@
 #include "segseg.h"
 #include "walls.h"
 #include "contact_law.h"
+#include "broadphase.h"
 
 CD_DEVICE_BEGIN
 
@@ -54,6 +55,26 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
     cd_particle_id p = c.prim_particle[i];
     c.prim_a[i] = cd_rigid_to_world(c.position[p], c.orientation[p], c.prim_a_body[i]);
     c.prim_b[i] = cd_rigid_to_world(c.position[p], c.orientation[p], c.prim_b_body[i]);
+}
+
+/* Steps 1-4 of particle q in one pass over its data: the first half kick
+ * over dt/2, the drift over dt [s], the world ends of its primitives, and
+ * the skin test of those ends (limit2 = (skin/2)^2 [m^2], broadphase.h).
+ * Returns 1 when one of its primitives moved more than half the skin since
+ * the last neighbour-list build.  The same arithmetic as the four items
+ * one after the other: fused because each reads what the one before wrote
+ * (docs/performance.md, "Bytes per step"). */
+CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real limit2)
+{
+    cd_item_kick(c, q, CD_R(0.5) * dt);
+    cd_item_drift(c, q, dt);
+    int moved = 0;
+    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
+    for (cd_int i = first; i < last; i++) {
+        cd_item_prim_ends(c, i);
+        moved |= cd_bp_moved(c.prim_a[i], c.prim_a_ref[i], c.prim_b[i], c.prim_b_ref[i], limit2);
+    }
+    return moved;
 }
 
 /* Contact geometry of pair row k (SPEC 2): closest points of the two axes

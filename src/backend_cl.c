@@ -20,13 +20,12 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_int N = (cd_int)s->n_particles, P = (cd_int)s->n_prims, W = (cd_int)s->n_walls, one = 1;
     cd_real dt = p->dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
     if (cl->cols_dirty) cd_cl_bind_cols(cl);
-    cd_cl_arg(cl, CD_CLK_KICK_DRIFT, F, sizeof cl->walls, &cl->walls);
-    cd_cl_arg(cl, CD_CLK_KICK_DRIFT, F + 1, sizeof W, &W);
-    cd_cl_arg(cl, CD_CLK_KICK_DRIFT, F + 2, sizeof N, &N);
-    cd_cl_arg(cl, CD_CLK_KICK_DRIFT, F + 3, sizeof dt, &dt);
-    cd_cl_arg(cl, CD_CLK_PRIM_ENDS, F, sizeof P, &P);
-    cd_cl_arg(cl, CD_CLK_PRIM_ENDS, F + 1, sizeof limit2, &limit2);
-    cd_cl_arg(cl, CD_CLK_PRIM_ENDS, F + 2, sizeof cl->flags, &cl->flags);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F, sizeof cl->walls, &cl->walls);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 1, sizeof W, &W);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 2, sizeof N, &N);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 3, sizeof dt, &dt);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 4, sizeof limit2, &limit2);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 5, sizeof cl->flags, &cl->flags);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 1, sizeof p->law, &p->law);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 2, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 3, sizeof p->sin_parallel, &p->sin_parallel);
@@ -148,8 +147,7 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
     set_step_args(cl, sim);
     size_t items = s->n_particles > s->n_walls ? s->n_particles : s->n_walls;
     for (long long it = 0; it < n && !cl->status; it++) {
-        cd_cl_run(cl, CD_CLK_KICK_DRIFT, items);
-        cd_cl_run(cl, CD_CLK_PRIM_ENDS, s->n_prims);
+        cd_cl_run(cl, CD_CLK_ADVANCE, items);
         int rebuild = sim->nb.force_rebuild;
         if (!rebuild && !cl->status) {
             cd_int moved = 0; /* the one read per step */

@@ -14,7 +14,7 @@
 /* Kernels of the .cl files in kernels/cl.  Those marked "cols" in backend_cl_device.c
  * take the state's columns as their first CD_CL_N_FIELDS arguments. */
 enum cd_cl_kernel {
-    CD_CLK_KICK_DRIFT, CD_CLK_PRIM_ENDS, CD_CLK_PAIR_FORCES, CD_CLK_WALL_FORCES, CD_CLK_GATHER_KICK,
+    CD_CLK_ADVANCE, CD_CLK_PAIR_FORCES, CD_CLK_WALL_FORCES, CD_CLK_GATHER_KICK,
     CD_CLK_CHECK_FINITE, CD_CLK_WALL_LOAD,
     CD_CLK_BOUNDS, CD_CLK_GRID, CD_CLK_BIN, CD_CLK_CELL_FILL, CD_CLK_PAIR_COLLECT, CD_CLK_PAIR_PLACE, CD_CLK_PAIR_FILL,
     CD_CLK_PAIR_KEYS,

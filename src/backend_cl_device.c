@@ -17,7 +17,7 @@ static const struct {
     const char *name;
     int cols;
 } kernel_table[CD_CLK_COUNT] = {
-    {"cd_cl_kick_drift", 1},   {"cd_cl_prim_ends", 1},    {"cd_cl_pair_forces", 1}, {"cd_cl_wall_forces", 1},
+    {"cd_cl_advance", 1},      {"cd_cl_pair_forces", 1}, {"cd_cl_wall_forces", 1},
     {"cd_cl_gather_kick", 1},  {"cd_cl_check_finite", 1}, {"cd_cl_wall_load", 1},   {"cd_cl_bounds", 1},
     {"cd_cl_grid", 0},         {"cd_cl_bin", 1},          {"cd_cl_cell_fill", 0},   {"cd_cl_pair_collect", 1},
     {"cd_cl_pair_place", 1},   {"cd_cl_pair_fill", 1},    {"cd_cl_pair_keys", 1},   {"cd_cl_pair_carry", 1},

@@ -45,18 +45,6 @@ void cd_neighbors_free(cd_neighbors *nb)
     memset(nb, 0, sizeof(*nb));
 }
 
-int cd_neighbors_needed(cd_sim *sim)
-{
-    if (sim->nb.force_rebuild) return 1;
-    const cd_state *s = &sim->s;
-    double limit2 = cd_bp_skin_limit2(sim->nb.skin); /* (skin/2)^2 [m^2] */
-    int moved = 0;
-#pragma omp parallel for schedule(static) reduction(|| : moved) if (CD_PARALLEL(s->n_prims))
-    for (size_t i = 0; i < s->n_prims; i++)
-        moved = moved || cd_bp_moved(s->prim_a[i], s->prim_a_ref[i], s->prim_b[i], s->prim_b_ref[i], limit2);
-    return moved;
-}
-
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
 {
     if (need <= *cap && *p) return 0;

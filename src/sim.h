@@ -130,7 +130,6 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o);
 /* Neighbour list (neighbors.c). */
 void cd_neighbors_init(cd_neighbors *nb, double skin);
 void cd_neighbors_free(cd_neighbors *nb);
-int cd_neighbors_needed(cd_sim *sim);
 int cd_neighbors_build(cd_sim *sim);
 
 #endif

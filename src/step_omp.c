@@ -2,7 +2,10 @@
  * or particle calling the shared kernel headers (kernels/step_items.h, the
  * same functions the OpenCL kernels call), and forces reach particles by a
  * gather in fixed order (no floating-point atomics), so results are bitwise
- * identical for any thread count.
+ * identical for any thread count.  Four loops per step: advance (kick,
+ * drift, primitive ends, skin test), pair forces, wall forces, gather with
+ * the second kick; a neighbour-list rebuild between the first two when
+ * the skin test asks for it.
  *
  * Two variants of the same loops (docs/offload.md):
  * - host (CAPDEM_OFFLOAD=none): `omp parallel for schedule(static)` over the
@@ -265,14 +268,23 @@ static cd_cols step_cols(cd_sim *sim)
 
 /* ---- the loops of a step ------------------------------------------------ */
 
-/* World endpoints of every primitive from its particle's pose. */
-static void update_prims(cd_sim *sim)
+/* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
+ * world ends of its primitives and the skin test; the walls move on the
+ * host.  Returns 1 when the neighbour list must be rebuilt (some end moved
+ * more than half the skin, or a rebuild was asked for); on the offload
+ * device one int comes back. */
+static int advance(cd_sim *sim)
 {
     cd_cols c = step_cols(sim);
-    size_t n = sim->s.n_prims;
+    cd_real dt = sim->p.dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    size_t n = sim->s.n_particles;
+    int moved = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c))
-    for (size_t i = 0; i < n; i++) cd_item_prim_ends(c, (cd_prim_id)i);
+    CD_STEP_FOR(n, firstprivate(c) reduction(| : moved) CD_DEV(map(tofrom : moved)))
+    for (size_t q = 0; q < n; q++) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+    cd_state *s = &sim->s;
+    for (size_t w = 0; w < s->n_walls; w++) s->walls[w] = cd_wall_advanced(s->walls[w], dt);
+    return moved || sim->nb.force_rebuild;
 }
 
 /* One work item per pair of the Verlet list: narrow phase + contact law. */
@@ -304,69 +316,34 @@ static void wall_forces(cd_sim *sim)
     for (size_t i = 0; i < n; i++) cd_item_wall_forces(c, (cd_prim_id)i, walls, W, law, dt, sin_parallel, blend);
 }
 
-/* One work item per particle: gravity plus its contacts in fixed order.
- * The gather lists are mapped host pointers: translated on entry. */
-static void gather(cd_sim *sim)
+/* One work item per particle: gravity plus its contacts in fixed order,
+ * then (kick = 1) the second half kick with that force, in the same pass
+ * (steps 7-8).  The gather lists are mapped host pointers: translated on
+ * entry. */
+static void gather_kick(cd_sim *sim, int kick)
 {
     cd_cols c = step_cols(sim);
     const cd_int *gs = sim->nb.gather_start;
     const cd_pair_id *gr = sim->nb.gather_rows;
     cd_int W = (cd_int)sim->s.n_walls, dim = sim->p.dimension;
     cd_vec3 g = sim->p.gravity;
-    size_t n = sim->s.n_particles;
-    CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, g))
-    for (size_t q = 0; q < n; q++) cd_item_gather(c, (cd_particle_id)q, gs, gr, W, g, dim);
-}
-
-static void kick(cd_sim *sim)
-{
-    cd_cols c = step_cols(sim);
     cd_real h = 0.5 * sim->p.dt;
     size_t n = sim->s.n_particles;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c))
-    for (size_t q = 0; q < n; q++) cd_item_kick(c, (cd_particle_id)q, h);
+    CD_STEP_FOR(n, firstprivate(c, g))
+    for (size_t q = 0; q < n; q++) {
+        cd_item_gather(c, (cd_particle_id)q, gs, gr, W, g, dim);
+        if (kick) cd_item_kick(c, (cd_particle_id)q, h);
+    }
 }
 
-static void drift(cd_sim *sim)
-{
-    cd_cols c = step_cols(sim);
-    cd_real dt = sim->p.dt;
-    size_t n = sim->s.n_particles;
-    CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c))
-    for (size_t q = 0; q < n; q++) cd_item_drift(c, (cd_particle_id)q, dt);
-    cd_state *s = &sim->s;
-    for (size_t w = 0; w < s->n_walls; w++) s->walls[w] = cd_wall_advanced(s->walls[w], dt);
-}
-
-/* Forces for the current positions (neighbour list up to date). */
-static void compute_forces(cd_sim *sim)
+/* Forces for the current positions (neighbour list up to date), and with
+ * kick = 1 the second half kick. */
+static void compute_forces(cd_sim *sim, int kick)
 {
     pair_forces(sim);
     wall_forces(sim);
-    gather(sim);
-}
-
-/* Has some primitive end moved more than half the skin since the last
- * build?  On the device in the offload variant (one int comes back). */
-static int neighbors_needed(cd_sim *sim)
-{
-#if CD_OFFLOAD
-    if (sim->nb.force_rebuild) return 1;
-    cd_cols c = step_cols(sim);
-    cd_real limit2 = cd_bp_skin_limit2(sim->nb.skin);
-    size_t n = sim->s.n_prims;
-    int moved = 0;
-    CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c) reduction(|| : moved) map(tofrom : moved))
-    for (size_t i = 0; i < n; i++)
-        moved = moved || cd_bp_moved(c.prim_a[i], c.prim_a_ref[i], c.prim_b[i], c.prim_b_ref[i], limit2);
-    return moved;
-#else
-    return cd_neighbors_needed(sim);
-#endif
+    gather_kick(sim, kick);
 }
 
 static int rebuild(cd_sim *sim)
@@ -450,7 +427,7 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
     }
 #endif
     /* without compute the neighbour list is rebuilt at the first step */
-    if (compute) compute_forces(sim);
+    if (compute) compute_forces(sim, 0);
     return 0;
 }
 
@@ -458,15 +435,11 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
     for (long long it = 0; it < n; it++) {
-        kick(sim);
-        drift(sim);
-        update_prims(sim);
-        if (neighbors_needed(sim) && rebuild(sim)) {
+        if (advance(sim) && rebuild(sim)) {
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }
-        compute_forces(sim);
-        kick(sim);
+        compute_forces(sim, 1);
         s->step++;
         s->time += sim->p.dt;
     }

@@ -6,33 +6,18 @@
 #include "../step_items.h"
 #include "../broadphase.h"
 
-/* Step 1-2: first half kick and drift of particle q (the same item, as the
- * drift reads only its own particle); item w < n_walls also moves wall w. */
-__kernel void cd_cl_kick_drift(
+/* Steps 1-4: first half kick, drift, world ends of the particle's
+ * primitives and their skin test (cd_item_advance); any particle with a
+ * primitive past half the skin raises flags[0] (every writer writes 1, so
+ * the race is harmless); item w < n_walls also moves wall w. */
+__kernel void cd_cl_advance(
 #include "col_params.h"
-    __global cd_wall *walls, cd_int n_walls, cd_int n_particles, cd_real dt)
+    __global cd_wall *walls, cd_int n_walls, cd_int n_particles, cd_real dt, cd_real limit2, __global cd_int *flags)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
-    if (q < n_particles) {
-        cd_item_kick(c, q, CD_R(0.5) * dt);
-        cd_item_drift(c, q, dt);
-    }
+    if (q < n_particles && cd_item_advance(c, q, dt, limit2)) flags[0] = 1;
     if (q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
-}
-
-/* Step 3-4: world axis ends of primitive i and the skin criterion; any
- * primitive past half the skin raises flags[0] (every writer writes 1, so
- * the race is harmless). */
-__kernel void cd_cl_prim_ends(
-#include "col_params.h"
-    cd_int n_prims, cd_real limit2, __global cd_int *flags)
-{
-#include "col_bind.h"
-    cd_int i = (cd_int)get_global_id(0);
-    if (i >= n_prims) return;
-    cd_item_prim_ends(c, i);
-    if (cd_bp_moved(c.prim_a[i], c.prim_a_ref[i], c.prim_b[i], c.prim_b_ref[i], limit2)) flags[0] = 1;
 }
 
 /* Step 5: narrow phase and contact law of pair row k. */
