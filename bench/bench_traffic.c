@@ -21,32 +21,28 @@ void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS])
     double A = 0, Aw = 0; /* active pair rows, active wall rows */
     for (size_t k = 0; k < s->n_pairs; k++) A += s->pair_active[k] != 0;
     for (size_t r = 0; r < s->n_prims * s->n_walls; r++) Aw += s->wallc_active[r] != 0;
-    /* cd_item_kick: reads v, L, F, T (24 each), m (8), q (32), I (24);
-     * writes v, L, omega.  Twice per step. */
-    out[0] = (cd_traffic){"kick (x2)", 2 * N * 160, 2 * N * 72};
-    /* cd_item_drift: reads x, q, v, L, I; writes x, q, omega. */
-    out[1] = (cd_traffic){"drift", N * 128, N * 80};
-    /* cd_item_prim_ends: per primitive its particle (4) and body-frame ends
-     * (48), per particle the pose (56); writes the world ends. */
-    out[2] = (cd_traffic){"prim_ends", P * 52 + N * 56, P * 48};
-    /* the skin check: world ends and the ends at the last build */
-    out[3] = (cd_traffic){"skin_check", P * 96, 0};
+    /* advance (cd_item_advance: kick, drift, primitive ends, skin test):
+     * reads v, L, F, T, x (24 each), m (8), q (32), I (24) and per primitive
+     * its particle (4), body-frame ends (48) and ends at the last build
+     * (48); writes x, q, v, L, omega and the primitives' world ends (48). */
+    out[0] = (cd_traffic){"advance", N * 184 + P * 100, N * 128 + P * 48};
     /* cd_item_pair_force: every row its primitives and flag (12); the
      * primitives' particle, ends and radius (60); an active row its history
      * (24) and its particles' x, v, omega, m (80 per particle, counted for
      * every particle); writes flag, history, point, force, overlap, F_n. */
-    out[4] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 92};
+    out[1] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 92};
     /* cd_item_wall_forces: per primitive its particle, ends, radius (60) and
      * one flag per wall; an active row its history (24) and the particle's
      * x, v, omega, m (80); writes flag, history, force, torque, overlap, F_n. */
-    out[5] = (cd_traffic){"wall_forces", P * 60 + P * W * 4 + Aw * (24 + 80), Aw * 92};
-    /* cd_item_gather: per particle m, prim_first, prim_count, x, its CSR
-     * start (44); per primitive one wall flag per wall, per active wall row
-     * force and torque (48); per pair row two entries and two flag reads
-     * (16); per active row force and point from each side (2 x 48);
-     * writes F and T. */
-    out[6] = (cd_traffic){"gather", N * 44 + P * W * 4 + Aw * 48 + R * 16 + A * 96, N * 48};
+    out[2] = (cd_traffic){"wall_forces", P * 60 + P * W * 4 + Aw * (24 + 80), Aw * 92};
+    /* gather and second kick (cd_item_gather, cd_item_kick): per particle
+     * m, prim_first, prim_count, x, its CSR start (44) and v, L, q, I (104);
+     * per primitive one wall flag per wall, per active wall row force and
+     * torque (48); per pair row two entries and two flag reads (16); per
+     * active row force and point from each side (2 x 48); writes F, T, v,
+     * L, omega. */
+    out[3] = (cd_traffic){"gather_kick", N * 148 + P * W * 4 + Aw * 48 + R * 16 + A * 96, N * 120};
     /* the blow-up check at the end of cd_sim_step (x, v, L), amortised
      * over the steps of one call: counted once per step as an upper bound */
-    out[7] = (cd_traffic){"finite_check", N * 72, 0};
+    out[4] = (cd_traffic){"finite_check", N * 72, 0};
 }

@@ -3,10 +3,10 @@
 #define CD_BENCH_TRAFFIC_H
 #include "sim.h"
 
-enum { CD_TRAFFIC_KERNELS = 8 };
+enum { CD_TRAFFIC_KERNELS = 5 };
 
 typedef struct {
-    const char *kernel; /* the loop of src/step_omp.c (one OpenCL kernel or less) */
+    const char *kernel; /* the loop of src/step_omp.c (one OpenCL kernel) */
     double read, write; /* bytes per step [B] */
 } cd_traffic;
 
