@@ -13,14 +13,20 @@
  * step_items.h changes what it reads or writes, this table changes with
  * it. */
 #include "bench_traffic.h"
+#include "../kernels/broadphase.h"
 
 void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS])
 {
     const cd_state *s = &sim->s;
-    double N = (double)s->n_particles, P = (double)s->n_prims, R = (double)s->n_pairs, W = (double)s->n_walls;
+    double N = (double)s->n_particles, P = (double)s->n_prims, R = (double)s->n_pairs;
     double A = 0, Aw = 0; /* active pair rows, active wall rows */
     for (size_t k = 0; k < s->n_pairs; k++) A += s->pair_active[k] != 0;
     for (size_t r = 0; r < s->n_prims * s->n_walls; r++) Aw += s->wallc_active[r] != 0;
+    /* wall candidates as the next build would choose them (cd_item_wall_candidates) */
+    double C = 0;
+    for (size_t i = 0; i < s->n_prims; i++)
+        for (size_t w = 0; w < s->n_walls; w++)
+            C += cd_bp_wall_candidate(&s->walls[w], s->prim_a[i], s->prim_b[i], s->prim_radius[i], sim->nb.skin);
     /* advance (cd_item_advance: kick, drift, primitive ends, skin test):
      * reads v, L, F, T, x (24 each), m (8), q (32), I (24) and per primitive
      * its particle (4), body-frame ends (48) and ends at the last build
@@ -31,17 +37,19 @@ void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS])
      * (24) and its particles' x, v, omega, m (80 per particle, counted for
      * every particle); writes flag, history, point, force, overlap, F_n. */
     out[1] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 92};
-    /* cd_item_wall_forces: per primitive its particle, ends, radius (60) and
-     * one flag per wall; an active row its history (24) and the particle's
-     * x, v, omega, m (80); writes flag, history, force, torque, overlap, F_n. */
-    out[2] = (cd_traffic){"wall_forces", P * 60 + P * W * 4 + Aw * (24 + 80), Aw * 92};
+    /* cd_item_wall_row over the wall candidates: per candidate its entry,
+     * flag and primitive (particle, ends, radius: 4 + 4 + 60, an upper
+     * bound when a primitive has several); an active row its history (24)
+     * and the particle's x, v, omega, m (80); writes flag, history, force,
+     * torque, overlap, F_n. */
+    out[2] = (cd_traffic){"wall_forces", C * 68 + Aw * (24 + 80), Aw * 92};
     /* gather and second kick (cd_item_gather, cd_item_kick): per particle
-     * m, prim_first, prim_count, x, its CSR start (44) and v, L, q, I (104);
-     * per primitive one wall flag per wall, per active wall row force and
-     * torque (48); per pair row two entries and two flag reads (16); per
-     * active row force and point from each side (2 x 48); writes F, T, v,
-     * L, omega. */
-    out[3] = (cd_traffic){"gather_kick", N * 148 + P * W * 4 + Aw * 48 + R * 16 + A * 96, N * 120};
+     * m, x, its two CSR starts (40) and v, L, q, I (104); per wall
+     * candidate its entry and flag (8), per active wall row force and torque
+     * (48); per pair row two entries and two flag reads (16); per active
+     * row force and point from each side (2 x 48); writes F, T, v, L,
+     * omega. */
+    out[3] = (cd_traffic){"gather_kick", N * 144 + C * 8 + Aw * 48 + R * 16 + A * 96, N * 120};
     /* the blow-up check at the end of cd_sim_step (x, v, L), amortised
      * over the steps of one call: counted once per step as an upper bound */
     out[4] = (cd_traffic){"finite_check", N * 72, 0};

@@ -11,6 +11,7 @@
 #include "defs.h"
 #include "vec3.h"
 #include "segseg.h"
+#include "walls.h"
 
 /* Uniform grid.  Plain struct of 8-byte members: same layout in C and in
  * OpenCL, so it can live in a device buffer. */
@@ -191,6 +192,30 @@ CD_INLINE cd_real cd_bp_skin_limit2(cd_real skin) { return CD_R(0.25) * skin * s
 CD_INLINE int cd_bp_moved(cd_vec3 a, cd_vec3 a_ref, cd_vec3 b, cd_vec3 b_ref, cd_real limit2)
 {
     return cd_v3_norm2(cd_v3_sub(a, a_ref)) > limit2 || cd_v3_norm2(cd_v3_sub(b, b_ref)) > limit2;
+}
+
+/* Wall candidates.  A primitive (axis ends a, b, radius r [m]) is tested
+ * against wall w in the steps until the next build only if, at the build,
+ * it is not clearly apart from the wall with its radius grown by the whole
+ * skin [m]: until the next build its ends move at most half the skin (the
+ * skin criterion above) and the wall at most half the skin (cd_bp_wall_moved
+ * below), so a primitive left out stays clearly apart (walls.h) and its
+ * row stays inactive. */
+CD_INLINE int cd_bp_wall_candidate(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r, cd_real skin)
+{
+    return !cd_wall_clearly_apart(w, a, b, r + skin);
+}
+
+/* How far wall w has moved since its state ref at the last build, as the
+ * wall-candidate test needs it [m]: the displacement of its point bounds
+ * how far a plane moved along its normal and how far an axis or centre
+ * moved; a radius change counts twice, which covers the clearance of
+ * 1e-5 of the radius that the curved test of cd_wall_clearly_apart keeps.
+ * A rebuild is due when it exceeds half the skin. */
+CD_INLINE cd_real cd_bp_wall_moved(cd_wall w, cd_wall ref)
+{
+    cd_real dr = w.radius - ref.radius;
+    return cd_v3_norm(cd_v3_sub(w.point, ref.point)) + CD_R(2) * (dr < CD_R(0) ? -dr : dr);
 }
 
 CD_DEVICE_END

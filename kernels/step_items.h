@@ -141,70 +141,96 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     c.pair_fn[k] = f.fn;
 }
 
-/* Primitive i against every wall (SPEC 2, walls; SPEC 3): rows
- * i n_walls .. i n_walls + n_walls - 1 of the wall-contact columns.
- * wall_law: particle-wall law (its mu is replaced by each wall's friction). */
-CD_INLINE void cd_item_wall_forces(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_wall *walls, cd_int n_walls,
-                                   cd_law_params wall_law, cd_real dt, cd_real sin_parallel,
-                                   cd_int parallel_blend)
+/* Ends the contact of wall-contact row `row`: an inactive row holds zeros
+ * (the load sums read every row). */
+CD_INLINE void cd_wall_row_clear(cd_cols c, cd_long row)
 {
+    c.wallc_active[row] = 0;
+    c.wallc_shear[row] = cd_v3_zero();
+    c.wallc_overlap[row] = 0;
+    c.wallc_fn[row] = 0;
+}
+
+/* Wall-contact row `row` = i n_walls + w: primitive i against wall w (SPEC
+ * 2, walls; SPEC 3).  The step runs it for the candidate rows of the last
+ * neighbour-list build only (cd_item_wall_candidates).  wall_law: the
+ * particle-wall law (its mu is replaced by the wall's friction). */
+CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall *walls, cd_int n_walls,
+                                cd_law_params wall_law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend)
+{
+    cd_prim_id i = (cd_prim_id)(row / n_walls);
     cd_particle_id pi = c.prim_particle[i];
-    for (cd_int w = 0; w < n_walls; w++) {
-        cd_long row = (cd_long)i * n_walls + w;
-        cd_wall wall = walls[w]; /* private copy: the wall functions take private pointers */
-        cd_contact_geom g;
-        int apart = cd_wall_clearly_apart(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
-        if (!apart)
-            cd_wall_contact_rule(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, parallel_blend, &g);
-        if (apart || !(g.overlap > 0)) {
-            /* An inactive row holds zeros (the load sums read every row);
-             * it is written only when it changes, to spare the bandwidth. */
-            if (c.wallc_active[row]) {
-                c.wallc_active[row] = 0;
-                c.wallc_shear[row] = cd_v3_zero();
-                c.wallc_overlap[row] = 0;
-                c.wallc_fn[row] = 0;
-            }
-            continue;
-        }
-        cd_vec3 vi = cd_rigid_point_velocity(c.position[pi], c.velocity[pi], c.angvel[pi], g.point);
-        cd_vec3 vw = cd_wall_velocity_at(&wall, g.point);
-        cd_law_params law = wall_law;
-        law.mu = wall.friction;
-        cd_vec3 shear = c.wallc_shear[row];
-        /* The particle is body i, the wall body j of infinite mass. */
-        cd_contact_force f = cd_contact_law(law, c.mass[pi], &g, cd_v3_sub(vw, vi), dt, &shear);
-        cd_vec3 fi = cd_v3_neg(f.force_j);
-        c.wallc_active[row] = 1;
-        c.wallc_shear[row] = shear;
-        c.wallc_overlap[row] = g.overlap;
-        c.wallc_fn[row] = f.fn;
-        c.wallc_force[row] = fi;
-        c.wallc_torque[row] = cd_contact_torque(g.point, c.position[pi], fi);
+    cd_wall wall = walls[row % n_walls]; /* private copy: the wall functions take private pointers */
+    cd_contact_geom g;
+    int apart = cd_wall_clearly_apart(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
+    if (!apart) cd_wall_contact_rule(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, parallel_blend, &g);
+    if (apart || !(g.overlap > 0)) {
+        /* written only when it changes, to spare the bandwidth */
+        if (c.wallc_active[row]) cd_wall_row_clear(c, row);
+        return;
     }
+    cd_vec3 vi = cd_rigid_point_velocity(c.position[pi], c.velocity[pi], c.angvel[pi], g.point);
+    cd_vec3 vw = cd_wall_velocity_at(&wall, g.point);
+    cd_law_params law = wall_law;
+    law.mu = wall.friction;
+    cd_vec3 shear = c.wallc_shear[row];
+    /* The particle is body i, the wall body j of infinite mass. */
+    cd_contact_force f = cd_contact_law(law, c.mass[pi], &g, cd_v3_sub(vw, vi), dt, &shear);
+    cd_vec3 fi = cd_v3_neg(f.force_j);
+    c.wallc_active[row] = 1;
+    c.wallc_shear[row] = shear;
+    c.wallc_overlap[row] = g.overlap;
+    c.wallc_fn[row] = f.fn;
+    c.wallc_force[row] = fi;
+    c.wallc_torque[row] = cd_contact_torque(g.point, c.position[pi], fi);
+}
+
+/* Wall candidates of particle q at a neighbour-list build: the rows
+ * i n_walls + w of its primitives i and the walls w a primitive is not
+ * clearly apart from with its radius grown by the skin [m]
+ * (cd_bp_wall_candidate), in ascending order.  Writes them from out[0]
+ * unless out is null (the counting pass) and returns how many.  A row
+ * left out can hold no contact; one still marked active (impossible while
+ * the skin criteria hold) is ended, so that no stale force stays behind. */
+CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_wall *walls, cd_int n_walls,
+                                         cd_real skin, CD_GLOBAL cd_int *out)
+{
+    cd_int n = 0, first = c.prim_first[q], last = first + c.prim_count[q];
+    for (cd_int i = first; i < last; i++)
+        for (cd_int w = 0; w < n_walls; w++) {
+            cd_long row = (cd_long)i * n_walls + w;
+            cd_wall wall = walls[w];
+            if (cd_bp_wall_candidate(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], skin)) {
+                if (out) out[n] = (cd_int)row;
+                n++;
+            } else if (c.wallc_active[row]) {
+                cd_wall_row_clear(c, row);
+            }
+        }
+    return n;
 }
 
 /* Total force and torque of particle q: gravity [m/s^2] times its mass,
- * then its wall contacts primitive by primitive, then its pair rows in
- * ascending row order, so the sum has one fixed order on every backend.
+ * then its wall contacts (its candidate rows wall_rows[wall_start[q] ..
+ * wall_start[q+1]), ascending, i.e. primitive by primitive and wall by
+ * wall), then its pair rows in ascending row order, so the sum has one
+ * fixed order on every backend.
  * gather_rows[gather_start[q] .. gather_start[q+1]) hold 2 k + side for
  * pair row k: side 1 when q owns the row's primitive j (it gets +F_j), 0
  * when it owns primitive i (it gets -F_j), so the gather reads only the
  * row's force and point.  dimension 2 keeps the motion in the x-y plane. */
 CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
-                              const CD_GLOBAL cd_pair_id *gather_rows, cd_int n_walls, cd_vec3 gravity,
-                              cd_int dimension)
+                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
+                              const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension)
 {
     cd_vec3 F = cd_v3_scale(gravity, c.mass[q]);
     cd_vec3 T = cd_v3_zero();
-    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
-    for (cd_int i = first; i < last; i++)
-        for (cd_int w = 0; w < n_walls; w++) {
-            cd_long row = (cd_long)i * n_walls + w;
-            if (!c.wallc_active[row]) continue;
-            F = cd_v3_add(F, c.wallc_force[row]);
-            T = cd_v3_add(T, c.wallc_torque[row]);
-        }
+    for (cd_int r = wall_start[q]; r < wall_start[q + 1]; r++) {
+        cd_int row = wall_rows[r];
+        if (!c.wallc_active[row]) continue;
+        F = cd_v3_add(F, c.wallc_force[row]);
+        T = cd_v3_add(T, c.wallc_torque[row]);
+    }
     cd_vec3 x = c.position[q];
     for (cd_int r = gather_start[q]; r < gather_start[q + 1]; r++) {
         cd_pair_id e = gather_rows[r], k = e >> 1;

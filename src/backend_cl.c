@@ -8,6 +8,7 @@
 #include <string.h>
 #include "backend_cl.h"
 #include "../kernels/broadphase.h"
+#include "../kernels/step_items.h"
 
 #define F CD_CL_N_FIELDS /* first kernel argument after the columns */
 
@@ -17,7 +18,7 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
 {
     const cd_state *s = &sim->s;
     const cd_step_params *p = &sim->p;
-    cd_int N = (cd_int)s->n_particles, P = (cd_int)s->n_prims, W = (cd_int)s->n_walls, one = 1;
+    cd_int N = (cd_int)s->n_particles, W = (cd_int)s->n_walls, one = 1;
     cd_real dt = p->dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
     if (cl->cols_dirty) cd_cl_bind_cols(cl);
     cd_cl_arg(cl, CD_CLK_ADVANCE, F, sizeof cl->walls, &cl->walls);
@@ -30,20 +31,21 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 2, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 3, sizeof p->sin_parallel, &p->sin_parallel);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 4, sizeof p->parallel_blend, &p->parallel_blend);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F, sizeof P, &P);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->walls, &cl->walls);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 2, sizeof W, &W);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 3, sizeof p->wall_law, &p->wall_law);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 4, sizeof dt, &dt);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 5, sizeof p->sin_parallel, &p->sin_parallel);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 6, sizeof p->parallel_blend, &p->parallel_blend);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 2, sizeof cl->walls, &cl->walls);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 3, sizeof W, &W);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 4, sizeof p->wall_law, &p->wall_law);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 5, sizeof dt, &dt);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 6, sizeof p->sin_parallel, &p->sin_parallel);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 7, sizeof p->parallel_blend, &p->parallel_blend);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 1, sizeof cl->gather_start, &cl->gather_start);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof W, &W);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof p->gravity, &p->gravity);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->dimension, &p->dimension);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof one, &one);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof dt, &dt);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof cl->wall_start, &cl->wall_start);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->gravity, &p->gravity);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof p->dimension, &p->dimension);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 8, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F + 1, sizeof cl->flags, &cl->flags);
 }
@@ -54,6 +56,7 @@ static void set_list_args(cd_cl *cl)
     cd_int n = (cd_int)cl->n_pairs;
     if (cl->cols_dirty) cd_cl_bind_cols(cl);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F, sizeof n, &n);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F, sizeof cl->n_wall_rows, &cl->n_wall_rows);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 2, sizeof cl->gather_rows, &cl->gather_rows);
 }
 
@@ -66,7 +69,7 @@ static int forces(cd_cl *cl, cd_sim *sim, int rebuild)
         set_list_args(cl);
     }
     cd_cl_run(cl, CD_CLK_PAIR_FORCES, cl->n_pairs);
-    if (s->n_walls) cd_cl_run(cl, CD_CLK_WALL_FORCES, s->n_prims);
+    if (cl->n_wall_rows) cd_cl_run(cl, CD_CLK_WALL_FORCES, (size_t)cl->n_wall_rows);
     return cd_cl_run(cl, CD_CLK_GATHER_KICK, s->n_particles);
 }
 
@@ -107,11 +110,12 @@ static int cl_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
     if (cd_cl_buffers_create(cl, sim) || cd_cl_buffers_upload(cl, sim)) return fail(sim, err, errlen);
     set_step_args(cl, sim);
     set_list_args(cl);
+    memcpy(cl->host_walls, sim->s.walls, sizeof cl->host_walls);
     if (compute_forces) {
         cd_int no_kick = 0, one = 1;
-        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof no_kick, &no_kick);
+        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof no_kick, &no_kick);
         forces(cl, sim, 1);
-        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof one, &one);
+        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
     }
     /* Not compute_forces: the forces of the checkpoint are kept and the
      * list is rebuilt at the first step (sim->nb.force_rebuild is set), as
@@ -145,10 +149,17 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
         cd_cl_check(cl, clEnqueueWriteBuffer(cl->queue, cl->walls, CL_FALSE, 0, s->n_walls * sizeof(cd_wall), s->walls,
                                              0, NULL, NULL), "uploading the walls");
     set_step_args(cl, sim);
+    memcpy(cl->host_walls, s->walls, sizeof cl->host_walls);
     size_t items = s->n_particles > s->n_walls ? s->n_particles : s->n_walls;
     for (long long it = 0; it < n && !cl->status; it++) {
         cd_cl_run(cl, CD_CLK_ADVANCE, items);
+        /* the walls move on the device; their host mirror (the same
+         * arithmetic) tells whether one moved far enough for a rebuild */
         int rebuild = sim->nb.force_rebuild;
+        for (size_t w = 0; w < s->n_walls; w++) {
+            cl->host_walls[w] = cd_wall_advanced(cl->host_walls[w], sim->p.dt);
+            rebuild |= cd_bp_wall_moved(cl->host_walls[w], sim->nb.walls_ref[w]) > CD_R(0.5) * sim->nb.skin;
+        }
         if (!rebuild && !cl->status) {
             cd_int moved = 0; /* the one read per step */
             cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->flags, CL_TRUE, 0, sizeof moved, &moved, 0, NULL, NULL),

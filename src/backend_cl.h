@@ -19,7 +19,7 @@ enum cd_cl_kernel {
     CD_CLK_BOUNDS, CD_CLK_GRID, CD_CLK_BIN, CD_CLK_CELL_FILL, CD_CLK_PAIR_COLLECT, CD_CLK_PAIR_PLACE, CD_CLK_PAIR_FILL,
     CD_CLK_PAIR_KEYS,
     CD_CLK_PAIR_CARRY, CD_CLK_GATHER_COUNT, CD_CLK_GATHER_FILL, CD_CLK_GATHER_SORT,
-    CD_CLK_SCAN_BLOCKS, CD_CLK_SCAN_TOP, CD_CLK_SCAN_FILL,
+    CD_CLK_SCAN_BLOCKS, CD_CLK_SCAN_TOP, CD_CLK_SCAN_FILL, CD_CLK_WALL_CAND_COUNT, CD_CLK_WALL_CAND_FILL,
     CD_CLK_COUNT
 };
 
@@ -77,6 +77,11 @@ typedef struct cd_cl {
     cd_int slot;
     cl_mem gather_count, gather_start, gather_cursor, gather_rows;
     size_t gather_cap;
+    /* wall candidates of the last build (cd_item_wall_candidates): counts
+     * per particle, CSR offsets, rows (at most n_prims n_walls) */
+    cl_mem wall_count, wall_start, wall_rows;
+    cd_int n_wall_rows;
+    cd_wall host_walls[CD_MAX_WALLS]; /* the walls as the device moves them, for the rebuild test */
     int cols_dirty;             /* a column buffer changed: rebind the column arguments */
 } cd_cl;
 

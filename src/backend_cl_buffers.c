@@ -157,6 +157,10 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->gather_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_cursor = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the gather lists");
+    size_t wall_rows = (size_t)P * s->n_walls + 1;
+    cl->wall_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the wall lists");
+    cl->wall_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the wall lists");
+    cl->wall_rows = cd_cl_buffer(cl, wall_rows * sizeof(cd_int), "allocating the wall lists");
     if (cl->status) return -1;
     return cd_cl_bind_cols(cl);
 }
@@ -225,7 +229,7 @@ void cd_cl_buffers_release(cd_cl *cl)
     cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->partial, &cl->grid, &cl->part_cell,
                        &cl->part_bound, &cl->cell_count, &cl->cell_start, &cl->cell_cursor, &cl->cell_parts, &cl->pair_count,
                        &cl->pair_offset, &cl->block_sum, &cl->cand, &cl->gather_count, &cl->gather_start,
-                       &cl->gather_cursor, &cl->gather_rows};
+                       &cl->gather_cursor, &cl->gather_rows, &cl->wall_count, &cl->wall_start, &cl->wall_rows};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
     cl->cap_pairs = cl->gather_cap = 0;
 }

@@ -6,6 +6,7 @@
  * new key among the old sorted keys, and the per-particle gather lists.
  * The only transfer to the host is the number of pairs (one int), which
  * sizes the buffers. */
+#include <string.h>
 #include "backend_cl.h"
 #include "../kernels/broadphase.h"
 
@@ -97,6 +98,33 @@ static void gather_lists(cd_cl *cl, cd_int N, cd_int n_pairs)
     cd_cl_run(cl, CD_CLK_GATHER_SORT, (size_t)N);
 }
 
+/* Per-particle wall candidates (CSR wall_start / wall_rows, ascending):
+ * count, scan, fill; the number of rows comes back (the wall kernel's
+ * size), and the walls become the reference of the wall-motion test. */
+static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
+{
+    cd_int W = (cd_int)sim->s.n_walls;
+    cd_real skin = sim->nb.skin; /* [m] */
+    cl->n_wall_rows = 0; /* without walls the passes run too: wall_start all 0 for the gather */
+    for (int k = CD_CLK_WALL_CAND_COUNT; k <= CD_CLK_WALL_CAND_FILL; k++) {
+        cd_cl_arg(cl, k, F, sizeof N, &N);
+        cd_cl_arg(cl, k, F + 1, sizeof cl->walls, &cl->walls);
+        cd_cl_arg(cl, k, F + 2, sizeof W, &W);
+        cd_cl_arg(cl, k, F + 3, sizeof skin, &skin);
+    }
+    cd_cl_arg(cl, CD_CLK_WALL_CAND_COUNT, F + 4, sizeof cl->wall_count, &cl->wall_count);
+    cd_cl_run(cl, CD_CLK_WALL_CAND_COUNT, (size_t)N);
+    cd_cl_scan(cl, cl->wall_count, (size_t)N, cl->wall_start);
+    cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 4, sizeof cl->wall_start, &cl->wall_start);
+    cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 5, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_run(cl, CD_CLK_WALL_CAND_FILL, (size_t)N);
+    if (!cl->status)
+        cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->wall_start, CL_TRUE, (size_t)N * sizeof(cd_int),
+                                            sizeof cl->n_wall_rows, &cl->n_wall_rows, 0, NULL, NULL),
+                    "reading the number of wall candidates");
+    memcpy(sim->nb.walls_ref, cl->host_walls, sizeof sim->nb.walls_ref);
+}
+
 int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
 {
     const cd_state *s = &sim->s;
@@ -157,6 +185,7 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
         cd_cl_run(cl, CD_CLK_PAIR_CARRY, (size_t)n_new);
     }
     gather_lists(cl, N, n_new);
+    wall_lists(cl, sim, N);
 
     /* Reference ends for the skin criterion (its flag was cleared above). */
     copy(cl, cl->col[CD_CL_F_prim_a], cl->col[CD_CL_F_prim_a_ref], (size_t)P * sizeof(cd_vec3));

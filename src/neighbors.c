@@ -12,6 +12,7 @@
 #include <math.h>
 #include "sim.h"
 #include "../kernels/broadphase.h"
+#include "../kernels/step_items.h"
 
 /* Particles per block of the build: each block fills its own row buffer,
  * and the buffers are copied into the list in block order, so the rows
@@ -35,6 +36,8 @@ void cd_neighbors_free(cd_neighbors *nb)
 {
     free(nb->gather_start);
     free(nb->gather_rows);
+    free(nb->wall_start);
+    free(nb->wall_rows);
     free(nb->cell_start);
     free(nb->cell_parts);
     free(nb->part_cell);
@@ -81,6 +84,36 @@ static int build_gather(cd_sim *sim)
         nb->gather_rows[fill[s->prim_particle[s->pair_prim_i[k]]]++] = (cd_pair_id)(2 * k);
         nb->gather_rows[fill[s->prim_particle[s->pair_prim_j[k]]]++] = (cd_pair_id)(2 * k + 1);
     }
+    return 0;
+}
+
+/* The wall candidates of every particle (cd_item_wall_candidates): a
+ * counting pass, the offsets, a filling pass; then the walls become the
+ * reference of the wall-motion test. */
+static int build_wall_lists(cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    cd_neighbors *nb = &sim->nb;
+    size_t N = s->n_particles, rows = s->n_prims * s->n_walls;
+    if (rows > (size_t)INT32_MAX) {
+        fprintf(stderr, "capdem: %zu primitive-wall rows exceed the wall lists' limit of %d\n", rows, INT32_MAX);
+        return -1;
+    }
+    if (!nb->wall_start) nb->wall_start = calloc(N + 1, sizeof(cd_int));
+    if (!nb->wall_rows) nb->wall_rows = malloc((rows + 1) * sizeof(cd_int));
+    if (!nb->wall_start || !nb->wall_rows) return -1;
+    cd_cols c = cd_sim_host_cols(s);
+    const cd_wall *walls = s->walls;
+    cd_int W = (cd_int)s->n_walls;
+    cd_real skin = nb->skin;
+    cd_int *start = nb->wall_start, *out = nb->wall_rows;
+#pragma omp parallel for schedule(static) if (CD_PARALLEL(N))
+    for (size_t q = 0; q < N; q++) start[q + 1] = cd_item_wall_candidates(c, (cd_particle_id)q, walls, W, skin, NULL);
+    start[0] = 0;
+    for (size_t q = 0; q < N; q++) start[q + 1] += start[q];
+#pragma omp parallel for schedule(static) if (CD_PARALLEL(N))
+    for (size_t q = 0; q < N; q++) cd_item_wall_candidates(c, (cd_particle_id)q, walls, W, skin, out + start[q]);
+    memcpy(nb->walls_ref, s->walls, sizeof nb->walls_ref);
     return 0;
 }
 
@@ -274,7 +307,7 @@ int cd_neighbors_build(cd_sim *sim)
     free(old_shear);
     free(old_active);
 
-    if (build_gather(sim)) return -1;
+    if (build_gather(sim) || build_wall_lists(sim)) return -1;
     memcpy(s->prim_a_ref, s->prim_a, P * sizeof(cd_vec3));
     memcpy(s->prim_b_ref, s->prim_b, P * sizeof(cd_vec3));
     nb->force_rebuild = 0;

@@ -38,6 +38,13 @@ typedef struct {
     cd_int *gather_start;     /* n_particles + 1 */
     cd_pair_id *gather_rows;  /* 2 n_pairs */
     size_t gather_cap;
+    /* per-particle wall candidates (CSR): for particle p the wall-contact
+     * rows wall_rows[wall_start[p] .. wall_start[p+1]) that the steps until
+     * the next build test (kernels/step_items.h, cd_item_wall_candidates),
+     * ascending; walls_ref: the walls at that build (cd_bp_wall_moved) */
+    cd_int *wall_start;       /* n_particles + 1 */
+    cd_int *wall_rows;        /* at most n_prims n_walls */
+    cd_wall walls_ref[CD_MAX_WALLS];
     /* scratch: particles binned by cell (CSR), per-particle bounding radii,
      * per-primitive row counts, and one row buffer per block of particles */
     cd_int *cell_start, *cell_parts, *part_cell, *pair_count;

@@ -75,6 +75,8 @@ typedef struct {
     size_t *bytes;     /* per field: bytes mapped */
     void *gs_host, *gr_host; /* gather_start / gather_rows as mapped */
     size_t gs_bytes, gr_bytes;
+    void *ws_host, *wr_host; /* wall_start / wall_rows as mapped (fixed size) */
+    size_t ws_bytes, wr_bytes;
     double *part;      /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;       /* device addresses of the columns */
@@ -165,6 +167,18 @@ static void off_map_gather(cd_sim *sim, cd_off *o)
     } else {
         off_to(o->gs_host, o->gs_bytes);
     }
+    /* the wall lists: allocated once at their largest, mapped once */
+    if (!o->ws_host && nb->wall_start) {
+        o->ws_host = nb->wall_start;
+        o->ws_bytes = (sim->s.n_particles + 1) * sizeof(cd_int);
+        o->wr_host = nb->wall_rows;
+        o->wr_bytes = (sim->s.n_prims * sim->s.n_walls + 1) * sizeof(cd_int);
+        off_map(o->ws_host, o->ws_bytes);
+        off_map(o->wr_host, o->wr_bytes);
+    } else if (o->ws_host) {
+        off_to(o->ws_host, o->ws_bytes);
+        off_to(o->wr_host, (size_t)nb->wall_start[sim->s.n_particles] * sizeof(cd_int));
+    }
     if (o->gr_host != (void *)nb->gather_rows || o->gr_bytes != gr) {
         off_unmap(o->gr_host, o->gr_bytes);
         o->gr_host = nb->gather_rows;
@@ -182,6 +196,8 @@ static void off_release(cd_sim *sim)
     for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
     off_unmap(o->gs_host, o->gs_bytes);
     off_unmap(o->gr_host, o->gr_bytes);
+    off_unmap(o->ws_host, o->ws_bytes);
+    off_unmap(o->wr_host, o->wr_bytes);
     off_unmap(o->part, o->part_n * sizeof(double));
     free(o->part);
     free(o->host);
@@ -283,7 +299,10 @@ static int advance(cd_sim *sim)
     CD_STEP_FOR(n, firstprivate(c) reduction(| : moved) CD_DEV(map(tofrom : moved)))
     for (size_t q = 0; q < n; q++) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
     cd_state *s = &sim->s;
-    for (size_t w = 0; w < s->n_walls; w++) s->walls[w] = cd_wall_advanced(s->walls[w], dt);
+    for (size_t w = 0; w < s->n_walls; w++) {
+        s->walls[w] = cd_wall_advanced(s->walls[w], dt);
+        moved |= cd_bp_wall_moved(s->walls[w], sim->nb.walls_ref[w]) > CD_R(0.5) * sim->nb.skin;
+    }
     return moved || sim->nb.force_rebuild;
 }
 
@@ -300,20 +319,22 @@ static void pair_forces(cd_sim *sim)
     for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
 }
 
-/* One work item per primitive: its contacts with every wall.  The walls
- * stay host data (the protocol drives them): a few hundred bytes go out. */
+/* One work item per wall candidate of the last build (cd_item_wall_row).
+ * The walls stay host data (the protocol drives them): a few hundred bytes
+ * go out. */
 static void wall_forces(cd_sim *sim)
 {
     cd_cols c = step_cols(sim);
     const cd_wall *walls = sim->s.walls;
+    const cd_int *rows = sim->nb.wall_rows;
     cd_int W = (cd_int)sim->s.n_walls;
     cd_law_params law = sim->p.wall_law;
     cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
     cd_int blend = sim->p.parallel_blend;
-    size_t n = sim->s.n_prims;
+    size_t n = W ? (size_t)sim->nb.wall_start[sim->s.n_particles] : 0;
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, law) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
-    for (size_t i = 0; i < n; i++) cd_item_wall_forces(c, (cd_prim_id)i, walls, W, law, dt, sin_parallel, blend);
+    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], walls, W, law, dt, sin_parallel, blend);
 }
 
 /* One work item per particle: gravity plus its contacts in fixed order,
@@ -323,16 +344,16 @@ static void wall_forces(cd_sim *sim)
 static void gather_kick(cd_sim *sim, int kick)
 {
     cd_cols c = step_cols(sim);
-    const cd_int *gs = sim->nb.gather_start;
+    const cd_int *gs = sim->nb.gather_start, *ws = sim->nb.wall_start, *wr = sim->nb.wall_rows;
     const cd_pair_id *gr = sim->nb.gather_rows;
-    cd_int W = (cd_int)sim->s.n_walls, dim = sim->p.dimension;
+    cd_int dim = sim->p.dimension;
     cd_vec3 g = sim->p.gravity;
     cd_real h = 0.5 * sim->p.dt;
     size_t n = sim->s.n_particles;
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, g))
     for (size_t q = 0; q < n; q++) {
-        cd_item_gather(c, (cd_particle_id)q, gs, gr, W, g, dim);
+        cd_item_gather(c, (cd_particle_id)q, gs, gr, ws, wr, g, dim);
         if (kick) cd_item_kick(c, (cd_particle_id)q, h);
     }
 }

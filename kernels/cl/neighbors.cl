@@ -7,6 +7,7 @@
  * feeds a scan that sorts its output), so the result is the same on every
  * run. */
 #include "../broadphase.h"
+#include "../step_items.h"
 #include "../cols.h"
 
 /* Bounding radius of each particle of the chunk [g chunk, (g+1) chunk)
@@ -221,4 +222,27 @@ __kernel void cd_cl_gather_sort(cd_int n_particles, __global const cd_int *gathe
         }
         gather_rows[b] = v;
     }
+}
+
+/* Wall candidates, pass 1: how many rows particle q tests until the next
+ * build (cd_item_wall_candidates, which also ends a stale row). */
+__kernel void cd_cl_wall_cand_count(
+#include "col_params.h"
+    cd_int n_particles, __global const cd_wall *walls, cd_int n_walls, cd_real skin, __global cd_int *count)
+{
+#include "col_bind.h"
+    cd_int q = (cd_int)get_global_id(0);
+    if (q < n_particles) count[q] = cd_item_wall_candidates(c, q, walls, n_walls, skin, (__global cd_int *)0);
+}
+
+/* Pass 2, after the scan of the counts into wall_start: the rows, in
+ * ascending order within each particle's slice. */
+__kernel void cd_cl_wall_cand_fill(
+#include "col_params.h"
+    cd_int n_particles, __global const cd_wall *walls, cd_int n_walls, cd_real skin,
+    __global const cd_int *wall_start, __global cd_int *wall_rows)
+{
+#include "col_bind.h"
+    cd_int q = (cd_int)get_global_id(0);
+    if (q < n_particles) cd_item_wall_candidates(c, q, walls, n_walls, skin, wall_rows + wall_start[q]);
 }
