@@ -193,6 +193,85 @@ static void test_resumed_file_without_pair_force_equals_uninterrupted(void **sta
     unlink(cfgpath); unlink(full); unlink(part);
 }
 
+/* Wall candidates (docs/motion.md): a wall that moves into the packing is
+ * tested only against the primitives listed at the last build, and its own
+ * motion triggers the rebuilds.  Pressed by a plane (a piston) brought down
+ * to 1 mm above it and closing in at 0.1 m/s, and by the ball around it
+ * shrinking at 0.05 m/s, a settled pile gives the same bits
+ * as with a rebuild (hence fresh candidates) at every step. */
+static const char *pile_in_ball =
+    "run: {dt: 1.0e-5, steps: 0, seed: 5}\n"
+    "physics: {gravity: [0, -98.1, 0]}\n"
+    "material: {density: 1000, kn: 1.0e5, kt: 5.0e4, damping_normal: 0.2, friction: 0.5, wall_friction: 0.3}\n"
+    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 40, polydispersity: 0.2}]\n"
+    "domain: {type: ball, radius: 0.05, walls: [{type: plane, point: [0, 0.045, 0], normal: [0, -1, 0]}]}\n"
+    "init: {placement: lattice, clearance: 1.0, speed: 0.2}\n";
+
+/* Active wall-contact rows of the plane wall (wall 1: the ball is wall 0). */
+static double piston_contacts(const cd_sim *sim)
+{
+    double n = 0;
+    for (size_t i = 0; i < sim->s.n_prims; i++) n += sim->s.wallc_active[i * sim->s.n_walls + 1] != 0;
+    return n;
+}
+
+static void test_moving_walls_same_bits_with_rebuild_every_step(void **state)
+{
+    (void)state;
+    static cd_sim a, b;
+    cd_config ca, cb;
+    cdt_setup(&a, &ca, pile_in_ball);
+    cdt_setup(&b, &cb, pile_in_ball);
+    assert_int_equal(cd_sim_initial_forces(&a), 0);
+    assert_int_equal(cd_sim_initial_forces(&b), 0);
+    cdt_step(&a, 6000); /* 0.06 s under 10 g: a pile at the bottom of the ball */
+    cdt_step(&b, 6000);
+    assert_int_equal(a.s.n_walls, 2);
+    assert_int_equal(a.s.walls[0].type, CD_WALL_SPHERE);
+    assert_int_equal(a.s.walls[1].type, CD_WALL_PLANE);
+    char err[256];
+    double top = -1; /* highest point of the pile [m] */
+    for (size_t i = 0; i < a.s.n_prims; i++) {
+        double y = fmax(a.s.prim_a[i].y, a.s.prim_b[i].y) + a.s.prim_radius[i];
+        if (y > top) top = y;
+    }
+    for (cd_sim *sim = &a; sim; sim = sim == &a ? &b : NULL) {
+        for (size_t w = 0; w < 2; w++) {
+            cd_wall *wl = &sim->s.walls[w];
+            if (wl->type == CD_WALL_SPHERE) {
+                wl->radial_velocity = -0.05; /* [m/s] */
+            } else {
+                wl->point.y = top + 1e-3;
+                wl->velocity = cd_v3(0, -0.1, 0);
+            }
+        }
+        /* the host changed the walls: hand them to the backend again */
+        sim->backend->stop(sim);
+        if (cd_sim_start(sim, 0, err, sizeof err)) fail_msg("%s", err);
+    }
+    long long builds0 = a.nb.builds;
+    double wall_contacts = 0;
+    for (int it = 0; it < 40; it++) {
+        cdt_step(&a, 100);
+        for (int k = 0; k < 100; k++) {
+            b.nb.force_rebuild = 1;
+            cdt_step(&b, 1);
+        }
+        cd_observables o;
+        cd_sim_observe(&a, &o);
+        wall_contacts += o.n_wall_contacts;
+    }
+    print_message("%lld rebuilds in 4000 steps (walls moved 4 and 2 mm), %.0f wall contacts seen, %.0f with the piston "
+                  "at the end\n", a.nb.builds - builds0, wall_contacts, piston_contacts(&a));
+    assert_true(wall_contacts > 100);
+    assert_true(piston_contacts(&a) > 0);
+    assert_true(a.nb.builds - builds0 > 4); /* the walls' motion alone asks for one every skin/2 */
+    assert_true(a.nb.builds - builds0 < 4000);
+    assert_same_particles(&a.s, &b.s);
+    cd_sim_free(&a); cd_sim_free(&b);
+    cd_config_free(&ca); cd_config_free(&cb);
+}
+
 int main(void)
 {
     /* Parallelise every loop, however small, so that 2 threads really split
@@ -203,6 +282,7 @@ int main(void)
         cmocka_unit_test(test_history_survives_forced_rebuilds),
         cmocka_unit_test(test_resumed_run_equals_uninterrupted),
         cmocka_unit_test(test_resumed_file_without_pair_force_equals_uninterrupted),
+        cmocka_unit_test(test_moving_walls_same_bits_with_rebuild_every_step),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
