@@ -59,6 +59,7 @@ CD_INLINE void cd_rigid_cayley_axis(cd_quat *q, cd_vec3 *Lb, int k, cd_real a)
     if (k == 0) { tau = a * v.x; li = v.y; lj = v.z; }
     else if (k == 1) { tau = a * v.y; li = v.z; lj = v.x; }
     else { tau = a * v.z; li = v.x; lj = v.y; }
+    if (tau == CD_R(0)) return; /* the identity (2D: the x and y sub-rotations) */
     cd_real t2 = tau * tau, den = CD_R(1) / (CD_R(1) + t2);
     cd_real c = (CD_R(1) - t2) * den, s = CD_R(2) * tau * den;
     cd_real ni = c * li + s * lj, nj = c * lj - s * li;
