@@ -126,10 +126,11 @@ static void test_asymmetric_top_is_second_order(void **state)
 }
 
 /* Energy over many periods at the coarse step: the error oscillates with the
- * motion (relative amplitude of order (|w| dt)^2 / 10) and does not grow:
- * its largest value over the last tenth of the run is no larger than over
- * the first tenth (a drift of 1 % of the amplitude per period would fail
- * this within the 2000 periods). */
+ * motion (measured: relative amplitude 7.1e-5 at |w| dt = 0.064, bound
+ * 1e-3) and does not grow: its largest value over the last tenth of the
+ * run is within 5 % of that over the first tenth (measured: equal), which
+ * a drift of even 3e-5 of the amplitude per turn over the 1,800 turns in
+ * between would break. */
 static void test_asymmetric_top_energy_bounded(void **state)
 {
     (void)state;
