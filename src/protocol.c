@@ -337,7 +337,8 @@ static int apply_strain(cd_sim *sim, double eps, char *err, size_t errlen)
  * state is put at rest first (every velocity and angular momentum zero):
  * the relaxation criterion leaves out the particles without contacts, and
  * these rattlers keep nearly all the kinetic energy of a "relaxed" packing
- * (CI twin: > 99 %, 1e-9 to 1e-8 J against ~1e-11 J in the contacts).
+ * (CI twin, seeds 1-8: > 99 %, 0.8e-9 to 1.3e-8 J against ~1e-11 J in
+ * the particles that touch something).
  * Bouncing in their cages they make the strained run diverge from the
  * reference run chaotically, whatever the strain, and add to p - p_ref an
  * offset of order 1e-4 Pa that does not scale with the strain (K wrong by
