@@ -23,6 +23,50 @@ CD_INLINE cd_quat cd_q_normalize(cd_quat q)
     return cd_q(q.w * s, q.x * s, q.y * s, q.z * s);
 }
 
+/* q / |q| for a q within round-off of unit length, without a sqrt: with
+ * |q|^2 = 1 + e, (3 - |q|^2) / 2 = 1 - e/2 equals 1/sqrt(1 + e) up to
+ * 3 e^2 / 8, far below round-off for |e| ~ 1e-16.  Keeps products of unit
+ * quaternions from drifting off unit length over many steps. */
+CD_INLINE cd_quat cd_q_renormalize(cd_quat q)
+{
+    cd_real s = CD_R(0.5) * (CD_R(3) - (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z));
+    return cd_q(q.w * s, q.x * s, q.y * s, q.z * s);
+}
+
+/* sin x and cos x [rad] from +, -, *, floor only: every backend rounds these
+ * the same way (IEEE, contraction off), while libm's sin and cos differ
+ * between glibc and an OpenCL library in the last bit now and then, which
+ * a packing amplifies past the backend-parity bound (docs/motion.md).
+ * x is reduced by k pi/2 in three parts (Cody-Waite, the constants of
+ * fdlibm, exact products for |k| < 2^20), then Taylor polynomials on
+ * |r| <= pi/4 whose first omitted terms are below 2e-18: about 1 ulp.
+ * Rotation angles per step are small, where the reduction is skipped. */
+CD_INLINE void cd_sincos(cd_real x, cd_real *sin_x, cd_real *cos_x)
+{
+    cd_real k = CD_R(0), r = x;
+    if (!(x >= CD_R(-0.78539816339744828) && x <= CD_R(0.78539816339744828))) {
+        k = floor(x * CD_R(0.63661977236758138) + CD_R(0.5));
+        r = ((x - k * CD_R(1.57079632673412561417e+00)) - k * CD_R(6.07710050630396597660e-11)) -
+            k * CD_R(2.02226624871116645580e-21);
+    }
+    cd_real z = r * r;
+    cd_real ps = CD_R(-7.647163731819816e-13) + z * (CD_R(2.8114572543455206e-15) + z * CD_R(-8.22063524662433e-18));
+    ps = CD_R(-1.9841269841269841e-04) +
+         z * (CD_R(2.7557319223985893e-06) + z * (CD_R(-2.505210838544172e-08) + z * (CD_R(1.6059043836821613e-10) + z * ps)));
+    cd_real sr = r + r * z * (CD_R(-0.16666666666666666) + z * (CD_R(8.3333333333333332e-03) + z * ps));
+    cd_real pc = CD_R(-1.1470745597729725e-11) + z * (CD_R(4.779477332387385e-14) + z * CD_R(-1.5619206968586225e-16));
+    pc = CD_R(-1.3888888888888889e-03) +
+         z * (CD_R(2.4801587301587302e-05) + z * (CD_R(-2.755731922398589e-07) + z * (CD_R(2.08767569878681e-09) + z * pc)));
+    cd_real cr = CD_R(1) + z * (CD_R(-0.5) + z * (CD_R(4.1666666666666664e-02) + z * pc));
+    /* quadrant: k mod 4 (exact for |k| < 2^53; a non-finite x gives NaN) */
+    cd_real m = k - CD_R(4) * floor(CD_R(0.25) * k);
+    if (m == CD_R(0)) { *sin_x = sr; *cos_x = cr; }
+    else if (m == CD_R(1)) { *sin_x = cr; *cos_x = -sr; }
+    else if (m == CD_R(2)) { *sin_x = -sr; *cos_x = -cr; }
+    else if (m == CD_R(3)) { *sin_x = -cr; *cos_x = sr; }
+    else { *sin_x = x - x; *cos_x = x - x; } /* x not finite: NaN */
+}
+
 /* Rotation by angle [rad] about a unit axis. */
 CD_INLINE cd_quat cd_q_from_axis_angle(cd_vec3 axis, cd_real angle)
 {

@@ -32,12 +32,12 @@ CD_INLINE void cd_item_kick(cd_cols c, cd_particle_id q, cd_real h)
 /* Drift of particle q over dt [s]: position and free rotation (SPEC 4). */
 CD_INLINE void cd_item_drift(cd_cols c, cd_particle_id q, cd_real dt)
 {
-    cd_vec3 x = c.position[q];
+    cd_vec3 x = c.position[q], w;
     cd_quat o = c.orientation[q];
-    cd_rigid_drift(&x, &o, c.velocity[q], c.angmom[q], c.inertia[q], dt);
+    cd_rigid_drift_angvel(&x, &o, &w, c.velocity[q], c.angmom[q], c.inertia[q], dt);
     c.position[q] = x;
     c.orientation[q] = o;
-    c.angvel[q] = cd_rigid_angvel(o, c.angmom[q], c.inertia[q]);
+    c.angvel[q] = w;
 }
 
 /* A wall after moving for dt [s] with its translational and radial
