@@ -3,11 +3,13 @@
  * Snapshots: io_h5_snapshot.c; header and helpers: io_h5_write.c; reading
  * back: io_h5_read.c.  The layout, the order of writes and what a crash
  * leaves behind are documented in docs/output.md. */
+#define _POSIX_C_SOURCE 200809L
 #include "io_h5.h"
 #include "io_h5_internal.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* ---- observables (time series) ------------------------------------------ */
 
@@ -149,6 +151,7 @@ static cd_output *output_new(const char *path, char *err, size_t errlen)
     strcpy(o->path, path);
     o->file = o->step = o->time = o->walls = o->wall_type = H5I_INVALID_HID;
     o->c_offset = o->c_pi = o->c_pj = o->w_offset = o->w_index = o->control = H5I_INVALID_HID;
+    o->old_fd = -1;
     for (size_t k = 0; k < cd_n_fields; k++) o->cols[k].dset = H5I_INVALID_HID;
     return o;
 }
@@ -170,6 +173,9 @@ static void output_free(cd_output *o)
         free(o->obs[i].name);
     }
     if (o->file >= 0) H5Fclose(o->file);
+    /* CD_OUTPUT_REPLACE closed before its first snapshot: the old file stays */
+    if (o->tmp_path[0] && o->n_snap == 0) unlink(o->tmp_path);
+    if (o->old_fd >= 0) close(o->old_fd);
     free(o->obs);
     free(o->cols);
     free(o->buf_step);
@@ -185,8 +191,45 @@ static hid_t file_access(void)
     return fapl;
 }
 
+/* Opens the file that o will write: path itself, created exclusively, or
+ * (CD_OUTPUT_REPLACE of an existing path) a file beside it, with the old
+ * one locked until the first commit. */
+static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
+{
+    const char *target = path;
+    if (how == CD_OUTPUT_REPLACE) {
+        int fd = cdh5_target_lock(path, &o->old_dev, &o->old_ino, o->err, sizeof o->err);
+        if (fd == -1) return cdh5_report(o);
+        if (fd >= 0) {
+            o->old_fd = fd;
+            if (cdh5_target_aside(path, o->tmp_path, sizeof o->tmp_path, o->err, sizeof o->err)) return cdh5_report(o);
+            target = o->tmp_path;
+        }
+    } else if (how != CD_OUTPUT_NEW) {
+        return FAIL("%s: cd_output_create_mode: mode %d is not a way to create a file", path, (int)how);
+    }
+    hid_t fapl = file_access();
+    /* EXCL: never truncates; TRUNC only on the empty file mkstemp made for us */
+    o->file = H5Fcreate(target, target == path ? H5F_ACC_EXCL : H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    if (o->file < 0) {
+        if (target == path && access(path, F_OK) == 0)
+            return FAIL("%s exists (created by another process after the checks?): refused, the file is left as it is",
+                        path);
+        return FAIL("%s: cannot create the output file", target);
+    }
+    return 0;
+}
+
 cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
                             const cd_observable_info *obs, int n_obs, char *err, size_t errlen)
+{
+    return cd_output_create_mode(path, CD_OUTPUT_REPLACE, cfg, shapes, n_shapes, obs, n_obs, err, errlen);
+}
+
+cd_output *cd_output_create_mode(const char *path, enum cd_output_mode how, const cd_config *cfg,
+                                 const cd_shape *shapes, int n_shapes, const cd_observable_info *obs, int n_obs,
+                                 char *err, size_t errlen)
 {
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
@@ -195,10 +238,7 @@ cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_sha
         cdh5_quiet_end(&q);
         return NULL;
     }
-    hid_t fapl = file_access();
-    o->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    int rc = o->file < 0 ? FAIL("%s: cannot create the output file", path) : 0;
-    H5Pclose(fapl);
+    int rc = create_file(o, path, how);
     if (!rc) rc = obs_check(o, obs, n_obs);
     if (!rc) rc = cdh5_write_header(o, cfg, shapes, n_shapes);
     if (!rc) rc = obs_setup(o, obs, n_obs);

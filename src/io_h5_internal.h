@@ -108,7 +108,27 @@ struct cd_output {
     size_t buf_n;
     long long *buf_step;
     double *buf_time, *buf_val;
+    /* CD_OUTPUT_REPLACE until the first commit: the file written aside
+     * (tmp_path, "" once renamed to path) and the locked file it replaces
+     * (old_fd, -1 when none; its device and inode) */
+    char tmp_path[1024];
+    int old_fd;
+    unsigned long long old_dev, old_ino;
 };
+
+/* ---- output target: io_h5_target.c ------------------------------------------ */
+
+/* Opens the existing regular file path without truncating it and takes an
+ * exclusive flock on it (released by closing the descriptor; refused when
+ * another process holds a lock: HDF5 writers and readers lock their files).
+ * Returns the descriptor, -2 when path does not exist, -1 with a message. */
+int cdh5_target_lock(const char *path, unsigned long long *dev, unsigned long long *ino, char *err, size_t errlen);
+/* Creates an empty file with a unique name (mkstemp) next to path, with
+ * the permissions a plain create would give; its name into tmp. */
+int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t errlen);
+/* After the first commit: renames tmp_path over path, unless path no
+ * longer is the file locked at creation. */
+int cdh5_target_publish(cd_output *o);
 
 /* Every writer failure goes through FAIL: message into o->err (with the
  * HDF5 detail), printed to stderr, value -1. */

@@ -281,7 +281,8 @@ static int snapshot(cd_output *o, const cd_state *s)
     o->n_snap = n + 1;
     o->c_rows += m;
     o->w_rows += wm;
-    return 0;
+    /* CD_OUTPUT_REPLACE: the new file takes the old one's place now that it holds a snapshot */
+    return o->tmp_path[0] ? cdh5_target_publish(o) : 0;
 }
 
 int cd_output_snapshot(cd_output *o, const cd_state *s)

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include <sys/stat.h>
 #include "run.h"
 #include "sim.h"
 #include "io_h5.h"
@@ -91,6 +92,90 @@ static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables 
     return cd_output_thermo(out, sim->s.step, sim->s.time, row);
 }
 
+/* Whether paths a and b name the same file (device and inode; the same
+ * name when neither exists). */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    int ea = stat(a, &sa), eb = stat(b, &sb);
+    if (ea == 0 && eb == 0) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    return ea != 0 && eb != 0 && !strcmp(a, b);
+}
+
+/* --resume: the config given against the one stored in the run file, key
+ * by key.  0, or 2 (refused, message printed). */
+static int check_resume_config(const cd_run_options *opt, const cd_config *given)
+{
+    char err[2048];
+    char *text = cd_h5_read_config_text(opt->resume_path, err, sizeof err);
+    if (!text) {
+        fprintf(stderr, "capdem: --resume %s\n", err);
+        return 2;
+    }
+    char where[CD_PATH_MAX + 32];
+    snprintf(where, sizeof where, "%s:/parameters/config", opt->resume_path);
+    cd_config stored;
+    int rc = cd_config_parse(text, where, &stored, err, sizeof err);
+    free(text);
+    if (rc) {
+        fprintf(stderr, "capdem: --resume %s: the config stored in the run file is not valid for this capdem: %s\n",
+                opt->resume_path, err);
+        return 2;
+    }
+    static char refused[16384], accepted[16384];
+    int n = cd_config_resume_diff(&stored, given, opt->allow_change, opt->n_allow_change, refused, sizeof refused,
+                                  accepted, sizeof accepted);
+    cd_config_free(&stored);
+    if (accepted[0] && !opt->quiet)
+        fprintf(stderr, "capdem: --resume %s: %s changes keys that may change on a resume or were allowed:\n%s",
+                opt->resume_path, opt->config_path, accepted);
+    if (n == 0) return 0;
+    fprintf(stderr, "capdem: --resume %s: %s changes %d key%s of the run's own config (/parameters/config in the run "
+            "file) that set%s the physics or the set-up; a resume continues the same simulation, so this is refused:\n%s"
+            "capdem: pass --allow-change KEY for each change that is meant (it applies from the resumed step on; masses, "
+            "shapes and counts stay the file's), or start a new run\n",
+            opt->resume_path, opt->config_path, n, n == 1 ? "" : "s", n == 1 ? "s" : "", refused);
+    return 2;
+}
+
+/* Checks of the command line against the files, before anything is set up
+ * or written: 0, or 2 (refused, message printed). */
+static int check_files(const cd_run_options *opt, const cd_config *cfg, const cd_config *as_given)
+{
+    char err[2048], near[128];
+    const char *inputs[1] = {opt->config_path};
+    for (int i = 0; i < opt->n_allow_change; i++) {
+        if (!opt->resume_path) {
+            fprintf(stderr, "capdem: --allow-change %s: only a --resume compares configs\n", opt->allow_change[i]);
+            return 2;
+        }
+        if (!cd_config_key_known(opt->allow_change[i], near, sizeof near)) {
+            fprintf(stderr, "capdem: --allow-change %s: expected a config key (capdem run --help lists them)%s%s%s\n",
+                    opt->allow_change[i], near[0] ? "; did you mean " : "", near, near[0] ? "?" : "");
+            return 2;
+        }
+    }
+    if (opt->resume_path) {
+        if (opt->output_path && !same_file(opt->output_path, opt->resume_path)) {
+            fprintf(stderr, "capdem: --output %s with --resume %s: a resume appends to the file it resumes; copy %s "
+                    "to %s first and resume that copy\n", opt->output_path, opt->resume_path, opt->resume_path,
+                    opt->output_path);
+            return 2;
+        }
+        if (cd_output_check_target(opt->resume_path, CD_OUTPUT_RESUME, inputs, 1, err, sizeof err)) {
+            fprintf(stderr, "capdem: --resume %s\n", err);
+            return 2;
+        }
+        return check_resume_config(opt, as_given);
+    }
+    if (cd_output_check_target(cfg->output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, inputs, 1, err,
+                               sizeof err)) {
+        fprintf(stderr, "capdem: output %s\n", err);
+        return 2;
+    }
+    return 0;
+}
+
 int cd_run(const cd_run_options *opt)
 {
     char err[2048];
@@ -99,10 +184,16 @@ int cd_run(const cd_run_options *opt)
         fprintf(stderr, "capdem: %s\n", err);
         return 2;
     }
+    static cd_config as_given; /* the config as read (a shallow copy, not freed): what a resume compares */
+    as_given = cfg;
     if (opt->steps >= 0) cfg.steps = opt->steps;
     if (opt->output_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->output_path);
     if (!cfg.output[0]) snprintf(cfg.output, sizeof cfg.output, "%s.h5", cfg.name);
     if (opt->resume_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->resume_path);
+    if (check_files(opt, &cfg, &as_given)) {
+        cd_config_free(&cfg);
+        return 2;
+    }
 
     static cd_sim sim;
     if (cd_sim_setup(&sim, &cfg, err, sizeof err)) {
@@ -127,6 +218,21 @@ int cd_run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
+        /* On a resume the step count (--steps or run.steps) is the step to
+         * reach, counted from the start of the run, not a number of steps
+         * more: one behind the resumed step is refused. */
+        if (cfg.steps < sim.s.step) {
+            if (opt->steps >= 0)
+                fprintf(stderr, "capdem: --steps %lld: the run file %s is at step %lld already; on a resume --steps "
+                        "is the step to reach, counted from the start of the run: expected an integer >= %lld\n",
+                        cfg.steps, opt->resume_path, sim.s.step, sim.s.step);
+            else
+                fprintf(stderr, "capdem: %s: run.steps = %lld, but the run file %s is at step %lld already; on a "
+                        "resume it is the step to reach, counted from the start of the run: give --steps N with "
+                        "N >= %lld\n", opt->config_path, cfg.steps, opt->resume_path, sim.s.step, sim.s.step);
+            status = 2;
+            goto done;
+        }
         if (cd_sim_start(&sim, 0, err, sizeof err)) {
             fprintf(stderr, "capdem: %s\n", err);
             status = 2;
@@ -146,7 +252,8 @@ int cd_run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        out = cd_output_create(cfg.output, &cfg, sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
+        out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg, sim.shapes,
+                                    sim.n_shapes, info, n_obs, err, sizeof err);
     }
     if (!out) {
         fprintf(stderr, "capdem: %s\n", err);
