@@ -86,6 +86,32 @@ static void progress(progress_t *pg, const cd_sim *sim, long long total, int fin
     fflush(stderr);
 }
 
+/* After a failed step: whether the state blew up (a non-finite value, or a
+ * particle moving more than half the thinnest arm per step), and then what
+ * into cause.  A backend's own report of such a state may name a
+ * consequence (an overflowing neighbour list) rather than the cause. */
+static int blowup_cause(cd_sim *sim, char *cause, size_t len)
+{
+    char tmp[512];
+    cd_sim_sync(sim, tmp, sizeof tmp); /* the device's state, where there is one */
+    const cd_state *s = &sim->s;
+    if (cd_sim_check_state(sim, cause, len)) return 1;
+    double dmin = INFINITY, vmax = 0;
+    size_t qmax = 0;
+    for (size_t i = 0; i < s->n_prims; i++)
+        if (2 * s->prim_radius[i] < dmin) dmin = 2 * s->prim_radius[i];
+    for (size_t q = 0; q < s->n_particles; q++) {
+        double v = sqrt(s->velocity[q].x * s->velocity[q].x + s->velocity[q].y * s->velocity[q].y +
+                        s->velocity[q].z * s->velocity[q].z);
+        if (v > vmax) vmax = v, qmax = q;
+    }
+    if (!(vmax * sim->p.dt > 0.5 * dmin)) return 0;
+    snprintf(cause, len, "runaway velocity at step %lld (t = %.9g s): particle %zu moves at %.3g m/s, %.3g arm "
+             "diameters per step (dt = %g s): the run blew up; reduce run.dt or check the material parameters",
+             s->step, s->time, qmax, vmax, vmax * sim->p.dt / dmin, sim->p.dt);
+    return 1;
+}
+
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
 {
     observable_row(sim, o, row);
@@ -293,8 +319,10 @@ int cd_run(const cd_run_options *opt)
         long long to_control = cd_protocol_steps_until_control(&sim);
         if (n > to_control) n = to_control;
         if (cd_sim_step(&sim, n, err, sizeof err)) {
-            fprintf(stderr, "\ncapdem: run stopped: %s\ncapdem: %s keeps the snapshots written before step %lld\n",
-                    err, cfg.output, sim.s.step);
+            /* a blown-up state is named as such, whatever the backend tripped over first */
+            char cause[768];
+            fprintf(stderr, "\ncapdem: run stopped: %s\n", blowup_cause(&sim, cause, sizeof cause) ? cause : err);
+            fprintf(stderr, "capdem: %s keeps the snapshots written before step %lld\n", cfg.output, sim.s.step);
             status = 3;
             break;
         }
