@@ -13,6 +13,7 @@
 #include "sim.h"
 #include "io_h5.h"
 #include "protocol.h"
+#include "../kernels/rigid.h"
 
 enum { OBS_KT, OBS_KR, OBS_KC, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
 
@@ -84,6 +85,56 @@ static void progress(progress_t *pg, const cd_sim *sim, long long total, int fin
             pg->tty ? "\r" : "", sim->s.step, total, sim->s.time, rate * (double)sim->s.n_particles, eta,
             pg->tty ? (final ? "\n" : "   ") : "\n");
     fflush(stderr);
+}
+
+/* A new run: every arm on the inner side of every plane wall, by at least
+ * its radius: the placement (cd_sim_setup) fills the domain.type container, and domain.walls may cut
+ * through it (or face away from it).  Refused here, naming the particle and
+ * the wall, rather than as a huge overlap at the first step.  (Particles
+ * cannot overlap each other at set-up: the lattice and random placements
+ * keep their bounding spheres apart, init.exclusion: shape tests the arms.)
+ * Checked here, not in cd_sim_setup, because programs that place particles
+ * themselves after cd_sim_setup (tests) start from other positions. */
+static int check_wall_placement(const cd_sim *sim, char *err, size_t errlen)
+{
+    const cd_config *c = &sim->cfg;
+    const cd_state *s = &sim->s;
+    size_t first_extra = s->n_walls - (size_t)c->n_extra_walls;
+    for (size_t w = 0; w < s->n_walls; w++) {
+        const cd_wall *W = &s->walls[w];
+        if (W->type != CD_WALL_PLANE) continue;
+        size_t crossing = 0, worst_q = 0;
+        double worst = 0, worst_r = 0; /* [m] depth beyond the wall, arm radius */
+        for (size_t q = 0; q < s->n_particles; q++)
+            for (cd_int u = s->prim_first[q]; u < s->prim_first[q] + s->prim_count[q]; u++) {
+                cd_vec3 e[2] = {cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_a_body[u]),
+                                cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_b_body[u])};
+                double r = s->prim_radius[u], depth = 0;
+                for (int k = 0; k < 2; k++) {
+                    double d = cd_v3_dot(W->normal, cd_v3_sub(e[k], W->point)); /* [m] signed distance */
+                    if (r - d > depth) depth = r - d;
+                }
+                if (depth > 1e-9 * r) {
+                    if (depth > worst) worst = depth, worst_q = q, worst_r = r;
+                    crossing++;
+                    break;
+                }
+            }
+        if (!crossing) continue;
+        char wall[96];
+        if (w >= first_extra) snprintf(wall, sizeof wall, "domain.walls[%zu]", w - first_extra);
+        else snprintf(wall, sizeof wall, "wall %zu of domain.type %s", w, c->domain);
+        const cd_vec3 x = s->position[worst_q];
+        snprintf(err, errlen, "%s: %s (point [%g, %g, %g] m, normal [%g, %g, %g]) cuts through the start positions: "
+                 "%zu particle%s reach%s across it, the deepest particle %zu (particles[%d], centre [%g, %g, %g] m) by "
+                 "%g m (%.3g arm diameters) beyond the contact distance; every arm must start on the side the normal "
+                 "points to, at least its radius %g m away: move the wall, turn its normal, or shrink the domain",
+                 c->source_path, wall, W->point.x, W->point.y, W->point.z, W->normal.x, W->normal.y, W->normal.z,
+                 crossing, crossing == 1 ? "" : "s", crossing == 1 ? "es" : "", worst_q, (int)s->shape[worst_q], x.x,
+                 x.y, x.z, worst, worst / (2 * worst_r), worst_r);
+        return -1;
+    }
+    return 0;
 }
 
 /* After a failed step: whether the state blew up (a non-finite value, or a
@@ -272,6 +323,11 @@ int cd_run(const cd_run_options *opt)
         out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
     } else {
+        if (check_wall_placement(&sim, err, sizeof err)) {
+            fprintf(stderr, "capdem: %s\n", err);
+            status = 2;
+            goto done;
+        }
         cd_protocol_begin(&sim);
         if (cd_sim_start(&sim, 1, err, sizeof err)) {
             fprintf(stderr, "capdem: %s\n", err);
