@@ -123,9 +123,19 @@ int cdh5_obs_flush(cd_output *o)
 int cd_output_thermo(cd_output *o, long long step, double time, const double *values)
 {
     if (o->n_obs == 0) return 0;
+    if (o->io_failed) return -1; /* reported when it happened */
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
-    int rc = o->buf_n == CDH5_OBS_BLOCK ? cdh5_obs_flush(o) : 0;
+    int rc = 0;
+    if (o->buf_n == CDH5_OBS_BLOCK) {
+        unsigned long long bytes = 65536;
+        for (int i = 0; i < o->n_obs; i++)
+            bytes += cdh5_growth(o->obs[i].value, o->buf_n) + cdh5_growth(o->obs[i].step, o->buf_n) +
+                     cdh5_growth(o->obs[i].time, o->buf_n);
+        rc = cdh5_reserve(o, bytes, "the time series");
+        if (!rc) rc = cdh5_obs_flush(o);
+        if (rc) o->io_failed = 1;
+    }
     if (!rc) {
         o->buf_step[o->buf_n] = step;
         o->buf_time[o->buf_n] = time;
@@ -257,11 +267,18 @@ int cd_output_close(cd_output *o)
     if (!o) return 0;
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
-    int rc = cdh5_obs_flush(o);
-    if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
+    /* After a failed write nothing more is written (and nothing more said):
+     * the file keeps what its last commit left. */
+    int rc = o->io_failed ? -1 : cdh5_obs_flush(o);
+    if (!o->io_failed && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
     output_free(o);
     cdh5_quiet_end(&q);
     return rc;
+}
+
+void cd_h5_no_atexit(void)
+{
+    H5dont_atexit();
 }
 
 const char *cd_output_error(const cd_output *o)

@@ -77,6 +77,12 @@ const char *cd_output_error(const cd_output *o);
 /* Flushes and closes. Returns 0 or -1. */
 int cd_output_close(cd_output *o);
 
+/* To be called before any other HDF5 call of a program that writes run
+ * files: HDF5 then installs no exit handler.  (HDF5 1.10's exit handler
+ * closes the files still open, and crashes on a file whose close failed,
+ * as one does after a full disk.)  Every file is closed explicitly. */
+void cd_h5_no_atexit(void);
+
 /* Number of snapshots in a run file, or -1 (message in err). */
 int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
 

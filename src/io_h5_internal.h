@@ -114,7 +114,20 @@ struct cd_output {
     char tmp_path[1024];
     int old_fd;
     unsigned long long old_dev, old_ino;
+    int io_failed;                   /* a write failed or found no room: nothing more is written */
+    int writing;                     /* inside a snapshot, past its checks */
 };
+
+/* Makes sure bytes more can be written at the end of the file (the space
+ * is allocated with posix_fallocate past HDF5's end of allocation, so a
+ * full disk or a file size limit shows here, before anything of what
+ * follows is written, rather than halfway through a flush); -1 with a
+ * message naming what, and o->io_failed set, when it cannot. */
+int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what);
+/* Bytes the file grows by when add rows are appended to the chunked
+ * dataset d: the chunks those rows start (each allocated whole) and room
+ * for its chunk index to grow (0 when no chunk starts). */
+unsigned long long cdh5_growth(hid_t d, unsigned long long add);
 
 /* ---- output target: io_h5_target.c ------------------------------------------ */
 

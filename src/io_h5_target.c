@@ -152,3 +152,40 @@ int cd_output_check_target(const char *path, enum cd_output_mode how, const char
     close(fd);
     return 0;
 }
+
+unsigned long long cdh5_growth(hid_t d, unsigned long long add)
+{
+    if (d < 0 || add == 0) return 0;
+    hsize_t ch[3] = {1, 1, 1}, dims[3] = {0, 1, 1};
+    hid_t pl = H5Dget_create_plist(d);
+    int rank = pl < 0 ? -1 : H5Pget_chunk(pl, 3, ch);
+    if (pl >= 0) H5Pclose(pl);
+    if (rank <= 0 || cdh5_dims(d, dims) != rank) {
+        H5Eclear2(H5E_DEFAULT);
+        return 0;
+    }
+    hid_t t = H5Dget_type(d);
+    unsigned long long chunk = t < 0 ? 0 : H5Tget_size(t), across = 1;
+    if (t >= 0) H5Tclose(t);
+    for (int k = 0; k < rank && k < 3; k++) chunk *= ch[k];
+    for (int k = 1; k < rank && k < 3; k++) across *= (dims[k] + ch[k] - 1) / ch[k] ? (dims[k] + ch[k] - 1) / ch[k] : 1;
+    unsigned long long before = (dims[0] + ch[0] - 1) / ch[0], after = (dims[0] + add + ch[0] - 1) / ch[0];
+    unsigned long long fresh = (after - before) * across;
+    /* the new chunks, and room for the chunk index to grow by a node */
+    return fresh ? fresh * chunk + 8192 : 0;
+}
+
+int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what)
+{
+    haddr_t eoa = 0;
+    void *handle = NULL;
+    if (H5Fget_eoa(o->file, &eoa) < 0 || H5Fget_vfd_handle(o->file, H5P_DEFAULT, &handle) < 0 || !handle) {
+        H5Eclear2(H5E_DEFAULT);
+        return 0; /* a driver without a plain descriptor: no reservation */
+    }
+    int e = posix_fallocate(*(int *)handle, (off_t)eoa, (off_t)bytes);
+    if (e == 0 || e == EINVAL || e == EOPNOTSUPP || e == ENOSYS) return 0;
+    o->io_failed = 1;
+    return FAIL("%s: no room to write %s (up to %.2f MiB more): %s", o->path, what, (double)bytes / 1048576.0,
+                strerror(e));
+}

@@ -3,6 +3,7 @@
  * diagnostic when the run blows up. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -163,6 +164,19 @@ static int blowup_cause(cd_sim *sim, char *cause, size_t len)
     return 1;
 }
 
+/* After a failed write (message printed by the writer): what the file
+ * keeps and how to go on. */
+static void write_failed(const cd_run_options *opt, const cd_config *cfg, long long last_snap)
+{
+    if (last_snap < 0)
+        fprintf(stderr, "capdem: the run stops before its first snapshot%s\n",
+                opt->overwrite ? "; an existing file of that name is left as it was" : "");
+    else
+        fprintf(stderr, "capdem: the run stops; %s keeps its complete snapshots, the last at step %lld: make room, "
+                "then `capdem run %s --resume %s` continues from there\n", cfg->output, last_snap, opt->config_path,
+                cfg->output);
+}
+
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
 {
     observable_row(sim, o, row);
@@ -257,6 +271,12 @@ int cd_run(const cd_run_options *opt)
 {
     char err[2048];
     cd_config cfg;
+    cd_h5_no_atexit();
+#ifdef SIGXFSZ
+    /* a file size limit (ulimit -f) makes write() fail with EFBIG, reported
+     * as an I/O error, instead of killing the run */
+    signal(SIGXFSZ, SIG_IGN);
+#endif
     if (cd_config_load(opt->config_path, &cfg, err, sizeof err)) {
         fprintf(stderr, "capdem: %s\n", err);
         return 2;
@@ -353,6 +373,7 @@ int cd_run(const cd_run_options *opt)
                 !strcmp(cfg.domain, "box") ? sim.cfg.box_height : sim.cfg.cyl_height);
 
     cd_observables o;
+    long long last_snap = opt->resume_path ? sim.s.step : -1; /* step of the last snapshot committed */
     if (!opt->resume_path) {
         if (cd_sim_sync(&sim, err, sizeof err)) {
             fprintf(stderr, "capdem: %s\n", err);
@@ -360,7 +381,12 @@ int cd_run(const cd_run_options *opt)
             goto done;
         }
         cd_sim_observe(&sim, &o);
-        if (write_thermo(out, &sim, &o, row) || cd_output_snapshot(out, &sim.s)) { status = 1; goto done; }
+        if (write_thermo(out, &sim, &o, row) || cd_output_snapshot(out, &sim.s)) {
+            write_failed(opt, &cfg, -1);
+            status = 1;
+            goto done;
+        }
+        last_snap = sim.s.step;
     }
     progress_t pg = {isatty(STDERR_FILENO), now_seconds(), 0, sim.s.step};
     pg.last = pg.start;
@@ -410,9 +436,20 @@ int cd_run(const cd_run_options *opt)
                 status = 3;
                 break;
             }
-            if (write_thermo(out, &sim, &o, row)) { status = 1; break; }
+            if (write_thermo(out, &sim, &o, row)) {
+                write_failed(opt, &cfg, last_snap);
+                status = 1;
+                break;
+            }
         }
-        if ((snap_due || last) && cd_output_snapshot(out, &sim.s)) { status = 1; break; }
+        if (snap_due || last) {
+            if (cd_output_snapshot(out, &sim.s)) {
+                write_failed(opt, &cfg, last_snap);
+                status = 1;
+                break;
+            }
+            last_snap = sim.s.step;
+        }
         if (!opt->quiet) progress(&pg, &sim, cfg.steps, 0);
     }
     if (!opt->quiet && status == 0) progress(&pg, &sim, cfg.steps, 1);
