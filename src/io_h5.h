@@ -61,6 +61,13 @@ cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_sha
 cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_observable_info *obs, int n_obs,
                             char *err, size_t errlen);
 
+/* Records, after cd_output_reopen, the config a resume from step `step`
+ * runs with: /parameters/resumes/<k> (k = 0, 1, ... in the order of the
+ * resumes), the config text verbatim, attributes step and source_path;
+ * /parameters/config stays the run's first config.  Written with the next
+ * snapshot's flush. */
+int cd_output_note_resume(cd_output *o, long long step, const cd_config *cfg);
+
 /* Appends a snapshot: every PARTICLE column, the active contacts (every PAIR
  * column of the active rows) and the active wall contacts, the walls, time
  * and step.  Everything needed to resume bit for bit.  Flushes the file. */
@@ -99,5 +106,10 @@ int64_t cd_h5_wall_type(void);
 
 /* Reads the config text echoed in a run file (malloc'd, caller frees). */
 char *cd_h5_read_config_text(const char *path, char *err, size_t errlen);
+
+/* The config the run file's latest part ran with: that of its last resume
+ * (/parameters/resumes/<k>, cd_output_note_resume), else /parameters/config;
+ * the dataset's path into where.  Malloc'd, caller frees. */
+char *cd_h5_read_latest_config_text(const char *path, char *where, size_t wlen, char *err, size_t errlen);
 
 #endif

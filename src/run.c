@@ -197,14 +197,14 @@ static int same_file(const char *a, const char *b)
  * by key.  0, or 2 (refused, message printed). */
 static int check_resume_config(const cd_run_options *opt, const cd_config *given)
 {
-    char err[2048];
-    char *text = cd_h5_read_config_text(opt->resume_path, err, sizeof err);
+    char err[2048], dpath[64];
+    char *text = cd_h5_read_latest_config_text(opt->resume_path, dpath, sizeof dpath, err, sizeof err);
     if (!text) {
         fprintf(stderr, "capdem: --resume %s\n", err);
         return 2;
     }
-    char where[CD_PATH_MAX + 32];
-    snprintf(where, sizeof where, "%s:/parameters/config", opt->resume_path);
+    char where[CD_PATH_MAX + 96];
+    snprintf(where, sizeof where, "%s:%s", opt->resume_path, dpath);
     cd_config stored;
     int rc = cd_config_parse(text, where, &stored, err, sizeof err);
     free(text);
@@ -221,11 +221,11 @@ static int check_resume_config(const cd_run_options *opt, const cd_config *given
         fprintf(stderr, "capdem: --resume %s: %s changes keys that may change on a resume or were allowed:\n%s",
                 opt->resume_path, opt->config_path, accepted);
     if (n == 0) return 0;
-    fprintf(stderr, "capdem: --resume %s: %s changes %d key%s of the run's own config (/parameters/config in the run "
-            "file) that set%s the physics or the set-up; a resume continues the same simulation, so this is refused:\n%s"
+    fprintf(stderr, "capdem: --resume %s: %s changes %d key%s of the run's own config (%s in the run file) that "
+            "set%s the physics or the set-up; a resume continues the same simulation, so this is refused:\n%s"
             "capdem: pass --allow-change KEY for each change that is meant (it applies from the resumed step on; masses, "
             "shapes and counts stay the file's), or start a new run\n",
-            opt->resume_path, opt->config_path, n, n == 1 ? "" : "s", n == 1 ? "s" : "", refused);
+            opt->resume_path, opt->config_path, n, n == 1 ? "" : "s", dpath, n == 1 ? "s" : "", refused);
     return 2;
 }
 
@@ -341,6 +341,11 @@ int cd_run(const cd_run_options *opt)
             goto done;
         }
         out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
+        if (out && cd_output_note_resume(out, sim.s.step, &cfg)) {
+            cd_output_close(out);
+            out = NULL;
+            snprintf(err, sizeof err, "%s: cannot record the resume under /parameters/resumes", opt->resume_path);
+        }
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
     } else {
         if (check_wall_placement(&sim, err, sizeof err)) {

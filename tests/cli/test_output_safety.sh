@@ -90,6 +90,13 @@ if "$capdem" run cadence.yaml --resume r.h5 --steps 300 2> err && grep -q 'run.s
    && [ "$(snapshots r.h5)" = 6 ]; then ok; else bad "resume with another cadence and --steps 300: $(snapshots r.h5) snapshots, expected 6"; fi
 if "$capdem" run changed.yaml --quiet --resume r.h5 --allow-change material.kn --allow-change material.kt \
      --allow-change material.friction 2> err && [ "$(snapshots r.h5)" = 7 ]; then ok; else bad "resume with allowed changes"; fi
+# the allowed changes are recorded (/parameters/resumes/<k>), and the next
+# resume is compared with them: the same config needs no --allow-change
+h5dump -a /parameters/resumes/1/step r.h5 2> /dev/null | grep -q '(0): 300' && ok || bad "resume not recorded under /parameters/resumes/1"
+if "$capdem" run changed.yaml --quiet --resume r.h5 --steps 500 2> err && [ "$(snapshots r.h5)" = 8 ]; then ok
+else bad "second resume with the config of the last one"; fi
+expect 2 'material\.kn: 200000 in the run file, 100000 given' "back to the first config" -- run short.yaml --quiet --resume r.h5 --steps 600
+grep -q '/parameters/resumes/2 in the run file' err && ok || bad "the refusal does not name the config compared with"
 expect 2 'missing.h5: no such run file' "resume of a missing file" -- run a.yaml --quiet --resume missing.h5
 
 echo "$pass passed, $fails failed"
