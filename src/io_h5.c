@@ -221,14 +221,16 @@ static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
     hid_t fapl = file_access();
     /* EXCL: never truncates; TRUNC only on the empty file mkstemp made for us */
     o->file = H5Fcreate(target, target == path ? H5F_ACC_EXCL : H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    H5Pclose(fapl);
+    int rc = 0;
     if (o->file < 0) {
         if (target == path && access(path, F_OK) == 0)
-            return FAIL("%s exists (created by another process after the checks?): refused, the file is left as it is",
-                        path);
-        return FAIL("%s: cannot create the output file", target);
+            rc = FAIL("%s exists (created by another process after the checks?): refused, the file is left as it is",
+                      path);
+        else
+            rc = FAIL("%s: cannot create the output file", target); /* (before H5Pclose clears HDF5's error stack) */
     }
-    return 0;
+    H5Pclose(fapl);
+    return rc;
 }
 
 cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
@@ -245,6 +247,7 @@ cd_output *cd_output_create_mode(const char *path, enum cd_output_mode how, cons
     cdh5_quiet_begin(&q);
     cd_output *o = output_new(path, err, errlen);
     if (!o) {
+        fprintf(stderr, "capdem: %s\n", err);
         cdh5_quiet_end(&q);
         return NULL;
     }
@@ -381,6 +384,7 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
     cdh5_quiet_begin(&q);
     cd_output *o = output_new(path, err, errlen);
     if (!o) {
+        fprintf(stderr, "capdem: %s\n", err);
         cdh5_quiet_end(&q);
         return NULL;
     }

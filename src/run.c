@@ -341,10 +341,9 @@ int cd_run(const cd_run_options *opt)
             goto done;
         }
         out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
-        if (out && cd_output_note_resume(out, sim.s.step, &cfg)) {
+        if (out && cd_output_note_resume(out, sim.s.step, &cfg)) { /* (the writer says why) */
             cd_output_close(out);
             out = NULL;
-            snprintf(err, sizeof err, "%s: cannot record the resume under /parameters/resumes", opt->resume_path);
         }
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
     } else {
@@ -362,8 +361,7 @@ int cd_run(const cd_run_options *opt)
         out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg, sim.shapes,
                                     sim.n_shapes, info, n_obs, err, sizeof err);
     }
-    if (!out) {
-        fprintf(stderr, "capdem: %s\n", err);
+    if (!out) { /* the writer printed why (cd_output_* report every failure on stderr) */
         status = 1;
         goto done;
     }
