@@ -124,6 +124,9 @@ struct cd_output {
  * follows is written, rather than halfway through a flush); -1 with a
  * message naming what, and o->io_failed set, when it cannot. */
 int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what);
+/* -1 with a message (and o->io_failed) when the file has no name left
+ * (deleted, or its folder, while open), else 0. */
+int cdh5_check_linked(cd_output *o);
 /* Bytes the file grows by when add rows are appended to the chunked
  * dataset d: the chunks those rows start (each allocated whole) and room
  * for its chunk index to grow (0 when no chunk starts). */

@@ -189,3 +189,17 @@ int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what)
     return FAIL("%s: no room to write %s (up to %.2f MiB more): %s", o->path, what, (double)bytes / 1048576.0,
                 strerror(e));
 }
+
+int cdh5_check_linked(cd_output *o)
+{
+    void *handle = NULL;
+    struct stat st;
+    if (H5Fget_vfd_handle(o->file, H5P_DEFAULT, &handle) < 0 || !handle || fstat(*(int *)handle, &st) < 0) {
+        H5Eclear2(H5E_DEFAULT);
+        return 0;
+    }
+    if (st.st_nlink > 0) return 0;
+    o->io_failed = 1;
+    return FAIL("%s was deleted during the run (the file or its folder): the run stops, as what it writes could not "
+                "be read by anyone", o->tmp_path[0] ? o->tmp_path : o->path);
+}

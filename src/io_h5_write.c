@@ -234,6 +234,12 @@ int cd_output_note_resume(cd_output *o, long long step, const cd_config *cfg)
     while (cdh5_exists(o->file, p) && k < 1000000);
     const char *text = cfg && cfg->source_text ? cfg->source_text : "";
     size_t len = strlen(text);
+    /* room first, and written through at once: a full disk fails here with
+     * nothing of it left in HDF5's cache for a later flush */
+    if (o->io_failed || cdh5_reserve(o, len + 131072, p)) {
+        cdh5_quiet_end(&q);
+        return -1;
+    }
     hid_t t = H5Tcopy(H5T_C_S1);
     H5Tset_size(t, len ? len : 1);
     H5Tset_strpad(t, H5T_STR_NULLPAD);
@@ -247,6 +253,8 @@ int cd_output_note_resume(cd_output *o, long long step, const cd_config *cfg)
     }
     cdh5_close_dset(&d);
     H5Tclose(t);
+    if (!rc && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
+    if (rc) o->io_failed = 1;
     cdh5_quiet_end(&q);
     return rc;
 }

@@ -171,10 +171,12 @@ static void write_failed(const cd_run_options *opt, const cd_config *cfg, long l
     if (last_snap < 0)
         fprintf(stderr, "capdem: the run stops before its first snapshot%s\n",
                 opt->overwrite ? "; an existing file of that name is left as it was" : "");
+    else if (access(cfg->output, F_OK) != 0)
+        fprintf(stderr, "capdem: the run stops\n");
     else
-        fprintf(stderr, "capdem: the run stops; %s keeps its complete snapshots, the last at step %lld: make room, "
-                "then `capdem run %s --resume %s` continues from there\n", cfg->output, last_snap, opt->config_path,
-                cfg->output);
+        fprintf(stderr, "capdem: the run stops; %s keeps its complete snapshots, the last at step %lld: once the cause "
+                "is removed (room made), `capdem run %s --resume %s` continues from there\n", cfg->output, last_snap,
+                opt->config_path, cfg->output);
 }
 
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
