@@ -99,7 +99,7 @@ static int cmd_run(int argc, char **argv)
                    "  --allow-change KEY  with --resume: accept a changed KEY (e.g. material.friction); repeatable\n"
                    "  --steps N         run.steps: the step to reach, counted from step 0 of the run, also on a resume\n"
                    "                    (a resume at step S continues to N; N < S is refused)\n"
-                   "  --threads N       OpenMP threads (>= 1)\n"
+                   "  --threads N       OpenMP threads (1 to 4096)\n"
                    "Exit status: 0 done, 2 bad input (nothing written), 3 the run blew up (the snapshots written so far\n"
                    "stay readable), 1 other failures.\n\n"
                    "Config keys (YAML; SI units):\n");
