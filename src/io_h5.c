@@ -162,6 +162,7 @@ static cd_output *output_new(const char *path, char *err, size_t errlen)
     o->file = o->step = o->time = o->walls = o->wall_type = H5I_INVALID_HID;
     o->c_offset = o->c_pi = o->c_pj = o->w_offset = o->w_index = o->control = H5I_INVALID_HID;
     o->old_fd = -1;
+    o->own_lock = -1;
     for (size_t k = 0; k < cd_n_fields; k++) o->cols[k].dset = H5I_INVALID_HID;
     return o;
 }
@@ -186,6 +187,7 @@ static void output_free(cd_output *o)
     /* CD_OUTPUT_REPLACE closed before its first snapshot: the old file stays */
     if (o->tmp_path[0] && o->n_snap == 0) unlink(o->tmp_path);
     if (o->old_fd >= 0) close(o->old_fd);
+    if (o->own_lock >= 0) close(o->own_lock);
     free(o->obs);
     free(o->cols);
     free(o->buf_step);
@@ -230,6 +232,7 @@ static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
             rc = FAIL("%s: cannot create the output file", target); /* (before H5Pclose clears HDF5's error stack) */
     }
     H5Pclose(fapl);
+    if (!rc) rc = cdh5_own_lock(o, target);
     return rc;
 }
 
@@ -392,6 +395,7 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
     o->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
     int rc = o->file < 0 ? FAIL("%s: cannot open the run file for appending", path) : 0;
     H5Pclose(fapl);
+    if (!rc) rc = cdh5_own_lock(o, path);
     if (!rc && (!cdh5_exists(o->file, "/h5md") || !cdh5_exists(o->file, "/observables")))
         rc = FAIL("%s: not a capdem run file (no /h5md or /observables)", path);
     if (!rc) rc = obs_check(o, obs, n_obs);

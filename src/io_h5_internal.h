@@ -114,6 +114,7 @@ struct cd_output {
     char tmp_path[1024];
     int old_fd;
     unsigned long long old_dev, old_ino;
+    int own_lock;                    /* flock'ed descriptor of the file when HDF5 takes none, or -1 */
     int io_failed;                   /* a write failed or found no room: nothing more is written */
     int writing;                     /* inside a snapshot, past its checks */
 };
@@ -124,6 +125,11 @@ struct cd_output {
  * follows is written, rather than halfway through a flush); -1 with a
  * message naming what, and o->io_failed set, when it cannot. */
 int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what);
+/* With HDF5's own file locking switched off (HDF5_USE_FILE_LOCKING=FALSE
+ * or 0), takes the exclusive flock HDF5 would have taken on the open file
+ * (o->own_lock), so that cd_output_check_target still sees it in use;
+ * -1 with a message when another process holds it. */
+int cdh5_own_lock(cd_output *o, const char *opened_path);
 /* -1 with a message (and o->io_failed) when the file has no name left
  * (deleted, or its folder, while open), else 0. */
 int cdh5_check_linked(cd_output *o);

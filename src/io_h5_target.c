@@ -203,3 +203,14 @@ int cdh5_check_linked(cd_output *o)
     return FAIL("%s was deleted during the run (the file or its folder): the run stops, as what it writes could not "
                 "be read by anyone", o->tmp_path[0] ? o->tmp_path : o->path);
 }
+
+int cdh5_own_lock(cd_output *o, const char *opened_path)
+{
+    const char *env = getenv("HDF5_USE_FILE_LOCKING");
+    if (!env || (strcmp(env, "FALSE") && strcmp(env, "0"))) return 0; /* HDF5 holds the lock itself */
+    unsigned long long dev, ino;
+    int fd = cdh5_target_lock(opened_path, &dev, &ino, o->err, sizeof o->err);
+    if (fd == -1) return cdh5_report(o);
+    o->own_lock = fd >= 0 ? fd : -1; /* -2: the name vanished meanwhile (cdh5_check_linked will tell) */
+    return 0;
+}
