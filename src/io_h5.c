@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <errno.h>
+#include <fcntl.h>
 
 /* ---- observables (time series) ------------------------------------------ */
 
@@ -214,25 +216,29 @@ static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
         if (fd == -1) return cdh5_report(o);
         if (fd >= 0) {
             o->old_fd = fd;
-            if (cdh5_target_aside(path, o->tmp_path, sizeof o->tmp_path, o->err, sizeof o->err)) return cdh5_report(o);
+            if (cdh5_target_aside(path, o->tmp_path, sizeof o->tmp_path, o->err, sizeof o->err, &o->own_lock))
+                return cdh5_report(o);
             target = o->tmp_path;
         }
     } else if (how != CD_OUTPUT_NEW) {
         return FAIL("%s: cd_output_create_mode: mode %d is not a way to create a file", path, (int)how);
     }
-    hid_t fapl = file_access();
-    /* EXCL: never truncates; TRUNC only on the empty file mkstemp made for us */
-    o->file = H5Fcreate(target, target == path ? H5F_ACC_EXCL : H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    int rc = 0;
-    if (o->file < 0) {
-        if (target == path && access(path, F_OK) == 0)
-            rc = FAIL("%s exists (created by another process after the checks?): refused, the file is left as it is",
-                      path);
-        else
-            rc = FAIL("%s: cannot create the output file", target); /* (before H5Pclose clears HDF5's error stack) */
+    if (target == path) {
+        /* created here, exclusively, and marked before HDF5 writes a byte: a
+         * second capdem finds it in use from the start */
+        o->own_lock = open(path, O_RDWR | O_CREAT | O_EXCL | O_NOCTTY | O_CLOEXEC, 0666);
+        if (o->own_lock < 0)
+            return errno == EEXIST ? FAIL("%s exists (created by another process after the checks?): refused, the "
+                                          "file is left as it is", path)
+                                   : FAIL("%s: cannot create the output file: %s", path, strerror(errno));
+        cdh5_mark(o->own_lock);
     }
+    hid_t fapl = file_access();
+    /* TRUNC only on the empty file made here (or by mkstemp) */
+    o->file = H5Fcreate(target, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    int rc = o->file < 0 ? FAIL("%s: cannot create the output file", target) : 0; /* (before H5Pclose clears the stack) */
     H5Pclose(fapl);
-    if (!rc) rc = cdh5_own_lock(o, target);
+    if (rc && target == path) unlink(path); /* the empty file made above */
     return rc;
 }
 
@@ -395,7 +401,10 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
     o->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
     int rc = o->file < 0 ? FAIL("%s: cannot open the run file for appending", path) : 0;
     H5Pclose(fapl);
-    if (!rc) rc = cdh5_own_lock(o, path);
+    if (!rc) {
+        o->own_lock = open(path, O_RDONLY | O_NOCTTY | O_CLOEXEC);
+        if (o->own_lock >= 0) cdh5_mark(o->own_lock);
+    }
     if (!rc && (!cdh5_exists(o->file, "/h5md") || !cdh5_exists(o->file, "/observables")))
         rc = FAIL("%s: not a capdem run file (no /h5md or /observables)", path);
     if (!rc) rc = obs_check(o, obs, n_obs);

@@ -114,7 +114,7 @@ struct cd_output {
     char tmp_path[1024];
     int old_fd;
     unsigned long long old_dev, old_ino;
-    int own_lock;                    /* flock'ed descriptor of the file when HDF5 takes none, or -1 */
+    int own_lock;                    /* descriptor holding capdem's mark on the file (cdh5_mark), or -1 */
     int io_failed;                   /* a write failed or found no room: nothing more is written */
     int writing;                     /* inside a snapshot, past its checks */
 };
@@ -125,11 +125,9 @@ struct cd_output {
  * follows is written, rather than halfway through a flush); -1 with a
  * message naming what, and o->io_failed set, when it cannot. */
 int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what);
-/* With HDF5's own file locking switched off (HDF5_USE_FILE_LOCKING=FALSE
- * or 0), takes the exclusive flock HDF5 would have taken on the open file
- * (o->own_lock), so that cd_output_check_target still sees it in use;
- * -1 with a message when another process holds it. */
-int cdh5_own_lock(cd_output *o, const char *opened_path);
+/* Puts capdem's mark (an F_OFD_SETLK read lock, see io_h5_target.c) on
+ * the file open as fd; -1 when the file system has no such locks. */
+int cdh5_mark(int fd);
 /* -1 with a message (and o->io_failed) when the file has no name left
  * (deleted, or its folder, while open), else 0. */
 int cdh5_check_linked(cd_output *o);
@@ -146,8 +144,9 @@ unsigned long long cdh5_growth(hid_t d, unsigned long long add);
  * Returns the descriptor, -2 when path does not exist, -1 with a message. */
 int cdh5_target_lock(const char *path, unsigned long long *dev, unsigned long long *ino, char *err, size_t errlen);
 /* Creates an empty file with a unique name (mkstemp) next to path, with
- * the permissions a plain create would give; its name into tmp. */
-int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t errlen);
+ * the permissions a plain create would give and capdem's mark on it; its
+ * name into tmp, its descriptor into *fd (kept open while it is written). */
+int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t errlen, int *fd);
 /* After the first commit: renames tmp_path over path, unless path no
  * longer is the file locked at creation. */
 int cdh5_target_publish(cd_output *o);

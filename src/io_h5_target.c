@@ -2,7 +2,7 @@
  * not someone else's running output and not replaced before the new file
  * holds a snapshot; the locks and the write-aside-then-rename of
  * CD_OUTPUT_REPLACE.  Rules: docs/output.md, "Output safety". */
-#define _DEFAULT_SOURCE /* flock */
+#define _GNU_SOURCE /* flock, F_OFD_SETLK */
 #include "io_h5.h"
 #include "io_h5_internal.h"
 #include <errno.h>
@@ -13,6 +13,39 @@
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+/* capdem's mark on a file it writes: a read lock over the whole file held
+ * by the open file description (F_OFD_SETLK), taken right after the file is
+ * created or opened and kept until it is closed.  It does not conflict with
+ * the flock HDF5 takes on its own descriptor (flock and fcntl locks are
+ * separate on Linux), so it is held whether or not HDF5 locks
+ * (HDF5_USE_FILE_LOCKING), and cdh5_target_lock finds it with F_OFD_GETLK. */
+#ifdef F_OFD_SETLK
+#define CD_SETLK F_OFD_SETLK
+#define CD_GETLK F_OFD_GETLK
+#else
+#define CD_SETLK F_SETLK
+#define CD_GETLK F_GETLK
+#endif
+
+int cdh5_mark(int fd)
+{
+    struct flock l;
+    memset(&l, 0, sizeof l);
+    l.l_type = F_RDLCK;
+    l.l_whence = SEEK_SET;
+    return fcntl(fd, CD_SETLK, &l);
+}
+
+/* Whether another open file (another capdem) holds its mark on fd's file. */
+static int marked(int fd)
+{
+    struct flock l;
+    memset(&l, 0, sizeof l);
+    l.l_type = F_WRLCK;
+    l.l_whence = SEEK_SET;
+    return fcntl(fd, CD_GETLK, &l) == 0 && l.l_type != F_UNLCK;
+}
 
 int cdh5_target_lock(const char *path, unsigned long long *dev, unsigned long long *ino, char *err, size_t errlen)
 {
@@ -43,6 +76,12 @@ int cdh5_target_lock(const char *path, unsigned long long *dev, unsigned long lo
             return -1;
         }
     }
+    if (marked(fd)) {
+        snprintf(err, errlen, "%s is in use by another process (a running capdem): refused, the file is left as it is",
+                 path);
+        close(fd);
+        return -1;
+    }
     /* the name must still lead to the file locked (not to one renamed over it meanwhile) */
     if (stat(path, &now) < 0 || now.st_dev != st.st_dev || now.st_ino != st.st_ino) {
         snprintf(err, errlen, "%s was replaced by another process while it was being checked: refused", path);
@@ -63,7 +102,7 @@ static void folder_of(const char *path, char *buf, size_t len)
     else snprintf(buf, len, "%.*s", (int)(slash - path), path);
 }
 
-int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t errlen)
+int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t errlen, int *fd_out)
 {
     char dir[1024];
     folder_of(path, dir, sizeof dir);
@@ -82,7 +121,8 @@ int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t
     mode_t mask = umask(0); /* mkstemp gives 0600; a plain create 0666 & ~umask */
     umask(mask);
     fchmod(fd, 0666 & ~mask);
-    close(fd);
+    cdh5_mark(fd);
+    *fd_out = fd;
     return 0;
 }
 
@@ -202,15 +242,4 @@ int cdh5_check_linked(cd_output *o)
     o->io_failed = 1;
     return FAIL("%s was deleted during the run (the file or its folder): the run stops, as what it writes could not "
                 "be read by anyone", o->tmp_path[0] ? o->tmp_path : o->path);
-}
-
-int cdh5_own_lock(cd_output *o, const char *opened_path)
-{
-    const char *env = getenv("HDF5_USE_FILE_LOCKING");
-    if (!env || (strcmp(env, "FALSE") && strcmp(env, "0"))) return 0; /* HDF5 holds the lock itself */
-    unsigned long long dev, ino;
-    int fd = cdh5_target_lock(opened_path, &dev, &ino, o->err, sizeof o->err);
-    if (fd == -1) return cdh5_report(o);
-    o->own_lock = fd >= 0 ? fd : -1; /* -2: the name vanished meanwhile (cdh5_check_linked will tell) */
-    return 0;
 }

@@ -11,7 +11,7 @@ set -u
 capdem=$1
 work=$(mktemp -d)
 pid1=
-trap '[ -n "$pid1" ] && kill "$pid1" 2> /dev/null; rm -rf "$work"' EXIT
+trap '[ -n "$pid1" ] && kill -CONT "$pid1" 2> /dev/null && kill "$pid1" 2> /dev/null; rm -rf "$work"' EXIT
 cd "$work" || exit 1
 fails=0
 pass=0
@@ -56,35 +56,35 @@ expect 2 'folder no_such_dir does not exist' "missing folder" -- run a.yaml --qu
 [ -z "$(ls -A | grep '^\.r\.h5\.')" ] && ok || bad "--overwrite left a file beside the output: $(ls -A)"
 
 # ---- a second run on the file of a running one -----------------------------------
-printf '%s\nrun: {steps: 300000, snapshot_every: 60000}\n' "$base" > long.yaml
-"$capdem" run long.yaml --quiet --output same.h5 2> err1 &
-pid1=$!
-for _ in $(seq 100); do [ -f same.h5 ] && break; sleep 0.05; done
+# The first run is stopped (SIGSTOP) as soon as its file exists, so that the
+# second one surely meets it running, then continued to its end.
+printf '%s\nrun: {steps: 100000, snapshot_every: 20000}\n' "$base" > long.yaml
+# start_first FILE [ENV=VALUE]: the first run, stopped once FILE exists
+start_first() {
+  env ${2:-} "$capdem" run long.yaml --quiet --output "$1" 2> err1 &
+  pid1=$!
+  for _ in $(seq 1000); do [ -f "$1" ] && break; sleep 0.01; done
+  kill -STOP "$pid1" 2> /dev/null
+  sleep 0.05 # past HDF5's open-then-flock
+}
+# finish_first FILE NAME: continued, it ends with exit 0 and all its snapshots (0, 20000, ..., 100000)
+finish_first() {
+  kill -CONT "$pid1" 2> /dev/null
+  wait "$pid1"; local rc=$?; pid1=
+  [ $rc -eq 0 ] && [ "$(snapshots "$1")" = 6 ] && ok || { bad "$2: exit $rc, $(snapshots "$1") snapshots, expected 0 and 6"; cat err1; }
+}
+start_first same.h5
+kill -0 "$pid1" 2> /dev/null && ok || bad "the first run ended before it could be stopped"
 expect 2 'output same.h5 exists: refused' "second run, no --overwrite" -- run short.yaml --quiet --output same.h5 --steps 10
 expect 2 'same.h5 is in use by another process' "second run, --overwrite" -- run short.yaml --quiet --output same.h5 --steps 10 --overwrite
 expect 2 'same.h5 is in use by another process' "resume of a running run" -- run long.yaml --quiet --resume same.h5
-if kill -0 "$pid1" 2> /dev/null; then
-  wait "$pid1"; rc=$?; pid1=
-  # the first run ends normally, with all of its snapshots (0, 60000, ..., 300000)
-  [ $rc -eq 0 ] && [ "$(snapshots same.h5)" = 6 ] && ok || { bad "first run: exit $rc, $(snapshots same.h5) snapshots, expected 0 and 6"; cat err1; }
-else
-  wait "$pid1"; pid1=
-  bad "the first run ended before the second one was tried (machine too slow for this test's timing?)"
-fi
+finish_first same.h5 "first run"
 
 # the same with HDF5's own file locking switched off: capdem's lock holds
-HDF5_USE_FILE_LOCKING=FALSE "$capdem" run long.yaml --quiet --output nolock.h5 2> err1 &
-pid1=$!
-for _ in $(seq 100); do [ -f nolock.h5 ] && break; sleep 0.05; done
+start_first nolock.h5 HDF5_USE_FILE_LOCKING=FALSE
 HDF5_USE_FILE_LOCKING=FALSE expect 2 'nolock.h5 is in use by another process' "second run, --overwrite, HDF5 locking off" -- \
   run short.yaml --quiet --output nolock.h5 --steps 10 --overwrite
-if kill -0 "$pid1" 2> /dev/null; then
-  wait "$pid1"; rc=$?; pid1=
-  [ $rc -eq 0 ] && [ "$(snapshots nolock.h5)" = 6 ] && ok || bad "first run, HDF5 locking off: exit $rc, $(snapshots nolock.h5) snapshots"
-else
-  wait "$pid1"; pid1=
-  bad "the first run (HDF5 locking off) ended before the second one was tried"
-fi
+finish_first nolock.h5 "first run, HDF5 locking off"
 
 # ---- checked resumes -------------------------------------------------------------
 cp r.h5 before.h5
