@@ -37,6 +37,7 @@
  * untimed steps (first list build, lazy kernel compilation), so that one
  * invocation compares backends on the same packing. */
 #define _POSIX_C_SOURCE 200809L
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,6 +46,7 @@
 #include <omp.h>
 #include "sim.h"
 #include "io_h5.h"
+#include "config.h"
 #include "bench_cases.h"
 #include "bench_tile.h"
 #include "bench_traffic.h"
@@ -95,29 +97,48 @@ int main(int argc, char **argv)
     double gravity = 490.5; /* [m/s^2] after settling: the settling load */
     int threads = omp_get_max_threads();
     const char *backends = "omp", *device = "auto";
+    char perr[512];
+    long long v;
+    /* every number strictly (cd_parse_cli_int/real: whole argument, in range), exit 2 otherwise */
+#define INT_OPT(name, lo, hi, dst)                                                                              \
+    else if (!strcmp(argv[i], name)) {                                                                        \
+        if (cd_parse_cli_int(argv[i], argv[i + 1], lo, hi, &v, perr, sizeof perr)) return fail(perr, 2);      \
+        dst = v;                                                                                              \
+    }
     for (int i = 1; i < argc; i += 2) {
         if (i + 1 >= argc) { fprintf(stderr, "capdem-bench: %s needs a value\n", argv[i]); return 2; }
         if (!strcmp(argv[i], "--case")) case_name = argv[i + 1];
-        else if (!strcmp(argv[i], "--n")) n = atol(argv[i + 1]);
-        else if (!strcmp(argv[i], "--threads")) threads = atoi(argv[i + 1]);
-        else if (!strcmp(argv[i], "--settle-steps")) settle = atol(argv[i + 1]);
-        else if (!strcmp(argv[i], "--relax-steps")) relax = atol(argv[i + 1]);
-        else if (!strcmp(argv[i], "--gravity")) gravity = atof(argv[i + 1]);
-        else if (!strcmp(argv[i], "--steps")) steps = atol(argv[i + 1]);
-        else if (!strcmp(argv[i], "--repeat")) repeat = atol(argv[i + 1]);
+        INT_OPT("--n", 1, 2147483647LL, n)
+        INT_OPT("--threads", 1, 4096, threads)
+        INT_OPT("--settle-steps", 0, LLONG_MAX, settle)
+        INT_OPT("--relax-steps", 0, LLONG_MAX, relax)
+        INT_OPT("--steps", 1, LLONG_MAX, steps)
+        INT_OPT("--repeat", 0, LLONG_MAX, repeat)
+        INT_OPT("--seed", 0, 4294967295LL, seed)
+        else if (!strcmp(argv[i], "--gravity")) {
+            if (cd_parse_cli_real(argv[i], argv[i + 1], 0, HUGE_VAL, &gravity, perr, sizeof perr)) return fail(perr, 2);
+        }
         else if (!strcmp(argv[i], "--backend")) backends = argv[i + 1];
         else if (!strcmp(argv[i], "--device")) device = argv[i + 1];
-        else if (!strcmp(argv[i], "--seed")) seed = (unsigned)atol(argv[i + 1]);
         else if (!strcmp(argv[i], "--friction-limit")) friction_limit = argv[i + 1];
         else if (!strcmp(argv[i], "--save-settled")) save_path = argv[i + 1];
         else if (!strcmp(argv[i], "--load-settled")) load_path = argv[i + 1];
         else if (!strcmp(argv[i], "--tile")) {
-            if (sscanf(argv[i + 1], "%d,%d", &tile_x, &tile_z) != 2 || tile_x < 1 || tile_z < 1)
-                return fail("--tile: expected KX,KZ (copies along x and z, each >= 1)", 2);
+            char kx[32], *comma = strchr(argv[i + 1], ',');
+            long long tx, tz;
+            snprintf(kx, sizeof kx, "%.*s", comma ? (int)(comma - argv[i + 1]) : 0, argv[i + 1]);
+            if (!comma || cd_parse_cli_int("--tile KX", kx, 1, 1024, &tx, perr, sizeof perr) ||
+                cd_parse_cli_int("--tile KZ", comma + 1, 1, 1024, &tz, perr, sizeof perr)) {
+                fprintf(stderr, "capdem-bench: --tile %s: expected KX,KZ (copies along x and z, each an integer in "
+                        "[1, 1024])%s%s\n", argv[i + 1], comma ? ": " : "", comma ? perr : "");
+                return 2;
+            }
+            tile_x = (int)tx;
+            tile_z = (int)tz;
         }
         else { fprintf(stderr, "capdem-bench: unknown option %s\n", argv[i]); return 2; }
     }
-    if (n < 1 || steps < 1 || repeat < 0 || relax < 0 || threads < 1) return fail("--n, --steps, --threads must be >= 1", 2);
+#undef INT_OPT
     omp_set_num_threads(threads);
     char yaml[2048], err[2048];
     cd_config cfg;
@@ -170,8 +191,12 @@ int main(int argc, char **argv)
         /* "omp:1" runs that round with 1 thread: thread counts compared on
          * one packing in one invocation */
         char *colon = strchr(b, ':');
-        round_threads[n_backends] = colon ? atoi(colon + 1) : threads;
-        if (colon) *colon = 0;
+        round_threads[n_backends] = threads;
+        if (colon) {
+            if (cd_parse_cli_int("--backend NAME:THREADS", colon + 1, 1, 4096, &v, perr, sizeof perr)) return fail(perr, 2);
+            round_threads[n_backends] = (int)v;
+            *colon = 0;
+        }
         names[n_backends++] = b;
     }
     if (n_backends == 0) {

@@ -105,6 +105,31 @@ int cd_config_parse(const char *text, const char *name_for_errors, cd_config *c,
 
 void cd_config_free(cd_config *c);
 
+/* Compares, key by key, the config stored in a run file with the one given
+ * to resume it.  Each key whose value differs is written as a line
+ * "  KEY: A in the run file, B given" into accepted when the key may change
+ * on a resume (CD_KF_RESUMABLE in the key table: run length, output
+ * cadence, stopping criteria) or is named in allow (n_allow names, each a
+ * key such as "material.friction", "particles[].count" for every item or
+ * "particles[1].count" for one), else into refused.  A list with another
+ * number of items is the key of the list ("particles: 1 item ..., 2
+ * items given").  Returns the number of refused keys. */
+int cd_config_resume_diff(const cd_config *stored, const cd_config *given, const char *const *allow, int n_allow,
+                          char *refused, size_t rlen, char *accepted, size_t alen);
+
+/* 1 when name is a key of the table ("particles[0].count" and
+ * "particles[].count" both name particles[].count), else 0 with the
+ * nearest key, if any is close, in suggest. */
+int cd_config_key_known(const char *name, char *suggest, size_t n);
+
+/* Parses a whole command-line number strictly: optional sign, decimal
+ * digits only, nothing after them, within [lo, hi].  Returns 0, or -1 with
+ * "OPT VALUE: expected an integer in [lo, hi]" (or ">= lo") in err. */
+int cd_parse_cli_int(const char *opt, const char *s, long long lo, long long hi, long long *out, char *err,
+                     size_t errlen);
+/* The same for a real number (strtod forms, finite), within [lo, hi]. */
+int cd_parse_cli_real(const char *opt, const char *s, double lo, double hi, double *out, char *err, size_t errlen);
+
 /* Prints every key with type, unit, default and meaning (capdem run --help);
  * markdown: as the table of docs/config.md (capdem run --help-markdown). */
 void cd_config_print_keys(void *stream, int markdown);

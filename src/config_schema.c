@@ -36,7 +36,7 @@ _Static_assert(CD_WALL_PLANE == 0, "domain.walls[].type stores the index of \"pl
 
 const cd_key cd_config_keys[] = {
     /* run */
-    {"run.name", CD_KT_STRING, "-", "capdem", CFG_SIZED(name), .flags = CD_KF_NONEMPTY,
+    {"run.name", CD_KT_STRING, "-", "capdem", CFG_SIZED(name), .flags = CD_KF_NONEMPTY | CD_KF_RESUMABLE,
      .label = "run name", .meaning = "name of the run; the output file defaults to <name>.h5"},
     {"run.seed", CD_KT_UINT, "-", "1", CFG(seed),
      .label = "random seed", .meaning = "seed of the random numbers (placement, velocities, polydispersity)"},
@@ -44,17 +44,17 @@ const cd_key cd_config_keys[] = {
      .label = "time step", .meaning = "time step; refused above t_col/5 unless run.force_dt, warned above t_col/20"},
     {"run.steps_per_collision", CD_KT_REAL, "1", NULL, CFG(steps_per_collision), GE(5), .conflicts = "dt",
      .label = "steps per collision", .meaning = "instead of run.dt: dt = t_col / this, t_col of the lightest pair"},
-    {"run.steps", CD_KT_INT, "-", "10000", CFG_SIZED(steps), GE(0),
-     .label = "number of steps", .meaning = "steps to take"},
-    {"run.output", CD_KT_STRING, "path", "\"\"", CFG_SIZED(output),
+    {"run.steps", CD_KT_INT, "-", "10000", CFG_SIZED(steps), GE(0), .flags = CD_KF_RESUMABLE,
+     .label = "number of steps", .meaning = "steps to take: the step the run stops at, counted from step 0 (a resume continues up to it)"},
+    {"run.output", CD_KT_STRING, "path", "\"\"", CFG_SIZED(output), .flags = CD_KF_RESUMABLE,
      .label = "output file", .meaning = "HDF5 output file; empty: <name>.h5 in the working folder"},
-    {"run.snapshot_every", CD_KT_INT, "-", "1000", CFG_SIZED(snapshot_every), GE(1),
+    {"run.snapshot_every", CD_KT_INT, "-", "1000", CFG_SIZED(snapshot_every), GE(1), .flags = CD_KF_RESUMABLE,
      .label = "snapshot interval, steps", .meaning = "steps between full snapshots"},
-    {"run.thermo_every", CD_KT_INT, "-", "100", CFG_SIZED(thermo_every), GE(1),
+    {"run.thermo_every", CD_KT_INT, "-", "100", CFG_SIZED(thermo_every), GE(1), .flags = CD_KF_RESUMABLE,
      .label = "time-series interval, steps", .meaning = "steps between rows of the time series"},
-    {"run.force_dt", CD_KT_BOOL, "-", "false", CFG(force_dt),
+    {"run.force_dt", CD_KT_BOOL, "-", "false", CFG(force_dt), .flags = CD_KF_RESUMABLE,
      .label = "force the time step", .meaning = "run even when dt > t_col/5"},
-    {"run.max_overlap", CD_KT_REAL, "1", "0.5", CFG(max_overlap), GT(0), LE(2),
+    {"run.max_overlap", CD_KT_REAL, "1", "0.5", CFG(max_overlap), GT(0), LE(2), .flags = CD_KF_RESUMABLE,
      .label = "overlap limit", .meaning = "stop (exit 3) when an overlap exceeds this fraction of the arm diameter"},
 
     /* physics */
@@ -185,13 +185,13 @@ const cd_key cd_config_keys[] = {
      .label = "pressure", .meaning = "ball: pressure on the ball; 0: pressure_ratio x kn / L"},
     {"protocol.pressure_ratio", CD_KT_REAL, "1", "1e-5", CFG(pressure_ratio), GT(0), .applies = P_RADIAL | P_BULK,
      .label = "pressure ratio", .meaning = "ball: p L / kn when protocol.pressure is 0 (seed 001)"},
-    {"protocol.relax_ratio", CD_KT_REAL, "1", "1e-6", CFG(relax_ratio), GT(0), .applies = P_ANY,
+    {"protocol.relax_ratio", CD_KT_REAL, "1", "1e-6", CFG(relax_ratio), GT(0), .applies = P_ANY, .flags = CD_KF_RESUMABLE,
      .label = "relaxation ratio", .meaning = "relaxed when kinetic energy < relax_ratio x elastic energy"},
-    {"protocol.energy_tolerance", CD_KT_REAL, "1", "1e-3", CFG(energy_tolerance), GT(0), .applies = P_ANY,
+    {"protocol.energy_tolerance", CD_KT_REAL, "1", "1e-3", CFG(energy_tolerance), GT(0), .applies = P_ANY, .flags = CD_KF_RESUMABLE,
      .label = "elastic-energy tolerance", .meaning = "...and the elastic energy changed by less than this fraction since the last check"},
-    {"protocol.check_every", CD_KT_INT, "-", "1000", CFG_SIZED(check_every), GE(1), .applies = P_ANY,
+    {"protocol.check_every", CD_KT_INT, "-", "1000", CFG_SIZED(check_every), GE(1), .applies = P_ANY, .flags = CD_KF_RESUMABLE,
      .label = "check interval, steps", .meaning = "steps between checks of the relaxation criterion"},
-    {"protocol.relax_sample", CD_KT_INT, "-", "0", CFG_SIZED(relax_sample), GE(0), .applies = P_ANY,
+    {"protocol.relax_sample", CD_KT_INT, "-", "0", CFG_SIZED(relax_sample), GE(0), .applies = P_ANY, .flags = CD_KF_RESUMABLE,
      .label = "relaxation sample interval, steps",
      .meaning = "> 0: the kinetic/elastic ratio is sampled this often, and a check passes only if every sample since the last one was below relax_ratio; 0: the check's own ratio only"},
     {"protocol.strain_max", CD_KT_REAL, "1", "1e-6", CFG(strain_max), GT(0), LT(0.1), .applies = P_BULK,
@@ -488,6 +488,8 @@ static void key_texts(const cd_key *k, char *def, size_t ndef, char *cond, size_
         mask_text(sel, required, m, sizeof m);
         snprintf(cond + strlen(cond), ncond - strlen(cond), " Required for %s = %s.", sel->path, m);
     }
+    if (k->flags & CD_KF_RESUMABLE)
+        snprintf(cond + strlen(cond), ncond - strlen(cond), " May change on --resume.");
     if (k->conflicts) {
         size_t sl = cd_key_section_len(k->path);
         snprintf(cond + strlen(cond), ncond - strlen(cond), " Not together with %.*s.%s.", (int)sl, k->path, k->conflicts);

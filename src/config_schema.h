@@ -38,7 +38,9 @@ enum {
     CD_KF_DERIVED  = 1u << 0, /* def describes a rule applied after reading, not a literal */
     CD_KF_SELECTOR = 1u << 1, /* this enum's value decides which sibling keys apply */
     CD_KF_UNIT     = 1u << 2, /* vec3 that must be nonzero; stored normalised */
-    CD_KF_NONEMPTY = 1u << 3  /* string that must not be empty */
+    CD_KF_NONEMPTY = 1u << 3, /* string that must not be empty */
+    CD_KF_RESUMABLE = 1u << 4 /* may differ from the run file's config on --resume (run length, output cadence,
+                               * stopping criteria): neither the physics nor the set-up */
 };
 
 #define CD_ALL_CHOICES (~0u)

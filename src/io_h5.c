@@ -3,11 +3,15 @@
  * Snapshots: io_h5_snapshot.c; header and helpers: io_h5_write.c; reading
  * back: io_h5_read.c.  The layout, the order of writes and what a crash
  * leaves behind are documented in docs/output.md. */
+#define _POSIX_C_SOURCE 200809L
 #include "io_h5.h"
 #include "io_h5_internal.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+#include <errno.h>
+#include <fcntl.h>
 
 /* ---- observables (time series) ------------------------------------------ */
 
@@ -121,9 +125,19 @@ int cdh5_obs_flush(cd_output *o)
 int cd_output_thermo(cd_output *o, long long step, double time, const double *values)
 {
     if (o->n_obs == 0) return 0;
+    if (o->io_failed) return -1; /* reported when it happened */
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
-    int rc = o->buf_n == CDH5_OBS_BLOCK ? cdh5_obs_flush(o) : 0;
+    int rc = 0;
+    if (o->buf_n == CDH5_OBS_BLOCK) {
+        unsigned long long bytes = 65536;
+        for (int i = 0; i < o->n_obs; i++)
+            bytes += cdh5_growth(o->obs[i].value, o->buf_n) + cdh5_growth(o->obs[i].step, o->buf_n) +
+                     cdh5_growth(o->obs[i].time, o->buf_n);
+        rc = cdh5_reserve(o, bytes, "the time series");
+        if (!rc) rc = cdh5_obs_flush(o);
+        if (rc) o->io_failed = 1;
+    }
     if (!rc) {
         o->buf_step[o->buf_n] = step;
         o->buf_time[o->buf_n] = time;
@@ -149,6 +163,8 @@ static cd_output *output_new(const char *path, char *err, size_t errlen)
     strcpy(o->path, path);
     o->file = o->step = o->time = o->walls = o->wall_type = H5I_INVALID_HID;
     o->c_offset = o->c_pi = o->c_pj = o->w_offset = o->w_index = o->control = H5I_INVALID_HID;
+    o->old_fd = -1;
+    o->own_lock = -1;
     for (size_t k = 0; k < cd_n_fields; k++) o->cols[k].dset = H5I_INVALID_HID;
     return o;
 }
@@ -170,6 +186,10 @@ static void output_free(cd_output *o)
         free(o->obs[i].name);
     }
     if (o->file >= 0) H5Fclose(o->file);
+    /* CD_OUTPUT_REPLACE closed before its first snapshot: the old file stays */
+    if (o->tmp_path[0] && o->n_snap == 0) unlink(o->tmp_path);
+    if (o->old_fd >= 0) close(o->old_fd);
+    if (o->own_lock >= 0) close(o->own_lock);
     free(o->obs);
     free(o->cols);
     free(o->buf_step);
@@ -185,20 +205,62 @@ static hid_t file_access(void)
     return fapl;
 }
 
+/* Opens the file that o will write: path itself, created exclusively, or
+ * (CD_OUTPUT_REPLACE of an existing path) a file beside it, with the old
+ * one locked until the first commit. */
+static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
+{
+    const char *target = path;
+    if (how == CD_OUTPUT_REPLACE) {
+        int fd = cdh5_target_lock(path, &o->old_dev, &o->old_ino, o->err, sizeof o->err);
+        if (fd == -1) return cdh5_report(o);
+        if (fd >= 0) {
+            o->old_fd = fd;
+            if (cdh5_target_aside(path, o->tmp_path, sizeof o->tmp_path, o->err, sizeof o->err, &o->own_lock))
+                return cdh5_report(o);
+            target = o->tmp_path;
+        }
+    } else if (how != CD_OUTPUT_NEW) {
+        return FAIL("%s: cd_output_create_mode: mode %d is not a way to create a file", path, (int)how);
+    }
+    if (target == path) {
+        /* created here, exclusively, and marked before HDF5 writes a byte: a
+         * second capdem finds it in use from the start */
+        o->own_lock = open(path, O_RDWR | O_CREAT | O_EXCL | O_NOCTTY | O_CLOEXEC, 0666);
+        if (o->own_lock < 0)
+            return errno == EEXIST ? FAIL("%s exists (created by another process after the checks?): refused, the "
+                                          "file is left as it is", path)
+                                   : FAIL("%s: cannot create the output file: %s", path, strerror(errno));
+        cdh5_mark(o->own_lock);
+    }
+    hid_t fapl = file_access();
+    /* TRUNC only on the empty file made here (or by mkstemp) */
+    o->file = H5Fcreate(target, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    int rc = o->file < 0 ? FAIL("%s: cannot create the output file", target) : 0; /* (before H5Pclose clears the stack) */
+    H5Pclose(fapl);
+    if (rc && target == path) unlink(path); /* the empty file made above */
+    return rc;
+}
+
 cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
                             const cd_observable_info *obs, int n_obs, char *err, size_t errlen)
+{
+    return cd_output_create_mode(path, CD_OUTPUT_REPLACE, cfg, shapes, n_shapes, obs, n_obs, err, errlen);
+}
+
+cd_output *cd_output_create_mode(const char *path, enum cd_output_mode how, const cd_config *cfg,
+                                 const cd_shape *shapes, int n_shapes, const cd_observable_info *obs, int n_obs,
+                                 char *err, size_t errlen)
 {
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
     cd_output *o = output_new(path, err, errlen);
     if (!o) {
+        fprintf(stderr, "capdem: %s\n", err);
         cdh5_quiet_end(&q);
         return NULL;
     }
-    hid_t fapl = file_access();
-    o->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    int rc = o->file < 0 ? FAIL("%s: cannot create the output file", path) : 0;
-    H5Pclose(fapl);
+    int rc = create_file(o, path, how);
     if (!rc) rc = obs_check(o, obs, n_obs);
     if (!rc) rc = cdh5_write_header(o, cfg, shapes, n_shapes);
     if (!rc) rc = obs_setup(o, obs, n_obs);
@@ -217,11 +279,18 @@ int cd_output_close(cd_output *o)
     if (!o) return 0;
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
-    int rc = cdh5_obs_flush(o);
-    if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
+    /* After a failed write nothing more is written (and nothing more said):
+     * the file keeps what its last commit left. */
+    int rc = o->io_failed ? -1 : cdh5_obs_flush(o);
+    if (!o->io_failed && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
     output_free(o);
     cdh5_quiet_end(&q);
     return rc;
+}
+
+void cd_h5_no_atexit(void)
+{
+    H5dont_atexit();
 }
 
 const char *cd_output_error(const cd_output *o)
@@ -324,6 +393,7 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
     cdh5_quiet_begin(&q);
     cd_output *o = output_new(path, err, errlen);
     if (!o) {
+        fprintf(stderr, "capdem: %s\n", err);
         cdh5_quiet_end(&q);
         return NULL;
     }
@@ -331,6 +401,10 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
     o->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
     int rc = o->file < 0 ? FAIL("%s: cannot open the run file for appending", path) : 0;
     H5Pclose(fapl);
+    if (!rc) {
+        o->own_lock = open(path, O_RDONLY | O_NOCTTY | O_CLOEXEC);
+        if (o->own_lock >= 0) cdh5_mark(o->own_lock);
+    }
     if (!rc && (!cdh5_exists(o->file, "/h5md") || !cdh5_exists(o->file, "/observables")))
         rc = FAIL("%s: not a capdem run file (no /h5md or /observables)", path);
     if (!rc) rc = obs_check(o, obs, n_obs);

@@ -17,9 +17,40 @@ typedef struct {
     int ncomp;         /* values per row (1 for scalars) */
 } cd_observable_info;
 
-/* Creates (truncates) path and writes the config text verbatim, units, the
- * shape catalogue and the static particle columns.  Returns NULL with a
- * message in err on failure. */
+/* How an output path may be used (cd_output_check_target, cd_output_create_mode). */
+enum cd_output_mode {
+    CD_OUTPUT_NEW,      /* path must not exist; created exclusively (O_EXCL) */
+    CD_OUTPUT_REPLACE,  /* an existing path is replaced, but only once the new file's first snapshot is
+                         * committed: the new file is written aside (a mkstemp name in the same folder) and
+                         * renamed over path then; the old file is locked (flock) meanwhile and is never
+                         * replaced while another process holds it */
+    CD_OUTPUT_RESUME    /* path must exist, be a regular file and not be held by another process */
+};
+
+/* Checks, before anything is written, that path may be used as `how` says:
+ * it must not be the same file (device and inode) as any of the n_inputs
+ * paths in inputs (NULL entries skipped), must be a regular file when it
+ * exists, must not exist for CD_OUTPUT_NEW and must exist for
+ * CD_OUTPUT_RESUME, must not be locked by another process (a running
+ * capdem, any HDF5 writer), and its folder must exist.  Returns 0, or -1
+ * with a message naming path in err.  Touches nothing. */
+int cd_output_check_target(const char *path, enum cd_output_mode how, const char *const *inputs, int n_inputs,
+                           char *err, size_t errlen);
+
+/* Creates a run file at path as `how` says (CD_OUTPUT_NEW or
+ * CD_OUTPUT_REPLACE) and writes the config text verbatim, units, the shape
+ * catalogue and the static particle columns.  Nothing existing is truncated:
+ * CD_OUTPUT_NEW fails when path exists (created meanwhile by someone else),
+ * CD_OUTPUT_REPLACE writes aside and renames at the first committed snapshot
+ * (closing before any snapshot leaves the old file as it was and removes the
+ * one written aside).  Returns NULL with a message in err on failure. */
+cd_output *cd_output_create_mode(const char *path, enum cd_output_mode how, const cd_config *cfg,
+                                 const cd_shape *shapes, int n_shapes, const cd_observable_info *obs, int n_obs,
+                                 char *err, size_t errlen);
+
+/* cd_output_create_mode(path, CD_OUTPUT_REPLACE, ...): the writer of
+ * programs that deliberately rewrite their file (tests, capdem-bench
+ * --save-settled). */
 cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
                             const cd_observable_info *obs, int n_obs, char *err, size_t errlen);
 
@@ -29,6 +60,13 @@ cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_sha
  * interrupted run) are discarded. */
 cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_observable_info *obs, int n_obs,
                             char *err, size_t errlen);
+
+/* Records, after cd_output_reopen, the config a resume from step `step`
+ * runs with: /parameters/resumes/<k> (k = 0, 1, ... in the order of the
+ * resumes), the config text verbatim, attributes step and source_path;
+ * /parameters/config stays the run's first config.  Written with the next
+ * snapshot's flush. */
+int cd_output_note_resume(cd_output *o, long long step, const cd_config *cfg);
 
 /* Appends a snapshot: every PARTICLE column, the active contacts (every PAIR
  * column of the active rows) and the active wall contacts, the walls, time
@@ -46,6 +84,12 @@ const char *cd_output_error(const cd_output *o);
 /* Flushes and closes. Returns 0 or -1. */
 int cd_output_close(cd_output *o);
 
+/* To be called before any other HDF5 call of a program that writes run
+ * files: HDF5 then installs no exit handler.  (HDF5 1.10's exit handler
+ * closes the files still open, and crashes on a file whose close failed,
+ * as one does after a full disk.)  Every file is closed explicitly. */
+void cd_h5_no_atexit(void);
+
 /* Number of snapshots in a run file, or -1 (message in err). */
 int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
 
@@ -62,5 +106,10 @@ int64_t cd_h5_wall_type(void);
 
 /* Reads the config text echoed in a run file (malloc'd, caller frees). */
 char *cd_h5_read_config_text(const char *path, char *err, size_t errlen);
+
+/* The config the run file's latest part ran with: that of its last resume
+ * (/parameters/resumes/<k>, cd_output_note_resume), else /parameters/config;
+ * the dataset's path into where.  Malloc'd, caller frees. */
+char *cd_h5_read_latest_config_text(const char *path, char *where, size_t wlen, char *err, size_t errlen);
 
 #endif

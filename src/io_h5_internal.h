@@ -108,7 +108,48 @@ struct cd_output {
     size_t buf_n;
     long long *buf_step;
     double *buf_time, *buf_val;
+    /* CD_OUTPUT_REPLACE until the first commit: the file written aside
+     * (tmp_path, "" once renamed to path) and the locked file it replaces
+     * (old_fd, -1 when none; its device and inode) */
+    char tmp_path[1024];
+    int old_fd;
+    unsigned long long old_dev, old_ino;
+    int own_lock;                    /* descriptor holding capdem's mark on the file (cdh5_mark), or -1 */
+    int io_failed;                   /* a write failed or found no room: nothing more is written */
+    int writing;                     /* inside a snapshot, past its checks */
 };
+
+/* Makes sure bytes more can be written at the end of the file (the space
+ * is allocated with posix_fallocate past HDF5's end of allocation, so a
+ * full disk or a file size limit shows here, before anything of what
+ * follows is written, rather than halfway through a flush); -1 with a
+ * message naming what, and o->io_failed set, when it cannot. */
+int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what);
+/* Puts capdem's mark (an F_OFD_SETLK read lock, see io_h5_target.c) on
+ * the file open as fd; -1 when the file system has no such locks. */
+int cdh5_mark(int fd);
+/* -1 with a message (and o->io_failed) when the file has no name left
+ * (deleted, or its folder, while open), else 0. */
+int cdh5_check_linked(cd_output *o);
+/* Bytes the file grows by when add rows are appended to the chunked
+ * dataset d: the chunks those rows start (each allocated whole) and room
+ * for its chunk index to grow (0 when no chunk starts). */
+unsigned long long cdh5_growth(hid_t d, unsigned long long add);
+
+/* ---- output target: io_h5_target.c ------------------------------------------ */
+
+/* Opens the existing regular file path without truncating it and takes an
+ * exclusive flock on it (released by closing the descriptor; refused when
+ * another process holds a lock: HDF5 writers and readers lock their files).
+ * Returns the descriptor, -2 when path does not exist, -1 with a message. */
+int cdh5_target_lock(const char *path, unsigned long long *dev, unsigned long long *ino, char *err, size_t errlen);
+/* Creates an empty file with a unique name (mkstemp) next to path, with
+ * the permissions a plain create would give and capdem's mark on it; its
+ * name into tmp, its descriptor into *fd (kept open while it is written). */
+int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t errlen, int *fd);
+/* After the first commit: renames tmp_path over path, unless path no
+ * longer is the file locked at creation. */
+int cdh5_target_publish(cd_output *o);
 
 /* Every writer failure goes through FAIL: message into o->err (with the
  * HDF5 detail), printed to stderr, value -1. */

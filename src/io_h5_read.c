@@ -451,28 +451,55 @@ done:
     return rc;
 }
 
+static char *read_text(const char *path, const char *dpath, char *err, size_t errlen);
+
 char *cd_h5_read_config_text(const char *path, char *err, size_t errlen)
+{
+    return read_text(path, "/parameters/config", err, errlen);
+}
+
+char *cd_h5_read_latest_config_text(const char *path, char *where, size_t wlen, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    hid_t f = open_ro(path, err, errlen);
+    int k = 0;
+    char p[CDH5_PATH_LEN];
+    while (f >= 0 && k < 1000000) {
+        snprintf(p, sizeof p, "/parameters/resumes/%d", k);
+        if (!cdh5_exists(f, p)) break;
+        k++;
+    }
+    if (f >= 0) H5Fclose(f);
+    cdh5_quiet_end(&q);
+    if (f < 0) return NULL;
+    if (k > 0) snprintf(where, wlen, "/parameters/resumes/%d", k - 1);
+    else snprintf(where, wlen, "/parameters/config");
+    return read_text(path, where, err, errlen);
+}
+
+static char *read_text(const char *path, const char *dpath, char *err, size_t errlen)
 {
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
     char *out = NULL;
     hid_t f = open_ro(path, err, errlen), d = -1, t = -1, mt = -1;
     if (f < 0) goto done;
-    d = H5Dopen2(f, "/parameters/config", H5P_DEFAULT);
+    d = H5Dopen2(f, dpath, H5P_DEFAULT);
     if (d < 0) {
-        cdh5_msg(err, errlen, "%s: cannot open dataset /parameters/config", path);
+        cdh5_msg(err, errlen, "%s: cannot open dataset %s", path, dpath);
         goto done;
     }
     t = H5Dget_type(d);
     if (H5Tget_class(t) != H5T_STRING) {
-        cdh5_msg(err, errlen, "%s: /parameters/config is not a string", path);
+        cdh5_msg(err, errlen, "%s: %s is not a string", path, dpath);
         goto done;
     }
     mt = H5Tcopy(t);
     if (H5Tis_variable_str(t) > 0) {
         char *p = NULL;
         if (H5Dread(d, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p) < 0 || !p) {
-            cdh5_msg(err, errlen, "%s: cannot read /parameters/config", path);
+            cdh5_msg(err, errlen, "%s: cannot read %s", path, dpath);
             goto done;
         }
         size_t len = strlen(p);
@@ -483,7 +510,7 @@ char *cd_h5_read_config_text(const char *path, char *err, size_t errlen)
         size_t size = H5Tget_size(t);
         out = malloc(size + 1);
         if (out && H5Dread(d, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) < 0) {
-            cdh5_msg(err, errlen, "%s: cannot read /parameters/config", path);
+            cdh5_msg(err, errlen, "%s: cannot read %s", path, dpath);
             free(out);
             out = NULL;
             goto done;

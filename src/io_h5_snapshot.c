@@ -282,32 +282,96 @@ static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g
                        &end);
 }
 
+/* An upper bound of the bytes a snapshot with m contact and wm wall-contact
+ * rows adds to the file: the chunks its rows start in every dataset (HDF5
+ * allocates a chunk whole when it is first written), the chunk indices
+ * growing, the buffered time-series rows, and 64 KiB for headers (the
+ * fixed columns, written at the first snapshot, are in the headroom: they
+ * are contiguous and small next to the chunks of the first snapshot). */
+static unsigned long long snapshot_bytes(const cd_output *o, size_t m, size_t wm)
+{
+    unsigned long long b = 65536;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        enum cdh5_store st = cdh5_store_of(f);
+        if (st == CDH5_SERIES) b += cdh5_growth(o->cols[k].dset, 1);
+        if (st == CDH5_ROWS) b += cdh5_growth(o->cols[k].dset, f->group == CD_GROUP_PAIR ? m : wm);
+    }
+    hid_t one[] = {o->step, o->time, o->walls, o->control, o->c_offset, o->w_offset};
+    for (size_t i = 0; i < sizeof one / sizeof one[0]; i++) b += cdh5_growth(one[i], 1);
+    b += cdh5_growth(o->c_pi, m) + cdh5_growth(o->c_pj, m) + cdh5_growth(o->w_index, wm);
+    for (int i = 0; i < o->n_obs; i++)
+        b += cdh5_growth(o->obs[i].value, o->buf_n) + cdh5_growth(o->obs[i].step, o->buf_n) +
+             cdh5_growth(o->obs[i].time, o->buf_n);
+    return b / 4 * 5; /* and a quarter more for what the bound may miss */
+}
+
+/* The same bound for the first snapshot, before its datasets exist: the
+ * fixed columns, and one first chunk of every dataset as
+ * cdh5_layout_create and create_col size them (their rows when larger). */
+static unsigned long long first_snapshot_bytes(const cd_output *o, const cd_state *s, size_t m, size_t wm)
+{
+    unsigned long long b = 65536, P = s->n_prims, nw1 = s->n_walls ? s->n_walls : 1;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        unsigned long long e = f->elem_size, rows = cd_state_rows(s, f->group), row = rows * e;
+        switch (cdh5_store_of(f)) {
+        case CDH5_FIXED: b += row; break;
+        case CDH5_SERIES: /* a chunk of up to 64 KiB of rows, one row, or a row split into 1 MiB chunks */
+            b += row > CDH5_LARGE_CHUNK ? row + CDH5_LARGE_CHUNK : row > CDH5_SMALL_CHUNK ? row : CDH5_SMALL_CHUNK;
+            break;
+        case CDH5_ROWS: {
+            unsigned long long hint = f->group == CD_GROUP_PAIR ? 4 * P : P, used = f->group == CD_GROUP_PAIR ? m : wm;
+            b += clamp(hint, 256, CDH5_LARGE_CHUNK / e) * e + used * e;
+            break;
+        }
+        }
+        b += 8192;
+    }
+    b += 4ULL * CDH5_CLOCK_CHUNK * 8 + 64 * nw1 * sizeof(cd_wall) + 64ULL * CD_CONTROL_SLOTS * 8;
+    b += 2 * (clamp(4 * P, 256, CDH5_LARGE_CHUNK / 4) * 4 + 4ULL * m) + clamp(P, 256, CDH5_LARGE_CHUNK / 8) * 8 + 8ULL * wm;
+    for (int i = 0; i < o->n_obs; i++)
+        b += cdh5_growth(o->obs[i].value, o->buf_n) + cdh5_growth(o->obs[i].step, o->buf_n) +
+             cdh5_growth(o->obs[i].time, o->buf_n);
+    return (b + 16 * 8192) / 4 * 5; /* and a quarter more: the first snapshot measured 0.97 of the bound without it */
+}
+
 static int snapshot(cd_output *o, const cd_state *s)
 {
-    if (!o->have_layout) {
-        if (cdh5_layout_create(o, s)) return -1;
-    } else if (check_counts(o, s)) {
-        return -1;
-    }
+    if (o->have_layout && check_counts(o, s)) return -1;
     hsize_t n = o->n_snap;
+    /* active contacts and wall contacts */
+    size_t nwc = s->n_prims * s->n_walls, cap = (s->n_pairs > nwc ? s->n_pairs : nwc) + 1;
+    size_t m = 0, wm = 0;
+    for (size_t r = 0; r < s->n_pairs; r++) m += s->pair_active[r] != 0;
+    for (size_t r = 0; r < nwc; r++) wm += s->wallc_active[r] != 0;
+    /* room for all of it first: a full disk or a file size limit stops the
+     * run here, with the file as the last commit left it and nothing
+     * unwritten in HDF5's cache */
+    char what[64];
+    snprintf(what, sizeof what, "snapshot %llu (step %lld)", (unsigned long long)n, s->step);
+    if (cdh5_check_linked(o) ||
+        cdh5_reserve(o, o->have_layout ? snapshot_bytes(o, m, wm) : first_snapshot_bytes(o, s, m, wm), what))
+        return -1;
+    o->writing = 1; /* from here on a failure leaves the file to its last commit */
+    if (!o->have_layout && cdh5_layout_create(o, s)) return -1;
     for (size_t k = 0; k < cd_n_fields; k++) {
         const cd_field_info *f = &cd_fields[k];
         if (cdh5_store_of(f) != CDH5_SERIES) continue;
         if (cdh5_append(o, o->cols[k].dset, f->name, n, 1, cdh5_mem_type(f), *cd_field_ptr((cd_state *)s, f)))
             return -1;
     }
-    /* active contacts and wall contacts */
-    size_t nwc = s->n_prims * s->n_walls, cap = (s->n_pairs > nwc ? s->n_pairs : nwc) + 1;
     size_t *idx = malloc(cap * sizeof *idx);
     void *tmp = malloc(cap * cdh5_max_row_bytes());
     int rc = idx && tmp ? 0 : FAIL("%s: out of memory", o->path);
-    size_t m = 0, wm = 0;
     if (!rc) {
+        m = 0;
         for (size_t r = 0; r < s->n_pairs; r++)
             if (s->pair_active[r]) idx[m++] = r;
         rc = write_contacts(o, s, CD_GROUP_PAIR, idx, m, tmp);
     }
     if (!rc) {
+        wm = 0;
         for (size_t r = 0; r < nwc; r++)
             if (s->wallc_active[r]) idx[wm++] = r;
         rc = write_contacts(o, s, CD_GROUP_WALLC, idx, wm, tmp);
@@ -328,14 +392,19 @@ static int snapshot(cd_output *o, const cd_state *s)
     o->n_snap = n + 1;
     o->c_rows += m;
     o->w_rows += wm;
-    return 0;
+    /* CD_OUTPUT_REPLACE: the new file takes the old one's place now that it holds a snapshot */
+    return o->tmp_path[0] ? cdh5_target_publish(o) : 0;
 }
 
 int cd_output_snapshot(cd_output *o, const cd_state *s)
 {
+    if (o->io_failed) return -1; /* reported when it happened */
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
+    o->writing = 0;
     int rc = snapshot(o, s);
+    if (rc && o->writing) o->io_failed = 1; /* a write failed: nothing more is written into this file */
+    o->writing = 0;
     cdh5_quiet_end(&q);
     return rc;
 }

@@ -224,6 +224,41 @@ static int write_config(cd_output *o, const cd_config *cfg)
     return rc;
 }
 
+int cd_output_note_resume(cd_output *o, long long step, const cd_config *cfg)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    char p[CDH5_PATH_LEN];
+    int k = 0;
+    do snprintf(p, sizeof p, "/parameters/resumes/%d", k++);
+    while (cdh5_exists(o->file, p) && k < 1000000);
+    const char *text = cfg && cfg->source_text ? cfg->source_text : "";
+    size_t len = strlen(text);
+    /* room first, and written through at once: a full disk fails here with
+     * nothing of it left in HDF5's cache for a later flush */
+    if (o->io_failed || cdh5_reserve(o, len + 131072, p)) {
+        cdh5_quiet_end(&q);
+        return -1;
+    }
+    hid_t t = H5Tcopy(H5T_C_S1);
+    H5Tset_size(t, len ? len : 1);
+    H5Tset_strpad(t, H5T_STR_NULLPAD);
+    hid_t d = cdh5_make_dset(o, p, t, 0, NULL, NULL, NULL, NULL);
+    int rc = cdh5_write_all(o, d, p, t, text);
+    if (!rc) rc = cdh5_attr_str(o, d, p, "source_path", cfg ? cfg->source_path : "");
+    if (!rc) {
+        hid_t sp = H5Screate(H5S_SCALAR);
+        rc = cdh5_attr_write(o, d, p, "step", H5T_NATIVE_LLONG, sp, &step);
+        H5Sclose(sp);
+    }
+    cdh5_close_dset(&d);
+    H5Tclose(t);
+    if (!rc && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
+    if (rc) o->io_failed = 1;
+    cdh5_quiet_end(&q);
+    return rc;
+}
+
 static int write_shape(cd_output *o, int k, const cd_shape *sh)
 {
     char g[96], p[160];

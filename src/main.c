@@ -1,4 +1,6 @@
 /* capdem command line: run, shape, --version. */
+#include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,8 +19,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: capdem <command> [options]\n"
             "commands:\n"
-            "  run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n"
-            "                  [--backend omp|opencl] [--device cpu|gpu|auto]\n"
+            "  run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--overwrite] [--steps N] [--threads N]\n"
+            "                  [--allow-change KEY]... [--quiet] [--backend omp|opencl] [--device cpu|gpu|auto]\n"
             "                  run a simulation; `capdem run --help` lists every config key\n"
             "  shape KIND [--aspect A] [--diameter D] [--density RHO] [--json]\n"
             "                  mass properties of a sphere, rod, cross or hexapod (SI units)\n"
@@ -33,10 +35,9 @@ static void usage(FILE *f)
 
 static int parse_double(const char *opt, const char *s, double *out)
 {
-    char *end;
-    *out = strtod(s, &end);
-    if (end == s || *end) {
-        fprintf(stderr, "capdem: %s %s: expected a number\n", opt, s);
+    char err[256];
+    if (cd_parse_cli_real(opt, s, -HUGE_VAL, HUGE_VAL, out, err, sizeof err)) {
+        fprintf(stderr, "capdem: %s\n", err);
         return -1;
     }
     return 0;
@@ -79,13 +80,28 @@ static int cmd_shape(int argc, char **argv)
 
 static int cmd_run(int argc, char **argv)
 {
-    cd_run_options opt = {NULL, NULL, NULL, -1, 0, NULL, NULL};
+    cd_run_options opt = {NULL, NULL, NULL, -1, 0, NULL, NULL, 0, NULL, 0};
+    static const char *allow[64];
+    char err[512];
+    long long v;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         int has_value = i + 1 < argc;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            printf("usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--steps N] [--threads N] [--quiet]\n"
-                   "                  [--backend omp|opencl] [--device cpu|gpu|auto]\n\n"
+            printf("usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--overwrite] [--steps N] [--threads N]\n"
+                   "                  [--allow-change KEY]... [--quiet] [--backend omp|opencl] [--device cpu|gpu|auto]\n\n"
+                   "  --output RUN.h5   run file (default run.output, else <run.name>.h5); an existing file is refused\n"
+                   "  --overwrite       replace an existing output, once the new run's first snapshot is written (the old\n"
+                   "                    file stays until then); never an input, never a file another process has open\n"
+                   "  --resume RUN.h5   continue RUN.h5 from its last complete snapshot, appending to it (--output, if\n"
+                   "                    given, must name the same file); the config must match the one stored in RUN.h5\n"
+                   "                    except for keys marked 'May change on --resume' below\n"
+                   "  --allow-change KEY  with --resume: accept a changed KEY (e.g. material.friction); repeatable\n"
+                   "  --steps N         run.steps: the step to reach, counted from step 0 of the run, also on a resume\n"
+                   "                    (a resume at step S continues to N; N < S is refused)\n"
+                   "  --threads N       OpenMP threads (1 to 4096)\n"
+                   "Exit status: 0 done, 2 bad input (nothing written), 3 the run blew up (the snapshots written so far\n"
+                   "stay readable), 1 other failures.\n\n"
                    "Config keys (YAML; SI units):\n");
             cd_config_print_keys(stdout, 0);
             return 0;
@@ -94,15 +110,30 @@ static int cmd_run(int argc, char **argv)
             return 0;
         } else if (!strcmp(a, "--resume") && has_value) opt.resume_path = argv[++i];
         else if (!strcmp(a, "--output") && has_value) opt.output_path = argv[++i];
-        else if (!strcmp(a, "--steps") && has_value) opt.steps = atoll(argv[++i]);
-        else if (!strcmp(a, "--quiet")) opt.quiet = 1;
+        else if (!strcmp(a, "--steps") && has_value) {
+            if (cd_parse_cli_int(a, argv[++i], 0, LLONG_MAX, &v, err, sizeof err)) {
+                fprintf(stderr, "capdem run: %s\n", err);
+                return 2;
+            }
+            opt.steps = v;
+        } else if (!strcmp(a, "--overwrite")) opt.overwrite = 1;
+        else if (!strcmp(a, "--allow-change") && has_value) {
+            if (opt.n_allow_change == (int)(sizeof allow / sizeof allow[0])) {
+                fprintf(stderr, "capdem run: --allow-change given more than %d times\n", (int)(sizeof allow / sizeof allow[0]));
+                return 2;
+            }
+            allow[opt.n_allow_change++] = argv[++i];
+            opt.allow_change = allow;
+        } else if (!strcmp(a, "--quiet")) opt.quiet = 1;
         else if (!strcmp(a, "--backend") && has_value) opt.backend = argv[++i];
         else if (!strcmp(a, "--device") && has_value) opt.device = argv[++i];
         else if (!strcmp(a, "--threads") && has_value) {
-            int n = atoi(argv[++i]);
-            if (n < 1) { fprintf(stderr, "capdem run: --threads %s: expected an integer >= 1\n", argv[i]); return 2; }
+            if (cd_parse_cli_int(a, argv[++i], 1, 4096, &v, err, sizeof err)) {
+                fprintf(stderr, "capdem run: %s\n", err);
+                return 2;
+            }
 #ifdef _OPENMP
-            omp_set_num_threads(n);
+            omp_set_num_threads((int)v);
 #endif
         } else if (a[0] != '-' && !opt.config_path) opt.config_path = a;
         else {

@@ -10,6 +10,10 @@ typedef struct {
     int quiet;                /* 1: no progress lines */
     const char *backend;      /* omp | opencl (NULL: omp) */
     const char *device;       /* cpu | gpu | auto (NULL: auto; OpenCL) */
+    int overwrite;            /* 1: an existing output is replaced once the new run's first snapshot is
+                               * written (0: an existing output is refused); no effect on a resume */
+    const char *const *allow_change; /* --resume: keys that may differ from the run file's config */
+    int n_allow_change;
 } cd_run_options;
 
 /* Returns the process exit status: 0 success, 2 bad input, 3 the run blew

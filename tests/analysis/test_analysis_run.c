@@ -60,7 +60,7 @@ static int setup(void **state)
     if (!f) return -1;
     fputs(config, f);
     fclose(f);
-    cd_run_options opt = {.config_path = CONFIG_FILE, .output_path = RUN_FILE, .steps = -1, .quiet = 1};
+    cd_run_options opt = {.config_path = CONFIG_FILE, .output_path = RUN_FILE, .steps = -1, .quiet = 1, .overwrite = 1};
     return cd_run(&opt) == 0 ? 0 : -1;
 }
 

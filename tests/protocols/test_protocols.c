@@ -20,7 +20,7 @@ static const char *preset(const char *name)
 static int run_preset(const char *name, const char *out, const char *resume, long long steps)
 {
     cd_run_options o = {.config_path = preset(name), .resume_path = resume, .output_path = resume ? NULL : out,
-                        .steps = steps, .quiet = 1, .backend = cdt_backend()};
+                        .steps = steps, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     return cd_run(&o);
 }
 
@@ -131,7 +131,7 @@ static void test_piston_hold_position_and_sampled_relaxation(void **state)
     fputs(yaml, out);
     fclose(out);
     cd_run_options o = {.config_path = "proto_hold_position.yaml", .output_path = "proto_hold_position.h5", .steps = -1,
-                        .quiet = 1, .backend = cdt_backend()};
+                        .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o), 0);
 
     static cd_sim sim;

@@ -118,9 +118,9 @@ static void test_resumed_run_equals_uninterrupted(void **state)
     assert_non_null(f);
     fputs(settling, f);
     fclose(f);
-    cd_run_options o1 = {.config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .backend = cdt_backend()};
+    cd_run_options o1 = {.config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o1), 0);
-    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = 1000, .quiet = 1, .backend = cdt_backend()};
+    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = 1000, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o2), 0);
     cd_run_options o3 = {.config_path = cfgpath, .resume_path = part, .steps = -1, .quiet = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o3), 0);

@@ -520,6 +520,106 @@ static void test_io_h5_bad_observables_are_refused(void **state)
     remove(path);
 }
 
+/* The bytes of a file (malloc'd, *n its size), or NULL when it cannot be read. */
+static unsigned char *slurp(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long len = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char *b = malloc(len > 0 ? (size_t)len : 1);
+    *n = b && len >= 0 && fread(b, 1, (size_t)len, f) == (size_t)len ? (size_t)len : 0;
+    fclose(f);
+    return b;
+}
+
+/* Files in the working folder whose name starts with prefix. */
+static int count_prefixed(const char *prefix)
+{
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "ls -a | grep -c '^%s' || true", prefix);
+    FILE *p = popen(cmd, "r");
+    int n = -1;
+    if (p && fscanf(p, "%d", &n) != 1) n = -1;
+    if (p) pclose(p);
+    return n;
+}
+
+/* CD_OUTPUT_NEW refuses an existing file; CD_OUTPUT_REPLACE leaves the old
+ * file byte for byte as it was (and locked against a second writer) until
+ * the new file's first snapshot is committed, then puts the new one in its
+ * place; closed before a snapshot, it leaves the old file and nothing
+ * beside it.  An output that is an input is refused. */
+static void test_io_h5_replace_keeps_old_file_until_first_snapshot(void **state)
+{
+    (void)state;
+    char path[128], aside[160], err[1024] = "";
+    test_path(path, sizeof path, "replace");
+    snprintf(aside, sizeof aside, ".%s.", path);
+    cd_state s[3];
+    for (int j = 0; j < 3; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
+    remove(path);
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_NEW, NULL, 0, err, sizeof err), 0);
+    write_run(path, 3, s);
+    size_t n0, n1;
+    unsigned char *before = slurp(path, &n0);
+    assert_non_null(before);
+
+    cd_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.source_text = (char *)CONFIG_TEXT;
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_NEW, NULL, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "exists"));
+    assert_null(cd_output_create_mode(path, CD_OUTPUT_NEW, &cfg, NULL, 0, OBS, 2, err, sizeof err));
+    assert_non_null(strstr(err, "exists"));
+    const char *inputs[2] = {"no_such_input.yaml", path};
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_REPLACE, inputs, 2, err, sizeof err), -1);
+    assert_non_null(strstr(err, "same file as the input"));
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_REPLACE, inputs, 1, err, sizeof err), 0);
+
+    /* replaced, but only at the first snapshot */
+    cd_output *o = cd_output_create_mode(path, CD_OUTPUT_REPLACE, &cfg, NULL, 0, OBS, 2, err, sizeof err);
+    if (!o) print_error("%s\n", err);
+    assert_non_null(o);
+    assert_int_equal(count_prefixed(aside), 1);
+    unsigned char *during = slurp(path, &n1);
+    assert_true(during && n1 == n0 && memcmp(before, during, n0) == 0);
+    free(during);
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_REPLACE, NULL, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "in use by another process"));
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_RESUME, NULL, 0, err, sizeof err), -1);
+    fill_state(&s[0], 0);
+    assert_int_equal(cd_output_snapshot(o, &s[0]), 0);
+    assert_int_equal(count_prefixed(aside), 0);
+    assert_int_equal(cd_output_close(o), 0);
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 1);
+    check_snapshot(path, 0, &s[0]);
+
+    /* closed before its first snapshot: the old file stays, nothing beside it */
+    free(before);
+    before = slurp(path, &n0);
+    o = cd_output_create_mode(path, CD_OUTPUT_REPLACE, &cfg, NULL, 0, OBS, 2, err, sizeof err);
+    assert_non_null(o);
+    assert_int_equal(cd_output_close(o), 0);
+    unsigned char *after = slurp(path, &n1);
+    assert_true(after && n1 == n0 && memcmp(before, after, n0) == 0);
+    assert_int_equal(count_prefixed(aside), 0);
+    free(before);
+    free(after);
+
+    /* CD_OUTPUT_REPLACE of a path that does not exist creates it */
+    remove(path);
+    o = cd_output_create_mode(path, CD_OUTPUT_REPLACE, &cfg, NULL, 0, OBS, 2, err, sizeof err);
+    assert_non_null(o);
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_RESUME, NULL, 0, err, sizeof err), -1);
+    assert_int_equal(cd_output_close(o), 0);
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 0);
+    assert_int_equal(cd_output_check_target(path, CD_OUTPUT_RESUME, NULL, 0, err, sizeof err), 0);
+    for (int j = 0; j < 3; j++) cd_state_free(&s[j]);
+    remove(path);
+}
+
 /* Every function closes what it opened. */
 static void test_io_h5_leaves_no_hdf5_object_open(void **state)
 {
@@ -537,6 +637,7 @@ int main(void)
         cmocka_unit_test(test_io_h5_wrong_counts_are_refused),
         cmocka_unit_test(test_io_h5_missing_file_is_named),
         cmocka_unit_test(test_io_h5_bad_observables_are_refused),
+        cmocka_unit_test(test_io_h5_replace_keeps_old_file_until_first_snapshot),
         cmocka_unit_test(test_io_h5_leaves_no_hdf5_object_open),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
