@@ -155,9 +155,9 @@ static void test_resumed_file_without_pair_force_equals_uninterrupted(void **sta
     assert_non_null(f);
     fputs(settling, f);
     fclose(f);
-    cd_run_options o1 = {.config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .backend = cdt_backend()};
+    cd_run_options o1 = {.config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o1), 0);
-    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = 2000, .quiet = 1, .backend = cdt_backend()};
+    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = 2000, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o2), 0);
     hid_t file = H5Fopen(part, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(file >= 0);
