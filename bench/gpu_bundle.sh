@@ -143,8 +143,8 @@ done
 # ------------------------------------------------------------- assemble
 say "assembling $OUT"
 case $OUT/ in "$ROOT"/*) git -C "$ROOT" check-ignore -q "$OUT" || die "$OUT is inside the repository but not ignored by git" ;; esac
-# The programs, libraries and packings are staged, then travel as one xz
-# archive (payload.tar.xz; run_on_gpu.sh unpacks it outside the bundle):
+# The programs, libraries and packings are staged, then travel as xz
+# archives (payload-*.tar.xz; run_on_gpu.sh unpacks them outside the bundle):
 # libLLVM-16 alone is 118 MiB raw, 21 MiB packed, and the 14 programs of a
 # build, which share most of their code, pack 25 to 1.
 STAGE=$WORK/stage
@@ -205,8 +205,26 @@ for name in "${!SEEN[@]}"; do
     esac
 done
 cp "$SETTLED"/*_n"$SETTLED_N".h5 "$STAGE/inputs/"
-say "packing payload.tar.xz ($(du -sm "$STAGE" | cut -f1) MiB raw; xz -9, a few minutes)"
-tar -C "$STAGE" -cf - . | nice xz -9 -T"$JOBS" >"$OUT/payload.tar.xz"
+# Two archives: the libraries (220 MiB raw, several minutes of xz -9
+# here) are packed again only when one of them changed; the programs and
+# inputs (they change with every commit: capdem --version names it) pack in
+# a minute.
+pack() { # archive folders...
+    local a=$1 sum
+    shift
+    sum=$(cd "$STAGE" && find "$@" \( -type f -o -type l \) | sort | xargs sha256sum | sha256sum | cut -c1-32)
+    if [ -e "$WORK/$a" ] && [ "$(cat "$WORK/$a.sum" 2>/dev/null)" = "$sum" ]; then
+        say "$a: unchanged, reused"
+    else
+        say "packing $a ($(cd "$STAGE" && du -scm "$@" | tail -1 | cut -f1) MiB raw; xz -9)"
+        rm -f "$WORK/$a.sum"
+        tar -C "$STAGE" -cf - "$@" | nice xz -9 -T"$JOBS" >"$WORK/$a"
+        echo "$sum" >"$WORK/$a.sum"
+    fi
+    cp "$WORK/$a" "$OUT/$a"
+}
+pack payload-lib.tar.xz lib lib.cxx
+pack payload-bin.tar.xz bin inputs
 
 # The part of the source tree the tests read through CAPDEM_SOURCE_DIR
 # (presets, example configs, kernels), unpacked: small, and readable there.
@@ -225,7 +243,8 @@ chmod +x "$OUT/run_on_gpu.sh"
     echo "settled: $(cd "$STAGE/inputs" && ls)"
     echo "tests: ${TESTS[*]}"
     echo
-    echo "payload.tar.xz: $(stat -c %s "$OUT/payload.tar.xz") bytes, sha256 $(sha256sum "$OUT/payload.tar.xz" | cut -c1-16); unpacked (bytes, sha256):"
+    for a in payload-lib.tar.xz payload-bin.tar.xz; do echo "$a: $(stat -c %s "$OUT/$a") bytes, sha256 $(sha256sum "$OUT/$a" | cut -c1-16)"; done
+    echo "unpacked (bytes, sha256):"
     (cd "$STAGE" && find . -type f | sort | while read -r f; do echo "$(stat -c %s "$f") $(sha256sum "$f" | cut -c1-16) $f"; done)
 } >"$OUT/MANIFEST.txt"
 size=$(du -sb "$OUT" | cut -f1)

@@ -9,7 +9,7 @@
 #
 # 1. ldd of every binary and offload plugin: each library must resolve into
 #    the bundle, or be one of glibc's (libc, libm, libpthread, libdl, librt,
-#    ld-linux) that the GPU machine has; nothing "not found".
+#    libresolv, ld-linux) that the GPU machine has; nothing "not found".
 # 2. LD_DEBUG=files of `capdem --version` of each build (which makes the
 #    OpenMP runtimes dlopen their CUDA plugins, and these libLLVM-16) and of
 #    an OpenCL start: every object loaded must come from the same places.
@@ -28,13 +28,13 @@ UNPACK=$(mktemp -d /tmp/capdem-bundle-check.XXXXXX)
 trap 'rm -rf "$UNPACK"' EXIT
 fail=0
 
-# Unpacks payload.tar.xz the way run_on_gpu.sh does (the first thing it
+# Unpacks the payload archives the way run_on_gpu.sh does (the first thing it
 # does; `info` alone is cheap, so run it for that).
 U=$UNPACK/u
 env -i PATH=/usr/bin:/bin HOME="$UNPACK" CAPDEM_BUNDLE_HOST=1 CAPDEM_BUNDLE_UNPACK="$U" OUT="$UNPACK/out0" \
     bash "$B/run_on_gpu.sh" info >/dev/null 2>&1 || true
 [ -e "$U/.complete" ] || { echo "check_bundle.sh: run_on_gpu.sh did not unpack the bundle" >&2; exit 1; }
-if [ -e "$B/payload.tar.xz" ]; then R=$U; else R=$B; fi
+if ls "$B"/payload*.tar.xz >/dev/null 2>&1; then R=$U; else R=$B; fi
 BIN=$R/bin
 LP=$R/lib:$R/lib.cxx # lib.cxx last: run_on_gpu.sh adds it only where the machine's libstdc++ is older
 
@@ -42,7 +42,9 @@ allowed() { # path of a loaded library -> 0 if inside the bundle or glibc's
     case $1 in
     "$B"/* | "$UNPACK"/*) return 0 ;;
     /lib/x86_64-linux-gnu/* | /usr/lib/x86_64-linux-gnu/* | /lib64/* | /usr/lib64/*)
-        case $(basename "$1") in ld-linux-x86-64.so.* | libc.so.* | libm.so.* | libpthread.so.* | libdl.so.* | librt.so.*) return 0 ;; esac ;;
+        # glibc's own (the GPU machine's glibc 2.39 provides them)
+        case $(basename "$1") in ld-linux-x86-64.so.* | libc.so.* | libm.so.* | libpthread.so.* | libdl.so.* | librt.so.* | \
+            libresolv.so.* | libutil.so.* | libanl.so.* | libnss_*) return 0 ;; esac ;;
     esac
     return 1
 }

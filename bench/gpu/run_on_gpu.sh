@@ -40,7 +40,7 @@
 #   CAPDEM_BUNDLE_TILES        "KX,KZ KX,KZ KX,KZ": the copies of the settled
 #                              packing for the 1e4, 1e5, 1e6 entries (default
 #                              from its N: 1e3 -> 5,2 10,10 40,25)
-#   CAPDEM_BUNDLE_UNPACK       where payload.tar.xz is unpacked
+#   CAPDEM_BUNDLE_UNPACK       where payload-*.tar.xz are unpacked
 #                              (default /tmp/capdem-bundle-<manifest cksum>,
 #                              outside the bundle so that it stays small)
 #
@@ -72,6 +72,7 @@ if [ "${1:-}" = _test ]; then
 fi
 
 W=$(mktemp -d /tmp/capdem-bundle-run.XXXXXX)
+trap 'rm -rf "$W"' EXIT # what matters is copied to $OUT at the end
 LOGS=$W/logs
 mkdir -p "$LOGS"
 SUMMARY=$W/summary.txt
@@ -102,21 +103,23 @@ step() {
 }
 
 # ------------------------------------------------- binaries and libraries
-# bin/, lib/, lib.cxx/ and inputs/ travel as one xz archive (libLLVM-16 is
-# 118 MiB raw; the 14 programs of a build share most of their code): it is
-# unpacked once per machine, outside the bundle (which must stay small
+# bin/, lib/, lib.cxx/ and inputs/ travel as xz archives (libLLVM-16 is
+# 118 MiB raw; the 14 programs of a build share most of their code): they
+# are unpacked once per machine, outside the bundle (which must stay small
 # enough to travel), into a folder keyed by the bundle's manifest.  A bundle
-# without payload.tar.xz holds those folders unpacked (the CTest fixture).
+# without payload archives holds those folders unpacked (the CTest fixture).
 KEY=$(cksum <"$B/MANIFEST.txt" | cut -d' ' -f1)
 U=${CAPDEM_BUNDLE_UNPACK:-/tmp/capdem-bundle-$KEY}
-if [ -e "$B/payload.tar.xz" ]; then
+if ls "$B"/payload*.tar.xz >/dev/null 2>&1; then
     if [ ! -e "$U/.complete" ]; then
         mkdir -p "$U"
-        if command -v xz >/dev/null; then
-            xz -dc "$B/payload.tar.xz" | tar -C "$U" -xf -
-        else # Python reads .xz where xz-utils is absent
-            python3 -c 'import sys, tarfile; tarfile.open(sys.argv[1], "r:xz").extractall(sys.argv[2])' "$B/payload.tar.xz" "$U"
-        fi || { echo "run_on_gpu.sh: cannot unpack $B/payload.tar.xz into $U" >&2; exit 1; }
+        for a in "$B"/payload*.tar.xz; do
+            if command -v xz >/dev/null; then
+                xz -dc "$a" | tar -C "$U" -xf -
+            else # Python reads .xz where xz-utils is absent
+                python3 -c 'import sys, tarfile; tarfile.open(sys.argv[1], "r:xz").extractall(sys.argv[2])' "$a" "$U"
+            fi || { echo "run_on_gpu.sh: cannot unpack $a into $U" >&2; exit 1; }
+        done
         touch "$U/.complete"
     fi
     R=$U
@@ -142,7 +145,17 @@ fi
 export LD_LIBRARY_PATH=$LIBPATH${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export CAPDEM_SOURCE_DIR=$B/src
 export OMP_WAIT_POLICY=PASSIVE
-if [ "$HOST" = 1 ]; then export OMP_TARGET_OFFLOAD=DISABLED; else export OMP_TARGET_OFFLOAD=MANDATORY; fi
+if [ "$HOST" = 1 ]; then
+    export OMP_TARGET_OFFLOAD=DISABLED
+    # LLVM 16's libomp aborts ("Assertion failure at kmp_runtime.cpp(1128)")
+    # or hangs when a target region with if(parallel: false) falls back to
+    # the host and a host parallel loop follows, as CD_STEP_FOR does below
+    # wide_min_ rows; one thread avoids it.  Only the host fallback: on a
+    # GPU the target regions never run on the host.
+    export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+else
+    export OMP_TARGET_OFFLOAD=MANDATORY
+fi
 VARIANTS=$(cd "$BIN" && ls)
 has() { [ -x "$BIN/$1/capdem" ]; }
 
@@ -243,8 +256,12 @@ part_tests() { # variant
 
 part_opencl() {
     if [ -z "$ICD" ]; then note "SKIP opencl: no OpenCL ICD (no /etc/OpenCL/vendors/*.icd, no libnvidia-opencl.so.1)"; return 0; fi
-    local v
-    v=$(echo "$VARIANTS" | head -1)
+    # The Clang build on a GPU (its omp side then runs there too).  Without
+    # one the GCC build: a Clang build loads libLLVM-16 (libomptarget), and
+    # with PoCL's libLLVM-15 in the same process it crashed here.
+    local v=${CAPDEM_BUNDLE_CL_BUILD:-clang}
+    [ "$HOST" = 1 ] && v=${CAPDEM_BUNDLE_CL_BUILD:-gcc}
+    has "$v" || v=$(echo "$VARIANTS" | head -1)
     step "opencl_version" 30 "$BIN/$v/capdem-bench" --case spheres --n 200 --settle-steps 10 --steps 10 --repeat 1 --backend opencl --device "${CAPDEM_BUNDLE_CL_DEVICE:-auto}"
     { echo "== OpenCL (ICD: $ICD; CAPDEM_OPENCL_PLATFORM=${CAPDEM_OPENCL_PLATFORM:-})"; cat "$LOGS/opencl_version.log"; } >>"$INFO"
     # test_parity: omp against OpenCL; with the omp side on the host first

@@ -2,7 +2,7 @@
 # The GPU bundle's scripts (docs/gpu_bundle.md) without a GPU, clang-16 or
 # network: a miniature bundle made of this build's host binaries (standing
 # in for the "clang" offload build), its shared libraries and two tiny
-# settled packings, packed as gpu_bundle.sh packs them (payload.tar.xz);
+# settled packings, packed as gpu_bundle.sh packs them (payload-*.tar.xz);
 # then bench/gpu/check_bundle.sh on it: ldd and LD_DEBUG find nothing
 # outside the bundle but glibc, and run_on_gpu.sh (info, tests, ladder;
 # CAPDEM_BUNDLE_HOST=1) unpacks the payload, passes, and leaves at most 8
@@ -16,7 +16,7 @@ build=$(dirname "$bench")
 dir=$(realpath "$(mktemp -d gpu-bundle-test.XXXXXX)")
 trap 'rm -rf "$dir"' EXIT
 B=$dir/bundle
-S=$dir/stage # what goes into payload.tar.xz
+S=$dir/stage # what goes into the payload archives
 mkdir -p "$B/src" "$S"/{bin/clang,lib,lib.cxx,inputs}
 
 cp "$build/capdem" "$bench" "$build/tests/test_walls" "$S/bin/clang/"
@@ -35,7 +35,8 @@ if [ -e "$S/lib/libgomp.so.1" ] && p=$(ls /usr/lib/x86_64-linux-gnu/libgomp-plug
 cp -r "$src/configs" "$src/kernels" "$B/src/"
 "$bench" --case hexapods_a3 --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/hexapods_a3_n40.h5" >/dev/null 2>&1
 "$bench" --case spheres --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/spheres_n40.h5" >/dev/null 2>&1
-tar -C "$S" -cf - . | xz -0 -T2 >"$B/payload.tar.xz"
+tar -C "$S" -cf - lib lib.cxx | xz -0 -T2 >"$B/payload-lib.tar.xz"
+tar -C "$S" -cf - bin inputs | xz -0 -T2 >"$B/payload-bin.tar.xz"
 cp "$src/bench/gpu/run_on_gpu.sh" "$B/"
 echo "capdem GPU bundle (test fixture: host build as 'clang')" >"$B/MANIFEST.txt"
 
