@@ -234,13 +234,13 @@ cp "$ROOT/bench/gpu/run_on_gpu.sh" "$OUT/"
 chmod +x "$OUT/run_on_gpu.sh"
 {
     echo "capdem GPU bundle"
-    echo "commit: $(git -C "$ROOT" rev-parse HEAD)$(git -C "$ROOT" diff --quiet HEAD -- src kernels host bench tests CMakeLists.txt || echo ' (with uncommitted changes)')"
+    echo "commit: $(git -C "$ROOT" rev-parse HEAD)$(git -C "$ROOT" diff --quiet HEAD -- src kernels host CMakeLists.txt 'bench/*.[ch]' 'tests/*.[ch]' || echo ' (with uncommitted changes to the code)')"
     echo "built: $(date -u +%Y-%m-%dT%H:%M:%SZ) on $(uname -srm), $(ldd --version | head -1)"
     echo "variants: ${VARIANTS[*]}"
-    [ $WANT_CLANG = 1 ] && echo "clang: $(clang-16 --version | head -1); -fopenmp -fopenmp-targets=nvptx64-nvidia-cuda --offload-arch=sm_90; LLVM OpenMP $(ls "$WORK"/debs/libomp-16-dev_*.deb | sed 's/.*_1%3a//; s/_amd64.deb//')"
+    [ $WANT_CLANG = 1 ] && echo "clang: $(clang-16 --version | head -1); -fopenmp -fopenmp-targets=nvptx64-nvidia-cuda --offload-arch=sm_90; LLVM OpenMP (libomp-16-dev) $(zcat "$WORK"/llvm16/usr/share/doc/libomp-16-dev/changelog.Debian.gz | head -1 | cut -d' ' -f2)"
     [ $WANT_GCC = 1 ] && echo "gcc: $(gcc --version | head -1); -foffload=nvptx-none -misa=sm_80"
     echo "cuda (build): $("$CUDA"/bin/ptxas --version | tail -1)"
-    echo "settled: $(cd "$STAGE/inputs" && ls)"
+    echo "settled: $(cd "$STAGE/inputs" && ls | tr '\n' ' ')"
     echo "tests: ${TESTS[*]}"
     echo
     for a in payload-lib.tar.xz payload-bin.tar.xz; do echo "$a: $(stat -c %s "$OUT/$a") bytes, sha256 $(sha256sum "$OUT/$a" | cut -c1-16)"; done
@@ -253,5 +253,7 @@ say "bundle: $OUT, $((size / 1024 / 1024)) MiB ($size bytes)"
 
 if [ $CHECK = 1 ]; then
     say "checking the bundle with everything outside it hidden"
-    bash "$ROOT/bench/gpu/check_bundle.sh" "$OUT"
+    # Its run_on_gpu.sh files stay in <work>/check-out for a look.
+    rm -rf "$WORK/check-out"
+    CHECK_OUT=$WORK/check-out bash "$ROOT/bench/gpu/check_bundle.sh" "$OUT"
 fi

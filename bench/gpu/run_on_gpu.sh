@@ -21,9 +21,9 @@
 #   ladder      throughput: settled hexapods alpha 3 at 1e4, 1e5 and 1e6
 #               (tiled) and spheres 1e6, Clang build, omp (and opencl when
 #               there): JSON lines in $OUT/ladder.jsonl
-#   profile     time per launch kind: nsys if on PATH, else ncu if on PATH
-#               (kernel time and DRAM bytes), and always libomptarget's own
-#               profile (LIBOMPTARGET_PROFILE) summarised per kernel
+#   profile     time per launch kind on 1e6 hexapods: libomptarget's own
+#               profile (LIBOMPTARGET_PROFILE) summarised per kernel line,
+#               then nsys if on PATH, else ncu (kernel time, DRAM bytes)
 #   tests-gcc   the tests on the GCC 12 nvptx build
 #   ladder-gcc  the ladder on the GCC build
 # Also: tests-clang, all, quick (info tests-clang ladder).
@@ -133,7 +133,9 @@ LIBPATH=$R/lib
 # not cover them: an older C++ runtime ahead of the system's would break
 # driver libraries that need a newer one.
 need=$(grep -ao 'GLIBCXX_3\.4\.[0-9]*' "$R/lib.cxx/libstdc++.so.6" 2>/dev/null | sort -uV | tail -1)
-sys=$(ldconfig -p 2>/dev/null | awk '/libstdc\+\+\.so\.6 .*x86-64/ {print $NF; exit}')
+LDCONFIG=$(command -v ldconfig || echo /sbin/ldconfig) # /sbin may be off a user's PATH
+sys=$({ "$LDCONFIG" -p 2>/dev/null | awk '/libstdc\+\+\.so\.6 .*x86-64/ {print $NF}'
+    ls /usr/lib/x86_64-linux-gnu/libstdc++.so.6 /lib/x86_64-linux-gnu/libstdc++.so.6 2>/dev/null; } | head -1)
 if [ -e "$R/lib.cxx/libstdc++.so.6" ] && ! { [ -n "$sys" ] && grep -qa "$need" "$sys"; }; then
     LIBPATH=$LIBPATH:$R/lib.cxx
     CXXNOTE="bundle's ($need)"
@@ -164,7 +166,7 @@ has() { [ -x "$BIN/$1/capdem" ]; }
 ICD=
 if [ -n "${OCL_ICD_VENDORS:-}" ] || ls /etc/OpenCL/vendors/*.icd >/dev/null 2>&1; then
     ICD=$(cat "${OCL_ICD_VENDORS:-/etc/OpenCL/vendors}"/*.icd 2>/dev/null | tr '\n' ' ')
-elif lib=$({ ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1 / {print $NF}'
+elif lib=$({ "$LDCONFIG" -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1 / {print $NF}'
     ls /usr/local/nvidia/lib64/libnvidia-opencl.so.1 /usr/lib/x86_64-linux-gnu/libnvidia-opencl.so.1 2>/dev/null; } | head -1) && [ -n "$lib" ]; then
     mkdir -p "$W/vendors" && echo "$lib" >"$W/vendors/nvidia.icd"
     export OCL_ICD_VENDORS=$W/vendors
@@ -315,13 +317,15 @@ part_profile() {
     has clang || { note "SKIP profile: no clang build"; return 0; }
     local hex args tile
     hex=$(cd "$INPUTS" && ls hexapods_a3_n*.h5 | head -1)
-    case $hex in *_n1000.h5) tile=10,10 ;; *) tile=5,2 ;; esac # 1e5 particles
-    args=(--load-settled "$INPUTS/$hex" --tile $tile --relax-steps 20 --steps 100 --repeat 1 --device gpu)
-    # libomptarget's own trace (Chrome trace JSON): host-side time of each
-    # kernel launch and copy, always there.
+    case $hex in *_n1000.h5) tile=40,25 ;; *) tile=10,10 ;; esac # 1e6 particles
+    args=(--load-settled "$INPUTS/$hex" --tile $tile --relax-steps 10 --steps 40 --repeat 1 --device gpu)
+    # libomptarget's own trace (Chrome trace JSON), always there: LLVM 16
+    # keeps per-call events only above 500 us (so 1e6 particles, where a
+    # launch, synchronous without nowait, lasts that long) with their source
+    # line, and a "Total" per runtime call (count, time) for all.
     step profile_omptarget 120 env LIBOMPTARGET_PROFILE="$W/omptarget_profile.json" "$BIN/clang/capdem-bench" "${args[@]}"
     {
-        echo "== LIBOMPTARGET_PROFILE, clang, 1e5 hexapods, 20+100 steps (host-side spans; sum, count, mean)"
+        echo "== LIBOMPTARGET_PROFILE, clang, 1e6 hexapods (tile $tile), 10+40 steps (host-side spans: total, count, mean)"
         python3 - "$W/omptarget_profile.json" <<'EOF' 2>&1
 import json, sys, collections
 ev = json.load(open(sys.argv[1]))
@@ -329,21 +333,22 @@ ev = ev.get("traceEvents", ev) if isinstance(ev, dict) else ev
 tot = collections.defaultdict(lambda: [0.0, 0])
 for e in ev:
     if e.get("ph") != "X": continue
-    key = e.get("name", "?") + " | " + str(e.get("args", {}).get("detail", ""))[:90]
-    tot[key][0] += e.get("dur", 0); tot[key][1] += 1
+    a = e.get("args", {})
+    key = e.get("name", "?") + " | " + str(a.get("detail", ""))[:90]
+    tot[key][0] += e.get("dur", 0); tot[key][1] += a.get("count", 1) # "Total X" events carry their count
 for k, (d, n) in sorted(tot.items(), key=lambda kv: -kv[1][0])[:40]:
     print(f"{d/1e3:12.1f} ms {n:8d} {d/max(n,1):10.1f} us  {k}")
 EOF
     } >>"$PROFILE"
     if command -v nsys >/dev/null; then
         step profile_nsys 200 nsys profile --force-overwrite true -o "$W/capdem" --stats=true "$BIN/clang/capdem-bench" "${args[@]}"
-        { echo "== nsys --stats (clang, 1e5)"; grep -v '^{' "$LOGS/profile_nsys.log" | head -300; } >>"$PROFILE"
+        { echo "== nsys --stats (clang, 1e6)"; grep -v '^{' "$LOGS/profile_nsys.log" | head -300; } >>"$PROFILE"
     elif command -v ncu >/dev/null; then
         # Kernel time and DRAM bytes of 24 launches after the warm-up: the
         # bytes moved per particle-step against the bandwidth bound.
-        step profile_ncu 200 ncu --launch-skip 400 --launch-count 24 --metrics gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum \
+        step profile_ncu 200 ncu --launch-skip 200 --launch-count 24 --metrics gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum \
             "$BIN/clang/capdem-bench" "${args[@]}"
-        { echo "== ncu (clang, 1e5; 24 launches after 400)"; grep -v '^{' "$LOGS/profile_ncu.log" | head -400; } >>"$PROFILE"
+        { echo "== ncu (clang, 1e6; 24 launches after 200)"; grep -v '^{' "$LOGS/profile_ncu.log" | head -400; } >>"$PROFILE"
     else
         note "SKIP profile_nsys: neither nsys nor ncu on PATH"
     fi
