@@ -220,13 +220,17 @@ part_info() {
             grep 'Launching kernel' "$LOGS/launches_clang.log" | sed 's/.*Launching kernel //' | sort | uniq -c | sort -rn | head -20
             echo "copies: $(grep -c -i 'copying data' "$LOGS/launches_clang.log") lines"
         } >>"$INFO"
+        [ "$HOST" = 1 ] || grep -q 'Launching kernel' "$LOGS/launches_clang.log" || note "FAIL launches_clang: no kernel launched on a device (LIBOMPTARGET_INFO)"
     fi
     if has gcc; then
         step launches_gcc 60 env GOMP_DEBUG=1 "$BIN/gcc/capdem-bench" "${small[@]}"
         {
             echo "== launches, gcc (GOMP_DEBUG=1)"
+            echo "kernel launches: $(grep -c 'GOMP_OFFLOAD_run: kernel' "$LOGS/launches_gcc.log")"
             grep -E 'GOMP_OFFLOAD_run|nvptx_exec|launch' "$LOGS/launches_gcc.log" | sed 's/0x[0-9a-f]*/0x_/g' | sort | uniq -c | sort -rn | head -20
         } >>"$INFO"
+        # GCC 12 runs on the host when it finds no GPU, even under MANDATORY.
+        [ "$HOST" = 1 ] || grep -q 'GOMP_OFFLOAD_run' "$LOGS/launches_gcc.log" || note "FAIL launches_gcc: no kernel launched on a device (GOMP_DEBUG)"
         head -c 2000000 "$LOGS/launches_gcc.log" >"$LOGS/launches_gcc.log.cut" && mv "$LOGS/launches_gcc.log.cut" "$LOGS/launches_gcc.log"
     fi
 }
