@@ -93,7 +93,7 @@ OUTDIR=${CHECK_OUT:-$UNPACK/out}
 rc=0
 mapfile -t pass < <(env | grep '^CAPDEM_BUNDLE_' || true) # the caller's settings of run_on_gpu.sh go through
 env -i PATH=/usr/bin:/bin HOME="$UNPACK" CAPDEM_BUNDLE_JOBS=2 CAPDEM_BUNDLE_LADDER=h1e4 CAPDEM_BUNDLE_STEPS=20 \
-    CAPDEM_BUNDLE_BUDGET_S=1500 "${pass[@]}" CAPDEM_BUNDLE_HOST=1 CAPDEM_BUNDLE_UNPACK="$U" OUT="$OUTDIR" \
+    CAPDEM_BUNDLE_BUDGET_S=1500 CAPDEM_BUNDLE_TESTS_CAP=600 "${pass[@]}" CAPDEM_BUNDLE_HOST=1 CAPDEM_BUNDLE_UNPACK="$U" OUT="$OUTDIR" \
     POCL_CACHE_DIR="$UNPACK/pocl" nice bash "$B/run_on_gpu.sh" "$@" || rc=$?
 echo "run_on_gpu.sh exit status $rc; files back: $(ls "$OUTDIR" | tr '\n' ' ')"
 [ $rc = 0 ] || fail=1
