@@ -254,6 +254,23 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
     c.torque[q] = T;
 }
 
+/* Primitives per chunk of a wall-load sum: the load of a wall is the sum,
+ * in chunk order, of per-chunk sums in primitive order, on every backend
+ * (the chunks in parallel on a device), so every backend gets the same
+ * bits; with fewer primitives than a chunk it is the plain sum in
+ * primitive order. */
+#define CD_LOAD_CHUNK 4096
+
+/* Sum of the normal forces F_n [N] that the primitives of chunk ch exert
+ * on wall w, in primitive order. */
+CD_INLINE cd_real cd_item_wall_load_chunk(cd_cols c, cd_long ch, cd_long n_prims, cd_int n_walls, cd_int w)
+{
+    cd_long end = (ch + 1) * CD_LOAD_CHUNK < n_prims ? (ch + 1) * CD_LOAD_CHUNK : n_prims;
+    cd_real acc = 0;
+    for (cd_long i = ch * CD_LOAD_CHUNK; i < end; i++) acc += c.wallc_fn[i * n_walls + w];
+    return acc;
+}
+
 /* Has particle q a non-finite position, velocity or angular momentum (a
  * blown-up run)? */
 CD_INLINE int cd_item_not_finite(cd_cols c, cd_particle_id q)

@@ -193,8 +193,9 @@ static const char *cl_device(const cd_sim *sim)
     return cl ? cl->desc : "OpenCL (not started)";
 }
 
-/* Sum of wall w's normal forces, in the host's order (sim.c), without a
- * full download. */
+/* Sum of wall w's normal forces, in the order of every backend (chunks of
+ * CD_LOAD_CHUNK primitives in parallel, then the chunks in order), without
+ * a full download: one double comes back. */
 static int cl_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     cd_cl *cl = sim->backend_data;
@@ -203,11 +204,17 @@ static int cl_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errl
         return -1;
     }
     cd_int P = (cd_int)sim->s.n_prims, W = (cd_int)sim->s.n_walls, ww = w;
+    cd_int nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
     cd_cl_arg(cl, CD_CLK_WALL_LOAD, F, sizeof P, &P);
     cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 1, sizeof W, &W);
     cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 2, sizeof ww, &ww);
-    cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 3, sizeof cl->scratch_real, &cl->scratch_real);
-    cd_cl_run(cl, CD_CLK_WALL_LOAD, 1);
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 3, sizeof cl->load_part, &cl->load_part);
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 4, sizeof nch, &nch);
+    cd_cl_run(cl, CD_CLK_WALL_LOAD, (size_t)nch);
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD_SUM, 0, sizeof cl->load_part, &cl->load_part);
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD_SUM, 1, sizeof nch, &nch);
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD_SUM, 2, sizeof cl->scratch_real, &cl->scratch_real);
+    cd_cl_run(cl, CD_CLK_WALL_LOAD_SUM, 1);
     cd_real v = 0;
     if (!cl->status)
         cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->scratch_real, CL_TRUE, 0, sizeof v, &v, 0, NULL, NULL),

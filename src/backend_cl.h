@@ -15,7 +15,7 @@
  * take the state's columns as their first CD_CL_N_FIELDS arguments. */
 enum cd_cl_kernel {
     CD_CLK_ADVANCE, CD_CLK_PAIR_FORCES, CD_CLK_WALL_FORCES, CD_CLK_GATHER_KICK,
-    CD_CLK_CHECK_FINITE, CD_CLK_WALL_LOAD,
+    CD_CLK_CHECK_FINITE, CD_CLK_WALL_LOAD, CD_CLK_WALL_LOAD_SUM,
     CD_CLK_BOUNDS, CD_CLK_GRID, CD_CLK_BIN, CD_CLK_CELL_FILL, CD_CLK_PAIR_COLLECT, CD_CLK_PAIR_PLACE, CD_CLK_PAIR_FILL,
     CD_CLK_PAIR_KEYS,
     CD_CLK_PAIR_CARRY, CD_CLK_GATHER_COUNT, CD_CLK_GATHER_FILL, CD_CLK_GATHER_SORT,
@@ -67,6 +67,7 @@ typedef struct cd_cl {
     cl_mem walls;               /* cd_wall[n_walls] */
     cl_mem flags;               /* cd_int[3]: skin exceeded, highest non-finite particle, slot overflow */
     cl_mem scratch_real;        /* wall load result */
+    cl_mem load_part;           /* per-chunk sums of a wall load (CD_LOAD_CHUNK) */
 
     /* neighbour-list workspace */
     cl_mem partial, grid;       /* bounds per chunk (7 reals), the cd_grid */

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "backend_cl.h"
+#include "../kernels/step_items.h"
 
 /* Rows above need, so that a slowly growing list does not reallocate at
  * every rebuild (as the host list, neighbors.c). */
@@ -133,6 +134,7 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->walls = cd_cl_buffer(cl, (W > 0 ? W : 1) * sizeof(cd_wall), "allocating the walls");
     cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
     cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
+    cl->load_part = cd_cl_buffer(cl, (P / CD_LOAD_CHUNK + 1) * sizeof(cd_real), "allocating the wall-load sums");
     cl->partial = cd_cl_buffer(cl, 7 * CD_CL_MAX_BLOCKS * sizeof(cd_real), "allocating the neighbour list");
     cl->grid = cd_cl_buffer(cl, sizeof(cd_grid), "allocating the neighbour list");
     /* The grid has at most 8 N + 64 <= 8 P + 64 cells (cd_grid_make), so
@@ -226,7 +228,7 @@ void cd_cl_buffers_release(cd_cl *cl)
         release(&cl->hist[h].keys);
         cl->hist[h].cap = 0;
     }
-    cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->partial, &cl->grid, &cl->part_cell,
+    cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->load_part, &cl->partial, &cl->grid, &cl->part_cell,
                        &cl->part_bound, &cl->cell_count, &cl->cell_start, &cl->cell_cursor, &cl->cell_parts, &cl->pair_count,
                        &cl->pair_offset, &cl->block_sum, &cl->cand, &cl->gather_count, &cl->gather_start,
                        &cl->gather_cursor, &cl->gather_rows, &cl->wall_count, &cl->wall_start, &cl->wall_rows};

@@ -18,7 +18,7 @@ static const struct {
     int cols;
 } kernel_table[CD_CLK_COUNT] = {
     {"cd_cl_advance", 1},      {"cd_cl_pair_forces", 1}, {"cd_cl_wall_forces", 1},
-    {"cd_cl_gather_kick", 1},  {"cd_cl_check_finite", 1}, {"cd_cl_wall_load", 1},   {"cd_cl_bounds", 1},
+    {"cd_cl_gather_kick", 1},  {"cd_cl_check_finite", 1}, {"cd_cl_wall_load", 1},   {"cd_cl_wall_load_sum", 0},   {"cd_cl_bounds", 1},
     {"cd_cl_grid", 0},         {"cd_cl_bin", 1},          {"cd_cl_cell_fill", 0},   {"cd_cl_pair_collect", 1},
     {"cd_cl_pair_place", 1},   {"cd_cl_pair_fill", 1},    {"cd_cl_pair_keys", 1},   {"cd_cl_pair_carry", 1},
     {"cd_cl_gather_count", 1},
@@ -85,7 +85,7 @@ int cd_cl_run(cd_cl *cl, enum cd_cl_kernel k, size_t n)
     if (n == 0) return 0;
     size_t global = n, local = cl->local, *lp = &local;
     switch (k) {
-    case CD_CLK_GRID: case CD_CLK_SCAN_TOP: case CD_CLK_WALL_LOAD:
+    case CD_CLK_GRID: case CD_CLK_SCAN_TOP: case CD_CLK_WALL_LOAD_SUM:
         global = local = 1; /* one work-item */
         break;
     case CD_CLK_BOUNDS: case CD_CLK_SCAN_BLOCKS: case CD_CLK_SCAN_FILL:

@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "sim.h"
+#include "../kernels/step_items.h"
 
 int cd_sim_use_backend(cd_sim *sim, const char *name, const char *device, char *err, size_t errlen)
 {
@@ -58,9 +59,11 @@ int cd_sim_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     if (sim->backend && sim->backend->wall_load) return sim->backend->wall_load(sim, w, load, err, errlen);
     if (cd_sim_sync(sim, err, errlen)) return -1;
-    const cd_state *s = &sim->s;
+    /* the order of every backend (kernels/step_items.h, CD_LOAD_CHUNK) */
+    cd_cols c = cd_sim_host_cols(&sim->s);
+    cd_long P = (cd_long)sim->s.n_prims, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
     double sum = 0;
-    for (size_t i = 0; i < s->n_prims; i++) sum += s->wallc_fn[i * s->n_walls + (size_t)w];
+    for (cd_long ch = 0; ch < nch; ch++) sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w);
     *load = sum;
     return 0;
 }

@@ -82,7 +82,6 @@ typedef struct {
     cd_cols dev;       /* device addresses of the columns */
 } cd_off;
 
-#define CD_LOAD_CHUNK 4096
 
 static void off_map(void *p, size_t bytes)
 {
@@ -508,8 +507,10 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     cd_off *o = sim->backend_data;
     (void)err; (void)errlen;
     if (!o) { /* not started: the host columns are current */
+        cd_cols h = cd_sim_host_cols(&sim->s);
+        cd_long P = (cd_long)sim->s.n_prims, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
         double acc = 0;
-        for (size_t i = 0; i < sim->s.n_prims; i++) acc += sim->s.wallc_fn[i * sim->s.n_walls + (size_t)w];
+        for (cd_long ch = 0; ch < nch; ch++) acc += cd_item_wall_load_chunk(h, ch, P, (cd_int)sim->s.n_walls, w);
         *load = acc;
         return 0;
     }
@@ -519,12 +520,7 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     double sum = 0;
     CD_WIDE_MIN
     CD_STEP_FOR(nch, firstprivate(c))
-    for (size_t ch = 0; ch < nch; ch++) {
-        double acc = 0;
-        size_t end = (ch + 1) * CD_LOAD_CHUNK < P ? (ch + 1) * CD_LOAD_CHUNK : P;
-        for (size_t i = ch * CD_LOAD_CHUNK; i < end; i++) acc += c.wallc_fn[i * W + (size_t)w];
-        part[ch] = acc;
-    }
+    for (size_t ch = 0; ch < nch; ch++) part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w);
 #pragma omp target map(tofrom : sum)
     for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
     *load = sum;

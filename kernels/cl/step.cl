@@ -67,14 +67,22 @@ __kernel void cd_cl_check_finite(
     if (q < n_particles && cd_item_not_finite(c, q)) atomic_max(&flags[1], q);
 }
 
-/* Sum of the normal forces of wall w's contacts [N], by one work-item in
- * primitive order: the same order as the host's sum, hence the same bits. */
+/* Sum of the normal forces of wall w's contacts [N], pass 1: one
+ * work-item per chunk of primitives (cd_item_wall_load_chunk). */
 __kernel void cd_cl_wall_load(
 #include "col_params.h"
-    cd_int n_prims, cd_int n_walls, cd_int w, __global cd_real *out)
+    cd_int n_prims, cd_int n_walls, cd_int w, __global cd_real *part, cd_int n_chunks)
 {
 #include "col_bind.h"
+    cd_int ch = (cd_int)get_global_id(0);
+    if (ch < n_chunks) part[ch] = cd_item_wall_load_chunk(c, ch, n_prims, n_walls, w);
+}
+
+/* Pass 2, one work-item: the chunks' sums in chunk order, as every backend
+ * adds them (the same bits). */
+__kernel void cd_cl_wall_load_sum(__global const cd_real *part, cd_int n_chunks, __global cd_real *out)
+{
     cd_real sum = 0;
-    for (cd_int i = 0; i < n_prims; i++) sum += c.wallc_fn[(cd_long)i * n_walls + w];
+    for (cd_int ch = 0; ch < n_chunks; ch++) sum += part[ch];
     out[0] = sum;
 }

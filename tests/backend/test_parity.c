@@ -8,6 +8,7 @@
 #define _POSIX_C_SOURCE 200809L /* setenv */
 #include "test_util.h"
 #include <math.h>
+#include "../kernels/step_items.h"
 
 static const char *settling =
     "run: {name: parity, dt: 1.0e-5, steps: 2000, seed: 21}\n"
@@ -16,11 +17,18 @@ static const char *settling =
     "domain: {type: cylinder, diameter: 0.14, height: 0.33}\n"
     "init: {placement: lattice, clearance: 1.0, speed: 2.0}\n";
 
-/* Sets up the case on a backend; 1 when OpenCL has no platform here. */
-static int start_on(cd_sim *sim, cd_config *cfg, const char *backend)
+/* 1,500 hexapods (4,500 primitives) standing in a box, for the wall load. */
+static const char *many =
+    "run: {name: parity_load, dt: 1.0e-5, steps: 0, seed: 22}\n"
+    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 1500}]\n"
+    "domain: {type: box, width: 0.3, height: 0.3, thickness: 0.3}\n"
+    "init: {placement: lattice, clearance: 1.0, speed: 0}\n";
+
+/* Sets up a case on a backend; 1 when OpenCL has no platform here. */
+static int start_yaml_on(cd_sim *sim, cd_config *cfg, const char *yaml, const char *backend)
 {
     char err[2048];
-    if (cd_config_parse(settling, "parity.yaml", cfg, err, sizeof err)) fail_msg("config: %s", err);
+    if (cd_config_parse(yaml, "parity.yaml", cfg, err, sizeof err)) fail_msg("config: %s", err);
     if (cd_sim_setup(sim, cfg, err, sizeof err)) fail_msg("setup: %s", err);
     if (cd_sim_use_backend(sim, backend, "auto", err, sizeof err)) fail_msg("%s", err);
     if (cd_sim_start(sim, 1, err, sizeof err)) {
@@ -28,6 +36,11 @@ static int start_on(cd_sim *sim, cd_config *cfg, const char *backend)
         fail_msg("start on %s: %s", backend, err);
     }
     return 0;
+}
+
+static int start_on(cd_sim *sim, cd_config *cfg, const char *backend)
+{
+    return start_yaml_on(sim, cfg, settling, backend);
 }
 
 /* Largest |a - b| / scale over the components of n vectors. */
@@ -148,11 +161,54 @@ static void test_candidate_slot_overflow_changes_nothing(void **state)
     cd_config_free(&cb);
 }
 
+/* A wall load over more primitives than one chunk (CD_LOAD_CHUNK): the
+ * OpenCL backend's parallel chunk sums, added in chunk order, give the
+ * bits of the host's sum (sim.c), which adds the chunks the same way; the
+ * plain sum in primitive order differs from it by rounding only. */
+static void test_wall_load_same_bits_on_both_backends(void **state)
+{
+    (void)state;
+    static cd_sim a, b;
+    cd_config ca, cb;
+    if (start_yaml_on(&a, &ca, many, "omp")) fail_msg("omp backend failed to start");
+    assert_true(a.s.n_prims > CD_LOAD_CHUNK); /* 1,500 hexapods, 4,500 primitives: two chunks */
+    uint64_t x = 12345;
+    for (size_t r = 0; r < a.s.n_prims * a.s.n_walls; r++) {
+        x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+        a.s.wallc_fn[r] = (double)(x >> 11) * 0x1.0p-53 * 10; /* [N], 0..10 */
+    }
+    char err[1024];
+    if (cd_sim_start(&a, 0, err, sizeof err)) fail_msg("%s", err);
+    int no_platform = start_yaml_on(&b, &cb, many, "opencl");
+    if (no_platform) {
+        cd_sim_free(&a);
+        cd_config_free(&ca);
+        skip();
+    }
+    b.backend->stop(&b);
+    if (cd_state_copy(&b.s, &a.s)) fail_msg("copy");
+    if (cd_sim_start(&b, 0, err, sizeof err)) fail_msg("%s", err);
+    for (int w = 0; w < (int)a.s.n_walls; w++) {
+        double la, lb, plain = 0;
+        if (cd_sim_wall_load(&a, w, &la, err, sizeof err) || cd_sim_wall_load(&b, w, &lb, err, sizeof err))
+            fail_msg("%s", err);
+        for (size_t i = 0; i < a.s.n_prims; i++) plain += a.s.wallc_fn[i * a.s.n_walls + (size_t)w];
+        print_message("wall %d: %.17g N (plain sum %+.3g)\n", w, la, lb - plain);
+        assert_memory_equal(&la, &lb, sizeof la);
+        assert_true(fabs(la - plain) <= 1e-12 * plain);
+    }
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_omp_and_opencl_agree_on_settling_hexapods),
         cmocka_unit_test(test_candidate_slot_overflow_changes_nothing),
+        cmocka_unit_test(test_wall_load_same_bits_on_both_backends),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
