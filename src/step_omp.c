@@ -185,14 +185,36 @@ static void off_release(cd_sim *sim)
     sim->backend_data = NULL;
 }
 
-/* Copies every column of the host state to the device, once per run. */
-static int off_acquire(cd_sim *sim)
+/* Is OMP_TARGET_OFFLOAD set to MANDATORY (any case)?  GCC 12's libgomp
+ * falls back to the host without a device even then, so the check is ours. */
+static int offload_mandatory(void)
+{
+    const char *v = getenv("OMP_TARGET_OFFLOAD"), *m = "MANDATORY";
+    if (!v) return 0;
+    for (; *v && *m; v++, m++)
+        if ((*v | 0x20) != (*m | 0x20)) return 0;
+    return !*v && !*m;
+}
+
+/* Copies every column of the host state to the device, once per run.  A
+ * build for offload that finds no device runs on the host, unless
+ * OMP_TARGET_OFFLOAD=MANDATORY: then the run fails rather than pass for a
+ * device run. */
+static int off_acquire(cd_sim *sim, char *err, size_t errlen)
 {
     static int warned = 0;
-    if (omp_get_num_devices() == 0 && !warned) {
-        fprintf(stderr, "capdem: built for %s offload but no GPU found: running on the host\n", CAPDEM_OFFLOAD_VARIANT);
+    if (omp_get_num_devices() == 0) {
+        if (offload_mandatory()) {
+            snprintf(err, errlen, "built for %s offload and OMP_TARGET_OFFLOAD=MANDATORY, but the OpenMP runtime "
+                     "finds no offload device (docs/offload.md)", CAPDEM_OFFLOAD_VARIANT);
+            return -1;
+        }
+        if (!warned)
+            fprintf(stderr, "capdem: built for %s offload but no offload device found: running on the host\n",
+                    CAPDEM_OFFLOAD_VARIANT);
         warned = 1;
     }
+    snprintf(err, errlen, "out of memory while mapping the state to the offload device");
     cd_off *o = calloc(1, sizeof *o);
     if (!o) return -1;
     sim->backend_data = o;
@@ -214,6 +236,11 @@ static int off_rebuild(cd_sim *sim)
 {
     cd_state *s = &sim->s;
     cd_off *o = sim->backend_data;
+    /* Everything the build reads that the steps change: the particle
+     * centres (cell grid, bounding spheres), the primitive ends and the
+     * contact history.  (Without the centres the host bins stale positions
+     * and the bounding radius grows with the drift since the last sync.) */
+    off_from(s->position, s->n_particles * sizeof(cd_vec3));
     off_from(s->prim_a, s->n_prims * sizeof(cd_vec3));
     off_from(s->prim_b, s->n_prims * sizeof(cd_vec3));
     off_from(s->pair_active, s->n_pairs * sizeof(cd_int));
@@ -433,6 +460,8 @@ static void omp_stop(cd_sim *sim)
 #endif
 }
 
+static int omp_sync(cd_sim *sim, char *err, size_t errlen);
+
 static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 {
     omp_stop(sim);
@@ -442,13 +471,17 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
         return -1;
     }
 #if CD_OFFLOAD
-    if (off_acquire(sim)) {
-        snprintf(err, errlen, "out of memory while mapping the state to the offload device");
-        return -1;
-    }
+    if (off_acquire(sim, err, errlen)) return -1;
 #endif
     /* without compute the neighbour list is rebuilt at the first step */
-    if (compute) compute_forces(sim);
+    if (compute) {
+        compute_forces(sim);
+        /* The new forces, contacts and wall contacts were computed on the
+         * device: copy them back once, so that the host state is current
+         * after start (tests and tools read energies right after it), as
+         * the OpenCL backend does. */
+        return omp_sync(sim, err, errlen);
+    }
     return 0;
 }
 
@@ -494,7 +527,7 @@ static const char *omp_device(const cd_sim *sim)
         snprintf(buf, sizeof buf, "%s offload device %d of %d", CAPDEM_OFFLOAD_VARIANT, omp_get_default_device(),
                  omp_get_num_devices());
     else
-        snprintf(buf, sizeof buf, "host (built for %s offload, no GPU found)", CAPDEM_OFFLOAD_VARIANT);
+        snprintf(buf, sizeof buf, "host (built for %s offload, no offload device found)", CAPDEM_OFFLOAD_VARIANT);
 #else
     snprintf(buf, sizeof buf, "host, %d OpenMP thread(s)", sim->threads);
 #endif
