@@ -22,8 +22,8 @@ fail=0 caught=0
 # (to the end of their protocol), hexapods deposited in a cylinder (to the
 # end), and a radial compaction of alpha-2 hexapods in a sphere (moving
 # walls, wall loads every step) stopped at step 3000 and resumed to 6000.
-# Together: rebuilds of the Verlet list with and without growth of the
-# pair capacity, protocol phase changes, strains (stop and start), resume.
+# Together: Verlet rebuilds as packings form, protocol phase changes,
+# moving walls, resume.
 # (steps "full": the twin's own run.steps cap, which its protocol ends before)
 cases="deposit_2d_crosses:full deposit_cylinder_D6L:full radial_hexapods_a2:3000:6000"
 
