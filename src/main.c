@@ -148,24 +148,42 @@ static int cmd_run(int argc, char **argv)
     return cd_run(&opt);
 }
 
-static void print_version(void)
+/* Exit status 1 when built for offload, no device is found and
+ * OMP_TARGET_OFFLOAD=MANDATORY: a GPU machine's first check. */
+static int print_version(void)
 {
     printf("capdem %s (commit %s)\n", CAPDEM_VERSION, CAPDEM_COMMIT);
+#if defined(__clang__)
+    printf("omp backend: offload variant '%s', compiler clang %s", CAPDEM_OFFLOAD_VARIANT, __clang_version__);
+#elif defined(__GNUC__)
+    printf("omp backend: offload variant '%s', compiler gcc %s", CAPDEM_OFFLOAD_VARIANT, __VERSION__);
+#else
     printf("omp backend: offload variant '%s'", CAPDEM_OFFLOAD_VARIANT);
+#endif
 #ifdef _OPENMP
-    printf(", OpenMP %d, %d host thread(s), %d offload device(s)\n", _OPENMP, omp_get_max_threads(), omp_get_num_devices());
-    if (strcmp(CAPDEM_OFFLOAD_VARIANT, "none") && omp_get_num_devices() == 0)
-        printf("built for %s offload but no GPU found: running on the host (docs/offload.md)\n", CAPDEM_OFFLOAD_VARIANT);
+    int devices = omp_get_num_devices();
+    printf(", OpenMP %d, %d host thread(s), %d offload device(s)\n", _OPENMP, omp_get_max_threads(), devices);
+    if (strcmp(CAPDEM_OFFLOAD_VARIANT, "none") && devices == 0) {
+        const char *m = getenv("OMP_TARGET_OFFLOAD");
+        if (m && (!strcmp(m, "MANDATORY") || !strcmp(m, "mandatory"))) {
+            printf("built for %s offload but no offload device found, and OMP_TARGET_OFFLOAD=%s (docs/offload.md)\n",
+                   CAPDEM_OFFLOAD_VARIANT, m);
+            return 1;
+        }
+        printf("built for %s offload but no offload device found: running on the host (docs/offload.md)\n",
+               CAPDEM_OFFLOAD_VARIANT);
+    }
 #else
     printf(", built without OpenMP\n");
 #endif
+    return 0;
 }
 
 int main(int argc, char **argv)
 {
     if (argc < 2) { usage(stderr); return 2; }
     const char *cmd = argv[1];
-    if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) { print_version(); return 0; }
+    if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) return print_version();
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) { usage(stdout); return 0; }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "shape")) return cmd_shape(argc - 2, argv + 2);

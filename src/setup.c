@@ -166,7 +166,11 @@ static void sampling_box(const cd_config *c, double R, size_t max, double lo[3],
 
 static cd_vec3 random_point(const cd_config *c, cd_rng *r, const double lo[3], const double hi[3])
 {
-    cd_vec3 p = cd_v3(cd_rng_range(r, lo[0], hi[0]), cd_rng_range(r, lo[1], hi[1]), cd_rng_range(r, lo[2], hi[2]));
+    /* One draw per statement, z first: C leaves the order in which function
+     * arguments are evaluated unspecified (GCC went right to left, Clang
+     * goes left to right), and z, y, x is the order of every earlier run. */
+    double z = cd_rng_range(r, lo[2], hi[2]), y = cd_rng_range(r, lo[1], hi[1]), x = cd_rng_range(r, lo[0], hi[0]);
+    cd_vec3 p = cd_v3(x, y, z);
     if (c->dimension == 2) p.z = 0.5 * (lo[2] + hi[2]);
     return p;
 }
@@ -351,7 +355,10 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
     for (size_t q = 0; q < N; q++) {
         if (!by_shape) s->orientation[q] = random_orientation(rng, c->dimension); /* drawn with the place otherwise */
         double v = c->init_speed; /* [m/s] */
-        s->velocity[q] = cd_v3(cd_rng_range(rng, -v, v), cd_rng_range(rng, -v, v), c->dimension == 2 ? 0 : cd_rng_range(rng, -v, v));
+        /* z, y, x one by one, as in random_point (argument order is unspecified) */
+        double vz = c->dimension == 2 ? 0 : cd_rng_range(rng, -v, v), vy = cd_rng_range(rng, -v, v);
+        double vx = cd_rng_range(rng, -v, v);
+        s->velocity[q] = cd_v3(vx, vy, vz);
         s->angmom[q] = cd_v3_zero();
     }
     return 0;
