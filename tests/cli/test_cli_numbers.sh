@@ -8,11 +8,7 @@
 set -u
 capdem=$1
 bench=$(dirname "$capdem")/capdem-bench
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-fails=0
-pass=0
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 # expect CODE REGEX NAME -- command: exit status CODE, stderr matching REGEX
 expect() {

@@ -6,11 +6,7 @@
 # usage: test_diagnostics.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-fails=0
-pass=0
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 # expect CODE REGEX NAME CONFIG_TEXT: capdem run exits CODE, stderr matches REGEX
 expect() {

@@ -8,14 +8,7 @@
 # usage: test_io_faults.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-fails=0
-pass=0
-ok() { pass=$((pass+1)); }
-bad() { echo "FAIL $1"; [ -f err ] && sed 's/^/    /' err; fails=$((fails+1)); }
-snapshots() { h5dump -a /n_snapshots "$1" 2> /dev/null | sed -n 's/^ *(0): *//p'; }
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 limited() { local kib=$1; shift; (ulimit -f "$kib"; exec "$capdem" "$@"); }
 
 # 200 spheres, a snapshot every 100 steps: about 2.7 MB with the first snapshot, 30 KB more a snapshot

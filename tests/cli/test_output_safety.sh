@@ -9,15 +9,9 @@
 # usage: test_output_safety.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1
-work=$(mktemp -d)
+. "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 pid1=
 trap '[ -n "$pid1" ] && kill -CONT "$pid1" 2> /dev/null && kill "$pid1" 2> /dev/null; rm -rf "$work"' EXIT
-cd "$work" || exit 1
-fails=0
-pass=0
-ok() { pass=$((pass+1)); }
-bad() { echo "FAIL $1"; [ -f err ] && sed 's/^/    /' err; fails=$((fails+1)); }
-snapshots() { h5dump -a /n_snapshots "$1" 2> /dev/null | sed -n 's/^ *(0): *//p'; }
 
 # expect CODE REGEX NAME -- capdem args: exit status CODE and a message matching REGEX
 expect() {

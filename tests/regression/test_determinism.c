@@ -108,20 +108,27 @@ static void test_history_survives_forced_rebuilds(void **state)
     cd_config_free(&ca); cd_config_free(&cb);
 }
 
-/* A run stopped after 1000 steps and resumed from its file to 3000 steps
- * ends with the same bits as a run of 3000 steps in one go. */
-static void test_resumed_run_equals_uninterrupted(void **state)
+/* Writes the settling case to cfgpath, runs it to the end into full and
+ * to `part_steps` steps into part (new files, or rerun into them). */
+static void run_full_and_part(const char *cfgpath, const char *full, const char *part, long long part_steps)
 {
-    (void)state;
-    char cfgpath[] = "det_resume.yaml", full[] = "det_full.h5", part[] = "det_part.h5";
     FILE *f = fopen(cfgpath, "w");
     assert_non_null(f);
     fputs(settling, f);
     fclose(f);
     cd_run_options o1 = {.config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o1), 0);
-    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = 1000, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
+    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = part_steps, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o2), 0);
+}
+
+/* A run stopped after 1000 steps and resumed from its file to 3000 steps
+ * ends with the same bits as a run of 3000 steps in one go. */
+static void test_resumed_run_equals_uninterrupted(void **state)
+{
+    (void)state;
+    char cfgpath[] = "det_resume.yaml", full[] = "det_full.h5", part[] = "det_part.h5";
+    run_full_and_part(cfgpath, full, part, 1000);
     cd_run_options o3 = {.config_path = cfgpath, .resume_path = part, .steps = -1, .quiet = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o3), 0);
 
@@ -151,14 +158,7 @@ static void test_resumed_file_without_pair_force_equals_uninterrupted(void **sta
 {
     (void)state;
     char cfgpath[] = "det_legacy.yaml", full[] = "det_legacy_full.h5", part[] = "det_legacy_part.h5";
-    FILE *f = fopen(cfgpath, "w");
-    assert_non_null(f);
-    fputs(settling, f);
-    fclose(f);
-    cd_run_options o1 = {.config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
-    assert_int_equal(cd_run(&o1), 0);
-    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = 2000, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
-    assert_int_equal(cd_run(&o2), 0);
+    run_full_and_part(cfgpath, full, part, 2000);
     hid_t file = H5Fopen(part, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(file >= 0);
     assert_true(H5Ldelete(file, "/contacts/pair_force", H5P_DEFAULT) >= 0);
