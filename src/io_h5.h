@@ -100,6 +100,11 @@ int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
  * step. */
 int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t errlen);
 
+/* Reads the last row of every chunked dataset of the run file at path, so
+ * that HDF5 verifies the Fletcher-32 checksums of the chunks a resume
+ * appends to.  Returns 0, or -1 naming the corrupted dataset in err. */
+int cd_h5_check_tails(const char *path, char *err, size_t errlen);
+
 /* The HDF5 memory type of cd_wall, as /walls/value stores it (an hid_t the
  * caller closes with H5Tclose), for readers of run files. */
 int64_t cd_h5_wall_type(void);

@@ -247,6 +247,76 @@ int cd_h5_snapshot_count(const char *path, char *err, size_t errlen)
     return n > 2147483647LL ? 2147483647 : (int)n;
 }
 
+/* ---- checksums of the chunks a resume appends to --------------------------- */
+
+typedef struct {
+    char *err;
+    size_t errlen;
+    const char *path;
+    int bad;
+} tail_check;
+
+/* Reads the last row of dataset `name` when it is chunked, so that HDF5
+ * verifies that chunk's Fletcher-32 checksum (every other chunk a resume
+ * reads is verified as it is read). */
+static herr_t check_tail(hid_t loc, const char *name, const H5O_info_t *info, void *data)
+{
+    tail_check *t = data;
+    if (info->type != H5O_TYPE_DATASET || t->bad) return 0;
+    hid_t d = H5Dopen2(loc, name, H5P_DEFAULT);
+    if (d < 0) {
+        t->bad = 1;
+        cdh5_msg(t->err, t->errlen, "%s: cannot open dataset /%s", t->path, name);
+        return 1;
+    }
+    hid_t dcpl = H5Dget_create_plist(d), sp = H5Dget_space(d), ft = H5Dget_type(d);
+    hid_t mt = ft >= 0 ? H5Tget_native_type(ft, H5T_DIR_ASCEND) : -1;
+    int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+    hsize_t dims[8], start[8] = {0}, count[8];
+    int chunked = dcpl >= 0 && H5Pget_layout(dcpl) == H5D_CHUNKED;
+    int ok = rank >= 0 && rank <= 8 && mt >= 0;
+    if (ok && chunked && rank >= 1 && H5Sget_simple_extent_dims(sp, dims, NULL) == rank && dims[0] > 0) {
+        size_t row = H5Tget_size(mt);
+        for (int r = 1; r < rank; r++) row *= (size_t)dims[r];
+        void *buf = malloc(row ? row : 1);
+        start[0] = dims[0] - 1;
+        count[0] = 1;
+        for (int r = 1; r < rank; r++) count[r] = dims[r];
+        hid_t ms = H5Screate_simple(rank, count, NULL);
+        ok = buf && ms >= 0 && H5Sselect_hyperslab(sp, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
+             H5Dread(d, mt, ms, sp, H5P_DEFAULT, buf) >= 0;
+        if (ms >= 0) H5Sclose(ms);
+        free(buf);
+    }
+    if (!ok) {
+        t->bad = 1;
+        cdh5_msg(t->err, t->errlen, "%s: dataset /%s is corrupted (its checksum or layout does not match); the file is "
+                 "refused, nothing was read from it or written to it", t->path, name);
+    }
+    if (mt >= 0) H5Tclose(mt);
+    if (ft >= 0) H5Tclose(ft);
+    if (sp >= 0) H5Sclose(sp);
+    if (dcpl >= 0) H5Pclose(dcpl);
+    H5Dclose(d);
+    return t->bad ? 1 : 0;
+}
+
+int cd_h5_check_tails(const char *path, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    tail_check t = {err, errlen, path, 0};
+    hid_t f = open_ro(path, err, errlen);
+    if (f < 0) t.bad = 1;
+    else if (H5Ovisit2(f, H5_INDEX_NAME, H5_ITER_NATIVE, check_tail, &t, H5O_INFO_BASIC) < 0 && !t.bad) {
+        t.bad = 1;
+        cdh5_msg(err, errlen, "%s: its object tree cannot be walked (a corrupted file?)", path);
+    }
+    if (f >= 0) H5Fclose(f);
+    cdh5_quiet_end(&q);
+    return t.bad ? -1 : 0;
+}
+
 typedef struct {
     const char *path;
     char *err;

@@ -52,7 +52,9 @@ static int create_col(cd_output *o, const cd_state *s, size_t k)
     case CDH5_FIXED: {
         size_t rows = rows_of(o, f->group);
         hsize_t d[2] = {rows, nc};
-        c->dset = cdh5_make_dset(o, p, ft, 1 + vec, d, NULL, NULL, f->unit);
+        /* chunked, so that it carries a checksum like the rest */
+        hsize_t ch[2] = {clamp(rows ? rows : 1, 1, CDH5_LARGE_CHUNK / f->elem_size), nc};
+        c->dset = cdh5_make_dset(o, p, ft, 1 + vec, d, NULL, ch, f->unit);
         const void *col = *cd_field_ptr((cd_state *)s, f);
         if (c->dset < 0 || (rows && cdh5_write_all(o, c->dset, p, cdh5_mem_type(f), col))) return -1;
         c->fixed_bytes = rows * f->elem_size;

@@ -105,7 +105,13 @@ hid_t cdh5_make_dset(cd_output *o, const char *path, hid_t ftype, int rank, cons
     hid_t sp = rank ? H5Screate_simple(rank, dims, maxdims) : H5Screate(H5S_SCALAR);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE), lcpl = H5Pcreate(H5P_LINK_CREATE);
     H5Pset_create_intermediate_group(lcpl, 1);
-    if (chunk) H5Pset_chunk(dcpl, rank, chunk);
+    /* Every chunked dataset carries a Fletcher-32 checksum per chunk, which
+     * HDF5 verifies on every read: a corrupted snapshot is refused, never
+     * carried on (docs/output.md, "Corruption"). */
+    if (chunk) {
+        H5Pset_chunk(dcpl, rank, chunk);
+        H5Pset_fletcher32(dcpl);
+    }
     hid_t d = H5Dcreate2(o->file, path, ftype, sp, lcpl, dcpl, H5P_DEFAULT);
     if (d < 0) FAIL("%s: cannot create dataset %s", o->path, path);
     H5Sclose(sp);

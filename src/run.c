@@ -312,7 +312,8 @@ int cd_run(const cd_run_options *opt)
     cd_output *out = NULL;
     int status = 0;
     if (opt->resume_path) {
-        if (cd_h5_read_snapshot(opt->resume_path, -1, &sim.s, err, sizeof err)) {
+        if (cd_h5_check_tails(opt->resume_path, err, sizeof err) ||
+            cd_h5_read_snapshot(opt->resume_path, -1, &sim.s, err, sizeof err)) {
             fprintf(stderr, "capdem: --resume %s: %s\n", opt->resume_path, err);
             status = 2;
             goto done;
