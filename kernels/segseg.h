@@ -296,6 +296,38 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
     }
 }
 
+/* The narrow phase of two points (spheres: axes of zero length, p0 == p1
+ * and q0 == q1): cd_segseg_closest, cd_segseg_clearly_apart and
+ * cd_segseg_contact_at with the same operations on the same values, so the
+ * same bits, less what vanishes for points: the closest points are the
+ * points (s = t = 0) and the parallel rule never applies.  Returns 1 when
+ * the spheres (centres p, q [m], radii ri, rj [m]) are clearly apart (g is
+ * then not filled), 0 after filling g. */
+CD_INLINE int cd_segseg_point_contact(cd_vec3 p, cd_real ri, cd_vec3 q, cd_real rj, cd_contact_geom *g)
+{
+    /* P(0) = p + 0 (p1 - p0): the general path's sum, which turns a -0
+     * coordinate into +0, is kept for the same bits */
+    cd_vec3 a = cd_v3_add(p, cd_v3_zero()), b = cd_v3_add(q, cd_v3_zero());
+    cd_vec3 ab = cd_v3_sub(b, a);
+    cd_real reach = ri + rj; /* [m] */
+    if (cd_v3_dot(ab, ab) > reach * reach * CD_R(1.000000001)) return 1;
+    cd_vec3 n = cd_v3(0, 0, 1);
+    cd_real D = cd_segseg_normalize(ab, &n);
+    if (D == CD_R(0)) {
+        cd_vec3 wm = cd_v3_scale(cd_v3_sub(cd_v3_add(q, q), cd_v3_add(p, p)), CD_R(0.5));
+        n = cd_segseg_touch_normal(cd_v3_sub(p, p), cd_v3_sub(q, q), wm);
+    }
+    g->distance = D;
+    g->overlap = ri + rj - D;
+    g->normal = n;
+    g->point = cd_v3_scale(cd_v3_add(a, b), CD_R(0.5));
+    g->parallel = 0;
+    return 0;
+}
+
+/* Is the segment with ends a, b a point (an arm of zero length: a sphere)? */
+CD_INLINE int cd_segseg_is_point(cd_vec3 a, cd_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
 /* cd_segseg_contact_at at the closest points of cd_segseg_closest, with
  * the paper's parallel rule (no blend). */
 CD_INLINE void cd_segseg_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,

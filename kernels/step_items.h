@@ -111,10 +111,16 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     cd_vec3 ai = c.prim_a[i], bi = c.prim_b[i], aj = c.prim_a[j], bj = c.prim_b[j];
     cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
     cd_contact_geom g;
-    cd_real s, t;
-    cd_segseg_closest(ai, bi, aj, bj, &s, &t);
-    int apart = cd_segseg_clearly_apart(ai, bi, ri, aj, bj, rj, s, t);
-    if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, &g);
+    int apart;
+    if (cd_segseg_is_point(ai, bi) && cd_segseg_is_point(aj, bj)) {
+        /* two spheres: the same geometry without the segment machinery */
+        apart = cd_segseg_point_contact(ai, ri, aj, rj, &g);
+    } else {
+        cd_real s, t;
+        cd_segseg_closest(ai, bi, aj, bj, &s, &t);
+        apart = cd_segseg_clearly_apart(ai, bi, ri, aj, bj, rj, s, t);
+        if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, &g);
+    }
     if (apart || !(g.overlap > 0)) {
         /* Separated: the contact and its history end.  An inactive row is
          * read by nobody but its own next step and the history carry-over

@@ -626,6 +626,40 @@ static void test_headers_compile_as_opencl_c_1_2(void **state)
     assert_int_equal(rc, 0);
 }
 
+/* Two spheres (axes of zero length): the point path of the pair kernel
+ * (cd_segseg_point_contact) gives the bits of the general one
+ * (cd_segseg_closest, cd_segseg_clearly_apart, cd_segseg_contact_at) for
+ * random pairs apart, touching and overlapping, coincident centres (the
+ * touch normal) and centres with -0 coordinates. */
+static void test_point_contact_equals_general_path(void **state)
+{
+    (void)state;
+    double sp = sin(2.0 * CD_PI / 180.0);
+    int overlapping = 0;
+    rng_state = 4242;
+    for (int i = 0; i < 20000; i++) {
+        cd_vec3 p = rng_vec(0.01), q = cd_v3_add(p, rng_vec(0.006));
+        if (i % 97 == 0) q = p;                                /* coincident centres */
+        if (i % 89 == 0) p = cd_v3(-0.0, p.y, -0.0);           /* signed zeros */
+        double ri = 0.001 + 0.002 * rng_u(), rj = 0.001 + 0.002 * rng_u(), s, t;
+        cd_contact_geom want, got;
+        memset(&want, 0, sizeof want);
+        memset(&got, 0, sizeof got);
+        cd_segseg_closest(p, p, q, q, &s, &t);
+        int apart = cd_segseg_clearly_apart(p, p, ri, q, q, rj, s, t);
+        if (!apart) cd_segseg_contact_at(p, p, ri, q, q, rj, s, t, sp, 1, &want);
+        assert_int_equal(cd_segseg_point_contact(p, ri, q, rj, &got), apart);
+        if (apart) continue;
+        overlapping += want.overlap > 0;
+        assert_memory_equal(&got.normal, &want.normal, sizeof got.normal);
+        assert_memory_equal(&got.point, &want.point, sizeof got.point);
+        assert_memory_equal(&got.distance, &want.distance, sizeof got.distance);
+        assert_memory_equal(&got.overlap, &want.overlap, sizeof got.overlap);
+        assert_int_equal(got.parallel, want.parallel);
+    }
+    assert_true(overlapping > 1000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -639,6 +673,7 @@ int main(void)
         cmocka_unit_test(test_touching_axes_give_deterministic_unit_normal),
         cmocka_unit_test(test_extreme_scales_stay_finite),
         cmocka_unit_test(test_clearly_apart_never_hides_a_contact),
+        cmocka_unit_test(test_point_contact_equals_general_path),
         cmocka_unit_test(test_parallel_point_is_continuous_in_the_angle),
         cmocka_unit_test(test_headers_compile_as_opencl_c_1_2),
     };
