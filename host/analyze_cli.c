@@ -3,6 +3,7 @@
  * run file (/analysis) and prints a summary or one JSON object.  Usage and
  * output keys: docs/analysis.md. */
 #include "analyze.h"
+#include "config.h"
 #include <gsl/gsl_errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -242,11 +243,15 @@ int cd_cmd_analyze(int argc, char **argv)
             opt.timings = 1;
         } else if (!strcmp(a, "--snapshot") && more) {
             const char *t = argv[++i];
-            if (!strcmp(t, "last")) opt.snapshot = -1;
-            else if (parse_num(a, t, &v) || v != floor(v) || fabs(v) > 2e9) {
-                fprintf(stderr, "capdem analyze: --snapshot %s: expected last or an integer\n", t);
+            long long k = -1;
+            char err[256];
+            /* the strict parser of every command line (src/config_cli.c):
+             * no 1e3, 2x or blanks; negative counts from the end */
+            if (strcmp(t, "last") && cd_parse_cli_int("--snapshot", t, -2147483647LL, 2147483647LL, &k, err, sizeof err)) {
+                fprintf(stderr, "capdem analyze: %s (or last)\n", err);
                 return 2;
-            } else opt.snapshot = (int)v;
+            }
+            opt.snapshot = (int)k;
         } else if (!strcmp(a, "--measures") && more) {
             char list[256];
             snprintf(list, sizeof list, "%s", argv[++i]);

@@ -38,6 +38,11 @@ done
 [ ! -e n.h5 ] && pass=$((pass+1)) || { echo "FAIL: a refused command line wrote n.h5"; fails=$((fails+1)); }
 # good numbers still work
 expect 0 'output g.h5' "run --steps 10 --threads 1" -- "$capdem" run a.yaml --quiet --output g.h5 --steps 10 --threads 1
+# capdem analyze --snapshot: last or an integer (negative from the end), nothing else
+for v in 1e3 2x '' ' 1' 1.0; do
+  expect 2 "^capdem analyze: --snapshot $v: expected an integer in .* \(or last\)$" "analyze --snapshot '$v'" -- \
+    "$capdem" analyze g.h5 --snapshot "$v" --no-write --quiet
+done
 for v in 3x nan inf ''; do
   expect 2 "^capdem: --aspect $v: expected a finite number$" "shape --aspect '$v'" -- "$capdem" shape rod --aspect "$v"
 done
