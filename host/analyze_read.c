@@ -134,6 +134,10 @@ static int rd_shapes(rd *r, cd_an_snapshot *s)
         return rd_fail(r, 2, "/parameters/shapes or its attribute count is missing");
     int32_t count = 0;
     hid_t a = H5Aopen_by_name(r->file, "/parameters/shapes", "count", H5P_DEFAULT, H5P_DEFAULT);
+    if (a < 0 || cd_h5_check_number_attr(a, r->path, "/parameters/shapes count", r->err, r->errlen)) {
+        if (a >= 0) H5Aclose(a);
+        return a < 0 ? rd_fail(r, 2, "cannot open the attribute count of /parameters/shapes") : 2;
+    }
     herr_t st = H5Aread(a, H5T_NATIVE_INT32, &count);
     H5Aclose(a);
     if (st < 0 || count < 1 || count > 4096) return rd_fail(r, 2, "/parameters/shapes: bad count %d", (int)count);

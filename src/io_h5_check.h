@@ -24,6 +24,10 @@ int cd_h5_check_dset(hid_t d, const char *file, const char *dpath, H5T_class_t c
 int cd_h5_check_string(hid_t obj, int attr, const char *file, const char *what, size_t max_bytes, char *err,
                        size_t errlen);
 
+/* 0 when attribute a (named what in file) holds exactly one integer or
+ * floating-point number; otherwise -1 and a message naming file and what. */
+int cd_h5_check_number_attr(hid_t a, const char *file, const char *what, char *err, size_t errlen);
+
 /* *out = a * b * c; -1 (and *out 0) when the product overflows size_t. */
 int cd_h5_mul(size_t *out, size_t a, size_t b, size_t c);
 

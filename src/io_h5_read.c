@@ -203,6 +203,10 @@ long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen)
     if (H5Aexists(file, CDH5_COMMIT_ATTR) > 0) {
         long long c = -1;
         hid_t a = H5Aopen(file, CDH5_COMMIT_ATTR, H5P_DEFAULT);
+        if (a >= 0 && cd_h5_check_number_attr(a, path, "/" CDH5_COMMIT_ATTR, err, errlen)) {
+            H5Aclose(a);
+            return -1;
+        }
         if (a < 0 || H5Aread(a, H5T_NATIVE_LLONG, &c) < 0) {
             cdh5_msg(err, errlen, "%s: cannot read attribute /%s", path, CDH5_COMMIT_ATTR);
             if (a >= 0) H5Aclose(a);
@@ -289,6 +293,22 @@ int cd_h5_check_string(hid_t obj, int attr, const char *file, const char *what, 
         snprintf(err, errlen, "%s: %s must hold one string%s, it holds %lld %s%s; the file is refused", file, what,
                  var ? "" : " of bounded length", (long long)n, str ? "strings" : "non-strings",
                  !var && size > max_bytes ? " too long" : "");
+        return -1;
+    }
+    return 0;
+}
+
+int cd_h5_check_number_attr(hid_t a, const char *file, const char *what, char *err, size_t errlen)
+{
+    hid_t t = H5Aget_type(a), sp = H5Aget_space(a);
+    hssize_t n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
+    H5T_class_t c = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
+    if (t >= 0) H5Tclose(t);
+    if (sp >= 0) H5Sclose(sp);
+    H5Eclear2(H5E_DEFAULT);
+    if (n != 1 || (c != H5T_INTEGER && c != H5T_FLOAT)) {
+        snprintf(err, errlen, "%s: attribute %s must hold one number, it holds %lld %s; the file is refused", file,
+                 what, (long long)n, class_name(c));
         return -1;
     }
     return 0;

@@ -100,6 +100,12 @@ craft offset_rank2 're("/contacts/offset", np.zeros((3, 4096), dtype=np.int64))'
 # /contacts/offset claiming 2^62 contact rows (sizes multiplied from it must not overflow)
 craft offset_huge 're("/contacts/offset", np.array([0, 1 << 61, 1 << 62], dtype=np.int64))' &&
   { resume offset_huge /contacts/ refuse; export_ offset_huge /contacts/ refuse; }
+# the commit record n_snapshots as 4096 numbers (was read into one long long)
+craft commit_array 'f.attrs["n_snapshots"] = np.full(4096, 2, dtype=np.int64)' &&
+  { resume commit_array /n_snapshots refuse; analyze commit_array /n_snapshots refuse; export_ commit_array /n_snapshots refuse; }
+# the shape catalogue's count as 4096 numbers (was read into one int32)
+craft shapes_count 'f["/parameters/shapes"].attrs["count"] = np.full(4096, 1, dtype=np.int32)' &&
+  analyze shapes_count "/parameters/shapes count" refuse
 # /walls/value as plain doubles instead of wall records
 craft walls_float 're("/walls/value", np.zeros((2, 1)))' &&
   resume walls_float /walls/value refuse
