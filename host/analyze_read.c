@@ -5,6 +5,7 @@
  * walls, the shape catalogue and the echoed config. */
 #include "analyze.h"
 #include "io_h5.h"
+#include "io_h5_check.h"
 #include <hdf5.h>
 #include <math.h>
 #include <stdarg.h>
@@ -71,7 +72,7 @@ static int rd_rows(rd *r, const char *dpath, hsize_t start0, hsize_t count0, hsi
     if (row != inner)
         return rd_fail(r, 2, "dataset %s has %llu values per row, expected %llu", dpath, (unsigned long long)row,
                        (unsigned long long)inner);
-    if (start0 + count0 > dims[0])
+    if (start0 > dims[0] || count0 > dims[0] - start0)
         return rd_fail(r, 2, "dataset %s has %llu rows, rows %llu..%llu were asked for", dpath,
                        (unsigned long long)dims[0], (unsigned long long)start0,
                        (unsigned long long)(start0 + count0));
@@ -101,11 +102,15 @@ static int rd_string(rd *r, const char *dpath, char *buf, size_t len)
 {
     buf[0] = 0;
     if (H5Lexists(r->file, dpath, H5P_DEFAULT) <= 0) return rd_fail(r, 2, "dataset %s is missing", dpath);
-    hid_t d = H5Dopen2(r->file, dpath, H5P_DEFAULT), t = H5Dget_type(d);
+    hid_t d = H5Dopen2(r->file, dpath, H5P_DEFAULT);
+    if (d < 0) return rd_fail(r, 2, "cannot open dataset %s", dpath);
+    if (cd_h5_check_string(d, 0, r->path, dpath, 4096, r->err, r->errlen)) {
+        H5Dclose(d);
+        return 2;
+    }
+    hid_t t = H5Dget_type(d);
     int rc = 0;
-    if (H5Tget_class(t) != H5T_STRING) {
-        rc = rd_fail(r, 2, "dataset %s is not a string", dpath);
-    } else if (H5Tis_variable_str(t) > 0) {
+    if (H5Tis_variable_str(t) > 0) {
         char *s = NULL;
         if (H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &s) < 0 || !s) rc = rd_fail(r, 2, "cannot read %s", dpath);
         else snprintf(buf, len, "%s", s);
@@ -129,6 +134,10 @@ static int rd_shapes(rd *r, cd_an_snapshot *s)
         return rd_fail(r, 2, "/parameters/shapes or its attribute count is missing");
     int32_t count = 0;
     hid_t a = H5Aopen_by_name(r->file, "/parameters/shapes", "count", H5P_DEFAULT, H5P_DEFAULT);
+    if (a < 0 || cd_h5_check_number_attr(a, r->path, "/parameters/shapes count", r->err, r->errlen)) {
+        if (a >= 0) H5Aclose(a);
+        return a < 0 ? rd_fail(r, 2, "cannot open the attribute count of /parameters/shapes") : 2;
+    }
     herr_t st = H5Aread(a, H5T_NATIVE_INT32, &count);
     H5Aclose(a);
     if (st < 0 || count < 1 || count > 4096) return rd_fail(r, 2, "/parameters/shapes: bad count %d", (int)count);
@@ -185,18 +194,25 @@ void cd_an_snapshot_free(cd_an_snapshot *s)
     memset(s, 0, sizeof(*s));
 }
 
-/* The echoed config: domain type, dimension, k_n, parallel angle. */
-static void rd_config(rd *r, cd_an_snapshot *s)
+/* The echoed config: domain type, dimension, k_n, parallel angle.  A
+ * config that does not parse is tolerated (the caller warns); one whose
+ * dataset has the wrong shape or type is refused (2). */
+static int rd_config(rd *r, cd_an_snapshot *s)
 {
     char err[1024];
     cd_config_defaults(&s->cfg);
     char *text = cd_h5_read_config_text(r->path, err, sizeof err);
+    if (!text && strstr(err, "the file is refused")) {
+        snprintf(r->err, r->errlen, "%s", err);
+        return 2;
+    }
     s->cfg_ok = text && cd_config_parse(text, r->path, &s->cfg, err, sizeof err) == 0;
     if (!s->cfg_ok) {
         cd_config_free(&s->cfg);
         cd_config_defaults(&s->cfg);
     }
     free(text);
+    return 0;
 }
 
 static int rd_all(rd *r, int k, int S, cd_an_snapshot *s)
@@ -253,7 +269,12 @@ static int rd_all(rd *r, int k, int S, cd_an_snapshot *s)
     }
     /* protocol state (measured bulk modulus); older files have none */
     hsize_t dc[3];
-    if (rd_dims(r, "/walls/control", dc) == 2 && dc[0] > K && dc[1] <= 64) {
+    if (rd_dims(r, "/walls/control", dc) >= 0) {
+        const hsize_t lo[2] = {K + 1, 1}, hi[2] = {0, sizeof s->control / sizeof s->control[0]};
+        hid_t d = H5Dopen2(r->file, "/walls/control", H5P_DEFAULT);
+        int bad = d < 0 || cd_h5_check_dset(d, r->path, "/walls/control", H5T_FLOAT, 2, lo, hi, dc, r->err, r->errlen);
+        if (d >= 0) H5Dclose(d);
+        if (bad) return 2;
         if ((rc = rd_rows(r, "/walls/control", K, 1, dc[1], D, s->control))) return rc;
         s->n_control = (int)dc[1];
     }
@@ -307,7 +328,7 @@ int cd_an_read_snapshot(const char *path, int k, cd_an_snapshot *s, char *err, s
          * config (read through io_h5) come first and the file is opened the
          * same way. */
         int S = cd_h5_snapshot_count(path, err, errlen);
-        rd_config(&r, s);
+        if (S >= 0 && rd_config(&r, s)) S = -1;
         hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
         H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG);
         r.file = S < 0 ? H5I_INVALID_HID : H5Fopen(path, H5F_ACC_RDONLY, fapl);

@@ -11,6 +11,7 @@
  * resume). */
 #include "analyze.h"
 #include <hdf5.h>
+#include "io_h5_check.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,39 +78,67 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
         snprintf(p, sizeof p, "/observables/%s/value", s->name);
         hid_t d = H5Dopen2(f, p, H5P_DEFAULT);
         if (d < 0) continue;
+        /* value (rows[, ncomp]) of floats, time and step (rows) each: checked
+         * before the buffers are sized from them */
+        hsize_t dims[3], cl[2] = {0, 1}, ch[2] = {0, 64};
         hid_t sp = H5Dget_space(d);
-        hsize_t dims[2] = {0, 1};
-        int rank = H5Sget_simple_extent_ndims(sp);
-        if (rank >= 1 && rank <= 2) H5Sget_simple_extent_dims(sp, dims, NULL);
-        H5Sclose(sp);
+        int vrank = sp >= 0 && H5Sget_simple_extent_ndims(sp) == 2 ? 2 : 1;
+        if (sp >= 0) H5Sclose(sp);
+        if (cd_h5_check_dset(d, path, p, H5T_FLOAT, vrank, cl, ch, dims, err, errlen)) {
+            H5Dclose(d);
+            rc = 2;
+            break;
+        }
         s->rows = (size_t)dims[0];
-        s->ncomp = rank == 2 ? (int)dims[1] : 1;
-        s->value = malloc((s->rows ? s->rows : 1) * (size_t)s->ncomp * sizeof(double));
-        s->time = malloc((s->rows ? s->rows : 1) * sizeof(double));
-        s->step = malloc((s->rows ? s->rows : 1) * sizeof(long long));
+        s->ncomp = vrank == 2 ? (int)dims[1] : 1;
+        size_t vb, tb, sb, n1 = s->rows ? s->rows : 1;
+        if (cd_h5_mul(&vb, n1, (size_t)s->ncomp, sizeof(double)) || cd_h5_mul(&tb, n1, sizeof(double), 1) ||
+            cd_h5_mul(&sb, n1, sizeof(long long), 1)) {
+            snprintf(err, errlen, "%s: %s has %llu rows, too many to hold; the file is refused", path, p,
+                     (unsigned long long)dims[0]);
+            H5Dclose(d);
+            rc = 2;
+            break;
+        }
+        s->value = malloc(vb);
+        s->time = malloc(tb);
+        s->step = malloc(sb);
         if (H5Aexists(d, "unit") > 0) {
             hid_t a = H5Aopen(d, "unit", H5P_DEFAULT), t = H5Aget_type(a);
-            if (H5Tis_variable_str(t) > 0) {
+            char uerr[8];
+            if (cd_h5_check_string(a, 1, path, "unit", sizeof s->unit - 1, uerr, sizeof uerr)) {
+                /* not one short string: the unit is left empty */
+            } else if (H5Tis_variable_str(t) > 0) {
                 char *u = NULL;
                 if (H5Aread(a, t, &u) >= 0 && u) snprintf(s->unit, sizeof s->unit, "%s", u);
                 if (u) H5free_memory(u);
-            } else if (H5Tget_size(t) < sizeof s->unit) {
+            } else {
                 H5Aread(a, t, s->unit);
             }
             H5Tclose(t);
             H5Aclose(a);
         }
-        if (!s->value || !s->time || !s->step || (rank < 1 || rank > 2) ||
+        if (!s->value || !s->time || !s->step ||
             (s->rows && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->value) < 0)) {
             snprintf(err, errlen, "%s: cannot read %s", path, p);
             rc = 2;
         }
         H5Dclose(d);
-        snprintf(p, sizeof p, "/observables/%s/time", s->name);
-        hid_t dt = H5Dopen2(f, p, H5P_DEFAULT);
-        snprintf(p, sizeof p, "/observables/%s/step", s->name);
-        hid_t ds = H5Dopen2(f, p, H5P_DEFAULT);
-        if (!rc && s->rows && (dt < 0 || ds < 0 || H5Dread(dt, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->time) < 0 ||
+        char pt[160], ps[160];
+        snprintf(pt, sizeof pt, "/observables/%s/time", s->name);
+        hid_t dt = H5Dopen2(f, pt, H5P_DEFAULT);
+        snprintf(ps, sizeof ps, "/observables/%s/step", s->name);
+        hid_t ds = H5Dopen2(f, ps, H5P_DEFAULT);
+        hsize_t exact[1] = {dims[0]};
+        if (!rc && s->rows && (dt < 0 || ds < 0)) {
+            snprintf(err, errlen, "%s: cannot open the clock of /observables/%s", path, s->name);
+            rc = 2;
+        }
+        if (!rc && s->rows &&
+            (cd_h5_check_dset(dt, path, pt, H5T_FLOAT, 1, exact, exact, NULL, err, errlen) ||
+             cd_h5_check_dset(ds, path, ps, H5T_INTEGER, 1, exact, exact, NULL, err, errlen)))
+            rc = 2;
+        if (!rc && s->rows && (H5Dread(dt, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->time) < 0 ||
                                H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->step) < 0)) {
             snprintf(err, errlen, "%s: cannot read the clock of /observables/%s", path, s->name);
             rc = 2;

@@ -250,7 +250,7 @@ int cd_export_read_run(cd_export_ctx *x)
     cd_export_field pi, pj;
     if (x->off[x->S] > 0 &&
         (cd_export_describe(x->f, "/contacts/particle_i", &pi) || cd_export_describe(x->f, "/contacts/particle_j", &pj) ||
-         pi.dims[0] < (hsize_t)x->off[x->S] || pj.dims[0] < (hsize_t)x->off[x->S]))
+         pi.rank != 1 || pj.rank != 1 || pi.dims[0] < (hsize_t)x->off[x->S] || pj.dims[0] < (hsize_t)x->off[x->S]))
         return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: /contacts/particle_i and particle_j must hold the %lld contact rows",
                               x->path, x->off[x->S]);
     return 0;

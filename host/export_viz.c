@@ -1,11 +1,14 @@
 /* capdem export, the helper datasets under /visualization: connectivity,
  * and virtual datasets that select one snapshot of the run's datasets
  * (layout at the top of export_xdmf.c; export_internal.h). */
+#include <limits.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <hdf5.h>
 #include "export_internal.h"
+#include "io_h5_check.h"
 
 /* ---- helper datasets ---------------------------------------------------- */
 
@@ -17,8 +20,10 @@ static void cd_export_copy_unit(cd_export_ctx *x, const char *src, hid_t dst)
     if (d < 0) return;
     if (H5Aexists(d, "unit") > 0 && H5Aexists(dst, "unit") <= 0) {
         hid_t a = H5Aopen(d, "unit", H5P_DEFAULT), t = H5Aget_type(a);
+        char why[8];
+        int one = cd_h5_check_string(a, 1, x->path, "unit", 256, why, sizeof why) == 0; /* else not copied */
         size_t n = H5Tget_size(t);
-        char *buf = calloc(n + 1, 1);
+        char *buf = one ? calloc(n + 1, 1) : NULL;
         if (buf && H5Tget_class(t) == H5T_STRING && !H5Tis_variable_str(t) && H5Aread(a, t, buf) >= 0) {
             hid_t s = H5Screate(H5S_SCALAR), b = H5Acreate2(dst, "unit", t, s, H5P_DEFAULT, H5P_DEFAULT);
             if (b >= 0) { H5Awrite(b, t, buf); H5Aclose(b); }
@@ -187,8 +192,15 @@ static int cd_export_open_viz(cd_export_ctx *x)
 /* The helpers shared by every snapshot. */
 static int cd_export_fixed_helpers(cd_export_ctx *x)
 {
+    /* ids are ints: counts past INT_MAX (a crafted extent) are refused */
+    if (x->N > INT_MAX || x->P > INT_MAX / 2)
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %llu particles, %llu primitives: more than ids can name; "
+                              "the file is refused", x->path, (unsigned long long)x->N, (unsigned long long)x->P);
     hsize_t n = x->N > 2 * x->P ? x->N : 2 * x->P;
-    int *v = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    size_t vb;
+    if (cd_h5_mul(&vb, (size_t)(n > 0 ? n : 1), sizeof(int), 1))
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: helper sizes overflow; the file is refused", x->path);
+    int *v = malloc(vb);
     if (!v) return cd_export_fail(x, CD_EXPORT_FAIL, "out of memory");
     for (hsize_t i = 0; i < x->N; i++) v[i] = (int)i;
     int rc = cd_export_ints(x, x->viz, "particle_id", 1, &x->N, v);
@@ -218,7 +230,11 @@ static int cd_export_contact_cells(cd_export_ctx *x, hid_t g, long long c0, long
         if (H5Lexists(g, "contact_cells", H5P_DEFAULT) > 0) H5Ldelete(g, "contact_cells", H5P_DEFAULT);
         return 0;
     }
-    int *ij = malloc(sizeof(int) * 2 * C), *col = malloc(sizeof(int) * C);
+    size_t ijb, colb;
+    if (cd_h5_mul(&ijb, (size_t)C, 2, sizeof(int)) || cd_h5_mul(&colb, (size_t)C, sizeof(int), 1) || C > (hsize_t)SIZE_MAX)
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: /contacts/offset: %llu contact rows overflow a size; the file "
+                              "is refused", x->path, (unsigned long long)C);
+    int *ij = malloc(ijb), *col = malloc(colb);
     if (!ij || !col) { free(ij); free(col); return cd_export_fail(x, CD_EXPORT_FAIL, "out of memory"); }
     const char *names[2] = {"/contacts/particle_i", "/contacts/particle_j"};
     int rc = 0;

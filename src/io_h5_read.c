@@ -2,8 +2,10 @@
  * layout helpers shared with the writer (io_h5.c).  Layout: docs/output.md. */
 #include "io_h5.h"
 #include "io_h5_internal.h"
+#include "io_h5_check.h"
 #include "../kernels/vec3.h"
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -201,6 +203,10 @@ long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen)
     if (H5Aexists(file, CDH5_COMMIT_ATTR) > 0) {
         long long c = -1;
         hid_t a = H5Aopen(file, CDH5_COMMIT_ATTR, H5P_DEFAULT);
+        if (a >= 0 && cd_h5_check_number_attr(a, path, "/" CDH5_COMMIT_ATTR, err, errlen)) {
+            H5Aclose(a);
+            return -1;
+        }
         if (a < 0 || H5Aread(a, H5T_NATIVE_LLONG, &c) < 0) {
             cdh5_msg(err, errlen, "%s: cannot read attribute /%s", path, CDH5_COMMIT_ATTR);
             if (a >= 0) H5Aclose(a);
@@ -222,6 +228,98 @@ void cdh5_quiet_begin(cdh5_quiet *q)
 void cdh5_quiet_end(const cdh5_quiet *q)
 {
     H5Eset_auto2(H5E_DEFAULT, q->func, q->data);
+}
+
+/* ---- hostile-file guards (io_h5_check.h) ------------------------------------ */
+
+static const char *class_name(H5T_class_t c)
+{
+    switch (c) {
+    case H5T_INTEGER: return "integers";
+    case H5T_FLOAT: return "floats";
+    case H5T_STRING: return "strings";
+    case H5T_COMPOUND: return "compound records";
+    default: return "values of another class";
+    }
+}
+
+int cd_h5_check_dset(hid_t d, const char *file, const char *dpath, H5T_class_t cls, int rank, const hsize_t *lo,
+                     const hsize_t *hi, hsize_t dims[3], char *err, size_t errlen)
+{
+    hsize_t own[3], *dm = dims ? dims : own;
+    dm[0] = dm[1] = dm[2] = 1;
+    hid_t t = H5Dget_type(d), sp = H5Dget_space(d);
+    H5T_class_t have = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
+    int r = sp >= 0 && H5Sget_simple_extent_type(sp) != H5S_NULL ? H5Sget_simple_extent_ndims(sp) : -1;
+    hsize_t got[H5S_MAX_RANK];
+    int ok = r == rank && (r == 0 || H5Sget_simple_extent_dims(sp, got, NULL) == r);
+    if (t >= 0) H5Tclose(t);
+    if (sp >= 0) H5Sclose(sp);
+    H5Eclear2(H5E_DEFAULT);
+    if (t < 0 || (cls != CD_H5_ANY_CLASS && have != cls)) {
+        snprintf(err, errlen, "%s: dataset %s holds %s, the layout allows only %s; the file is refused", file, dpath,
+                 class_name(have), class_name(cls));
+        return -1;
+    }
+    if (!ok) {
+        snprintf(err, errlen, "%s: dataset %s has rank %d, the layout allows only rank %d; the file is refused", file,
+                 dpath, r, rank);
+        return -1;
+    }
+    for (int k = 0; k < rank; k++) {
+        hsize_t a = lo ? lo[k] : 0, b = hi && hi[k] ? hi[k] : ~(hsize_t)0;
+        if (got[k] < a || got[k] > b) {
+            snprintf(err, errlen, "%s: dataset %s has %llu entries along dimension %d, the layout allows %llu..%llu; "
+                     "the file is refused", file, dpath, (unsigned long long)got[k], k, (unsigned long long)a,
+                     (unsigned long long)b);
+            return -1;
+        }
+        dm[k] = got[k];
+    }
+    return 0;
+}
+
+int cd_h5_check_string(hid_t obj, int attr, const char *file, const char *what, size_t max_bytes, char *err,
+                       size_t errlen)
+{
+    hid_t t = attr ? H5Aget_type(obj) : H5Dget_type(obj), sp = attr ? H5Aget_space(obj) : H5Dget_space(obj);
+    hssize_t n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
+    int str = t >= 0 && H5Tget_class(t) == H5T_STRING, var = str && H5Tis_variable_str(t) > 0;
+    size_t size = t >= 0 ? H5Tget_size(t) : 0;
+    if (t >= 0) H5Tclose(t);
+    if (sp >= 0) H5Sclose(sp);
+    H5Eclear2(H5E_DEFAULT);
+    if (!str || n != 1 || (!var && size > max_bytes)) {
+        snprintf(err, errlen, "%s: %s must hold one string%s, it holds %lld %s%s; the file is refused", file, what,
+                 var ? "" : " of bounded length", (long long)n, str ? "strings" : "non-strings",
+                 !var && size > max_bytes ? " too long" : "");
+        return -1;
+    }
+    return 0;
+}
+
+int cd_h5_check_number_attr(hid_t a, const char *file, const char *what, char *err, size_t errlen)
+{
+    hid_t t = H5Aget_type(a), sp = H5Aget_space(a);
+    hssize_t n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
+    H5T_class_t c = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
+    if (t >= 0) H5Tclose(t);
+    if (sp >= 0) H5Sclose(sp);
+    H5Eclear2(H5E_DEFAULT);
+    if (n != 1 || (c != H5T_INTEGER && c != H5T_FLOAT)) {
+        snprintf(err, errlen, "%s: attribute %s must hold one number, it holds %lld %s; the file is refused", file,
+                 what, (long long)n, class_name(c));
+        return -1;
+    }
+    return 0;
+}
+
+int cd_h5_mul(size_t *out, size_t a, size_t b, size_t c)
+{
+    *out = 0;
+    if ((b && a > SIZE_MAX / b) || (c && a * b > SIZE_MAX / c)) return -1;
+    *out = a * b * c;
+    return 0;
 }
 
 /* ---- reading ---------------------------------------------------------------- */
@@ -277,8 +375,9 @@ static herr_t check_tail(hid_t loc, const char *name, const H5O_info_t *info, vo
     int ok = rank >= 0 && rank <= 8 && mt >= 0;
     if (ok && chunked && rank >= 1 && H5Sget_simple_extent_dims(sp, dims, NULL) == rank && dims[0] > 0) {
         size_t row = H5Tget_size(mt);
-        for (int r = 1; r < rank; r++) row *= (size_t)dims[r];
-        void *buf = malloc(row ? row : 1);
+        for (int r = 1; r < rank && row; r++)
+            if (cd_h5_mul(&row, row, (size_t)dims[r], 1) || row > ((size_t)1 << 30)) row = 0; /* refused below */
+        void *buf = row ? malloc(row) : NULL;
         start[0] = dims[0] - 1;
         count[0] = 1;
         for (int r = 1; r < rank; r++) count[r] = dims[r];
@@ -373,8 +472,19 @@ static int check_snapshot(reader *r, long long k, const cd_state *s)
     r->control = ropen(r, CDH5_CONTROL_VALUE);
     if (r->control < 0) return -1;
     if (r->walls < 0 || r->step < 0 || r->time < 0 || r->c_offset < 0 || r->w_offset < 0 || r->w_index < 0) return -1;
-    if (cdh5_dims(r->walls, dims) != 2 || dims[0] <= (hsize_t)k)
-        return rfail(r, "%s lacks snapshot %lld", CDH5_WALLS_VALUE, k);
+    /* shapes first: every read below goes into a buffer sized by the layout */
+    const hsize_t one_snap[1] = {(hsize_t)k + 1}, two_snap[1] = {(hsize_t)k + 2};
+    const hsize_t ctl_lo[2] = {(hsize_t)k + 1, 1}, ctl_hi[2] = {0, CD_CONTROL_SLOTS}, walls_lo[2] = {(hsize_t)k + 1, 0};
+    if (cd_h5_check_dset(r->step, r->path, CDH5_SNAP_STEP, H5T_INTEGER, 1, one_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->time, r->path, CDH5_SNAP_TIME, H5T_FLOAT, 1, one_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->c_offset, r->path, CDH5_C_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->w_offset, r->path, CDH5_W_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->w_index, r->path, CDH5_W_INDEX, H5T_INTEGER, 1, NULL, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->control, r->path, CDH5_CONTROL_VALUE, H5T_FLOAT, 2, ctl_lo, ctl_hi, NULL, r->err,
+                         r->errlen) ||
+        cd_h5_check_dset(r->walls, r->path, CDH5_WALLS_VALUE, H5T_COMPOUND, 2, walls_lo, NULL, dims, r->err,
+                         r->errlen))
+        return -1;
     if (dims[1] != s->n_walls)
         return rfail(r, "the file holds %llu walls, the state %zu: was the state set up from the same config?",
                      (unsigned long long)dims[1], s->n_walls);
@@ -413,7 +523,11 @@ static int check_snapshot(reader *r, long long k, const cd_state *s)
     }
     /* wall-contact rows: where they go */
     long long wm = r->w1 - r->w0, nwc = (long long)(s->n_prims * s->n_walls);
-    r->windex = malloc((size_t)(wm > 0 ? wm : 1) * sizeof *r->windex);
+    size_t wbytes, big;
+    if (cd_h5_mul(&wbytes, (size_t)(wm > 0 ? wm : 1), sizeof *r->windex, 1) ||
+        cd_h5_mul(&big, (size_t)(wm > 0 ? wm : 1), cdh5_max_row_bytes(), 1))
+        return rfail(r, "%s: %lld wall-contact rows overflow a size; the file is refused", CDH5_W_OFFSET, wm);
+    r->windex = malloc(wbytes);
     if (!r->windex) return rfail(r, "out of memory");
     if (wm && cdh5_read_rows(r->w_index, (hsize_t)r->w0, (hsize_t)wm, H5T_NATIVE_LLONG, r->windex) < 0)
         return rfail(r, "cannot read %s rows %lld..%lld", CDH5_W_INDEX, r->w0, r->w1);
@@ -421,7 +535,6 @@ static int check_snapshot(reader *r, long long k, const cd_state *s)
         if (r->windex[j] < 0 || r->windex[j] >= nwc)
             return rfail(r, "%s row %lld is %lld, outside 0..%lld", CDH5_W_INDEX, r->w0 + j, r->windex[j], nwc - 1);
     long long m = r->c1 - r->c0;
-    size_t big = (size_t)(wm > 0 ? wm : 1) * cdh5_max_row_bytes();
     r->tmp = malloc(big);
     if (!r->tmp) return rfail(r, "out of memory");
     if ((size_t)m > s->cap_pairs && cd_state_reserve_pairs((cd_state *)s, (size_t)m))
@@ -469,6 +582,7 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
     H5Tclose(wt);
     if (e < 0) return rfail(r, "cannot read %s of snapshot %lld", CDH5_WALLS_VALUE, k);
     memcpy(s->walls, walls, s->n_walls * sizeof walls[0]);
+    memset(s->control, 0, sizeof s->control); /* a file may hold fewer slots (checked: never more) */
     if (cdh5_read_rows(r->control, (hsize_t)k, 1, H5T_NATIVE_DOUBLE, s->control) < 0)
         return rfail(r, "cannot read %s of snapshot %lld", CDH5_CONTROL_VALUE, k);
     long long step;
@@ -560,11 +674,8 @@ static char *read_text(const char *path, const char *dpath, char *err, size_t er
         cdh5_msg(err, errlen, "%s: cannot open dataset %s", path, dpath);
         goto done;
     }
+    if (cd_h5_check_string(d, 0, path, dpath, (size_t)1 << 26, err, errlen)) goto done;
     t = H5Dget_type(d);
-    if (H5Tget_class(t) != H5T_STRING) {
-        cdh5_msg(err, errlen, "%s: %s is not a string", path, dpath);
-        goto done;
-    }
     mt = H5Tcopy(t);
     if (H5Tis_variable_str(t) > 0) {
         char *p = NULL;

@@ -3,6 +3,7 @@
  * the commit record.  Layout and crash behaviour: docs/output.md. */
 #include "io_h5.h"
 #include "io_h5_internal.h"
+#include "io_h5_check.h"
 #include "../kernels/vec3.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -215,7 +216,8 @@ int cdh5_layout_open(cd_output *o)
             rows[f->group] = n;
         }
         if (cdh5_store_of(f) == CDH5_FIXED) {
-            c->fixed_bytes = (size_t)n * f->elem_size;
+            if (cd_h5_mul(&c->fixed_bytes, (size_t)n, f->elem_size, 1))
+                return FAIL("%s: %s has %lld rows, too many to hold; the file is refused", o->path, p, n);
             c->fixed = malloc(c->fixed_bytes ? c->fixed_bytes : 1);
             if (!c->fixed) return FAIL("%s: out of memory", o->path);
             if (n && H5Dread(c->dset, cdh5_mem_type(f), H5S_ALL, H5S_ALL, H5P_DEFAULT, c->fixed) < 0)

@@ -361,8 +361,23 @@ static int save_base(cd_sim *sim, char *err, size_t errlen)
     return 0;
 }
 
+/* Is v a whole number in lo..hi? (a NaN is not) */
+static int whole_in(double v, double lo, double hi) { return v >= lo && v <= hi && v == floor(v); }
+
 int cd_protocol_resume(cd_sim *sim, const char *path, char *err, size_t errlen)
 {
+    /* The protocol state comes from the file: slots used as indices are
+     * checked before they index anything (a crafted file is refused). */
+    const double *c = sim->s.control;
+    if (!whole_in(c[CTL_PHASE], CD_PHASE_FREE, CD_PHASE_DONE) ||
+        !whole_in(c[CTL_WALL], 0, sim->s.n_walls ? (double)sim->s.n_walls - 1 : 0) ||
+        !whole_in(c[CTL_N_PROBES], 0, CTL_MAX_PROBES)) {
+        snprintf(err, errlen, "%s: dataset /walls/control holds phase %g, wall %g, probes %g: not a state the protocol "
+                 "can be in (phases %d..%d, walls 0..%zu, probes 0..%d); the file is refused", path, c[CTL_PHASE],
+                 c[CTL_WALL], c[CTL_N_PROBES], CD_PHASE_FREE, CD_PHASE_DONE, sim->s.n_walls ? sim->s.n_walls - 1 : 0,
+                 CTL_MAX_PROBES);
+        return -1;
+    }
     if (phase_of(sim) != CD_PHASE_PROBE || sim->probe_base.position) return 0;
     long long base_step = (long long)sim->s.control[CTL_BASE_STEP];
     if (cd_state_copy(&sim->probe_base, &sim->s)) {
