@@ -9,6 +9,7 @@
  *   P_b  fraction with exactly b contact neighbours          (Z = sum b P_b)
  *   P_k  fraction of bonds with exactly k contacts. */
 #include "analyze.h"
+#include "../kernels/contact_law.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,7 +102,7 @@ int cd_an_bonds_build(const cd_an_snapshot *s, cd_an_bonds *b, char *err, size_t
             size_t c = b->order[a];
             /* force of the contact on cj is F_n n + F_t (fields.def);
              * the bond force is the force on its higher particle j */
-            cd_vec3 F = cd_v3_axpy(s->ft[c], s->fn[c], s->normal[c]); /* [N] */
+            cd_vec3 F = cd_contact_force_on_j(s->fn[c], s->normal[c], s->ft[c]); /* [N] */
             double sign = s->cj[c] == b->j[q - 1] ? 1 : -1;
             b->force[q - 1] = cd_v3_axpy(b->force[q - 1], sign, F);
             b->k[q - 1]++;

@@ -8,6 +8,7 @@
  * eigenvalues of the symmetric part (the antisymmetric part is the net
  * torque / V, zero in equilibrium). */
 #include "analyze.h"
+#include "../kernels/contact_law.h"
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_matrix.h>
 #include <math.h>
@@ -35,7 +36,7 @@ int cd_an_particle_stress(const cd_an_snapshot *s, double *sigma, int32_t *ncont
     memset(ncontacts, 0, s->n * sizeof(int32_t));
     for (size_t c = 0; c < s->nc; c++) {
         int i = s->ci[c], j = s->cj[c];
-        cd_vec3 F = cd_v3_axpy(s->ft[c], s->fn[c], s->normal[c]); /* on j [N] */
+        cd_vec3 F = cd_contact_force_on_j(s->fn[c], s->normal[c], s->ft[c]); /* on j [N] */
         add_dyad(sigma + 9 * (size_t)j, F, cd_v3_sub(s->point[c], s->pos[j]));
         add_dyad(sigma + 9 * (size_t)i, cd_v3_neg(F), cd_v3_sub(s->point[c], s->pos[i]));
         ncontacts[i]++;

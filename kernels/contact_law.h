@@ -26,6 +26,15 @@ typedef struct {
 
 CD_DEVICE_BEGIN
 
+/* The contact force on body j from its parts [N]: F_n n + F_t (body i
+ * gets its opposite).  The contact law, the readers of older run files and
+ * the analysis all build it here, so it has one set of bits. */
+CD_INLINE cd_vec3 cd_contact_force_on_j(cd_real fn, cd_vec3 n, cd_vec3 ft) { return cd_v3_axpy(ft, fn, n); }
+
+/* Its tangential part from the whole force [N]: F_j - F_n n, the law's F_t
+ * up to one rounding of F_n n (src/pair_output.c). */
+CD_INLINE cd_vec3 cd_contact_tangential(cd_vec3 force_j, cd_real fn, cd_vec3 n) { return cd_v3_axpy(force_j, -fn, n); }
+
 /* Effective mass m_ij = m_i m_j / (m_i + m_j) [kg]. */
 CD_INLINE cd_real cd_law_effective_mass(cd_real mi, cd_real mj) { return mi * mj / (mi + mj); }
 
@@ -87,7 +96,7 @@ CD_INLINE cd_contact_force cd_contact_law(cd_law_params p, cd_real m_eff, const 
     *shear = s;
     out.fn = fn;
     out.ft = ft;
-    out.force_j = cd_v3_axpy(ft, fn, n);
+    out.force_j = cd_contact_force_on_j(fn, n, ft);
     return out;
 }
 

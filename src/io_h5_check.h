@@ -2,7 +2,7 @@
  * host/analyze_*.c, host/export_*.c): a dataset's number class, rank and
  * extents are checked against what the layout allows before anything is
  * allocated for it or read from it, and sizes derived from extents are
- * multiplied with overflow checks.  Implemented in io_h5_read.c. */
+ * multiplied with overflow checks.  Implemented in io_h5_check.c. */
 #ifndef CD_IO_H5_CHECK_H
 #define CD_IO_H5_CHECK_H
 #include <stddef.h>

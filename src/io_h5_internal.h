@@ -1,4 +1,4 @@
-/* Private to io_h5.c and io_h5_read.c: names of the run-file layout and
+/* Private to the io_h5*.c files: names of the run-file layout and
  * small HDF5 helpers shared by the writer and the reader.  The layout
  * itself is documented in docs/output.md. */
 #ifndef CD_IO_H5_INTERNAL_H
@@ -68,6 +68,8 @@ herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype,
 /* Snapshots completely on disk: min(commit attribute, length of the
  * snapshot step and time); 0 when the file has no snapshot yet; -1 on error. */
 long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen);
+/* Opens a run file read-only (err names it on failure), or returns < 0. */
+hid_t cdh5_open_ro(const char *path, char *err, size_t errlen);
 
 /* Silences HDF5's automatic error printing inside a public function. */
 typedef struct { H5E_auto2_t func; void *data; } cdh5_quiet;

@@ -3,7 +3,7 @@
 #include "io_h5.h"
 #include "io_h5_internal.h"
 #include "io_h5_check.h"
-#include "../kernels/vec3.h"
+#include "../kernels/contact_law.h"
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -230,101 +230,9 @@ void cdh5_quiet_end(const cdh5_quiet *q)
     H5Eset_auto2(H5E_DEFAULT, q->func, q->data);
 }
 
-/* ---- hostile-file guards (io_h5_check.h) ------------------------------------ */
-
-static const char *class_name(H5T_class_t c)
-{
-    switch (c) {
-    case H5T_INTEGER: return "integers";
-    case H5T_FLOAT: return "floats";
-    case H5T_STRING: return "strings";
-    case H5T_COMPOUND: return "compound records";
-    default: return "values of another class";
-    }
-}
-
-int cd_h5_check_dset(hid_t d, const char *file, const char *dpath, H5T_class_t cls, int rank, const hsize_t *lo,
-                     const hsize_t *hi, hsize_t dims[3], char *err, size_t errlen)
-{
-    hsize_t own[3], *dm = dims ? dims : own;
-    dm[0] = dm[1] = dm[2] = 1;
-    hid_t t = H5Dget_type(d), sp = H5Dget_space(d);
-    H5T_class_t have = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
-    int r = sp >= 0 && H5Sget_simple_extent_type(sp) != H5S_NULL ? H5Sget_simple_extent_ndims(sp) : -1;
-    hsize_t got[H5S_MAX_RANK];
-    int ok = r == rank && (r == 0 || H5Sget_simple_extent_dims(sp, got, NULL) == r);
-    if (t >= 0) H5Tclose(t);
-    if (sp >= 0) H5Sclose(sp);
-    H5Eclear2(H5E_DEFAULT);
-    if (t < 0 || (cls != CD_H5_ANY_CLASS && have != cls)) {
-        snprintf(err, errlen, "%s: dataset %s holds %s, the layout allows only %s; the file is refused", file, dpath,
-                 class_name(have), class_name(cls));
-        return -1;
-    }
-    if (!ok) {
-        snprintf(err, errlen, "%s: dataset %s has rank %d, the layout allows only rank %d; the file is refused", file,
-                 dpath, r, rank);
-        return -1;
-    }
-    for (int k = 0; k < rank; k++) {
-        hsize_t a = lo ? lo[k] : 0, b = hi && hi[k] ? hi[k] : ~(hsize_t)0;
-        if (got[k] < a || got[k] > b) {
-            snprintf(err, errlen, "%s: dataset %s has %llu entries along dimension %d, the layout allows %llu..%llu; "
-                     "the file is refused", file, dpath, (unsigned long long)got[k], k, (unsigned long long)a,
-                     (unsigned long long)b);
-            return -1;
-        }
-        dm[k] = got[k];
-    }
-    return 0;
-}
-
-int cd_h5_check_string(hid_t obj, int attr, const char *file, const char *what, size_t max_bytes, char *err,
-                       size_t errlen)
-{
-    hid_t t = attr ? H5Aget_type(obj) : H5Dget_type(obj), sp = attr ? H5Aget_space(obj) : H5Dget_space(obj);
-    hssize_t n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
-    int str = t >= 0 && H5Tget_class(t) == H5T_STRING, var = str && H5Tis_variable_str(t) > 0;
-    size_t size = t >= 0 ? H5Tget_size(t) : 0;
-    if (t >= 0) H5Tclose(t);
-    if (sp >= 0) H5Sclose(sp);
-    H5Eclear2(H5E_DEFAULT);
-    if (!str || n != 1 || (!var && size > max_bytes)) {
-        snprintf(err, errlen, "%s: %s must hold one string%s, it holds %lld %s%s; the file is refused", file, what,
-                 var ? "" : " of bounded length", (long long)n, str ? "strings" : "non-strings",
-                 !var && size > max_bytes ? " too long" : "");
-        return -1;
-    }
-    return 0;
-}
-
-int cd_h5_check_number_attr(hid_t a, const char *file, const char *what, char *err, size_t errlen)
-{
-    hid_t t = H5Aget_type(a), sp = H5Aget_space(a);
-    hssize_t n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
-    H5T_class_t c = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
-    if (t >= 0) H5Tclose(t);
-    if (sp >= 0) H5Sclose(sp);
-    H5Eclear2(H5E_DEFAULT);
-    if (n != 1 || (c != H5T_INTEGER && c != H5T_FLOAT)) {
-        snprintf(err, errlen, "%s: attribute %s must hold one number, it holds %lld %s; the file is refused", file,
-                 what, (long long)n, class_name(c));
-        return -1;
-    }
-    return 0;
-}
-
-int cd_h5_mul(size_t *out, size_t a, size_t b, size_t c)
-{
-    *out = 0;
-    if ((b && a > SIZE_MAX / b) || (c && a * b > SIZE_MAX / c)) return -1;
-    *out = a * b * c;
-    return 0;
-}
-
 /* ---- reading ---------------------------------------------------------------- */
 
-static hid_t open_ro(const char *path, char *err, size_t errlen)
+hid_t cdh5_open_ro(const char *path, char *err, size_t errlen)
 {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG);
@@ -338,82 +246,11 @@ int cd_h5_snapshot_count(const char *path, char *err, size_t errlen)
 {
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
-    hid_t f = open_ro(path, err, errlen);
+    hid_t f = cdh5_open_ro(path, err, errlen);
     long long n = f < 0 ? -1 : cdh5_committed(f, path, err, errlen);
     if (f >= 0) H5Fclose(f);
     cdh5_quiet_end(&q);
     return n > 2147483647LL ? 2147483647 : (int)n;
-}
-
-/* ---- checksums of the chunks a resume appends to --------------------------- */
-
-typedef struct {
-    char *err;
-    size_t errlen;
-    const char *path;
-    int bad;
-} tail_check;
-
-/* Reads the last row of dataset `name` when it is chunked, so that HDF5
- * verifies that chunk's Fletcher-32 checksum (every other chunk a resume
- * reads is verified as it is read). */
-static herr_t check_tail(hid_t loc, const char *name, const H5O_info_t *info, void *data)
-{
-    tail_check *t = data;
-    if (info->type != H5O_TYPE_DATASET || t->bad) return 0;
-    hid_t d = H5Dopen2(loc, name, H5P_DEFAULT);
-    if (d < 0) {
-        t->bad = 1;
-        cdh5_msg(t->err, t->errlen, "%s: cannot open dataset /%s", t->path, name);
-        return 1;
-    }
-    hid_t dcpl = H5Dget_create_plist(d), sp = H5Dget_space(d), ft = H5Dget_type(d);
-    hid_t mt = ft >= 0 ? H5Tget_native_type(ft, H5T_DIR_ASCEND) : -1;
-    int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
-    hsize_t dims[8], start[8] = {0}, count[8];
-    int chunked = dcpl >= 0 && H5Pget_layout(dcpl) == H5D_CHUNKED;
-    int ok = rank >= 0 && rank <= 8 && mt >= 0;
-    if (ok && chunked && rank >= 1 && H5Sget_simple_extent_dims(sp, dims, NULL) == rank && dims[0] > 0) {
-        size_t row = H5Tget_size(mt);
-        for (int r = 1; r < rank && row; r++)
-            if (cd_h5_mul(&row, row, (size_t)dims[r], 1) || row > ((size_t)1 << 30)) row = 0; /* refused below */
-        void *buf = row ? malloc(row) : NULL;
-        start[0] = dims[0] - 1;
-        count[0] = 1;
-        for (int r = 1; r < rank; r++) count[r] = dims[r];
-        hid_t ms = H5Screate_simple(rank, count, NULL);
-        ok = buf && ms >= 0 && H5Sselect_hyperslab(sp, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
-             H5Dread(d, mt, ms, sp, H5P_DEFAULT, buf) >= 0;
-        if (ms >= 0) H5Sclose(ms);
-        free(buf);
-    }
-    if (!ok) {
-        t->bad = 1;
-        cdh5_msg(t->err, t->errlen, "%s: dataset /%s is corrupted (its checksum or layout does not match); the file is "
-                 "refused, nothing was read from it or written to it", t->path, name);
-    }
-    if (mt >= 0) H5Tclose(mt);
-    if (ft >= 0) H5Tclose(ft);
-    if (sp >= 0) H5Sclose(sp);
-    if (dcpl >= 0) H5Pclose(dcpl);
-    H5Dclose(d);
-    return t->bad ? 1 : 0;
-}
-
-int cd_h5_check_tails(const char *path, char *err, size_t errlen)
-{
-    cdh5_quiet q;
-    cdh5_quiet_begin(&q);
-    tail_check t = {err, errlen, path, 0};
-    hid_t f = open_ro(path, err, errlen);
-    if (f < 0) t.bad = 1;
-    else if (H5Ovisit2(f, H5_INDEX_NAME, H5_ITER_NATIVE, check_tail, &t, H5O_INFO_BASIC) < 0 && !t.bad) {
-        t.bad = 1;
-        cdh5_msg(err, errlen, "%s: its object tree cannot be walked (a corrupted file?)", path);
-    }
-    if (f >= 0) H5Fclose(f);
-    cdh5_quiet_end(&q);
-    return t.bad ? -1 : 0;
 }
 
 typedef struct {
@@ -574,7 +411,7 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
     /* The force on j of a file that stored only its parts: F_n n + F_t,
      * the law's expression (kernels/contact_law.h), so the same bits. */
     if (r->legacy_force)
-        for (long long j = 0; j < m; j++) s->pair_force[j] = cd_v3_axpy(s->pair_ft[j], s->pair_fn[j], s->pair_normal[j]);
+        for (long long j = 0; j < m; j++) s->pair_force[j] = cd_contact_force_on_j(s->pair_fn[j], s->pair_normal[j], s->pair_ft[j]);
     cd_wall walls[CD_MAX_WALLS];
     memset(walls, 0, sizeof walls);
     hid_t wt = cdh5_wall_mem_type();
@@ -606,7 +443,7 @@ int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t 
         goto done;
     }
     for (size_t i = 0; i < cd_n_fields; i++) r.ds[i] = H5I_INVALID_HID;
-    r.file = open_ro(path, err, errlen);
+    r.file = cdh5_open_ro(path, err, errlen);
     if (r.file < 0) goto done;
     long long n = cdh5_committed(r.file, path, err, errlen);
     if (n < 0) goto done;
@@ -646,7 +483,7 @@ char *cd_h5_read_latest_config_text(const char *path, char *where, size_t wlen, 
 {
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
-    hid_t f = open_ro(path, err, errlen);
+    hid_t f = cdh5_open_ro(path, err, errlen);
     int k = 0;
     char p[CDH5_PATH_LEN];
     while (f >= 0 && k < 1000000) {
@@ -667,7 +504,7 @@ static char *read_text(const char *path, const char *dpath, char *err, size_t er
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
     char *out = NULL;
-    hid_t f = open_ro(path, err, errlen), d = -1, t = -1, mt = -1;
+    hid_t f = cdh5_open_ro(path, err, errlen), d = -1, t = -1, mt = -1;
     if (f < 0) goto done;
     d = H5Dopen2(f, dpath, H5P_DEFAULT);
     if (d < 0) {

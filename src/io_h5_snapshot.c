@@ -4,7 +4,7 @@
 #include "io_h5.h"
 #include "io_h5_internal.h"
 #include "io_h5_check.h"
-#include "../kernels/vec3.h"
+#include "../kernels/contact_law.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -163,7 +163,7 @@ static int add_pair_force(cd_output *o, size_t k)
          cdh5_read_rows(d[1], 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, fn) < 0 ||
          cdh5_read_rows(d[2], 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, nrm) < 0))
         rc = FAIL("%s: cannot read the contact forces to add /contacts/pair_force", o->path);
-    for (long long j = 0; !rc && j < rows; j++) ft[j] = cd_v3_axpy(ft[j], fn[j], nrm[j]);
+    for (long long j = 0; !rc && j < rows; j++) ft[j] = cd_contact_force_on_j(fn[j], nrm[j], ft[j]);
     if (!rc) rc = create_col(o, NULL, k);
     if (!rc && rows > 0)
         rc = cdh5_append(o, o->cols[k].dset, "pair_force", 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, ft);

@@ -32,7 +32,7 @@ void cd_sim_derive_pair_output(cd_sim *sim)
         cd_pair_geometry(c, k, sin_parallel, blend, &g);
         cd_vec3 f = s->pair_force[k], point = s->pair_point[k];
         s->pair_normal[k] = g.normal;
-        s->pair_ft[k] = cd_v3_axpy(f, -s->pair_fn[k], g.normal);
+        s->pair_ft[k] = cd_contact_tangential(f, s->pair_fn[k], g.normal);
         s->pair_torque_i[k] = cd_contact_torque(point, s->position[s->prim_particle[s->pair_prim_i[k]]], cd_v3_neg(f));
         s->pair_torque_j[k] = cd_contact_torque(point, s->position[s->prim_particle[s->pair_prim_j[k]]], f);
     }

@@ -55,15 +55,22 @@ const cd_backend *cd_backend_find(const char *name)
     return NULL;
 }
 
-int cd_sim_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+double cd_sim_wall_load_host(cd_sim *sim, int w)
 {
-    if (sim->backend && sim->backend->wall_load) return sim->backend->wall_load(sim, w, load, err, errlen);
-    if (cd_sim_sync(sim, err, errlen)) return -1;
     /* the order of every backend (kernels/step_items.h, CD_LOAD_CHUNK) */
     cd_cols c = cd_sim_host_cols(&sim->s);
     cd_long P = (cd_long)sim->s.n_prims, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
     double sum = 0;
     for (cd_long ch = 0; ch < nch; ch++) sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w);
-    *load = sum;
+    return sum;
+}
+
+int cd_sim_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    if (sim->backend && sim->backend->wall_load) return sim->backend->wall_load(sim, w, load, err, errlen);
+    /* the backend's copy back only: the load reads no output-only column,
+     * and protocols ask for it every step */
+    if (sim->backend && sim->backend->sync(sim, err, errlen)) return -1;
+    *load = cd_sim_wall_load_host(sim, w);
     return 0;
 }

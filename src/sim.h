@@ -113,6 +113,9 @@ cd_cols cd_sim_host_cols(cd_state *s);
  * host state (src/pair_output.c).  cd_sim_sync calls it. */
 void cd_sim_derive_pair_output(cd_sim *sim);
 
+/* The same sum over the host columns, in the same chunk order. */
+double cd_sim_wall_load_host(cd_sim *sim, int w);
+
 /* Checks the host state for non-finite values (a blown-up run). */
 int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen);
 

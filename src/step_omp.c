@@ -560,11 +560,7 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     cd_off *o = sim->backend_data;
     (void)err; (void)errlen;
     if (!o) { /* not started: the host columns are current */
-        cd_cols h = cd_sim_host_cols(&sim->s);
-        cd_long P = (cd_long)sim->s.n_prims, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
-        double acc = 0;
-        for (cd_long ch = 0; ch < nch; ch++) acc += cd_item_wall_load_chunk(h, ch, P, (cd_int)sim->s.n_walls, w);
-        *load = acc;
+        *load = cd_sim_wall_load_host(sim, w);
         return 0;
     }
     cd_cols c = o->dev;
