@@ -67,7 +67,7 @@ static size_t state_bytes(const cd_sim *sim)
         size_t rows = cd_fields[f].group == CD_GROUP_PAIR ? sim->s.cap_pairs : cd_state_rows(&sim->s, cd_fields[f].group);
         b += rows * cd_fields[f].elem_size;
     }
-    b += (sim->s.n_particles + 1) * sizeof(cd_int) + sim->nb.gather_cap * sizeof(cd_pair_id);
+    b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
     return b;
 }
 

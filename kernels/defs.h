@@ -48,6 +48,30 @@ typedef cd_int cd_prim_id;     /* index into primitive (arm) columns */
 typedef cd_int cd_pair_id;     /* index into pair/contact columns */
 typedef cd_int cd_shape_id;    /* index into the shape catalogue */
 
+/* Integer atomic increment, returning the old value: counting sorts only
+ * (kernels/neighbor_items.h), never a floating-point sum.  OpenMP's atomic
+ * is atomic among all threads of the device (teams included); without
+ * OpenMP the code runs on one thread and it is a plain increment. */
+#ifdef __OPENCL_VERSION__
+#define cd_atomic_inc(p) atomic_inc(p)
+#else
+#if defined(_OPENMP)
+#pragma omp declare target
+#endif
+static inline cd_int cd_atomic_inc(cd_int *p)
+{
+    cd_int old;
+#if defined(_OPENMP)
+#pragma omp atomic capture
+#endif
+    old = (*p)++;
+    return old;
+}
+#if defined(_OPENMP)
+#pragma omp end declare target
+#endif
+#endif
+
 /* Own vector structs: OpenCL's double3 is 32 bytes and differs from C. */
 typedef struct { cd_real x, y, z; } cd_vec3;
 typedef struct { cd_real w, x, y, z; } cd_quat; /* unit quaternion, w scalar */

@@ -1,11 +1,12 @@
 /* OpenCL backend: the Verlet list rebuilt on the device (docs/opencl.md,
- * "Neighbour list").  The sequence mirrors src/neighbors.c: grid from the
- * box of the primitive centres, primitives binned by cell, candidates
- * counted per primitive, a prefix sum giving each primitive its rows, rows
- * filled sorted by (prim_i, prim_j), history found by binary search of each
- * new key among the old sorted keys, and the per-particle gather lists.
- * The only transfer to the host is the number of pairs (one int), which
- * sizes the buffers. */
+ * "Neighbour list"), pass by pass as kernels/neighbor_items.h lists them
+ * and src/neighbors.c runs them: grid from the box of the particle centres,
+ * particles binned by cell, candidates collected per particle into slots,
+ * a prefix sum giving each primitive its rows, rows placed sorted by
+ * (prim_i, prim_j), history found by binary search of each new key among
+ * the old sorted keys, the per-particle gather and wall lists.  The only
+ * transfers to the host are the numbers of pairs and of wall candidates
+ * and the overflow flag, which size the buffers. */
 #include <string.h>
 #include "backend_cl.h"
 #include "../kernels/broadphase.h"
@@ -67,10 +68,10 @@ static void grow_slots(cd_cl *cl, size_t P)
     cl->cand = cd_cl_buffer(cl, P * (size_t)cl->slot * sizeof(cd_prim_id), "enlarging the candidate slots");
 }
 
-/* Arguments shared by the scans of the candidates. */
-static void scan_args(cd_cl *cl, enum cd_cl_kernel k, cd_int P, cd_real skin)
+/* Arguments shared by the scans of the candidates (pass 5). */
+static void scan_args(cd_cl *cl, enum cd_cl_kernel k, cd_int N, cd_real skin)
 {
-    cd_cl_arg(cl, k, F, sizeof P, &P);
+    cd_cl_arg(cl, k, F, sizeof N, &N);
     cd_cl_arg(cl, k, F + 1, sizeof cl->grid, &cl->grid);
     cd_cl_arg(cl, k, F + 2, sizeof cl->cell_start, &cl->cell_start);
     cd_cl_arg(cl, k, F + 3, sizeof cl->cell_parts, &cl->cell_parts);
@@ -136,12 +137,12 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
         /* the skin flag (these ends become the references) and the overflow */
         cd_cl_fill_int(cl, cl->flags, 0, 0, 1);
         cd_cl_fill_int(cl, cl->flags, 0, 2, 1);
-        scan_args(cl, CD_CLK_PAIR_COLLECT, P, skin);
+        scan_args(cl, CD_CLK_PAIR_COLLECT, N, skin);
         cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 6, sizeof cl->pair_count, &cl->pair_count);
         cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 7, sizeof cl->cand, &cl->cand);
         cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 8, sizeof cl->slot, &cl->slot);
         cd_cl_arg(cl, CD_CLK_PAIR_COLLECT, F + 9, sizeof cl->flags, &cl->flags);
-        cd_cl_run(cl, CD_CLK_PAIR_COLLECT, (size_t)P);
+        cd_cl_run(cl, CD_CLK_PAIR_COLLECT, (size_t)N);
         cd_cl_scan(cl, cl->pair_count, (size_t)P, cl->pair_offset);
         /* the one wait of a rebuild: how many pairs (to size the buffers),
          * and whether a slot overflowed */
@@ -161,19 +162,22 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
     if (cd_cl_reserve_pairs(cl, (size_t)n_new, nxt)) return -1;
     cl->cur = nxt;
     if (cd_cl_bind_cols(cl)) return -1;
-    if (n_new > 0 && !overflow) {
+    if (n_new > 0) {
+        cd_int slot = cl->slot;
+        if (overflow) { /* rows written in place, then completed by the place pass */
+            scan_args(cl, CD_CLK_PAIR_FILL, N, skin);
+            cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 6, sizeof cl->pair_count, &cl->pair_count);
+            cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 7, sizeof cl->pair_offset, &cl->pair_offset);
+            cd_cl_run(cl, CD_CLK_PAIR_FILL, (size_t)N);
+            slot = 0;
+        }
         cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F, sizeof P, &P);
         cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 1, sizeof cl->pair_offset, &cl->pair_offset);
         cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 2, sizeof cl->cand, &cl->cand);
-        cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 3, sizeof cl->slot, &cl->slot);
+        cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 3, sizeof slot, &slot);
         cd_cl_arg(cl, CD_CLK_PAIR_PLACE, F + 4, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
         cd_cl_run(cl, CD_CLK_PAIR_PLACE, (size_t)P);
-    } else if (n_new > 0) {
-        scan_args(cl, CD_CLK_PAIR_FILL, P, skin);
-        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 6, sizeof cl->pair_offset, &cl->pair_offset);
-        cd_cl_arg(cl, CD_CLK_PAIR_FILL, F + 7, sizeof cl->hist[nxt].keys, &cl->hist[nxt].keys);
-        cd_cl_run(cl, CD_CLK_PAIR_FILL, (size_t)P);
-        grow_slots(cl, (size_t)P);
+        if (overflow) grow_slots(cl, (size_t)P);
     }
     if (n_new > 0) {
         cd_cl_arg(cl, CD_CLK_PAIR_CARRY, F, sizeof n_new, &n_new);

@@ -1,316 +1,276 @@
-/* Broad phase: cell lists over the bounding spheres of particles, then of
- * their primitives, feeding a Verlet list of primitive pairs with a skin.  The list is rebuilt only when
- * some primitive end has moved more than half the skin since the last build
- * (every point of a segment moves at most as far as its farthest end, so no
- * pair can come into contact unseen).  Contact history is carried over by
- * matching the sorted (primitive i, primitive j) keys of the new list
- * against the old one.  Every result is independent of the thread count. */
+/* Broad phase: the Verlet list of primitive pairs with a skin, built where
+ * the step runs (host threads, or the offload device) by the passes of
+ * kernels/neighbor_items.h -- the same items the OpenCL kernels call
+ * (kernels/cl/neighbors.cl).  The list is rebuilt only when some primitive
+ * end has moved more than half the skin since the last build (every point
+ * of a segment moves at most as far as its farthest end, so no pair can
+ * come into contact unseen), or a wall more than half the skin.  Contact
+ * history is carried over by matching the sorted (primitive i, primitive j)
+ * keys of the new list against the old one.  Between steps only two
+ * integers come back to the host (the numbers of pair rows and of wall
+ * candidates) and one overflow bound; the result is the same for every
+ * thread count and device. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
-#include "sim.h"
-#include "../kernels/broadphase.h"
+#include "omp_loops.h"
+#include "../kernels/neighbor_items.h"
 #include "../kernels/step_items.h"
 
-/* Particles per block of the build: each block fills its own row buffer,
- * and the buffers are copied into the list in block order, so the rows
- * come out in one fixed order whatever the threads. */
-#define CD_NB_BLOCK 64
-
-struct cd_nb_block {
-    cd_prim_id *rows; /* candidate j of the block's primitives, row after row */
-    size_t n, cap;
-};
-
+/* Particles per chunk of the bounds pass, entries per chunk of a prefix
+ * sum: a few thousand items at 1e6 particles, enough for any device. */
+#define CD_NB_CHUNK 256
+#define CD_SCAN_CHUNK 1024
+/* Candidate slots per primitive at the first build (a hexapod arm in a
+ * dense packing with a skin of 0.1 d has about 10); they double whenever a
+ * primitive overflows its slot. */
+#define CD_NB_SLOT 32
 
 void cd_neighbors_init(cd_neighbors *nb, double skin)
 {
     memset(nb, 0, sizeof(*nb));
     nb->skin = skin;
     nb->force_rebuild = 1;
+    nb->slot = CD_NB_SLOT;
 }
 
 void cd_neighbors_free(cd_neighbors *nb)
 {
-    free(nb->gather_start);
-    free(nb->gather_rows);
-    free(nb->wall_start);
-    free(nb->wall_rows);
-    free(nb->cell_start);
-    free(nb->cell_parts);
-    free(nb->part_cell);
-    free(nb->part_bound);
-    free(nb->pair_count);
-    for (size_t b = 0; b < nb->n_blocks; b++) free(nb->blocks[b].rows);
-    free(nb->blocks);
+    cd_nb_lists *d = &nb->d;
+    void *all[] = {d->gather_start, d->gather_rows, d->wall_start, d->wall_rows, d->grid, d->part_bound,
+                   d->partial, d->part_cell, d->cell_count, d->cell_start, d->cell_parts, d->pair_count,
+                   d->pair_offset, d->cand, d->keys, d->old_keys, d->old_active, d->old_shear, d->count,
+                   d->chunk_sum};
+    for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
 
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
+/* Allocates *p for n elements of elem bytes, contents discarded (0 or -1). */
+static int realloc_dev(void **p, size_t n, size_t elem)
 {
-    if (need <= *cap && *p) return 0;
-    size_t n = need + need / 2 + 16;
-    void *q = realloc(*p, n * elem);
-    if (!q) return -1;
-    *p = q;
-    *cap = n;
+    cd_dev_free(*p);
+    *p = cd_dev_alloc(n * elem);
+    return *p ? 0 : -1;
+}
+
+/* The lists whose size is fixed by the particle, primitive and wall counts
+ * (allocated at the first build), and room for rows pair rows. */
+static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
+{
+    cd_nb_lists *d = &nb->d;
+    size_t N = s->n_particles, P = s->n_prims;
+    if (!d->grid) {
+        nb->cell_cap = 8 * N + 65; /* cd_grid_make: at most 8 N + 64 cells */
+        size_t chunks = (nb->cell_cap > P ? nb->cell_cap : P) / CD_SCAN_CHUNK + 2;
+        if (realloc_dev((void **)&d->grid, 1, sizeof(cd_grid)) ||
+            realloc_dev((void **)&d->part_bound, N + 1, sizeof(cd_real)) ||
+            realloc_dev((void **)&d->partial, 7 * (N / CD_NB_CHUNK + 1), sizeof(cd_real)) ||
+            realloc_dev((void **)&d->part_cell, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cell_count, nb->cell_cap + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cell_start, nb->cell_cap + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cell_parts, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->pair_count, P + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->pair_offset, P + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cand, P * (size_t)nb->slot + 1, sizeof(cd_prim_id)) ||
+            realloc_dev((void **)&d->count, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->chunk_sum, chunks, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->gather_start, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->wall_start, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->wall_rows, P * s->n_walls + 1, sizeof(cd_int)))
+            return -1;
+    }
+    if (rows > nb->cap_rows || !d->keys) {
+        size_t cap = rows + rows / 4 + 16;
+        if (realloc_dev((void **)&d->keys, cap, sizeof(cd_ulong)) ||
+            realloc_dev((void **)&d->gather_rows, 2 * cap, sizeof(cd_pair_id)))
+            return -1;
+        nb->cap_rows = cap;
+    }
     return 0;
 }
 
-static int build_gather(cd_sim *sim)
+/* out[0] = 0, out[k+1] = out[k] + in[k] for k < n (kernels/neighbor_items.h). */
+static void scan(const cd_int *in, cd_int n, cd_int *out, cd_int *chunk_sum)
 {
-    cd_state *s = &sim->s;
+    cd_int chunk = CD_SCAN_CHUNK, n_chunks = (n + chunk - 1) / chunk;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(in, chunk_sum)))
+    for (cd_int g = 0; g < n_chunks; g++) cd_scan_item_sum(in, n, chunk, g, chunk_sum);
+    CD_STEP_FOR(1, CD_DEV(is_device_ptr(out, chunk_sum)))
+    for (int one = 0; one < 1; one++) cd_scan_item_top(chunk_sum, n_chunks, out, n);
+    CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(in, out, chunk_sum)))
+    for (cd_int g = 0; g < n_chunks; g++) cd_scan_item_fill(in, n, chunk, g, chunk_sum, out);
+}
+
+/* dst[k] = src[k] (k < n): a scan's output becomes the cursor of a fill. */
+static void copy_ints(cd_int *dst, const cd_int *src, size_t n)
+{
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, CD_DEV(is_device_ptr(dst, src)))
+    for (size_t k = 0; k < n; k++) dst[k] = src[k];
+}
+
+static void zero_ints(cd_int *dst, size_t n)
+{
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, CD_DEV(is_device_ptr(dst)))
+    for (size_t k = 0; k < n; k++) dst[k] = 0;
+}
+
+/* Passes 1-4: bounds, grid, particles binned by cell (CSR). */
+static void bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
+{
+    cd_int N = (cd_int)sim->s.n_particles, cell_cap = (cd_int)sim->nb.cell_cap;
+    cd_int chunk = CD_NB_CHUNK, n_chunks = (N + chunk - 1) / chunk;
+    cd_real skin = sim->nb.skin; /* [m] */
+    CD_WIDE_MIN
+    CD_STEP_FOR(n_chunks, firstprivate(c, d))
+    for (cd_int g = 0; g < n_chunks; g++) cd_nb_item_bounds(c, g, chunk, N, d.part_bound, d.partial);
+    CD_STEP_FOR(1, firstprivate(d))
+    for (int one = 0; one < 1; one++) cd_nb_item_grid(d.partial, n_chunks, skin, N, d.grid);
+    zero_ints(d.cell_count, (size_t)cell_cap);
+    CD_STEP_FOR(N, firstprivate(c, d))
+    for (cd_int q = 0; q < N; q++) cd_nb_item_bin(c, q, d.grid, cell_cap, d.part_cell, d.cell_count);
+    scan(d.cell_count, cell_cap, d.cell_start, d.chunk_sum);
+    copy_ints(d.cell_count, d.cell_start, (size_t)cell_cap);
+    CD_STEP_FOR(N, firstprivate(d))
+    for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, d.part_cell, d.cell_count, d.cell_parts);
+}
+
+/* Pass 5 in slot mode (slot > 0; returns the longest row, which may exceed
+ * the slot) or in fill mode (slot = 0: rows written in place into
+ * pair_prim_j at pair_offset). */
+static cd_int collect(cd_sim *sim, cd_cols c, cd_nb_lists d, cd_int slot)
+{
+    cd_int N = (cd_int)sim->s.n_particles, longest = 0;
+    cd_real skin = sim->nb.skin; /* [m] */
+    CD_WIDE_MIN
+    CD_STEP_FOR(N, firstprivate(c, d) reduction(max : longest) CD_DEV(map(tofrom : longest)))
+    for (cd_int p = 0; p < N; p++) {
+        if (slot > 0)
+            cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, d.cand, slot, 0,
+                               d.pair_count);
+        else
+            cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, c.pair_prim_j, 0,
+                               d.pair_offset, d.pair_count);
+        for (cd_int i = c.prim_first[p]; i < c.prim_first[p] + c.prim_count[p]; i++)
+            if (d.pair_count[i] > longest) longest = d.pair_count[i];
+    }
+    return longest;
+}
+
+/* The old rows' keys and history, before the rows are replaced (pass 8
+ * reads them). */
+static int keep_history(cd_sim *sim, cd_cols c)
+{
     cd_neighbors *nb = &sim->nb;
-    size_t cap_dummy = 0;
-    if (!nb->gather_start) {
-        nb->gather_start = calloc(s->n_particles + 1, sizeof(cd_int));
-        if (!nb->gather_start) return -1;
+    size_t n_old = sim->s.n_pairs;
+    if (n_old > nb->cap_old || !nb->d.old_keys) {
+        size_t cap = n_old + n_old / 4 + 16;
+        if (realloc_dev((void **)&nb->d.old_keys, cap, sizeof(cd_ulong)) ||
+            realloc_dev((void **)&nb->d.old_active, cap, sizeof(cd_int)) ||
+            realloc_dev((void **)&nb->d.old_shear, cap, sizeof(cd_vec3)))
+            return -1;
+        nb->cap_old = cap;
     }
-    if (grow((void **)&nb->gather_rows, &nb->gather_cap, 2 * s->n_pairs + 1, sizeof(cd_pair_id))) return -1;
-    (void)cap_dummy;
-    memset(nb->gather_start, 0, (s->n_particles + 1) * sizeof(cd_int));
-    for (size_t k = 0; k < s->n_pairs; k++) {
-        nb->gather_start[s->prim_particle[s->pair_prim_i[k]] + 1]++;
-        nb->gather_start[s->prim_particle[s->pair_prim_j[k]] + 1]++;
-    }
-    for (size_t p = 0; p < s->n_particles; p++) nb->gather_start[p + 1] += nb->gather_start[p];
-    /* Filling in pair order keeps every particle's rows ascending. */
-    cd_int *fill = nb->pair_count; /* reuse as cursor: sized n_prims+1 >= n_particles */
-    memcpy(fill, nb->gather_start, s->n_particles * sizeof(cd_int));
-    /* Entries 2 k + side (kernels/step_items.h, cd_item_gather). */
-    for (size_t k = 0; k < s->n_pairs; k++) {
-        nb->gather_rows[fill[s->prim_particle[s->pair_prim_i[k]]]++] = (cd_pair_id)(2 * k);
-        nb->gather_rows[fill[s->prim_particle[s->pair_prim_j[k]]]++] = (cd_pair_id)(2 * k + 1);
-    }
+    cd_nb_lists d = nb->d;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n_old, firstprivate(c, d))
+    for (size_t k = 0; k < n_old; k++) cd_nb_item_keep(c, (cd_long)k, d.old_keys, d.old_active, d.old_shear);
     return 0;
 }
 
-/* The wall candidates of every particle (cd_item_wall_candidates): a
- * counting pass, the offsets, a filling pass; then the walls become the
- * reference of the wall-motion test. */
-static int build_wall_lists(cd_sim *sim)
+/* Passes 9 (gather lists) and 10 (wall candidates; their number comes
+ * back). */
+static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
 {
     cd_state *s = &sim->s;
-    cd_neighbors *nb = &sim->nb;
-    size_t N = s->n_particles, rows = s->n_prims * s->n_walls;
-    if (rows > (size_t)INT32_MAX) {
-        fprintf(stderr, "capdem: %zu primitive-wall rows exceed the wall lists' limit of %d\n", rows, INT32_MAX);
-        return -1;
-    }
-    if (!nb->wall_start) nb->wall_start = calloc(N + 1, sizeof(cd_int));
-    if (!nb->wall_rows) nb->wall_rows = malloc((rows + 1) * sizeof(cd_int));
-    if (!nb->wall_start || !nb->wall_rows) return -1;
-    cd_cols c = cd_sim_host_cols(s);
+    cd_int N = (cd_int)s->n_particles, W = (cd_int)s->n_walls;
+    size_t n_pairs = s->n_pairs;
     const cd_wall *walls = s->walls;
-    cd_int W = (cd_int)s->n_walls;
-    cd_real skin = nb->skin;
-    cd_int *start = nb->wall_start, *out = nb->wall_rows;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(N))
-    for (size_t q = 0; q < N; q++) start[q + 1] = cd_item_wall_candidates(c, (cd_particle_id)q, walls, W, skin, NULL);
-    start[0] = 0;
-    for (size_t q = 0; q < N; q++) start[q + 1] += start[q];
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(N))
-    for (size_t q = 0; q < N; q++) cd_item_wall_candidates(c, (cd_particle_id)q, walls, W, skin, out + start[q]);
-    memcpy(nb->walls_ref, s->walls, sizeof nb->walls_ref);
-    return 0;
-}
+    cd_real skin = sim->nb.skin; /* [m] */
+    CD_WIDE_MIN
+    zero_ints(d.count, (size_t)N);
+    CD_STEP_FOR(n_pairs, firstprivate(c, d))
+    for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_count(c, (cd_long)k, d.count);
+    scan(d.count, N, d.gather_start, d.chunk_sum);
+    copy_ints(d.count, d.gather_start, (size_t)N);
+    CD_STEP_FOR(n_pairs, firstprivate(c, d))
+    for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_fill(c, (cd_long)k, d.count, d.gather_rows);
+    CD_STEP_FOR(N, firstprivate(d))
+    for (cd_int q = 0; q < N; q++) cd_nb_item_gather_sort(q, d.gather_start, d.gather_rows);
 
-/* Appends j to block b's rows (grows the buffer by half). */
-static int block_push(struct cd_nb_block *b, cd_prim_id j)
-{
-    if (b->n == b->cap && grow((void **)&b->rows, &b->cap, b->n + 1, sizeof(cd_prim_id))) return -1;
-    b->rows[b->n++] = j;
-    return 0;
-}
-
-/* Bounding sphere of each particle about its centre of mass [m]
- * (cd_bp_particle_bound), the box of the centres and the largest bound. */
-static double particle_bounds(const cd_state *s, double *bound, double lo[3], double hi[3])
-{
-    double rmax = 0;
-    for (int k = 0; k < 3; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
-    for (size_t p = 0; p < s->n_particles; p++) {
-        bound[p] = cd_bp_particle_bound(s->prim_a, s->prim_b, s->prim_radius, s->prim_first[p], s->prim_count[p],
-                                        s->position[p]);
-        cd_bp_bounds_add(lo, hi, &rmax, s->position[p], bound[p]);
-    }
-    return rmax;
-}
-
-/* Particles q > p whose bounding spheres come within the skin of p's, in
- * ascending order, into *list (grown as needed); returns how many.  (The
- * device's cd_bp_scan_prim makes the same scan once per primitive; here
- * the three arms of a hexapod share it.) */
-static long particle_candidates(const cd_state *s, const cd_neighbors *nb, const cd_grid *g, size_t p,
-                                cd_int **list, size_t *cap)
-{
-    cd_vec3 x = s->position[p];
-    double reach0 = nb->part_bound[p] + nb->skin;
-    cd_long cx = cd_grid_coord(g, x.x, 0), cy = cd_grid_coord(g, x.y, 1), cz = cd_grid_coord(g, x.z, 2);
-    size_t n = 0;
-    for (cd_long z = cz - 1; z <= cz + 1; z++) {
-        if (z < 0 || z >= g->dim[2]) continue;
-        for (cd_long y = cy - 1; y <= cy + 1; y++) {
-            if (y < 0 || y >= g->dim[1]) continue;
-            for (cd_long xx = cx - 1; xx <= cx + 1; xx++) {
-                if (xx < 0 || xx >= g->dim[0]) continue;
-                cd_long cell = (z * g->dim[1] + y) * g->dim[0] + xx;
-                for (cd_int k = nb->cell_start[cell]; k < nb->cell_start[cell + 1]; k++) {
-                    cd_int q = nb->cell_parts[k];
-                    if ((size_t)q <= p) continue;
-                    double reach = reach0 + nb->part_bound[q];
-                    if (cd_v3_norm2(cd_v3_sub(s->position[q], x)) > reach * reach) continue;
-                    if (n == *cap && grow((void **)list, cap, n + 1, sizeof(cd_int))) return -1;
-                    cd_int m = (cd_int)n++; /* insertion keeps the list ascending */
-                    while (m > 0 && (*list)[m - 1] > q) {
-                        (*list)[m] = (*list)[m - 1];
-                        m--;
-                    }
-                    (*list)[m] = q;
-                }
-            }
-        }
-    }
-    return (long)n;
-}
-
-/* Rows of the primitives of particles [p0, p1) into block b: for each
- * primitive i, the primitives j of the candidate particles (ascending, so
- * the row is sorted by j) that pass the primitive test cd_bp_is_candidate;
- * count[i + 1] = the row's length. */
-static int fill_block(const cd_state *s, const cd_neighbors *nb, const cd_grid *g, size_t p0, size_t p1,
-                      struct cd_nb_block *b, cd_int **list, size_t *cap)
-{
-    b->n = 0;
-    for (size_t p = p0; p < p1; p++) {
-        long nq = particle_candidates(s, nb, g, p, list, cap);
-        if (nq < 0) return -1;
-        for (cd_int i = s->prim_first[p]; i < s->prim_first[p] + s->prim_count[p]; i++) {
-            size_t before = b->n;
-            for (long k = 0; k < nq; k++) {
-                cd_int q = (*list)[k];
-                for (cd_int j = s->prim_first[q]; j < s->prim_first[q] + s->prim_count[q]; j++)
-                    if (cd_bp_is_candidate(s->prim_a[i], s->prim_b[i], s->prim_radius[i], s->prim_a[j], s->prim_b[j],
-                                           s->prim_radius[j], nb->skin) &&
-                        block_push(b, (cd_prim_id)j))
-                        return -1;
-            }
-            nb->pair_count[i + 1] = (cd_int)(b->n - before);
-        }
-    }
+    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    for (cd_int q = 0; q < N; q++) d.count[q] = cd_item_wall_candidates(c, q, walls, W, skin, 0);
+    scan(d.count, N, d.wall_start, d.chunk_sum);
+    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    for (cd_int q = 0; q < N; q++) cd_item_wall_candidates(c, q, walls, W, skin, d.wall_rows + d.wall_start[q]);
+    cd_int n_rows = 0;
+    if (cd_dev_get(&n_rows, d.wall_start + N, sizeof n_rows)) return -1;
+    sim->nb.n_wall_rows = (size_t)n_rows;
+    memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
     return 0;
 }
 
 /* The candidate pairs (i, j), i < j, of primitives of different particles
- * whose axes come within r_i + r_j + skin, sorted by i then j.  The scan
- * runs over particles (a grid of particle centres, particle bounding
- * spheres first): the three arms of a hexapod share one centre, and a
- * scan over primitives met each neighbour nine times.  The pairs are the
- * same set as the primitive test alone gives (the particle sphere holds
- * its primitives' spheres), in the same order.  One pass: each block of
- * CD_NB_BLOCK particles writes its rows into its own buffer. */
+ * whose axes come within r_i + r_j + skin, sorted by i then j, with their
+ * history carried over; the gather and wall lists; the primitive ends
+ * become the skin test's reference. */
 int cd_neighbors_build(cd_sim *sim)
 {
     cd_state *s = &sim->s;
     cd_neighbors *nb = &sim->nb;
-    size_t P = s->n_prims, N = s->n_particles;
-    size_t nblocks = (N + CD_NB_BLOCK - 1) / CD_NB_BLOCK;
-    if (!nb->part_cell) {
-        nb->part_cell = malloc((N + 1) * sizeof(cd_int));
-        nb->cell_parts = malloc((N + 1) * sizeof(cd_int));
-        nb->part_bound = malloc((N + 1) * sizeof(double));
-        nb->pair_count = malloc((P + 2) * sizeof(cd_int));
-    }
-    if (nb->n_blocks != nblocks) { /* first build (the particle count is fixed) */
-        for (size_t b = 0; b < nb->n_blocks; b++) free(nb->blocks[b].rows);
-        free(nb->blocks);
-        nb->blocks = calloc(nblocks + 1, sizeof(struct cd_nb_block));
-        nb->n_blocks = nblocks;
-    }
-    if (!nb->part_cell || !nb->cell_parts || !nb->part_bound || !nb->pair_count || !nb->blocks) return -1;
-
-    /* Grid of particle centres; counting sort into cells, stable in particle order. */
-    double lo[3], hi[3];
-    double rmax = particle_bounds(s, nb->part_bound, lo, hi);
-    cd_grid g;
-    cd_grid_make(&g, lo, hi, rmax, nb->skin, (cd_long)N);
-    size_t ncell = (size_t)(g.dim[0] * g.dim[1] * g.dim[2]);
-    free(nb->cell_start);
-    nb->cell_start = calloc(ncell + 1, sizeof(cd_int));
-    cd_int *cursor = malloc((ncell + 1) * sizeof(cd_int));
-    if (!nb->cell_start || !cursor) { free(cursor); return -1; }
-    for (size_t p = 0; p < N; p++) {
-        nb->part_cell[p] = (cd_int)cd_grid_cell_of(&g, s->position[p]);
-        nb->cell_start[nb->part_cell[p] + 1]++;
-    }
-    for (size_t c = 0; c < ncell; c++) nb->cell_start[c + 1] += nb->cell_start[c];
-    memcpy(cursor, nb->cell_start, (ncell + 1) * sizeof(cd_int));
-    for (size_t p = 0; p < N; p++) nb->cell_parts[cursor[nb->part_cell[p]]++] = (cd_int)p;
-    free(cursor);
-
-    /* The rows, block by block. */
-    int failed = 0;
-#pragma omp parallel if (CD_PARALLEL(P)) reduction(|| : failed)
-    {
-        cd_int *list = NULL;
-        size_t cap = 0;
-#pragma omp for schedule(dynamic, 1)
-        for (size_t b = 0; b < nblocks; b++) {
-            size_t p1 = (b + 1) * CD_NB_BLOCK < N ? (b + 1) * CD_NB_BLOCK : N;
-            if (!failed) failed = fill_block(s, nb, &g, b * CD_NB_BLOCK, p1, &nb->blocks[b], &list, &cap) != 0;
-        }
-        free(list);
-    }
-    if (failed) return -1;
-    cd_int *count = nb->pair_count;
-    count[0] = 0;
-    for (size_t i = 0; i < P; i++) count[i + 1] += count[i];
-    size_t n_new = (size_t)count[P];
-    /* Gather entries are 2 k + 1 in a cd_int (cd_item_gather). */
-    if (n_new > (size_t)(INT32_MAX - 1) / 2) {
-        fprintf(stderr, "capdem: %zu pair rows exceed the neighbour list's limit of %d\n", n_new, (INT32_MAX - 1) / 2);
+    cd_int P = (cd_int)s->n_prims;
+    if (reserve(nb, s, s->n_pairs)) return -1;
+    cd_cols c = cd_sim_step_cols(sim);
+    bin_particles(sim, c, nb->d);
+    cd_int longest = collect(sim, c, nb->d, nb->slot);
+    scan(nb->d.pair_count, P, nb->d.pair_offset, nb->d.chunk_sum);
+    cd_int n_new = 0;
+    if (cd_dev_get(&n_new, nb->d.pair_offset + P, sizeof n_new)) return -1;
+    /* Gather entries are 2 k + 1 in a cd_int (cd_item_gather); a negative
+     * total is a count that overflowed cd_int. */
+    if (n_new < 0 || (size_t)n_new > (size_t)(INT32_MAX - 1) / 2) {
+        fprintf(stderr, "capdem: the pair rows exceed the neighbour list's limit of %d\n", (INT32_MAX - 1) / 2);
         return -1;
     }
 
-    /* Keep the old keys and history for matching. */
+    /* Replace the rows: the old history aside, room for the new rows. */
+    if (keep_history(sim, c)) return -1;
     size_t n_old = s->n_pairs;
-    cd_ulong *old_keys = malloc((n_old + 1) * sizeof(cd_ulong));
-    cd_vec3 *old_shear = malloc((n_old + 1) * sizeof(cd_vec3));
-    cd_int *old_active = malloc((n_old + 1) * sizeof(cd_int));
-    if (!old_keys || !old_shear || !old_active) { free(old_keys); free(old_shear); free(old_active); return -1; }
-    for (size_t k = 0; k < n_old; k++) old_keys[k] = cd_bp_pair_key(s->pair_prim_i[k], s->pair_prim_j[k]);
-    memcpy(old_shear, s->pair_shear, n_old * sizeof(cd_vec3));
-    memcpy(old_active, s->pair_active, n_old * sizeof(cd_int));
-
-    if (cd_state_reserve_pairs(s, n_new + n_new / 4 + 16)) { free(old_keys); free(old_shear); free(old_active); return -1; }
-    s->n_pairs = n_new;
-
-    /* Copy each block's rows into place and carry the history over. */
-#pragma omp parallel for schedule(dynamic, 1) if (CD_PARALLEL(P))
-    for (size_t b = 0; b < nblocks; b++) {
-        size_t p1 = (b + 1) * CD_NB_BLOCK < N ? (b + 1) * CD_NB_BLOCK : N;
-        cd_int i0 = s->prim_first[b * CD_NB_BLOCK], i1 = s->prim_first[p1 - 1] + s->prim_count[p1 - 1];
-        const cd_prim_id *rows = nb->blocks[b].rows;
-        for (cd_int i = i0; i < i1; i++)
-            for (cd_int k = count[i]; k < count[i + 1]; k++) {
-                cd_prim_id j = rows[k - count[i0]];
-                s->pair_prim_i[k] = (cd_prim_id)i;
-                s->pair_prim_j[k] = j;
-                long o = cd_bp_find_key(old_keys, (cd_long)n_old, cd_bp_pair_key((cd_prim_id)i, j));
-                s->pair_active[k] = o >= 0 ? old_active[o] : 0;
-                s->pair_shear[k] = o >= 0 ? old_shear[o] : cd_v3_zero();
-            }
+    if (cd_sim_reserve_step_pairs(sim, (size_t)n_new + (size_t)n_new / 4 + 16) || reserve(nb, s, (size_t)n_new))
+        return -1;
+    c = cd_sim_step_cols(sim);
+    s->n_pairs = (size_t)n_new;
+    cd_int slot = nb->slot;
+    if (longest > nb->slot) { /* some row is incomplete in its slot: write the rows in place */
+        collect(sim, c, nb->d, 0);
+        slot = 0;
+        while (nb->slot < longest) nb->slot *= 2;
+        if (realloc_dev((void **)&nb->d.cand, (size_t)P * (size_t)nb->slot + 1, sizeof(cd_prim_id))) return -1;
     }
-    free(old_keys);
-    free(old_shear);
-    free(old_active);
-
-    if (build_gather(sim) || build_wall_lists(sim)) return -1;
-    memcpy(s->prim_a_ref, s->prim_a, P * sizeof(cd_vec3));
-    memcpy(s->prim_b_ref, s->prim_b, P * sizeof(cd_vec3));
+    cd_nb_lists d = nb->d;
+    CD_WIDE_MIN
+    CD_STEP_FOR(P, firstprivate(c, d))
+    for (cd_int i = 0; i < P; i++) cd_nb_item_place(c, i, d.pair_offset, d.cand, slot, d.keys);
+    CD_STEP_FOR(n_new, firstprivate(c, d))
+    for (cd_int k = 0; k < n_new; k++) cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active,
+                                                        d.old_shear);
+    if (particle_lists(sim, c, d)) return -1;
+    CD_STEP_FOR(P, firstprivate(c))
+    for (cd_int i = 0; i < P; i++) {
+        c.prim_a_ref[i] = c.prim_a[i];
+        c.prim_b_ref[i] = c.prim_b[i];
+    }
     nb->force_rebuild = 0;
     nb->builds++;
     return 0;
+}
+
+int cd_neighbors_part_bounds(const cd_sim *sim, double *out)
+{
+    if (!sim->nb.d.part_bound) return -1;
+    return cd_dev_get(out, sim->nb.d.part_bound, sim->s.n_particles * sizeof(double));
 }

@@ -8,6 +8,7 @@
 #include "shapes.h"
 #include "../kernels/contact_law.h"
 #include "../kernels/cols.h"
+#include "../kernels/broadphase.h"
 #include "backend.h"
 
 /* Loops over fewer rows than this run on one thread: a parallel region
@@ -27,30 +28,48 @@ typedef struct {
     cd_int dimension;         /* 3, or 2: motion in the x-y plane only */
 } cd_step_params;
 
-/* Neighbour-list workspace (host side). */
+/* The neighbour lists and the build's scratch (kernels/neighbor_items.h),
+ * in the memory the step loops run on: the offload device's in the offload
+ * variant (device addresses: never dereferenced on the host), host memory
+ * otherwise.  Handed to the loops as one firstprivate struct. */
 typedef struct {
-    double skin;              /* Verlet skin [m] */
-    long long builds;         /* rebuilds so far */
-    int force_rebuild;        /* 1: rebuild at the next step regardless of motion */
     /* per-particle gather lists (CSR over pair rows): for particle p the
      * entries gather_rows[gather_start[p] .. gather_start[p+1]), 2 k + side
      * for pair row k (side 1: p owns its primitive j), in ascending order */
     cd_int *gather_start;     /* n_particles + 1 */
     cd_pair_id *gather_rows;  /* 2 n_pairs */
-    size_t gather_cap;
     /* per-particle wall candidates (CSR): for particle p the wall-contact
      * rows wall_rows[wall_start[p] .. wall_start[p+1]) that the steps until
      * the next build test (kernels/step_items.h, cd_item_wall_candidates),
-     * ascending; walls_ref: the walls at that build (cd_bp_wall_moved) */
+     * ascending */
     cd_int *wall_start;       /* n_particles + 1 */
     cd_int *wall_rows;        /* at most n_prims n_walls */
-    cd_wall walls_ref[CD_MAX_WALLS];
-    /* scratch: particles binned by cell (CSR), per-particle bounding radii,
-     * per-primitive row counts, and one row buffer per block of particles */
-    cd_int *cell_start, *cell_parts, *part_cell, *pair_count;
-    double *part_bound;
-    struct cd_nb_block *blocks;
-    size_t n_blocks;
+    /* scratch of the build */
+    cd_grid *grid;            /* 1 */
+    cd_real *part_bound;      /* bounding radius per particle [m] */
+    cd_real *partial;         /* 7 per chunk of particles: box of centres, largest bound [m] */
+    cd_int *part_cell, *cell_count, *cell_start, *cell_parts; /* cell lists (CSR); count doubles as cursor */
+    cd_int *pair_count, *pair_offset; /* rows per primitive, their offsets (n_prims + 1) */
+    cd_prim_id *cand;         /* candidate slots, slot per primitive */
+    cd_ulong *keys, *old_keys;/* sorted keys of the new and the old rows */
+    cd_int *old_active;       /* history of the old rows */
+    cd_vec3 *old_shear;       /* [m] */
+    cd_int *count;            /* per particle: gather and wall counts, then cursors */
+    cd_int *chunk_sum;        /* prefix sums' chunk totals */
+} cd_nb_lists;
+
+/* Neighbour-list workspace. */
+typedef struct {
+    double skin;              /* Verlet skin [m] */
+    long long builds;         /* rebuilds so far */
+    int force_rebuild;        /* 1: rebuild at the next step regardless of motion */
+    cd_wall walls_ref[CD_MAX_WALLS]; /* the walls at the last build (cd_bp_wall_moved) */
+    size_t n_wall_rows;       /* entries of d.wall_rows (wall_start[n_particles]) */
+    cd_nb_lists d;            /* lists and scratch, where the loops run */
+    size_t cap_rows;          /* rows that keys and gather_rows (twice) hold */
+    size_t cap_old;           /* rows that old_keys, old_active, old_shear hold */
+    size_t cell_cap;          /* cells the cell lists hold */
+    cd_int slot;              /* candidate slot per primitive (doubles when one overflows) */
 } cd_neighbors;
 
 typedef struct cd_sim {
@@ -141,5 +160,8 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o);
 void cd_neighbors_init(cd_neighbors *nb, double skin);
 void cd_neighbors_free(cd_neighbors *nb);
 int cd_neighbors_build(cd_sim *sim);
+/* The bounding radii [m] of the last build, copied to out (n_particles);
+ * 0, or -1 before the first build.  For tests. */
+int cd_neighbors_part_bounds(const cd_sim *sim, double *out);
 
 #endif

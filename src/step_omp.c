@@ -7,71 +7,23 @@
  * the second kick; a neighbour-list rebuild between the first two when
  * the skin test asks for it.
  *
- * Two variants of the same loops (docs/offload.md):
- * - host (CAPDEM_OFFLOAD=none): `omp parallel for schedule(static)` over the
- *   host columns of sim->s;
- * - offload (CAPDEM_OFFLOAD=nvptx, CAPDEM_OFFLOAD_TARGET=1): `omp target
- *   teams distribute parallel for` over device copies of the columns, mapped
- *   once at start (target enter data over the cd_fields table), kept on the
- *   device across steps and copied back only by sync (CAPDEM_OFFLOAD=host
- *   runs the same on LLVM's x86-64 offload devices, whose memory is separate
- *   from the program's, to test the mapping without a GPU).  The neighbour-list
- *   rebuild stays on the host: the primitive ends and the pair history come
- *   back, the list is built, the pair and gather arrays go out again. */
+ * Two variants of the same loops (src/omp_loops.h, docs/offload.md): on
+ * host threads over the host columns of sim->s, or on an offload device
+ * over device copies of the columns, mapped once at start (target enter
+ * data over the cd_fields table), kept on the device across steps and
+ * copied back only by sync (CAPDEM_OFFLOAD=host runs the same on LLVM's
+ * x86-64 offload devices, whose memory is separate from the program's, to
+ * test the mapping without a GPU).  The neighbour-list rebuild runs where
+ * the steps run (src/neighbors.c). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "sim.h"
+#include "omp_loops.h"
 #include "../kernels/step_items.h"
 #include "../kernels/broadphase.h"
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 long cd_parallel_min_rows = 4096;
-
-#define CD_PRAGMA(...) _Pragma(#__VA_ARGS__)
-#if defined(CAPDEM_OFFLOAD_TARGET) && CAPDEM_OFFLOAD_TARGET && defined(_OPENMP)
-#define CD_OFFLOAD 1
-/* One loop of the step on the offload device, or on the host when the
- * runtime finds none: then, as in the host variant, a loop of fewer than
- * cd_parallel_min_rows rows runs on one thread (waking threads for every
- * small loop made the small test cases 100 times slower).  The same holds
- * on LLVM's host offload devices (CAPDEM_OFFLOAD=host), whose teams are
- * host threads: there test_protocols took over 300 s instead of 47 s.  A
- * function with such a loop declares CD_WIDE_MIN first. */
-static size_t cd_wide_min(void)
-{
-#if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
-    return (size_t)cd_parallel_min_rows;
-#else
-    static int devices = -1;
-    if (devices < 0) devices = omp_get_num_devices();
-    return devices > 0 ? 0 : (size_t)cd_parallel_min_rows;
-#endif
-}
-#define CD_WIDE_MIN const size_t wide_min_ = cd_wide_min();
-#if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
-/* Host devices: teams of one thread each (host threads), one team for a
- * small loop.  No inner parallel: a serialized one (if (parallel : 0))
- * trips an assertion of libomp 14 (kmp_runtime.cpp(1122), th_task_team). */
-#define CD_STEP_FOR(rows, ...) \
-    CD_PRAGMA(omp target teams distribute num_teams((rows) >= wide_min_ ? omp_get_max_threads() : 1) __VA_ARGS__)
-#else
-#define CD_STEP_FOR(rows, ...) \
-    CD_PRAGMA(omp target teams distribute parallel for if (parallel : (rows) >= wide_min_) __VA_ARGS__)
-#endif
-/* Clauses only the offload variant needs. */
-#define CD_DEV(...) __VA_ARGS__
-#else
-#define CD_OFFLOAD 0
-#define CD_WIDE_MIN
-#define CD_STEP_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
-#define CD_DEV(...)
-#endif
-/* Host-only loops (set-up work on the host columns). */
-#define CD_HOST_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
 
 /* The state's device columns for the per-item functions of
  * kernels/step_items.h. */
@@ -89,10 +41,6 @@ cd_cols cd_sim_host_cols(cd_state *s)
 typedef struct {
     void **host;       /* per field of cd_fields: host address mapped (NULL: none) */
     size_t *bytes;     /* per field: bytes mapped */
-    void *gs_host, *gr_host; /* gather_start / gather_rows as mapped */
-    size_t gs_bytes, gr_bytes;
-    void *ws_host, *wr_host; /* wall_start / wall_rows as mapped (fixed size) */
-    size_t ws_bytes, wr_bytes;
     double *part;      /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;       /* device addresses of the columns */
@@ -120,14 +68,6 @@ static void off_from(void *p, size_t bytes)
     char *c = p;
     if (c && bytes) {
 #pragma omp target update from(c[0:bytes])
-    }
-}
-
-static void off_to(void *p, size_t bytes)
-{
-    char *c = p;
-    if (c && bytes) {
-#pragma omp target update to(c[0:bytes])
     }
 }
 
@@ -168,51 +108,11 @@ static void off_map_field(cd_sim *sim, cd_off *o, size_t f)
     off_map(o->host[f], o->bytes[f]);
 }
 
-/* Maps (or re-maps, when the host reallocated them) the gather lists. */
-static void off_map_gather(cd_sim *sim, cd_off *o)
-{
-    cd_neighbors *nb = &sim->nb;
-    size_t gs = nb->gather_start ? (sim->s.n_particles + 1) * sizeof(cd_int) : 0;
-    size_t gr = nb->gather_rows ? nb->gather_cap * sizeof(cd_pair_id) : 0;
-    if (o->gs_host != (void *)nb->gather_start || o->gs_bytes != gs) {
-        off_unmap(o->gs_host, o->gs_bytes);
-        o->gs_host = nb->gather_start;
-        o->gs_bytes = gs;
-        off_map(o->gs_host, o->gs_bytes);
-    } else {
-        off_to(o->gs_host, o->gs_bytes);
-    }
-    /* the wall lists: allocated once at their largest, mapped once */
-    if (!o->ws_host && nb->wall_start) {
-        o->ws_host = nb->wall_start;
-        o->ws_bytes = (sim->s.n_particles + 1) * sizeof(cd_int);
-        o->wr_host = nb->wall_rows;
-        o->wr_bytes = (sim->s.n_prims * sim->s.n_walls + 1) * sizeof(cd_int);
-        off_map(o->ws_host, o->ws_bytes);
-        off_map(o->wr_host, o->wr_bytes);
-    } else if (o->ws_host) {
-        off_to(o->ws_host, o->ws_bytes);
-        off_to(o->wr_host, (size_t)nb->wall_start[sim->s.n_particles] * sizeof(cd_int));
-    }
-    if (o->gr_host != (void *)nb->gather_rows || o->gr_bytes != gr) {
-        off_unmap(o->gr_host, o->gr_bytes);
-        o->gr_host = nb->gather_rows;
-        o->gr_bytes = gr;
-        off_map(o->gr_host, o->gr_bytes);
-    } else {
-        off_to(o->gr_host, 2 * sim->s.n_pairs * sizeof(cd_pair_id));
-    }
-}
-
 static void off_release(cd_sim *sim)
 {
     cd_off *o = sim->backend_data;
     if (!o) return;
     for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
-    off_unmap(o->gs_host, o->gs_bytes);
-    off_unmap(o->gr_host, o->gr_bytes);
-    off_unmap(o->ws_host, o->ws_bytes);
-    off_unmap(o->wr_host, o->wr_bytes);
     off_unmap(o->part, o->part_n * sizeof(double));
     free(o->part);
     free(o->host);
@@ -261,66 +161,50 @@ static int off_acquire(cd_sim *sim, char *err, size_t errlen)
     if (!o->host || !o->bytes || !o->part) { off_release(sim); return -1; }
     for (size_t f = 0; f < cd_n_fields; f++) off_map_field(sim, o, f);
     off_map(o->part, o->part_n * sizeof(double));
-    off_map_gather(sim, o);
     off_refresh_cols(sim, o);
     return 0;
 }
 
-/* The host round trip of a neighbour-list rebuild: primitive ends and pair
- * history to the host, build, pair rows and gather lists back. */
-static int off_rebuild(cd_sim *sim)
+/* Room for n pair rows: the host columns grow, and when they moved the
+ * device copies are re-mapped (every old mapping goes before any new one:
+ * a new block may reuse an old address).  Their contents are not carried:
+ * the neighbour-list build keeps the history it needs before calling. */
+static int off_reserve_pairs(cd_sim *sim, size_t n)
 {
     cd_state *s = &sim->s;
     cd_off *o = sim->backend_data;
-    /* Everything the build reads that the steps change: the particle
-     * centres (cell grid, bounding spheres), the primitive ends and the
-     * contact history.  (Without the centres the host bins stale positions
-     * and the bounding radius grows with the drift since the last sync.) */
-    off_from(s->position, s->n_particles * sizeof(cd_vec3));
-    off_from(s->prim_a, s->n_prims * sizeof(cd_vec3));
-    off_from(s->prim_b, s->n_prims * sizeof(cd_vec3));
-    off_from(s->pair_active, s->n_pairs * sizeof(cd_int));
-    off_from(s->pair_shear, s->n_pairs * sizeof(cd_vec3));
-    if (cd_neighbors_build(sim)) return -1;
-    /* Pair columns: re-mapped when the capacity grew (every old mapping
-     * goes before any new one: a new block may reuse an old address),
-     * otherwise the rows the build wrote go out. */
+    if (cd_state_reserve_pairs(s, n)) return -1;
     int moved = 0;
     for (size_t f = 0; f < cd_n_fields; f++) {
         if (cd_fields[f].group != CD_GROUP_PAIR) continue;
         void *p = *cd_field_ptr(s, &cd_fields[f]);
         if (p != o->host[f] || s->cap_pairs * cd_fields[f].elem_size != o->bytes[f]) moved = 1;
     }
-    if (moved) {
-        for (size_t f = 0; f < cd_n_fields; f++)
-            if (cd_fields[f].group == CD_GROUP_PAIR) {
-                off_unmap(o->host[f], o->bytes[f]);
-                o->host[f] = NULL;
-                o->bytes[f] = 0;
-            }
-        for (size_t f = 0; f < cd_n_fields; f++)
-            if (cd_fields[f].group == CD_GROUP_PAIR) off_map_field(sim, o, f);
-    } else {
-        off_to(s->pair_prim_i, s->n_pairs * sizeof(cd_int));
-        off_to(s->pair_prim_j, s->n_pairs * sizeof(cd_int));
-#if !(defined(CAPDEM_PLANT_MISSING_UPDATE) && CAPDEM_PLANT_MISSING_UPDATE)
-        off_to(s->pair_active, s->n_pairs * sizeof(cd_int));
-#endif
-        /* (tests/offload builds capdem-planted with the update of
-         * pair_active left out: the offload checks must fail on it) */
-        off_to(s->pair_shear, s->n_pairs * sizeof(cd_vec3));
-    }
-    off_to(s->prim_a_ref, s->n_prims * sizeof(cd_vec3));
-    off_to(s->prim_b_ref, s->n_prims * sizeof(cd_vec3));
-    off_map_gather(sim, o);
-    if (moved) off_refresh_cols(sim, o);
+    if (!moved) return 0;
+    for (size_t f = 0; f < cd_n_fields; f++)
+        if (cd_fields[f].group == CD_GROUP_PAIR) {
+            off_unmap(o->host[f], o->bytes[f]);
+            o->host[f] = NULL;
+            o->bytes[f] = 0;
+        }
+    for (size_t f = 0; f < cd_n_fields; f++)
+        if (cd_fields[f].group == CD_GROUP_PAIR) off_map_field(sim, o, f);
+    off_refresh_cols(sim, o);
     return 0;
 }
 #endif
 
+int cd_sim_reserve_step_pairs(cd_sim *sim, size_t n)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data) return off_reserve_pairs(sim, n);
+#endif
+    return cd_state_reserve_pairs(&sim->s, n);
+}
+
 /* Columns the step loops work on: device addresses in the offload variant,
  * the host columns otherwise. */
-static cd_cols step_cols(cd_sim *sim)
+cd_cols cd_sim_step_cols(cd_sim *sim)
 {
 #if CD_OFFLOAD
     if (sim->backend_data) return ((cd_off *)sim->backend_data)->dev;
@@ -337,7 +221,7 @@ static cd_cols step_cols(cd_sim *sim)
  * device one int comes back. */
 static int advance(cd_sim *sim)
 {
-    cd_cols c = step_cols(sim);
+    cd_cols c = cd_sim_step_cols(sim);
     cd_real dt = sim->p.dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
     size_t n = sim->s.n_particles;
     int moved = 0;
@@ -355,7 +239,7 @@ static int advance(cd_sim *sim)
 /* One work item per pair of the Verlet list: narrow phase + contact law. */
 static void pair_forces(cd_sim *sim)
 {
-    cd_cols c = step_cols(sim);
+    cd_cols c = cd_sim_step_cols(sim);
     cd_law_params law = sim->p.law;
     cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
     cd_int blend = sim->p.parallel_blend;
@@ -370,36 +254,34 @@ static void pair_forces(cd_sim *sim)
  * go out. */
 static void wall_forces(cd_sim *sim)
 {
-    cd_cols c = step_cols(sim);
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
     const cd_wall *walls = sim->s.walls;
-    const cd_int *rows = sim->nb.wall_rows;
     cd_int W = (cd_int)sim->s.n_walls;
     cd_law_params law = sim->p.wall_law;
     cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
     cd_int blend = sim->p.parallel_blend;
-    size_t n = W ? (size_t)sim->nb.wall_start[sim->s.n_particles] : 0;
+    size_t n = W ? sim->nb.n_wall_rows : 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, law) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
-    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], walls, W, law, dt, sin_parallel, blend);
+    CD_STEP_FOR(n, firstprivate(c, d, law) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, d.wall_rows[e], walls, W, law, dt, sin_parallel, blend);
 }
 
 /* One work item per particle: gravity plus its contacts in fixed order,
  * then (kick = 1) the second half kick with that force, in the same pass
- * (steps 7-8).  The gather lists are mapped host pointers: translated on
- * entry. */
+ * (steps 7-8). */
 static void gather_kick(cd_sim *sim, int kick)
 {
-    cd_cols c = step_cols(sim);
-    const cd_int *gs = sim->nb.gather_start, *ws = sim->nb.wall_start, *wr = sim->nb.wall_rows;
-    const cd_pair_id *gr = sim->nb.gather_rows;
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
     cd_int dim = sim->p.dimension;
     cd_vec3 g = sim->p.gravity;
     cd_real h = 0.5 * sim->p.dt;
     size_t n = sim->s.n_particles;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, g))
+    CD_STEP_FOR(n, firstprivate(c, d, g))
     for (size_t q = 0; q < n; q++) {
-        cd_item_gather(c, (cd_particle_id)q, gs, gr, ws, wr, g, dim);
+        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
         if (kick) cd_item_kick(c, (cd_particle_id)q, h);
     }
 }
@@ -411,14 +293,6 @@ static void compute_forces(cd_sim *sim, int kick)
     pair_forces(sim);
     wall_forces(sim);
     gather_kick(sim, kick);
-}
-
-static int rebuild(cd_sim *sim)
-{
-#if CD_OFFLOAD
-    if (sim->backend_data) return off_rebuild(sim);
-#endif
-    return cd_neighbors_build(sim);
 }
 
 void cd_sim_refresh(cd_sim *sim)
@@ -457,7 +331,7 @@ int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
 static int check_step_state(cd_sim *sim, char *err, size_t errlen)
 {
 #if CD_OFFLOAD
-    cd_cols c = step_cols(sim);
+    cd_cols c = cd_sim_step_cols(sim);
     long bad = -1;
     size_t n = sim->s.n_particles;
     CD_WIDE_MIN
@@ -485,13 +359,13 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 {
     omp_stop(sim);
     cd_sim_refresh(sim);
+#if CD_OFFLOAD
+    if (off_acquire(sim, err, errlen)) return -1;
+#endif
     if (compute && cd_neighbors_build(sim)) {
         snprintf(err, errlen, "out of memory while building the first neighbour list");
         return -1;
     }
-#if CD_OFFLOAD
-    if (off_acquire(sim, err, errlen)) return -1;
-#endif
     /* without compute the neighbour list is rebuilt at the first step */
     if (compute) {
         compute_forces(sim, 0);
@@ -508,7 +382,7 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
     for (long long it = 0; it < n; it++) {
-        if (advance(sim) && rebuild(sim)) {
+        if (advance(sim) && cd_neighbors_build(sim)) {
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }
@@ -526,10 +400,17 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
     /* The only full copy back: every device column, rows in use. */
     cd_off *o = sim->backend_data;
     if (o)
-        for (size_t f = 0; f < cd_n_fields; f++)
+        for (size_t f = 0; f < cd_n_fields; f++) {
+#if defined(CAPDEM_PLANT_MISSING_UPDATE) && CAPDEM_PLANT_MISSING_UPDATE
+            /* tests/offload builds capdem-planted with the velocities left
+             * on the device: snapshots, observables and resumes see stale
+             * ones; the offload checks must fail on it */
+            if (*cd_field_ptr(&sim->s, &cd_fields[f]) == (void *)sim->s.velocity) continue;
+#endif
             if (o->host[f])
                 off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
-                     cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
+                         cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
+        }
 #else
     (void)sim; /* the state lives in host memory */
 #endif

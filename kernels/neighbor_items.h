@@ -1,0 +1,265 @@
+/* One work item of each pass of the Verlet-list build (docs/architecture.md,
+ * "Neighbour list").  The build exists once: the OpenMP loops of
+ * src/neighbors.c (host threads, or an offload device) and the OpenCL
+ * kernels of kernels/cl/neighbors.cl call these items in the same passes:
+ *
+ *   1. bounds    per chunk of particles: bounding radii, box of centres
+ *   2. grid      one item: merges the chunks' boxes, makes the grid
+ *   3. bin       per particle: its cell, counted (integer atomic)
+ *   4. scan      cell counts -> cell_start; cell_parts filled (atomic)
+ *   5. collect   per particle: the candidates of its primitives, each row
+ *                sorted by j, into fixed slots (a second pass writes the
+ *                rows in place when some primitive overflowed its slot)
+ *   6. scan      row counts -> pair offsets; the number of rows goes back
+ *   7. place     per primitive: slot -> rows (prim_i, prim_j) and keys
+ *   8. carry     per row: history of the old row with the same key
+ *   9. gather    per row: counted and filled into its two particles' lists
+ *                (atomic), then per particle sorted ascending
+ *  10. walls     per particle: wall candidates counted, scanned, filled
+ *
+ * Integer atomics only fill counting sorts; whatever they leave out of
+ * order is sorted again (rows by insertion in pass 5, gather lists in pass
+ * 9), or feeds only a scan, so the list is the same on every run, backend
+ * and thread count.  Device-safe: C11 and OpenCL C 1.2. */
+#ifndef CD_NEIGHBOR_ITEMS_H
+#define CD_NEIGHBOR_ITEMS_H
+#include "cols.h"
+#include "broadphase.h"
+
+CD_DEVICE_BEGIN
+
+/* Pass 1: bounding radius [m] of each particle of chunk g, [g chunk,
+ * (g+1) chunk), into part_bound, and the chunk's box of centres and largest
+ * bound as 7 reals (lo xyz, hi xyz, rmax) at partial + 7 g. */
+CD_INLINE void cd_nb_item_bounds(cd_cols c, cd_int g, cd_int chunk, cd_int n_particles,
+                                 CD_GLOBAL cd_real *part_bound, CD_GLOBAL cd_real *partial)
+{
+    cd_real lo[3], hi[3], rmax = 0;
+    for (int k = 0; k < 3; k++) {
+        lo[k] = (cd_real)INFINITY;
+        hi[k] = -(cd_real)INFINITY;
+    }
+    cd_int end = (g + 1) * chunk < n_particles ? (g + 1) * chunk : n_particles;
+    for (cd_int p = g * chunk; p < end; p++) {
+        cd_real b = cd_bp_particle_bound(c.prim_a, c.prim_b, c.prim_radius, c.prim_first[p], c.prim_count[p],
+                                         c.position[p]);
+        part_bound[p] = b;
+        cd_bp_bounds_add(lo, hi, &rmax, c.position[p], b);
+    }
+    for (int k = 0; k < 3; k++) {
+        partial[7 * g + k] = lo[k];
+        partial[7 * g + 3 + k] = hi[k];
+    }
+    partial[7 * g + 6] = rmax;
+}
+
+/* Pass 2 (one item): the boxes of n_chunks chunks merged (minimum and
+ * maximum are exact, so the grid does not depend on the chunking) and the
+ * grid made for skin [m]. */
+CD_INLINE void cd_nb_item_grid(const CD_GLOBAL cd_real *partial, cd_int n_chunks, cd_real skin, cd_int n_particles,
+                               CD_GLOBAL cd_grid *grid)
+{
+    cd_real lo[3], hi[3], rmax = 0;
+    for (int k = 0; k < 3; k++) {
+        lo[k] = (cd_real)INFINITY;
+        hi[k] = -(cd_real)INFINITY;
+    }
+    for (cd_int g = 0; g < n_chunks; g++) {
+        for (int k = 0; k < 3; k++) {
+            if (partial[7 * g + k] < lo[k]) lo[k] = partial[7 * g + k];
+            if (partial[7 * g + 3 + k] > hi[k]) hi[k] = partial[7 * g + 3 + k];
+        }
+        if (partial[7 * g + 6] > rmax) rmax = partial[7 * g + 6];
+    }
+    cd_grid gr;
+    cd_grid_make(&gr, lo, hi, rmax, skin, n_particles);
+    grid[0] = gr;
+}
+
+/* Pass 3: cell of particle q (its centre), counted in cell_count.  The
+ * index is bounded by cell_cap even for a non-finite position (a run
+ * blowing up before its check), so no write leaves the buffers. */
+CD_INLINE void cd_nb_item_bin(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_grid *grid, cd_int cell_cap,
+                              CD_GLOBAL cd_int *part_cell, CD_GLOBAL cd_int *cell_count)
+{
+    cd_grid g = grid[0];
+    cd_long idx = cd_grid_cell_of(&g, c.position[q]);
+    cd_int cell = idx >= 0 && idx < cell_cap ? (cd_int)idx : 0;
+    part_cell[q] = cell;
+    cd_atomic_inc(&cell_count[cell]);
+}
+
+/* Pass 4: particle q into its cell's slice of cell_parts (cursor starts as
+ * cell_start).  The order inside a cell may vary from run to run; pass 5
+ * sorts every row, so the list does not. */
+CD_INLINE void cd_nb_item_cell_fill(cd_particle_id q, const CD_GLOBAL cd_int *part_cell, CD_GLOBAL cd_int *cursor,
+                                    CD_GLOBAL cd_int *cell_parts)
+{
+    cell_parts[cd_atomic_inc(&cursor[part_cell[q]])] = q;
+}
+
+/* Pass 5: the candidates (i, j) with i a primitive of particle p and j a
+ * primitive of a particle q > p: the particles in the 27 cells around p's
+ * centre whose bounding spheres (part_bound [m]) come within the skin [m]
+ * of p's, then each pair passing cd_bp_is_candidate.  The scan runs over
+ * particles, so the arms of a hexapod share it.  Row i goes to
+ * out + i slot (slot mode, offset = 0: at most slot entries written) or to
+ * out + offset[i] (fill mode: the row's exact place); either way sorted by
+ * j (insertion), and count[i] = the row's length, which in slot mode may
+ * exceed slot (then the row is incomplete and the host runs fill mode). */
+CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL cd_grid *grid,
+                                  const CD_GLOBAL cd_int *cell_start, const CD_GLOBAL cd_int *cell_parts,
+                                  const CD_GLOBAL cd_real *part_bound, cd_real skin, CD_GLOBAL cd_prim_id *out,
+                                  cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count)
+{
+    cd_grid g = grid[0];
+    cd_int first = c.prim_first[p], last = first + c.prim_count[p];
+    cd_int cap = offset ? CD_BP_UNBOUNDED : slot;
+    for (cd_int i = first; i < last; i++) count[i] = 0;
+    cd_vec3 x = c.position[p];
+    cd_real reach0 = part_bound[p] + skin; /* [m] */
+    cd_long cx = cd_grid_coord(&g, x.x, 0), cy = cd_grid_coord(&g, x.y, 1), cz = cd_grid_coord(&g, x.z, 2);
+    for (cd_long z = cz - 1; z <= cz + 1; z++) {
+        if (z < 0 || z >= g.dim[2]) continue;
+        for (cd_long y = cy - 1; y <= cy + 1; y++) {
+            if (y < 0 || y >= g.dim[1]) continue;
+            for (cd_long xx = cx - 1; xx <= cx + 1; xx++) {
+                if (xx < 0 || xx >= g.dim[0]) continue;
+                cd_long cell = (z * g.dim[1] + y) * g.dim[0] + xx;
+                for (cd_int k = cell_start[cell]; k < cell_start[cell + 1]; k++) {
+                    cd_particle_id q = cell_parts[k];
+                    if (q <= p) continue;
+                    cd_real reach = reach0 + part_bound[q];
+                    if (cd_v3_norm2(cd_v3_sub(c.position[q], x)) > reach * reach) continue;
+                    for (cd_int i = first; i < last; i++) {
+                        CD_GLOBAL cd_prim_id *row = out + (offset ? (cd_long)offset[i] : (cd_long)i * slot);
+                        cd_vec3 ai = c.prim_a[i], bi = c.prim_b[i];
+                        cd_real ri = c.prim_radius[i];
+                        for (cd_prim_id j = c.prim_first[q]; j < c.prim_first[q] + c.prim_count[q]; j++) {
+                            if (!cd_bp_is_candidate(ai, bi, ri, c.prim_a[j], c.prim_b[j], c.prim_radius[j], skin))
+                                continue;
+                            cd_int n = count[i];
+                            if (n < cap) { /* insertion keeps the row sorted by j */
+                                cd_int m = n;
+                                while (m > 0 && row[m - 1] > j) {
+                                    row[m] = row[m - 1];
+                                    m--;
+                                }
+                                row[m] = j;
+                            }
+                            count[i] = n + 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* Key of pair row k (ordered by prim_i, then prim_j). */
+CD_INLINE cd_ulong cd_nb_row_key(cd_cols c, cd_long k) { return cd_bp_pair_key(c.pair_prim_i[k], c.pair_prim_j[k]); }
+
+/* Before the rows are replaced: the key and history of old row k, kept for
+ * the carry-over (pass 8). */
+CD_INLINE void cd_nb_item_keep(cd_cols c, cd_long k, CD_GLOBAL cd_ulong *old_keys, CD_GLOBAL cd_int *old_active,
+                               CD_GLOBAL cd_vec3 *old_shear)
+{
+    old_keys[k] = cd_nb_row_key(c, k);
+    old_active[k] = c.pair_active[k];
+    old_shear[k] = c.pair_shear[k];
+}
+
+/* Pass 7: the rows offset[i] .. offset[i+1] of primitive i from its slot
+ * (slot > 0) or, after a fill-mode pass 5 (slot = 0), already in
+ * pair_prim_j: prim_i set, and each row's key. */
+CD_INLINE void cd_nb_item_place(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_int *offset,
+                                const CD_GLOBAL cd_prim_id *cand, cd_int slot, CD_GLOBAL cd_ulong *keys)
+{
+    cd_int first = offset[i], n = offset[i + 1] - first;
+    for (cd_int m = 0; m < n; m++) {
+        cd_prim_id j = slot > 0 ? cand[(cd_long)i * slot + m] : c.pair_prim_j[first + m];
+        c.pair_prim_i[first + m] = i;
+        c.pair_prim_j[first + m] = j;
+        keys[first + m] = cd_bp_pair_key(i, j);
+    }
+}
+
+/* Pass 8: history of new row k: the old row with the same key keeps its
+ * activity and tangential spring [m]; a pair new to the list starts
+ * without history. */
+CD_INLINE void cd_nb_item_carry(cd_cols c, cd_long k, const CD_GLOBAL cd_ulong *keys,
+                                const CD_GLOBAL cd_ulong *old_keys, cd_long n_old,
+                                const CD_GLOBAL cd_int *old_active, const CD_GLOBAL cd_vec3 *old_shear)
+{
+    cd_long o = cd_bp_find_key(old_keys, n_old, keys[k]);
+    c.pair_active[k] = o >= 0 ? old_active[o] : 0;
+    c.pair_shear[k] = o >= 0 ? old_shear[o] : cd_v3_zero();
+}
+
+/* Pass 9a: row k counts once in each of its two particles' lists. */
+CD_INLINE void cd_nb_item_gather_count(cd_cols c, cd_long k, CD_GLOBAL cd_int *count)
+{
+    cd_atomic_inc(&count[c.prim_particle[c.pair_prim_i[k]]]);
+    cd_atomic_inc(&count[c.prim_particle[c.pair_prim_j[k]]]);
+}
+
+/* Pass 9b: row k into its particles' slices as 2 k + side (side 1 for the
+ * particle of primitive j: step_items.h, cd_item_gather); cursor starts as
+ * gather_start. */
+CD_INLINE void cd_nb_item_gather_fill(cd_cols c, cd_long k, CD_GLOBAL cd_int *cursor, CD_GLOBAL cd_pair_id *rows)
+{
+    rows[cd_atomic_inc(&cursor[c.prim_particle[c.pair_prim_i[k]]])] = (cd_pair_id)(2 * k);
+    rows[cd_atomic_inc(&cursor[c.prim_particle[c.pair_prim_j[k]]])] = (cd_pair_id)(2 * k + 1);
+}
+
+/* Pass 9c: particle q's entries in ascending order (insertion: a few tens),
+ * the order in which the gather sums them. */
+CD_INLINE void cd_nb_item_gather_sort(cd_particle_id q, const CD_GLOBAL cd_int *start, CD_GLOBAL cd_pair_id *rows)
+{
+    cd_int first = start[q], last = start[q + 1];
+    for (cd_int a = first + 1; a < last; a++) {
+        cd_pair_id v = rows[a];
+        cd_int b = a;
+        while (b > first && rows[b - 1] > v) {
+            rows[b] = rows[b - 1];
+            b--;
+        }
+        rows[b] = v;
+    }
+}
+
+/* The prefix sums of passes 4, 6, 9 and 10: out[0] = 0, out[k+1] = out[k] +
+ * in[k] (out has n + 1 entries, out[n] the total), in three steps: each
+ * chunk sums its inputs, one item scans the chunk sums, each chunk writes
+ * its outputs.  Integer arithmetic: exact whatever the chunking. */
+CD_INLINE void cd_scan_item_sum(const CD_GLOBAL cd_int *in, cd_int n, cd_int chunk, cd_int g,
+                                CD_GLOBAL cd_int *chunk_sum)
+{
+    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n, s = 0;
+    for (cd_int i = g * chunk; i < end; i++) s += in[i];
+    chunk_sum[g] = s;
+}
+
+CD_INLINE void cd_scan_item_top(CD_GLOBAL cd_int *chunk_sum, cd_int n_chunks, CD_GLOBAL cd_int *out, cd_int n)
+{
+    cd_int run = 0;
+    for (cd_int g = 0; g < n_chunks; g++) {
+        cd_int t = chunk_sum[g];
+        chunk_sum[g] = run;
+        run += t;
+    }
+    out[n] = run;
+}
+
+CD_INLINE void cd_scan_item_fill(const CD_GLOBAL cd_int *in, cd_int n, cd_int chunk, cd_int g,
+                                 const CD_GLOBAL cd_int *chunk_sum, CD_GLOBAL cd_int *out)
+{
+    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n, run = chunk_sum[g];
+    for (cd_int i = g * chunk; i < end; i++) {
+        out[i] = run;
+        run += in[i];
+    }
+}
+
+CD_DEVICE_END
+#endif
