@@ -28,4 +28,7 @@ typedef struct {
     cd_real friction;       /* Coulomb coefficient mu_w [1] */
 } cd_wall;
 
+/* Walls a simulation may have (the state's table, the observables' slots). */
+#define CD_MAX_WALLS 8
+
 #endif

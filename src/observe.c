@@ -1,118 +1,151 @@
-/* Observables of the state: energies, momentum, wall forces.  Sums run over
- * fixed blocks of rows, each block in order, then the blocks in order, so
- * the result does not depend on the number of threads. */
+/* Observables of the state: energies, momentum, wall forces, contact
+ * counts, largest overlap, as the fixed-order reductions of
+ * kernels/observe_items.h: on the host columns (cd_sim_observe, after a
+ * sync), or where the steps run (cd_sim_observe_step: on the offload
+ * device only the merged slots come back, so a thermo line or a
+ * relaxation check costs no state copy).  Both give the same bits. */
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
-#include "sim.h"
-#include "../kernels/rigid.h"
+#include "omp_loops.h"
+#include "../kernels/observe_items.h"
 
-#define CD_SUM_BLOCK 4096
-#define CD_OBS_SLOTS (10 + 3 * CD_MAX_WALLS)
+/* Blocks of the three reductions, in merge order. */
+typedef struct {
+    cd_long particles, pairs, walls;
+} obs_blocks;
 
-enum { O_KT, O_KR, O_EL, O_PE, O_NC, O_NW, O_PX, O_PY, O_PZ, O_KC, O_WALL };
-
-/* Adds the contributions of particle q into acc (slots as in the enum). */
-/* Particles with at least one active contact (pair or wall), or NULL. */
-static const unsigned char *touching;
-
-static void particle_terms(const cd_sim *sim, size_t q, double *acc)
+static obs_blocks count_blocks(const cd_state *s)
 {
-    const cd_state *s = &sim->s;
-    cd_vec3 v = s->velocity[q];
-    double kt = 0.5 * s->mass[q] * cd_v3_norm2(v), kr = cd_rigid_rot_energy(s->orientation[q], s->angmom[q], s->inertia[q]);
-    acc[O_KT] += kt;
-    acc[O_KR] += kr;
-    if (touching && touching[q]) acc[O_KC] += kt + kr;
-    acc[O_PE] -= s->mass[q] * cd_v3_dot(sim->p.gravity, s->position[q]);
-    acc[O_PX] += s->mass[q] * v.x;
-    acc[O_PY] += s->mass[q] * v.y;
-    acc[O_PZ] += s->mass[q] * v.z;
+    obs_blocks n;
+    n.particles = ((cd_long)s->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    n.pairs = ((cd_long)s->n_pairs + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    n.walls = ((cd_long)(s->n_prims * s->n_walls) + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    return n;
 }
 
-static void pair_terms(const cd_sim *sim, size_t k, double *acc)
+static void unpack(const cd_state *s, const double *t, cd_observables *o)
 {
-    const cd_state *s = &sim->s;
-    if (!s->pair_active[k]) return;
-    acc[O_EL] += cd_contact_elastic_energy(sim->p.law, s->pair_overlap[k], s->pair_shear[k]);
-    acc[O_NC] += 1;
-}
-
-static void wall_terms(const cd_sim *sim, size_t row, double *acc)
-{
-    const cd_state *s = &sim->s;
-    if (!s->wallc_active[row]) return;
-    size_t w = row % s->n_walls;
-    acc[O_EL] += cd_contact_elastic_energy(sim->p.wall_law, s->wallc_overlap[row], s->wallc_shear[row]);
-    acc[O_NW] += 1;
-    /* The particle pushes the wall with the opposite of the wall's force. */
-    acc[O_WALL + 3 * w + 0] -= s->wallc_force[row].x;
-    acc[O_WALL + 3 * w + 1] -= s->wallc_force[row].y;
-    acc[O_WALL + 3 * w + 2] -= s->wallc_force[row].z;
-}
-
-typedef void (*term_fn)(const cd_sim *, size_t, double *);
-
-static void block_sum(const cd_sim *sim, size_t rows, term_fn fn, double *total)
-{
-    size_t nblocks = (rows + CD_SUM_BLOCK - 1) / CD_SUM_BLOCK;
-    double partial[64][CD_OBS_SLOTS];
-    /* Blocks are processed in batches of 64 to bound the stack use. */
-    for (size_t b0 = 0; b0 < nblocks; b0 += 64) {
-        size_t nb = nblocks - b0 < 64 ? nblocks - b0 : 64;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(nb * CD_SUM_BLOCK))
-        for (size_t b = 0; b < nb; b++) {
-            memset(partial[b], 0, sizeof(partial[b]));
-            size_t end = (b0 + b + 1) * CD_SUM_BLOCK < rows ? (b0 + b + 1) * CD_SUM_BLOCK : rows;
-            for (size_t r = (b0 + b) * CD_SUM_BLOCK; r < end; r++) fn(sim, r, partial[b]);
-        }
-        for (size_t b = 0; b < nb; b++)
-            for (int k = 0; k < CD_OBS_SLOTS; k++) total[k] += partial[b][k];
-    }
+    memset(o, 0, sizeof(*o));
+    o->kinetic_translational = t[CD_OBS_KT];
+    o->kinetic_rotational = t[CD_OBS_KR];
+    o->kinetic_in_contact = t[CD_OBS_KC];
+    o->elastic = t[CD_OBS_EL];
+    o->potential = t[CD_OBS_PE];
+    o->n_contacts = t[CD_OBS_NC];
+    o->n_wall_contacts = t[CD_OBS_NW];
+    for (int k = 0; k < 3; k++) o->momentum[k] = t[CD_OBS_PX + k];
+    for (size_t w = 0; w < s->n_walls; w++)
+        for (int k = 0; k < 3; k++) o->wall_force[w][k] = t[CD_OBS_WALL + 3 * w + k];
+    o->max_overlap_ratio = t[CD_OBS_MAXOV];
 }
 
 void cd_sim_observe(const cd_sim *sim, cd_observables *o)
 {
     const cd_state *s = &sim->s;
-    double acc[CD_OBS_SLOTS] = {0};
+    cd_cols c = cd_sim_host_cols((cd_state *)s); /* read only */
+    obs_blocks nb = count_blocks(s);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_int W = (cd_int)s->n_walls;
+    cd_vec3 g = sim->p.gravity;
+    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_int *touch = calloc((size_t)N + 1, sizeof(cd_int));
+    double *part = malloc((size_t)(nb.particles + nb.pairs + nb.walls + 1) * CD_OBS_SLOTS * sizeof(double));
+    double total[CD_OBS_SLOTS];
+    if (!touch || !part) { /* without memory: what is known is nothing */
+        free(touch);
+        free(part);
+        memset(o, 0, sizeof(*o));
+        o->max_overlap_ratio = NAN;
+        return;
+    }
     /* Rattlers move freely in their cages (without gravity and friction
      * forever): relaxation criteria look at the particles that touch. */
-    unsigned char *mark = calloc(s->n_particles + 1, 1);
-    if (mark) {
-        for (size_t k = 0; k < s->n_pairs; k++)
-            if (s->pair_active[k]) mark[s->prim_particle[s->pair_prim_i[k]]] = mark[s->prim_particle[s->pair_prim_j[k]]] = 1;
-        for (size_t r = 0; r < s->n_prims * s->n_walls; r++)
-            if (s->wallc_active[r]) mark[s->prim_particle[r / s->n_walls]] = 1;
+    CD_HOST_FOR(K, firstprivate(c))
+    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
+    CD_HOST_FOR(R, firstprivate(c))
+    for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
+    double *pp = part, *pk = part + nb.particles * CD_OBS_SLOTS, *pw = pk + nb.pairs * CD_OBS_SLOTS;
+    CD_HOST_FOR(N, firstprivate(c))
+    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, pp + b * CD_OBS_SLOTS);
+    CD_HOST_FOR(K, firstprivate(c))
+    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS);
+    CD_HOST_FOR(R, firstprivate(c))
+    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS);
+    cd_obs_merge(part, nb.particles + nb.pairs + nb.walls, total);
+    unpack(s, total, o);
+    free(touch);
+    free(part);
+}
+
+#if CD_OFFLOAD
+/* The same reductions on the device the steps run on; the scratch stays
+ * allocated there (grown when the pair rows grow). */
+static int observe_device(cd_sim *sim, cd_observables *o)
+{
+    const cd_state *s = &sim->s;
+    cd_sim_obs_scratch *x = &sim->obs;
+    obs_blocks nb = count_blocks(s);
+    size_t blocks = (size_t)(nb.particles + nb.pairs + nb.walls) + 1;
+    if (!x->touch) {
+        x->touch = cd_dev_alloc((s->n_particles + 1) * sizeof(cd_int));
+        x->total = cd_dev_alloc(CD_OBS_SLOTS * sizeof(cd_real));
+        if (!x->touch || !x->total) return -1;
     }
-    touching = mark;
-    block_sum(sim, s->n_particles, particle_terms, acc);
-    touching = NULL;
-    free(mark);
-    block_sum(sim, s->n_pairs, pair_terms, acc);
-    block_sum(sim, s->n_prims * s->n_walls, wall_terms, acc);
-    memset(o, 0, sizeof(*o));
-    o->kinetic_translational = acc[O_KT];
-    o->kinetic_rotational = acc[O_KR];
-    o->kinetic_in_contact = acc[O_KC];
-    o->elastic = acc[O_EL];
-    o->potential = acc[O_PE];
-    o->n_contacts = acc[O_NC];
-    o->n_wall_contacts = acc[O_NW];
-    o->momentum[0] = acc[O_PX];
-    o->momentum[1] = acc[O_PY];
-    o->momentum[2] = acc[O_PZ];
-    for (size_t w = 0; w < s->n_walls; w++)
-        for (int c = 0; c < 3; c++) o->wall_force[w][c] = acc[O_WALL + 3 * w + c];
-    double worst = 0;
-    for (size_t k = 0; k < s->n_pairs; k++)
-        if (s->pair_active[k]) {
-            double d = 2 * fmin(s->prim_radius[s->pair_prim_i[k]], s->prim_radius[s->pair_prim_j[k]]);
-            if (s->pair_overlap[k] / d > worst) worst = s->pair_overlap[k] / d;
-        }
-    for (size_t r = 0; r < s->n_prims * s->n_walls; r++)
-        if (s->wallc_active[r]) {
-            double d = 2 * s->prim_radius[r / s->n_walls];
-            if (s->wallc_overlap[r] / d > worst) worst = s->wallc_overlap[r] / d;
-        }
-    o->max_overlap_ratio = worst;
+    if (blocks > x->cap_blocks) {
+        cd_dev_free(x->partial);
+        x->cap_blocks = blocks + blocks / 4;
+        x->partial = cd_dev_alloc(x->cap_blocks * CD_OBS_SLOTS * sizeof(cd_real));
+        if (!x->partial) return -1;
+    }
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_int W = (cd_int)s->n_walls;
+    cd_vec3 g = sim->p.gravity;
+    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_int *touch = x->touch;
+    cd_real *part = x->partial, *total = x->total;
+    cd_long pk = nb.particles * CD_OBS_SLOTS, pw = pk + nb.pairs * CD_OBS_SLOTS, n_blocks = (cd_long)blocks - 1;
+    CD_WIDE_MIN
+    CD_STEP_FOR(N, firstprivate(c) is_device_ptr(touch))
+    for (cd_long q = 0; q < N; q++) touch[q] = 0;
+    CD_STEP_FOR(K, firstprivate(c) is_device_ptr(touch))
+    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
+    CD_STEP_FOR(R, firstprivate(c) is_device_ptr(touch))
+    for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
+    CD_STEP_FOR(N, firstprivate(c, g) is_device_ptr(touch, part))
+    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS);
+    CD_STEP_FOR(K, firstprivate(c, law) is_device_ptr(part))
+    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS);
+    CD_STEP_FOR(R, firstprivate(c, wall_law) is_device_ptr(part))
+    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS);
+    CD_STEP_FOR(1, is_device_ptr(part, total))
+    for (int one = 0; one < 1; one++) cd_obs_merge(part, n_blocks, total);
+    double t[CD_OBS_SLOTS];
+    if (cd_dev_get(t, total, sizeof t)) return -1;
+    unpack(s, t, o);
+    return 0;
+}
+#endif
+
+int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data && sim->backend == &cd_backend_omp) {
+        if (observe_device(sim, o) == 0) return 0;
+        snprintf(err, errlen, "out of device memory while summing the observables");
+        return -1;
+    }
+#endif
+    if (cd_sim_sync(sim, err, errlen)) return -1;
+    cd_sim_observe(sim, o);
+    return 0;
+}
+
+void cd_sim_observe_free(cd_sim *sim)
+{
+    cd_dev_free(sim->obs.touch);
+    cd_dev_free(sim->obs.partial);
+    cd_dev_free(sim->obs.total);
+    memset(&sim->obs, 0, sizeof sim->obs);
 }

@@ -425,12 +425,19 @@ int cd_run(const cd_run_options *opt)
         sim.snapshot_request = 0;
         int last = sim.s.step == cfg.steps || protocol_done;
         if (thermo_due || snap_due || last) {
-            if (cd_sim_sync(&sim, err, sizeof err)) {
+            /* A thermo line alone sums the observables where the steps run
+             * (no state copy on an offload device); a snapshot brings the
+             * state back first.  The same bits either way. */
+            if ((snap_due || last) && cd_sim_sync(&sim, err, sizeof err)) {
                 fprintf(stderr, "\ncapdem: %s\n", err);
                 status = 1;
                 break;
             }
-            cd_sim_observe(&sim, &o);
+            if (cd_sim_observe_step(&sim, &o, err, sizeof err)) {
+                fprintf(stderr, "\ncapdem: %s\n", err);
+                status = 1;
+                break;
+            }
             /* Overlaps beyond run.max_overlap (default half the arm
              * diameter) are taken for a numerical failure (dt too large,
              * stiffness too low) or a load the stiffness cannot carry. */

@@ -485,4 +485,5 @@ void cd_sim_free(cd_sim *sim)
     cd_state_free(&sim->s);
     cd_state_free(&sim->probe_base);
     cd_neighbors_free(&sim->nb);
+    cd_sim_observe_free(sim);
 }

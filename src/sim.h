@@ -72,6 +72,15 @@ typedef struct {
     cd_int slot;              /* candidate slot per primitive (doubles when one overflows) */
 } cd_neighbors;
 
+/* Scratch of the observables' reductions where the steps run (the offload
+ * device's memory; src/observe.c). */
+typedef struct {
+    cd_int *touch;     /* per particle: active contacts (marks the particles that touch) */
+    cd_real *partial;  /* CD_OBS_SLOTS per block */
+    cd_real *total;    /* CD_OBS_SLOTS */
+    size_t cap_blocks;
+} cd_sim_obs_scratch;
+
 typedef struct cd_sim {
     cd_config cfg;
     cd_state s;
@@ -79,6 +88,7 @@ typedef struct cd_sim {
     cd_shape shapes[CD_MAX_SPECIES];
     int n_shapes;
     cd_neighbors nb;
+    cd_sim_obs_scratch obs;
     double collision_time;    /* smallest pair collision time [s] */
     double total_mass;        /* sum of the particle masses [kg] (fixed at set-up) */
     double solid_volume;      /* sum of the particle volumes [m^3] (fixed at set-up) */
@@ -154,7 +164,13 @@ typedef struct {
     double wall_force[CD_MAX_WALLS][3]; /* force of the particles on each wall [N] */
     double max_overlap_ratio; /* largest overlap / arm diameter [1] */
 } cd_observables;
+/* From the host columns (current after a sync). */
 void cd_sim_observe(const cd_sim *sim, cd_observables *o);
+/* From the columns the steps work on, without a state copy where the
+ * backend sums on its device (the offload variant), else after a sync;
+ * the same bits either way.  0, or -1 with a message. */
+int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen);
+void cd_sim_observe_free(cd_sim *sim);
 
 /* Neighbour list (neighbors.c). */
 void cd_neighbors_init(cd_neighbors *nb, double skin);

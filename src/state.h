@@ -14,8 +14,6 @@ enum cd_field_group { CD_GROUP_PARTICLE, CD_GROUP_PRIM, CD_GROUP_PAIR, CD_GROUP_
 static inline int cd_group_pair_rows(enum cd_field_group g) { return g == CD_GROUP_PAIR || g == CD_GROUP_PAIR_OUT; }
 enum cd_field_kind { CD_KIND_REAL, CD_KIND_INT };
 
-#define CD_MAX_WALLS 8
-
 typedef struct cd_state {
     /* rows in use and rows allocated per group */
     size_t n_particles, n_prims, n_pairs, n_walls;

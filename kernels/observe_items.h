@@ -1,0 +1,122 @@
+/* The observables of the state (energies, contact counts, momentum, wall
+ * forces, largest overlap) as fixed-order reductions: rows in blocks of
+ * CD_OBS_BLOCK, each block summed in row order into its own slots, then
+ * the blocks merged in order (particles, pairs, wall rows).  src/observe.c
+ * runs the items on host threads or, in the offload variant, on the device
+ * (then only the merged slots come back), so the sums have the same bits
+ * for every thread count and on every device.  Device-safe: C11 and
+ * OpenCL C 1.2. */
+#ifndef CD_OBSERVE_ITEMS_H
+#define CD_OBSERVE_ITEMS_H
+#include "cols.h"
+#include "rigid.h"
+#include "contact_law.h"
+
+#define CD_OBS_BLOCK 4096
+/* Slots of a partial sum: summed ... */
+#define CD_OBS_KT 0   /* translational kinetic energy [J] */
+#define CD_OBS_KR 1   /* rotational kinetic energy [J] */
+#define CD_OBS_EL 2   /* elastic energy of the contact springs [J] */
+#define CD_OBS_PE 3   /* gravitational potential energy [J] */
+#define CD_OBS_NC 4   /* active pair contacts */
+#define CD_OBS_NW 5   /* active wall contacts */
+#define CD_OBS_PX 6   /* momentum x, y, z [kg m/s] */
+#define CD_OBS_KC 9   /* kinetic energy of the particles that touch something [J] */
+#define CD_OBS_WALL 10 /* force on wall w, 3 per wall [N] */
+/* ... and merged by maximum */
+#define CD_OBS_MAXOV (CD_OBS_WALL + 3 * CD_MAX_WALLS) /* largest overlap / arm diameter [1] */
+#define CD_OBS_SLOTS (CD_OBS_MAXOV + 1)
+
+CD_DEVICE_BEGIN
+
+/* Particles with an active contact, marked by counting their contacts
+ * (integer atomics: a count, never a floating-point sum). */
+CD_INLINE void cd_obs_item_touch_pair(cd_cols c, cd_long k, CD_GLOBAL cd_int *touch)
+{
+    if (!c.pair_active[k]) return;
+    cd_atomic_inc(&touch[c.prim_particle[c.pair_prim_i[k]]]);
+    cd_atomic_inc(&touch[c.prim_particle[c.pair_prim_j[k]]]);
+}
+
+CD_INLINE void cd_obs_item_touch_wall(cd_cols c, cd_long row, cd_int n_walls, CD_GLOBAL cd_int *touch)
+{
+    if (c.wallc_active[row]) cd_atomic_inc(&touch[c.prim_particle[row / n_walls]]);
+}
+
+CD_INLINE void cd_obs_clear(CD_GLOBAL cd_real *acc)
+{
+    for (int k = 0; k < CD_OBS_SLOTS; k++) acc[k] = 0;
+}
+
+CD_INLINE cd_long cd_obs_block_end(cd_long b, cd_long n)
+{
+    return (b + 1) * CD_OBS_BLOCK < n ? (b + 1) * CD_OBS_BLOCK : n;
+}
+
+/* Block b of the particles: kinetic and potential energy in gravity
+ * [m/s^2], momentum. */
+CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 gravity,
+                                      const CD_GLOBAL cd_int *touch, CD_GLOBAL cd_real *acc)
+{
+    cd_obs_clear(acc);
+    for (cd_long q = b * CD_OBS_BLOCK; q < cd_obs_block_end(b, n); q++) {
+        cd_vec3 v = c.velocity[q];
+        cd_real m = c.mass[q];
+        cd_real kt = CD_R(0.5) * m * cd_v3_norm2(v), kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], c.inertia[q]);
+        acc[CD_OBS_KT] += kt;
+        acc[CD_OBS_KR] += kr;
+        if (touch[q]) acc[CD_OBS_KC] += kt + kr;
+        acc[CD_OBS_PE] -= m * cd_v3_dot(gravity, c.position[q]);
+        acc[CD_OBS_PX] += m * v.x;
+        acc[CD_OBS_PX + 1] += m * v.y;
+        acc[CD_OBS_PX + 2] += m * v.z;
+    }
+}
+
+/* Block b of the pair rows: elastic energy, contacts, largest overlap. */
+CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc)
+{
+    cd_obs_clear(acc);
+    for (cd_long k = b * CD_OBS_BLOCK; k < cd_obs_block_end(b, n); k++) {
+        if (!c.pair_active[k]) continue;
+        acc[CD_OBS_EL] += cd_contact_elastic_energy(law, c.pair_overlap[k], c.pair_shear[k]);
+        acc[CD_OBS_NC] += 1;
+        cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
+        cd_real ratio = c.pair_overlap[k] / (2 * (ri < rj ? ri : rj));
+        if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
+    }
+}
+
+/* Block b of the primitive-wall rows (n_walls per primitive): elastic
+ * energy, contacts, the particles' force on each wall, largest overlap. */
+CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
+                                  CD_GLOBAL cd_real *acc)
+{
+    cd_obs_clear(acc);
+    for (cd_long r = b * CD_OBS_BLOCK; r < cd_obs_block_end(b, n); r++) {
+        if (!c.wallc_active[r]) continue;
+        cd_long w = r % n_walls;
+        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.wallc_overlap[r], c.wallc_shear[r]);
+        acc[CD_OBS_NW] += 1;
+        /* The particle pushes the wall with the opposite of the wall's force. */
+        acc[CD_OBS_WALL + 3 * w + 0] -= c.wallc_force[r].x;
+        acc[CD_OBS_WALL + 3 * w + 1] -= c.wallc_force[r].y;
+        acc[CD_OBS_WALL + 3 * w + 2] -= c.wallc_force[r].z;
+        cd_real ratio = c.wallc_overlap[r] / (2 * c.prim_radius[r / n_walls]);
+        if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
+    }
+}
+
+/* One item: the n_blocks partial slots merged in order into total. */
+CD_INLINE void cd_obs_merge(const CD_GLOBAL cd_real *partial, cd_long n_blocks, CD_GLOBAL cd_real *total)
+{
+    cd_obs_clear(total);
+    for (cd_long b = 0; b < n_blocks; b++) {
+        const CD_GLOBAL cd_real *p = partial + b * CD_OBS_SLOTS;
+        for (int k = 0; k < CD_OBS_MAXOV; k++) total[k] += p[k];
+        if (p[CD_OBS_MAXOV] > total[CD_OBS_MAXOV]) total[CD_OBS_MAXOV] = p[CD_OBS_MAXOV];
+    }
+}
+
+CD_DEVICE_END
+#endif
