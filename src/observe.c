@@ -34,7 +34,8 @@ static void pair_terms(const cd_sim *sim, size_t k, double *acc)
 {
     const cd_state *s = &sim->s;
     if (!s->pair_active[k]) return;
-    acc[O_EL] += cd_contact_elastic_energy(sim->p.law, s->pair_overlap[k], s->pair_shear[k]);
+    cd_real r_eff = cd_law_pair_radius(s->prim_radius[s->pair_prim_i[k]], s->prim_radius[s->pair_prim_j[k]]);
+    acc[O_EL] += cd_contact_elastic_energy(sim->p.law, r_eff, s->pair_overlap[k], s->pair_shear[k]);
     acc[O_NC] += 1;
 }
 
@@ -43,7 +44,8 @@ static void wall_terms(const cd_sim *sim, size_t row, double *acc)
     const cd_state *s = &sim->s;
     if (!s->wallc_active[row]) return;
     size_t w = row % s->n_walls;
-    acc[O_EL] += cd_contact_elastic_energy(sim->p.wall_law, s->wallc_overlap[row], s->wallc_shear[row]);
+    acc[O_EL] += cd_contact_elastic_energy(sim->p.wall_law, s->prim_radius[row / s->n_walls], s->wallc_overlap[row],
+                                           s->wallc_shear[row]);
     acc[O_NW] += 1;
     /* The particle pushes the wall with the opposite of the wall's force. */
     acc[O_WALL + 3 * w + 0] -= s->wallc_force[row].x;
