@@ -79,9 +79,9 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
     cd_obs_clear(acc);
     for (cd_long k = b * CD_OBS_BLOCK; k < cd_obs_block_end(b, n); k++) {
         if (!c.pair_active[k]) continue;
-        acc[CD_OBS_EL] += cd_contact_elastic_energy(law, c.pair_overlap[k], c.pair_shear[k]);
-        acc[CD_OBS_NC] += 1;
         cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
+        acc[CD_OBS_EL] += cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
+        acc[CD_OBS_NC] += 1;
         cd_real ratio = c.pair_overlap[k] / (2 * (ri < rj ? ri : rj));
         if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
     }
@@ -96,7 +96,8 @@ CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_wall
     for (cd_long r = b * CD_OBS_BLOCK; r < cd_obs_block_end(b, n); r++) {
         if (!c.wallc_active[r]) continue;
         cd_long w = r % n_walls;
-        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.wallc_overlap[r], c.wallc_shear[r]);
+        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.prim_radius[r / n_walls], c.wallc_overlap[r],
+                                                     c.wallc_shear[r]);
         acc[CD_OBS_NW] += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
         acc[CD_OBS_WALL + 3 * w + 0] -= c.wallc_force[r].x;

@@ -138,7 +138,7 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     cd_vec3 vj = cd_rigid_point_velocity(c.position[pj], c.velocity[pj], c.angvel[pj], g.point);
     cd_real m_eff = cd_law_effective_mass(c.mass[pi], c.mass[pj]);
     cd_vec3 shear = c.pair_shear[k];
-    cd_contact_force f = cd_contact_law(law, m_eff, &g, cd_v3_sub(vj, vi), dt, &shear);
+    cd_contact_force f = cd_contact_law(law, m_eff, cd_law_pair_radius(ri, rj), &g, cd_v3_sub(vj, vi), dt, &shear);
     c.pair_active[k] = 1;
     c.pair_shear[k] = shear;
     c.pair_point[k] = g.point;
@@ -180,8 +180,8 @@ CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall 
     cd_law_params law = wall_law;
     law.mu = wall.friction;
     cd_vec3 shear = c.wallc_shear[row];
-    /* The particle is body i, the wall body j of infinite mass. */
-    cd_contact_force f = cd_contact_law(law, c.mass[pi], &g, cd_v3_sub(vw, vi), dt, &shear);
+    /* The particle is body i, the wall body j of infinite mass and radius. */
+    cd_contact_force f = cd_contact_law(law, c.mass[pi], c.prim_radius[i], &g, cd_v3_sub(vw, vi), dt, &shear);
     cd_vec3 fi = cd_v3_neg(f.force_j);
     c.wallc_active[row] = 1;
     c.wallc_shear[row] = shear;

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <yaml.h>
 #include "config_internal.h"
+#include "../kernels/contact_law.h"
 
 /* ---- mappings ---------------------------------------------------------- */
 
@@ -313,6 +314,10 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
     if (c->fill_ratio > 0 && !(c->fill_fraction > 0))
         return cd_cfg_fail(r, line_of(proto), "protocol.fill_fraction: missing; expected a number in (0, 1) (expected packing fraction), "
                            "needed for protocol.fill_ratio = %g", c->fill_ratio);
+    int ball = !strcmp(c->protocol, "radial_compaction") || !strcmp(c->protocol, "bulk_modulus");
+    if (ball && c->law == CD_LAW_HERTZ_MINDLIN && c->pressure == 0)
+        return cd_cfg_fail(r, line_of(proto), "protocol.pressure: missing; expected a number > 0 (pressure, Pa), needed for "
+                           "material.law = hertz_mindlin (protocol.pressure_ratio scales material.kn, which that law does not use)");
     yaml_node_t *dom = lookup(r->doc, root, "domain", NULL);
     int tall = !strcmp(c->domain, "box") || !strcmp(c->domain, "cylinder");
     double height = !strcmp(c->domain, "box") ? c->box_height : c->cyl_height;

@@ -47,7 +47,11 @@ typedef struct {
     double eta_n, eta_t;           /* damping ratios [1] */
     double friction;               /* mu between particles [1] */
     double wall_friction;          /* mu_w [1] */
-    int friction_limit_total;      /* 0: mu (kn/2) delta_n (seed 000); 1: mu F_n (seed 001, LAMMPS) */
+    int friction_limit_total;      /* 0: mu F_n,elastic ((kn/2) delta_n, seed 000); 1: mu F_n (seed 001, LAMMPS) */
+    int law;                       /* material.law: CD_LAW_LINEAR | CD_LAW_HERTZ_MINDLIN (kernels/contact_law.h) */
+    double young_modulus;          /* hertz_mindlin: E [Pa] */
+    double poisson_ratio;          /* hertz_mindlin: nu [1] */
+    double impact_speed;           /* hertz_mindlin: speed of the collision time t_col [m/s] */
     double parallel_angle_deg;     /* parallel-contact cut-off [deg] */
     int parallel_blend;            /* 1: contact point blended up to twice the cut-off (docs/contacts.md) */
 

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "config_schema.h"
+#include "../kernels/contact_law.h"
 
 /* Selector choices as bits, in the order of the choices strings below. */
 #define D_BOX 1u
@@ -19,8 +20,11 @@
 #define P_RADIAL 4u
 #define P_BULK 8u
 #define P_ANY (P_DEPOSIT | P_RADIAL | P_BULK)
+#define L_LINEAR 1u
+#define L_HERTZ 2u
 
 _Static_assert(CD_WALL_PLANE == 0, "domain.walls[].type stores the index of \"plane\" in its choices");
+_Static_assert(CD_LAW_LINEAR == 0 && CD_LAW_HERTZ_MINDLIN == 1, "material.law stores the index of its choice");
 
 #define CFG(f) .target = CD_TGT_CONFIG, .offset = offsetof(cd_config, f)
 #define CFG_SIZED(f) CFG(f), .size = sizeof(((cd_config *)0)->f)
@@ -64,14 +68,26 @@ const cd_key cd_config_keys[] = {
      .label = "gravity", .meaning = "gravity vector (y is up)"},
 
     /* material */
+    {"material.law", CD_KT_ENUM, "-", "linear", CFG(law), .flags = CD_KF_SELECTOR, .choices = "linear|hertz_mindlin",
+     .label = "contact law",
+     .meaning = "linear: spring-dashpot k_n, k_t; hertz_mindlin: Hertz normal and Mindlin tangential stiffness from E and nu "
+                "(docs/contacts.md)"},
     {"material.density", CD_KT_REAL, "kg/m^3", "1000", CFG(density), GT(0),
      .label = "particle density", .meaning = "density rho of the particles"},
-    {"material.kn", CD_KT_REAL, "N/m", "1e5", CFG(kn), GT(0),
+    {"material.kn", CD_KT_REAL, "N/m", "1e5", CFG(kn), GT(0), .applies = L_LINEAR,
      .label = "normal stiffness", .meaning = "normal stiffness k_n of one particle (a contact has k_n/2)"},
-    {"material.kt", CD_KT_REAL, "N/m", "0.5*kn", CFG(kt), GE(0), .flags = CD_KF_DERIVED,
+    {"material.kt", CD_KT_REAL, "N/m", "0.5*kn", CFG(kt), GE(0), .flags = CD_KF_DERIVED, .applies = L_LINEAR,
      .label = "tangential stiffness", .meaning = "tangential stiffness k_t of one particle (a contact has k_t/2)"},
+    {"material.young_modulus", CD_KT_REAL, "Pa", NULL, CFG(young_modulus), GT(0), .applies = L_HERTZ, .required = L_HERTZ,
+     .label = "Young's modulus", .meaning = "Young's modulus E of the particles and the walls (one material)"},
+    {"material.poisson_ratio", CD_KT_REAL, "1", NULL, CFG(poisson_ratio), GT(-1), LE(0.5), .applies = L_HERTZ,
+     .required = L_HERTZ, .label = "Poisson ratio", .meaning = "Poisson ratio nu of the particles and the walls"},
+    {"material.impact_speed", CD_KT_REAL, "m/s", "1", CFG(impact_speed), GT(0), .applies = L_HERTZ,
+     .label = "impact speed",
+     .meaning = "speed at which the Hertz collision time t_col is taken for the run.dt check and run.steps_per_collision"},
     {"material.damping_normal", CD_KT_REAL, "1", "0.2", CFG(eta_n), GE(0), LT(1), .conflicts = "restitution",
-     .label = "normal damping ratio", .meaning = "normal damping ratio eta_n (0.2 gives e = 0.53)"},
+     .label = "normal damping ratio",
+     .meaning = "normal damping ratio eta_n (linear: 0.2 gives e = 0.53; hertz_mindlin: docs/contacts.md)"},
     {"material.restitution", CD_KT_REAL, "1", NULL, SCRATCH(restitution), GT(0), LE(1), .conflicts = "damping_normal",
      .label = "coefficient of restitution",
      .meaning = "restitution e instead of eta_n: eta_n = -ln e / sqrt(pi^2 + ln^2 e) (e = 1: 0)"},
@@ -83,7 +99,7 @@ const cd_key cd_config_keys[] = {
      .label = "wall friction coefficient", .meaning = "Coulomb coefficient mu_w between particles and every wall"},
     {"material.friction_limit", CD_KT_ENUM, "-", "elastic", CFG(friction_limit_total), .choices = "elastic|total",
      .label = "Coulomb limit",
-     .meaning = "elastic: mu (k_n/2) delta_n (seed 000); total: mu F_n (seed 001, LAMMPS)"},
+     .meaning = "elastic: mu times the elastic part of F_n, (k_n/2) delta_n when linear (seed 000); total: mu F_n (seed 001, LAMMPS)"},
     {"material.parallel_angle", CD_KT_REAL, "deg", "2", CFG(parallel_angle_deg), GE(0), LT(45),
      .label = "parallel-contact angle", .meaning = "arms closer than this to parallel use the parallel-contact rule"},
     {"material.parallel_blend", CD_KT_BOOL, "-", "false", CFG(parallel_blend),

@@ -441,6 +441,14 @@ int cd_run(const cd_run_options *opt)
             /* Overlaps beyond run.max_overlap (default half the arm
              * diameter) are taken for a numerical failure (dt too large,
              * stiffness too low) or a load the stiffness cannot carry. */
+            char cause[768];
+            if (o.max_overlap_ratio > cfg.max_overlap && blowup_cause(&sim, cause, sizeof cause)) {
+                /* the overlap is a symptom: name the blow-up */
+                fprintf(stderr, "\ncapdem: run stopped: %s\n", cause);
+                fprintf(stderr, "capdem: %s keeps the snapshots written before step %lld\n", cfg.output, sim.s.step);
+                status = 3;
+                break;
+            }
             if (o.max_overlap_ratio > cfg.max_overlap) {
                 fprintf(stderr, "\ncapdem: run stopped at step %lld (t = %.9g s): an overlap reached %.3g of the arm diameter "
                         "(limit run.max_overlap = %.2g); the time step %g s, the stiffness or the load is unsuitable. "

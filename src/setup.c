@@ -377,7 +377,18 @@ static int check_time_step(cd_sim *sim, char *err, size_t errlen)
         else if (s->mass[q] < m2) m2 = s->mass[q];
     }
     double m_eff = s->n_particles > 1 ? cd_law_effective_mass(m1, m2) : m1;
-    sim->collision_time = cd_law_collision_time(c->kn, m_eff, c->eta_n);
+    if (c->law == CD_LAW_HERTZ_MINDLIN) {
+        /* The Hertz time falls with the impact speed (as v^(-1/5)) and with
+         * R_eff: the lightest pair with the largest arm radius, undamped,
+         * at material.impact_speed (damping only lengthens it). */
+        double r_max = 0; /* [m] */
+        for (size_t i = 0; i < s->n_prims; i++) r_max = fmax(r_max, s->prim_radius[i]);
+        double r_eff = s->n_particles > 1 ? cd_law_pair_radius(r_max, r_max) : r_max;
+        double e_eff = cd_law_contact_modulus(c->young_modulus, c->poisson_ratio);
+        sim->collision_time = cd_law_hertz_collision_time(e_eff, r_eff, m_eff, c->impact_speed);
+    } else {
+        sim->collision_time = cd_law_collision_time(c->kn, m_eff, c->eta_n);
+    }
     if (c->steps_per_collision > 0) c->dt = sim->collision_time / c->steps_per_collision;
     if (c->dt > sim->collision_time / 5 && !c->force_dt) {
         snprintf(err, errlen, "%s: run.dt = %g s: expected at most t_col/5 = %g s (collision time %g s of the lightest pair); "
@@ -469,6 +480,12 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
     sp->law.mu = c->friction;
     sp->law.limit_total = c->friction_limit_total;
     sp->law.clip_normal = 1;
+    sp->law.law = c->law;
+    if (c->law == CD_LAW_HERTZ_MINDLIN) {
+        /* walls are of the particles' material */
+        sp->law.e_eff = cd_law_contact_modulus(c->young_modulus, c->poisson_ratio);
+        sp->law.g_eff = cd_law_contact_shear_modulus(c->young_modulus, c->poisson_ratio);
+    }
     sp->wall_law = sp->law;
     sp->wall_law.mu = c->wall_friction;
     cd_neighbors_init(&sim->nb, c->skin > 0 ? c->skin : 0.1 * dmin);

@@ -7,6 +7,10 @@ capdem settled (spheres), and the normal forces are compared pair by pair.
 
 LAMMPS reads the packing (capdem_to_lammps.py), takes no step (`run 0`) and
 dumps every touching pair with its normal force (compute pair/local force).
+A run of `material.law: hertz_mindlin` (its config must give
+young_modulus, poisson_ratio, damping_normal and friction) is evaluated with
+LAMMPS's hertz/material and tangential mindlin (lammps_law.hertz_constants);
+any other run with the linear law of the bench cases.
 Prints the contact counts and the largest and median |F_n(capdem) -
 F_n(LAMMPS)| / <F_n>.  Exit 1 if the contact sets differ or the largest
 difference exceeds 1e-2 (the damping term sees velocities half a step
@@ -15,6 +19,7 @@ apart in the two codes; the elastic parts are identical).
 import argparse
 import json
 import os
+import re
 import sys
 
 import numpy as np
@@ -23,7 +28,18 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import capdem_to_lammps  # noqa: E402
 import compare  # noqa: E402
+import lammps_law  # noqa: E402
 import parity  # noqa: E402
+
+
+def law_of(cfg):
+    """LAMMPS constants for the run's law: Hertz-Mindlin from its config, or
+    None (compare.py's linear MATERIAL)."""
+    if not re.search(r"\blaw:\s*hertz_mindlin\b", cfg):
+        return None
+    E, nu = capdem_to_lammps.config_value(cfg, "young_modulus"), capdem_to_lammps.config_value(cfg, "poisson_ratio")
+    eta_n, mu = capdem_to_lammps.config_value(cfg, "damping_normal"), capdem_to_lammps.config_value(cfg, "friction")
+    return lammps_law.hertz_constants(E, nu, eta_n, eta_n, mu)
 
 
 def main():
@@ -36,10 +52,12 @@ def main():
     compare.ensure_lammps()
     os.makedirs(a.work, exist_ok=True)
     base = os.path.join(a.work, "check_forces")
-    meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(a.run), base + ".data")
+    run = capdem_to_lammps.read_run(a.run)
+    meta = capdem_to_lammps.convert(run, base + ".data")
     if meta["rigid"]:
         raise SystemExit("check_forces: spheres only (glued clusters are not capdem's shapes)")
-    compare.run_lammps(a, base + ".data", meta, base + ".lammps.log", 0, 0, contacts=base + ".contacts", nrepeat=0)
+    compare.run_lammps(a, base + ".data", meta, base + ".lammps.log", 0, 0, contacts=base + ".contacts", nrepeat=0,
+                        law=law_of(run["config"]))
     ci, cj, cf, _ = parity.capdem_contacts(a.run)
     li, lj, lf = parity.lammps_contacts(base + ".contacts")
     cd = {(min(p, q), max(p, q)): f for p, q, f in zip(ci, cj, cf)}

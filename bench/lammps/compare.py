@@ -77,10 +77,12 @@ def capdem_bench(args, extra):
     return [json.loads(l) for l in p.stdout.splitlines() if l.startswith("{")]
 
 
-def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None, nrepeat=None, write_data=None):
+def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None, nrepeat=None, write_data=None,
+               law=None):
     """Runs in.capdem.lmp; returns [(loop seconds, steps)] of the timed runs
-    and the mean contacts per atom at the end (compute contact/atom)."""
-    c = lammps_law.lammps_constants(**MATERIAL)
+    and the mean contacts per atom at the end (compute contact/atom).  law:
+    LAMMPS constants (lammps_law.py); default those of MATERIAL."""
+    c = law or lammps_law.lammps_constants(**MATERIAL)
     var = {
         "astyle": "hybrid sphere molecular" if meta["rigid"] else "sphere",
         "data": data, "rigid": int(meta["rigid"]),

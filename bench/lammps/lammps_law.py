@@ -73,8 +73,30 @@ def lammps_constants(kn, kt, eta_n, eta_t, mu):
     }
 
 
+def hertz_constants(E, nu, eta_n, eta_t, mu):
+    """pair_style granular coefficients equivalent to capdem's Hertz-Mindlin
+    law (docs/contacts.md).  LAMMPS's hertz/material takes E and nu for
+    E* = E / (2 (1 - nu^2)) and F_n = (4/3) E* a delta, its damping tsuji is
+    alpha sqrt(m (4/3) E* a) v_n; capdem's 2 sqrt(5/6) eta_n sqrt(2 E* a m)
+    is that with alpha = sqrt(5) eta_n.  tangential mindlin NULL gives
+    k_t = 8 G* a, and its damping x times the normal one; capdem's
+    gamma_t / gamma_n = (eta_t / eta_n) sqrt(8 G* / (2 E*))."""
+    e_star = E / (2 * (1 - nu * nu))
+    g_star = E / (4 * (2 - nu) * (1 + nu))
+    alpha = math.sqrt(5.0) * eta_n
+    return {
+        "law": "hertz_mindlin", "E": E, "nu": nu,
+        "tsuji_e": tsuji_input_for(alpha), "tsuji_alpha": alpha,
+        "xgammat": (eta_t / eta_n) * 2 * math.sqrt(g_star / e_star) if eta_n > 0 else 0.0,
+        "mu": mu,
+    }
+
+
 def pair_coeff_args(c, mu=None):
     """The model keywords of pair_coeff / fix wall/gran granular."""
+    if c.get("law") == "hertz_mindlin":
+        return ("hertz/material %.10g %.15g %.10g tangential mindlin NULL %.15g %.10g damping tsuji limit_damping"
+                % (c["E"], c["tsuji_e"], c["nu"], c["xgammat"], c["mu"] if mu is None else mu))
     return ("hooke %.10g %.15g tangential linear_history %.10g %.15g %.10g damping tsuji limit_damping"
             % (c["kn"], c["tsuji_e"], c["kt"], c["xgammat"], c["mu"] if mu is None else mu))
 
@@ -93,6 +115,31 @@ def restitution(kn_contact, alpha, m, clip, v0=0.1, steps_per_period=2000):
         return max(f, 0.0) if clip else f
 
     a = -force(d, v) / m
+    while True:
+        v_half = v + 0.5 * dt * a
+        d += dt * v_half
+        if d <= 0.0:
+            return -v_half / v0
+        a = -force(d, v_half) / m
+        v = v_half + 0.5 * dt * a
+
+
+def hertz_restitution(c, R, m, v0=0.1, steps=4000):
+    """Head-on collision with the LAMMPS hertz/material normal law and tsuji
+    damping, F = (4/3) E* a d + alpha sqrt(m (4/3) E* a) v (a = sqrt(R d)),
+    clipped at 0 (limit_damping): velocity Verlet on the relative
+    coordinate, about `steps` steps per contact; returns e = v_out / v_in."""
+    e_star = c["E"] / (2 * (1 - c["nu"] ** 2))
+    alpha = tsuji_alpha(c["tsuji_e"])  # what LAMMPS computes from the e' it is given
+    t_c = 2.87 * (m * m / (R * e_star * e_star * v0)) ** 0.2
+    dt = t_c / steps
+
+    def force(d, v):
+        k = 4.0 / 3.0 * e_star * math.sqrt(R * d)
+        return max(k * d + alpha * math.sqrt(m * k) * v, 0.0)
+
+    d, v = 0.0, v0
+    a = 0.0
     while True:
         v_half = v + 0.5 * dt * a
         d += dt * v_half
@@ -138,6 +185,17 @@ def main():
             ok &= abs(tsuji_alpha(c["tsuji_e"]) - 2 * a.eta_n) < 1e-12
             if abs(a.eta_n - 0.2) < 1e-12:  # docs/contacts.md: clipped law e = 0.572
                 ok &= abs(r["e_clipped"] - 0.572) < 0.005
+        # Hertz-Mindlin: capdem's restitution is the clipped linear law's
+        # (docs/contacts.md); the LAMMPS constants must give it too, for any
+        # mass, radius or modulus.
+        for E, R, m in ((1e7, 1.25e-3, 3e-5), (7e10, 5e-4, 1e-6)):
+            h = hertz_constants(E, 0.3, a.eta_n, eta_t, a.mu)
+            r = {"law": "hertz_mindlin", "E": E, "R": R, "m": m, "e_clipped": hertz_restitution(h, R, m),
+                 "pair_coeff": pair_coeff_args(h)}
+            print(json.dumps(r))
+            ok &= abs(tsuji_alpha(h["tsuji_e"]) - math.sqrt(5.0) * a.eta_n) < 1e-12
+            if abs(a.eta_n - 0.2) < 1e-12:  # docs/contacts.md: e = 0.57174 at eta 0.2
+                ok &= abs(r["e_clipped"] - 0.57174) < 1e-4  # Verlet with 4000 steps: ~1e-5
         print("restitution check:", "ok" if ok else "FAILED")
         return 0 if ok else 1
     return 0

@@ -1,6 +1,7 @@
 /* The same case on the omp and the OpenCL backends (docs/opencl.md,
  * "Parity"): 500 hexapods settling in a cylinder under a strengthened
- * gravity, compared every 500 steps over 2000 steps.  Both run the same
+ * gravity, compared every 500 steps over 2000 steps, with the linear and the
+ * Hertz-Mindlin law.  Both run the same
  * kernel headers (kernels/step_items.h, kernels/broadphase.h) with FMA
  * contraction off, so the contact sets must be identical and the particle
  * state must agree to 1e-10 relative; the test reports whether every bit
@@ -13,6 +14,16 @@
 static const char *settling =
     "run: {name: parity, dt: 1.0e-5, steps: 2000, seed: 21}\n"
     "physics: {gravity: [0, -981, 0]}\n"
+    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 500, polydispersity: 0.2}]\n"
+    "domain: {type: cylinder, diameter: 0.14, height: 0.33}\n"
+    "init: {placement: lattice, clearance: 1.0, speed: 2.0}\n";
+
+/* The same settling with the Hertz-Mindlin law (docs/contacts.md), over
+ * 2000 steps. */
+static const char *settling_hertz =
+    "run: {name: parity_hertz, dt: 1.0e-5, steps: 2000, seed: 21}\n"
+    "physics: {gravity: [0, -981, 0]}\n"
+    "material: {law: hertz_mindlin, young_modulus: 1.0e8, poisson_ratio: 0.3, friction_limit: total}\n"
     "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 500, polydispersity: 0.2}]\n"
     "domain: {type: cylinder, diameter: 0.14, height: 0.33}\n"
     "init: {placement: lattice, clearance: 1.0, speed: 2.0}\n";
@@ -87,13 +98,14 @@ static int same_particle_bits(const cd_state *a, const cd_state *b)
     return 1;
 }
 
-static void test_omp_and_opencl_agree_on_settling_hexapods(void **state)
+/* Runs yaml on both backends for chunks x 500 steps, comparing after each
+ * chunk. */
+static void settle_on_both(const char *yaml, int chunks)
 {
-    (void)state;
     static cd_sim a, b;
     cd_config ca, cb;
-    if (start_on(&a, &ca, "omp")) fail_msg("omp backend failed to start");
-    if (start_on(&b, &cb, "opencl")) {
+    if (start_yaml_on(&a, &ca, yaml, "omp")) fail_msg("omp backend failed to start");
+    if (start_yaml_on(&b, &cb, yaml, "opencl")) {
         cd_sim_free(&a);
         cd_config_free(&ca);
         fail_msg("%s", no_platform_msg);
@@ -104,7 +116,7 @@ static void test_omp_and_opencl_agree_on_settling_hexapods(void **state)
     size_t contacts = 0;
     int bitwise = 1;
     double worst_x = 0, worst_v = 0;
-    for (int chunk = 0; chunk < 4; chunk++) {
+    for (int chunk = 0; chunk < chunks; chunk++) {
         cdt_step(&a, 500);
         cdt_step(&b, 500);
         /* identical contact sets */
@@ -137,6 +149,19 @@ static void test_omp_and_opencl_agree_on_settling_hexapods(void **state)
     cd_sim_free(&b);
     cd_config_free(&ca);
     cd_config_free(&cb);
+}
+
+static void test_omp_and_opencl_agree_on_settling_hexapods(void **state)
+{
+    (void)state;
+    settle_on_both(settling, 4);
+}
+
+/* The Hertz-Mindlin law is the same source on both backends too. */
+static void test_omp_and_opencl_agree_with_hertz_mindlin(void **state)
+{
+    (void)state;
+    settle_on_both(settling_hertz, 4);
 }
 
 /* Candidate slots of one entry overflow at the first builds: the device
@@ -213,6 +238,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_omp_and_opencl_agree_on_settling_hexapods),
+        cmocka_unit_test(test_omp_and_opencl_agree_with_hertz_mindlin),
         cmocka_unit_test(test_candidate_slot_overflow_changes_nothing),
         cmocka_unit_test(test_wall_load_same_bits_on_both_backends),
     };

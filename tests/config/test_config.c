@@ -226,6 +226,34 @@ static void test_restitution_sets_damping_ratio(void **state)
     cd_config_free(&c);
 }
 
+/* material.law is stored as its choice's index; its keys apply only to it. */
+static void test_contact_law_and_its_keys(void **state)
+{
+    (void)state;
+    cd_config c;
+    parse_ok(PARTICLES, &c);
+    assert_int_equal(c.law, 0); /* linear */
+    cd_config_free(&c);
+    parse_ok(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.22, restitution: 0.9}\n", &c);
+    assert_int_equal(c.law, 1);
+    assert_close(c.young_modulus, 7e10, 0);
+    assert_close(c.poisson_ratio, 0.22, 0);
+    assert_close(c.impact_speed, 1, 0);
+    cd_config_free(&c);
+    expect_error(PARTICLES "material: {law: hertz}\n", "material.law = hertz", "linear, hertz_mindlin");
+    expect_error(PARTICLES "material: {law: hertz_mindlin, poisson_ratio: 0.3}\n", "material.young_modulus: missing",
+                 "needed for material.law = hertz_mindlin");
+    expect_error(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.3, kn: 1e5}\n",
+                 "material.kn = 1e5: does not apply to material.law = hertz_mindlin", NULL);
+    expect_error(PARTICLES "material: {young_modulus: 7e10}\n", "material.young_modulus = 7e10: does not apply to material.law = linear",
+                 NULL);
+    expect_error(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.6}\n",
+                 "material.poisson_ratio = 0.6", "(-1, 0.5]");
+    expect_error(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.3}\n"
+                           "domain: {type: ball, radius: 0.05}\nprotocol: {type: radial_compaction}\n",
+                 "protocol.pressure: missing", "material.law = hertz_mindlin");
+}
+
 static void test_extra_wall_is_normalised_and_takes_wall_friction(void **state)
 {
     (void)state;
@@ -540,6 +568,7 @@ int main(void)
         cmocka_unit_test(test_print_keys_lists_every_key),
         cmocka_unit_test(test_count_and_height_rules),
         cmocka_unit_test(test_alternative_keys_together_are_refused),
+        cmocka_unit_test(test_contact_law_and_its_keys),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
