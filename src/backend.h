@@ -24,6 +24,10 @@ typedef struct cd_backend {
     /* Optional (may be NULL): sum of the normal forces of all contacts on
      * wall w at the last force evaluation [N], without a full sync. */
     int (*wall_load)(struct cd_sim *sim, int w, double *load, char *err, size_t errlen);
+    /* Optional (may be NULL): the observables of the current state summed
+     * on the device, without a full sync: the CD_OBS_SLOTS merged slots of
+     * kernels/observe_items.h into slots. */
+    int (*observe)(struct cd_sim *sim, double *slots, char *err, size_t errlen);
 } cd_backend;
 
 extern const cd_backend cd_backend_omp;

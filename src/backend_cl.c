@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "backend_cl.h"
+#include "../kernels/observe_items.h"
 #include "../kernels/broadphase.h"
 #include "../kernels/step_items.h"
 
@@ -224,6 +225,63 @@ static int cl_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errl
     return 0;
 }
 
+/* The observables on the device (kernels/cl/observe.cl): CD_OBS_SLOTS
+ * doubles come back instead of the state. */
+static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    cd_cl *cl = sim->backend_data;
+    if (!cl) { /* not started: the host columns are current */
+        cd_observables_slots(sim, slots);
+        return 0;
+    }
+    const cd_state *s = &sim->s;
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)cl->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_long bp = (N + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, bk = (K + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    cd_long bw = (R + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, n_blocks = bp + bk + bw, first = 0;
+    cd_int W = (cd_int)s->n_walls, n_pairs = (cd_int)K;
+    if ((size_t)n_blocks + 1 > cl->obs_cap_blocks) {
+        if (cl->obs_part) clReleaseMemObject(cl->obs_part);
+        cl->obs_cap_blocks = (size_t)n_blocks + 1 + (size_t)n_blocks / 4;
+        cl->obs_part = cd_cl_buffer(cl, cl->obs_cap_blocks * CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
+    }
+    cd_cl_fill_int(cl, cl->obs_touch, 0, 0, (size_t)N);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_PAIRS, F, sizeof n_pairs, &n_pairs);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_PAIRS, F + 1, sizeof cl->obs_touch, &cl->obs_touch);
+    cd_cl_run(cl, CD_CLK_OBS_TOUCH_PAIRS, (size_t)K);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F, sizeof R, &R);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 1, sizeof W, &W);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 2, sizeof cl->obs_touch, &cl->obs_touch);
+    cd_cl_run(cl, CD_CLK_OBS_TOUCH_WALLS, (size_t)R);
+    cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F, sizeof N, &N);
+    cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 1, sizeof sim->p.gravity, &sim->p.gravity);
+    cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 2, sizeof cl->obs_touch, &cl->obs_touch);
+    cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 3, sizeof cl->obs_part, &cl->obs_part);
+    cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 4, sizeof first, &first);
+    cd_cl_run(cl, CD_CLK_OBS_PARTICLES, (size_t)bp);
+    first = bp;
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F, sizeof K, &K);
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 1, sizeof sim->p.law, &sim->p.law);
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 2, sizeof cl->obs_part, &cl->obs_part);
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 3, sizeof first, &first);
+    cd_cl_run(cl, CD_CLK_OBS_PAIRS, (size_t)bk);
+    first = bp + bk;
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F, sizeof R, &R);
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 1, sizeof W, &W);
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 2, sizeof sim->p.wall_law, &sim->p.wall_law);
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 3, sizeof cl->obs_part, &cl->obs_part);
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 4, sizeof first, &first);
+    cd_cl_run(cl, CD_CLK_OBS_WALLS, (size_t)bw);
+    cd_cl_arg(cl, CD_CLK_OBS_MERGE, 0, sizeof cl->obs_part, &cl->obs_part);
+    cd_cl_arg(cl, CD_CLK_OBS_MERGE, 1, sizeof n_blocks, &n_blocks);
+    cd_cl_arg(cl, CD_CLK_OBS_MERGE, 2, sizeof cl->obs_total, &cl->obs_total);
+    cd_cl_run(cl, CD_CLK_OBS_MERGE, 1);
+    if (!cl->status)
+        cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->obs_total, CL_TRUE, 0, CD_OBS_SLOTS * sizeof(double), slots,
+                                            0, NULL, NULL), "reading the observables");
+    if (cl->status) return fail(sim, err, errlen);
+    return 0;
+}
+
 const cd_backend cd_backend_opencl = {
     .name = "opencl",
     .start = cl_start,
@@ -232,4 +290,5 @@ const cd_backend cd_backend_opencl = {
     .stop = cl_stop,
     .device = cl_device,
     .wall_load = cl_wall_load,
+    .observe = cl_observe,
 };

@@ -20,6 +20,8 @@ enum cd_cl_kernel {
     CD_CLK_PAIR_KEYS,
     CD_CLK_PAIR_CARRY, CD_CLK_GATHER_COUNT, CD_CLK_GATHER_FILL, CD_CLK_GATHER_SORT,
     CD_CLK_SCAN_BLOCKS, CD_CLK_SCAN_TOP, CD_CLK_SCAN_FILL, CD_CLK_WALL_CAND_COUNT, CD_CLK_WALL_CAND_FILL,
+    CD_CLK_OBS_TOUCH_PAIRS, CD_CLK_OBS_TOUCH_WALLS, CD_CLK_OBS_PARTICLES, CD_CLK_OBS_PAIRS, CD_CLK_OBS_WALLS,
+    CD_CLK_OBS_MERGE,
     CD_CLK_COUNT
 };
 
@@ -68,6 +70,10 @@ typedef struct cd_cl {
     cl_mem flags;               /* cd_int[3]: skin exceeded, highest non-finite particle, slot overflow */
     cl_mem scratch_real;        /* wall load result */
     cl_mem load_part;           /* per-chunk sums of a wall load (CD_LOAD_CHUNK) */
+    /* observables (kernels/observe_items.h): contacts per particle, block
+     * sums (grown with the pair rows), merged slots */
+    cl_mem obs_touch, obs_part, obs_total;
+    size_t obs_cap_blocks;
 
     /* neighbour-list workspace */
     cl_mem partial, grid;       /* bounds per chunk (7 reals), the cd_grid */

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "backend_cl.h"
+#include "../kernels/observe_items.h"
 #include "../kernels/step_items.h"
 
 /* Rows above need, so that a slowly growing list does not reallocate at
@@ -135,6 +136,9 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
     cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
     cl->load_part = cd_cl_buffer(cl, (P / CD_LOAD_CHUNK + 1) * sizeof(cd_real), "allocating the wall-load sums");
+    cl->obs_touch = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the observables' sums");
+    cl->obs_total = cd_cl_buffer(cl, CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
+    cl->obs_cap_blocks = 0; /* obs_part: at the first sum (cl_observe) */
     cl->partial = cd_cl_buffer(cl, 7 * CD_CL_MAX_BLOCKS * sizeof(cd_real), "allocating the neighbour list");
     cl->grid = cd_cl_buffer(cl, sizeof(cd_grid), "allocating the neighbour list");
     /* The grid has at most 8 N + 64 <= 8 P + 64 cells (cd_grid_make), so
@@ -231,7 +235,8 @@ void cd_cl_buffers_release(cd_cl *cl)
     cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->load_part, &cl->partial, &cl->grid, &cl->part_cell,
                        &cl->part_bound, &cl->cell_count, &cl->cell_start, &cl->cell_cursor, &cl->cell_parts, &cl->pair_count,
                        &cl->pair_offset, &cl->block_sum, &cl->cand, &cl->gather_count, &cl->gather_start,
-                       &cl->gather_cursor, &cl->gather_rows, &cl->wall_count, &cl->wall_start, &cl->wall_rows};
+                       &cl->gather_cursor, &cl->gather_rows, &cl->wall_count, &cl->wall_start, &cl->wall_rows,
+                       &cl->obs_touch, &cl->obs_part, &cl->obs_total};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
-    cl->cap_pairs = cl->gather_cap = 0;
+    cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
 }

@@ -24,6 +24,8 @@ static const struct {
     {"cd_cl_gather_count", 1},
     {"cd_cl_gather_fill", 1},  {"cd_cl_gather_sort", 0},  {"cd_cl_scan_blocks", 0}, {"cd_cl_scan_top", 0},
     {"cd_cl_scan_fill", 0},    {"cd_cl_wall_cand_count", 1}, {"cd_cl_wall_cand_fill", 1},
+    {"cd_cl_obs_touch_pairs", 1}, {"cd_cl_obs_touch_walls", 1}, {"cd_cl_obs_particles", 1},
+    {"cd_cl_obs_pairs", 1},    {"cd_cl_obs_walls", 1},    {"cd_cl_obs_merge", 0},
 };
 
 int cd_cl_kernel_takes_cols(enum cd_cl_kernel k) { return kernel_table[k].cols; }

@@ -40,7 +40,7 @@ static void unpack(const cd_state *s, const double *t, cd_observables *o)
     o->max_overlap_ratio = t[CD_OBS_MAXOV];
 }
 
-void cd_sim_observe(const cd_sim *sim, cd_observables *o)
+void cd_observables_slots(const cd_sim *sim, double *total)
 {
     const cd_state *s = &sim->s;
     cd_cols c = cd_sim_host_cols((cd_state *)s); /* read only */
@@ -51,12 +51,10 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o)
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
     cd_int *touch = calloc((size_t)N + 1, sizeof(cd_int));
     double *part = malloc((size_t)(nb.particles + nb.pairs + nb.walls + 1) * CD_OBS_SLOTS * sizeof(double));
-    double total[CD_OBS_SLOTS];
     if (!touch || !part) { /* without memory: what is known is nothing */
         free(touch);
         free(part);
-        memset(o, 0, sizeof(*o));
-        o->max_overlap_ratio = NAN;
+        for (int k = 0; k < CD_OBS_SLOTS; k++) total[k] = NAN;
         return;
     }
     /* Rattlers move freely in their cages (without gravity and friction
@@ -73,20 +71,32 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o)
     CD_HOST_FOR(R, firstprivate(c))
     for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS);
     cd_obs_merge(part, nb.particles + nb.pairs + nb.walls, total);
-    unpack(s, total, o);
     free(touch);
     free(part);
 }
 
+void cd_sim_observe(const cd_sim *sim, cd_observables *o)
+{
+    double total[CD_OBS_SLOTS];
+    cd_observables_slots(sim, total);
+    unpack(&sim->s, total, o);
+}
+
 #if CD_OFFLOAD
-/* The same reductions on the device the steps run on; the scratch stays
- * allocated there (grown when the pair rows grow). */
-static int observe_device(cd_sim *sim, cd_observables *o)
+/* The same reductions on the offload device (the omp backend's observe
+ * operation in the offload variant); the scratch stays allocated there,
+ * grown when the pair rows grow. */
+int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     const cd_state *s = &sim->s;
+    if (!sim->backend_data) { /* not started: the host columns are current */
+        cd_observables_slots(sim, slots);
+        return 0;
+    }
     cd_sim_obs_scratch *x = &sim->obs;
     obs_blocks nb = count_blocks(s);
     size_t blocks = (size_t)(nb.particles + nb.pairs + nb.walls) + 1;
+    snprintf(err, errlen, "out of device memory while summing the observables");
     if (!x->touch) {
         x->touch = cd_dev_alloc((s->n_particles + 1) * sizeof(cd_int));
         x->total = cd_dev_alloc(CD_OBS_SLOTS * sizeof(cd_real));
@@ -121,22 +131,18 @@ static int observe_device(cd_sim *sim, cd_observables *o)
     for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS);
     CD_STEP_FOR(1, is_device_ptr(part, total))
     for (int one = 0; one < 1; one++) cd_obs_merge(part, n_blocks, total);
-    double t[CD_OBS_SLOTS];
-    if (cd_dev_get(t, total, sizeof t)) return -1;
-    unpack(s, t, o);
-    return 0;
+    return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;
 }
 #endif
 
 int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen)
 {
-#if CD_OFFLOAD
-    if (sim->backend_data && sim->backend == &cd_backend_omp) {
-        if (observe_device(sim, o) == 0) return 0;
-        snprintf(err, errlen, "out of device memory while summing the observables");
-        return -1;
+    if (sim->backend && sim->backend->observe) {
+        double t[CD_OBS_SLOTS];
+        if (sim->backend->observe(sim, t, err, errlen)) return -1;
+        unpack(&sim->s, t, o);
+        return 0;
     }
-#endif
     if (cd_sim_sync(sim, err, errlen)) return -1;
     cd_sim_observe(sim, o);
     return 0;

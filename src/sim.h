@@ -171,6 +171,10 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o);
  * the same bits either way.  0, or -1 with a message. */
 int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen);
 void cd_sim_observe_free(cd_sim *sim);
+/* The merged slots (kernels/observe_items.h, CD_OBS_SLOTS) from the host
+ * columns, and (offload variant) from the device: backends' observe. */
+void cd_observables_slots(const cd_sim *sim, double *slots);
+int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen);
 
 /* Neighbour list (neighbors.c). */
 void cd_neighbors_init(cd_neighbors *nb, double skin);

@@ -457,8 +457,10 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     return 0;
 }
 #define CD_OMP_WALL_LOAD omp_wall_load
+#define CD_OMP_OBSERVE cd_omp_observe_device /* src/observe.c */
 #else
+#define CD_OMP_OBSERVE NULL /* cd_sim_observe_step sums the host columns */
 #define CD_OMP_WALL_LOAD NULL /* cd_sim_wall_load sums the host columns */
 #endif
 
-const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, CD_OMP_WALL_LOAD};
+const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, CD_OMP_WALL_LOAD, CD_OMP_OBSERVE};

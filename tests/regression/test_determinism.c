@@ -59,6 +59,47 @@ static void test_same_bits_for_one_and_two_threads_and_twice(void **state)
     cd_config_free(&ca); cd_config_free(&cb); cd_config_free(&cc);
 }
 
+/* The observables summed where the steps run (cd_sim_observe_step: on the
+ * offload or OpenCL device, without a state copy) have the bits of those
+ * summed on the host after a sync (cd_sim_observe): the same blocks in the
+ * same order (kernels/observe_items.h).  Checked along a settling run,
+ * with contacts and wall contacts. */
+static void test_device_observables_equal_host_ones(void **state)
+{
+    (void)state;
+    static cd_sim sim;
+    cd_config cfg;
+    char err[512];
+    /* 70 hexapods dropped under 50 g into the bottom of a ball: a pile of
+     * about 200 contacts and 68 wall contacts within 4000 steps */
+    cdt_setup(&sim, &cfg,
+              "run: {dt: 8.5e-6, steps: 0, seed: 3}\n"
+              "physics: {gravity: [0, -490.5, 0]}\n"
+              "particles: [{shape: hexapod, aspect: 2, diameter: 0.005, count: 70}]\n"
+              "domain: {type: ball, radius: 0.03}\n"
+              "init: {placement: random, exclusion: shape, speed: 0.1}\n");
+    assert_int_equal(cd_sim_initial_forces(&sim), 0);
+    double contacts = 0, wall_contacts = 0;
+    for (int k = 0; k < 6; k++) {
+        if (cd_sim_step(&sim, 1000, err, sizeof err)) fail_msg("step: %s", err);
+        cd_observables dev, host;
+        memset(&dev, 0x5a, sizeof dev);
+        if (cd_sim_observe_step(&sim, &dev, err, sizeof err)) fail_msg("observe: %s", err);
+        if (cd_sim_sync(&sim, err, sizeof err)) fail_msg("sync: %s", err);
+        cd_sim_observe(&sim, &host);
+        if (memcmp(&dev, &host, sizeof dev))
+            fail_msg("step %lld: observables on the device differ from the host's (elastic %.17g vs %.17g J, "
+                     "kinetic %.17g vs %.17g J, contacts %g vs %g)", sim.s.step, dev.elastic, host.elastic,
+                     dev.kinetic_translational, host.kinetic_translational, dev.n_contacts, host.n_contacts);
+        contacts += host.n_contacts;
+        wall_contacts += host.n_wall_contacts;
+    }
+    print_message("%s: %g contacts and %g wall contacts summed bit for bit\n", cdt_backend(), contacts, wall_contacts);
+    assert_true(contacts > 500 && wall_contacts > 200);
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+}
+
 /* Rebuilding the Verlet list every step instead of when the skin is used up
  * changes nothing: the history is carried by key and the forces are
  * gathered in key order. */
@@ -282,6 +323,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bits_for_one_and_two_threads_and_twice),
         cmocka_unit_test(test_history_survives_forced_rebuilds),
+        cmocka_unit_test(test_device_observables_equal_host_ones),
         cmocka_unit_test(test_resumed_run_equals_uninterrupted),
         cmocka_unit_test(test_resumed_file_without_pair_force_equals_uninterrupted),
         cmocka_unit_test(test_moving_walls_same_bits_with_rebuild_every_step),
