@@ -10,7 +10,7 @@ For each case, capdem-bench settles --base particles once (the case's
 settling under 50 g, --friction-limit total as in bench/lammps/compare.py);
 each rung is KX x KZ copies of that packing side by side (capdem-bench
 --tile, the box KX x KZ times as wide and deep, same height), relaxed for
---relax steps under the same load and saved, so that every rung is a
+20 ms (--relax steps) under the same load and saved, so that every rung is a
 settled bed of the same material and depth, only wider.  The rung 1x1 is
 the base packing itself.  The rungs are then timed in --rounds rounds, each
 round visiting every rung once (one capdem-bench process per rung and
@@ -30,6 +30,11 @@ import os
 import statistics
 import subprocess
 import sys
+
+
+# a tiled packing has lost its tangential springs and needs about 20 ms to
+# find its contacts again (bench/lammps/compare.py, RELAX)
+RELAX = {"spheres": 10000, "hexapods_a3": 2000, "hexapods_a9": 2000, "crosses2d": 3333}
 
 
 def bench(args, extra):
@@ -55,7 +60,8 @@ def rungs(args, case):
             continue
         f = os.path.join(args.work, "ladder_%s_%d_%s.h5" % (case, args.base, tile))
         if not (args.reuse and os.path.exists(f)):
-            bench(args, ["--load-settled", base, "--tile", "%d,%d" % (kx, kz), "--relax-steps", str(args.relax),
+            bench(args, ["--load-settled", base, "--tile", "%d,%d" % (kx, kz), "--relax-steps",
+                     str(RELAX[case] if args.relax is None else args.relax),
                          "--repeat", "0", "--save-settled", f])
         out.append((tile, f))
     return out
@@ -95,7 +101,7 @@ def main():
     ap.add_argument("--cases", default="spheres,hexapods_a3")
     ap.add_argument("--tiles", default="1x1,3x1,5x2,6x5,10x10")
     ap.add_argument("--base", type=int, default=1000)
-    ap.add_argument("--relax", type=int, default=300)
+    ap.add_argument("--relax", type=int, default=None, help="relaxation steps of a tiled rung (default: 20 ms)")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--target", type=float, default=2e6, help="particle-steps per timed segment")
