@@ -38,7 +38,8 @@ in both codes, 13 or 49 LAMMPS atoms).  Prints one JSON line per case and
 a table; the ratio is capdem / LAMMPS of wall-clock throughput, taken per
 pair of segments (median and range over pairs).  The JSON lines also give
 the ratio of particle-steps per CPU second (capdem: the process's CPU time;
-LAMMPS: loop time x "% CPU use" x ranks), which other jobs on a shared
+LAMMPS: loop time x "% CPU use" x ranks; LIGGGHTS: rank 0's CPU time
+around the timed run, cpu_stamp.sh, x ranks), which other jobs on a shared
 machine disturb much less; with 2 ranks LAMMPS's CPU time includes MPI's
 busy waiting, so that ratio is clean with --threads 1 only.
 
@@ -167,7 +168,7 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
     nwarm = args.peer_warm  # a data file keeps no tangential history: let the springs build up again
     peers = [p for p in args.peers.split(",") if p and (p == "lammps" or case == "spheres")]
     lig_meta = liggghts_bench.convert(capdem_to_lammps.read_run(settled), w + "_liggghts") if "liggghts" in peers else None
-    capdem, rates, ratios, builds, cpu_ratios, z = [], {p: [] for p in peers}, {p: [] for p in peers}, {p: [] for p in peers}, [], {}
+    capdem, rates, ratios, builds, cpu_ratios, lig_cpu, z = [], {p: [] for p in peers}, {p: [] for p in peers}, {p: [] for p in peers}, [], [], {}
     for r in range(args.repeat):
         c = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps), "--repeat", "1"])[0]
         capdem.append(c)
@@ -180,6 +181,7 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
             else:
                 timed, z[peer] = liggghts_bench.run(lig_meta, w + ".liggghts.log", args.threads, nwarm, lammps_steps, 1)
                 b = timed[0][2]
+                lig_cpu.append((n * c["steps"] / c["cpu_s"]) / (n * timed[0][1] / timed[0][3]))
             rate = c["N"] * timed[0][1] / timed[0][0]
             rates[peer].append(rate)
             ratios[peer].append(c["particle_steps_per_s"] / rate)
@@ -209,6 +211,7 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
         })
     if "liggghts" in peers:
         out["liggghts_damping_rel_error_bound"] = lig_meta["damping_rel_error_bound"]
+        out.update(cpu_ratio_capdem_over_liggghts=statistics.median(lig_cpu), cpu_ratios_liggghts=lig_cpu)
     return out
 
 
@@ -252,16 +255,18 @@ def main():
         print(json.dumps(r), flush=True)
         rows.append(r)
     print("\n| case | N | threads | capdem p-steps/s | peer | peer p-steps/s | capdem / peer wall (median, range) "
-          "| list builds capdem / peer (per segment) |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| capdem / peer per CPU s (median, range) | list builds capdem / peer (per segment) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         for peer in ("lammps", "liggghts"):
             if "ratios_" + peer not in r:
                 continue
             q = r["ratios_" + peer]
-            print("| %s | %d | %d | %.3g | %s | %.3g | %.2f (%.2f-%.2f) | %s / %s |" % (
+            qc = r["cpu_ratios" + ("" if peer == "lammps" else "_" + peer)]
+            print("| %s | %d | %d | %.3g | %s | %.3g | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) | %s / %s |" % (
                 r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], peer, r[peer + "_particle_steps_per_s"],
-                r["ratio_capdem_over_" + peer], min(q), max(q), r["capdem_neighbor_builds"], r[peer + "_neighbor_builds"]))
+                r["ratio_capdem_over_" + peer], min(q), max(q), r["cpu_ratio_capdem_over_" + peer], min(qc), max(qc),
+                r["capdem_neighbor_builds"], r[peer + "_neighbor_builds"]))
     return 0
 
 

@@ -40,17 +40,30 @@ def convert(run, out_base, material=liggghts_law.MATERIAL):
 
 
 def run(meta, log, threads, nwarm=0, nsteps=0, nrepeat=0, gravity=490.5, contacts=None, yield_when_idle=True):
-    """in.capdem.liggghts on meta's files; returns ([(loop s, steps, builds)] of
-    the timed runs, mean contacts per sphere after the last run or None)."""
+    """in.capdem.liggghts on meta's files; returns ([(loop s, steps, builds, CPU s
+    of all ranks)] of the timed runs, mean contacts per sphere after the last
+    run or None)."""
     var = {"data": meta["data"], "material": meta["material"], "walltype": meta["wall_type"],
            "W": meta["width"], "H": meta["height"], "T": meta["thickness"], "dt": meta["dt"], "g": gravity,
            "skin": 0.1 * meta["min_diameter"],  # capdem's automatic skin
            "dumpc": int(contacts is not None), "contacts": contacts or "none",
-           "nwarm": nwarm, "nsteps": nsteps, "nrepeat": nrepeat}
+           "nwarm": nwarm, "nsteps": nsteps, "nrepeat": nrepeat,
+           "stamp": os.path.join(HERE, "cpu_stamp.sh"), "stampfile": log + ".cpu"}
+    if os.path.exists(var["stampfile"]):
+        os.remove(var["stampfile"])
     text = liggghts_law.run_liggghts(var, log, ranks=threads, yield_when_idle=yield_when_idle)
     loops = [(float(t), int(s)) for t, s in re.findall(r"Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps", text)]
     builds = [int(b) for b in re.findall(r"Neighbor list builds = (\d+)", text)]
-    timed = [(t, s, b) for (t, s), b in zip(loops, builds)][-nrepeat:] if nrepeat else []
+    # CPU seconds of each timed run: stamps alternate before / after; only rank 0
+    # runs `shell`, so its time x ranks stands for all (as compare.py reads
+    # LAMMPS's "% CPU use", also rank 0's)
+    ticks = {}
+    for line in open(var["stampfile"]) if nrepeat else []:
+        pid, t = line.split()
+        ticks.setdefault(pid, []).append(int(t))
+    cpu = [threads / max(1, len(ticks)) * sum(v[2 * k + 1] - v[2 * k] for v in ticks.values()) / os.sysconf("SC_CLK_TCK")
+           for k in range(nrepeat)]
+    timed = [(t, s, b, c) for (t, s), b, c in zip(loops[-nrepeat:], builds[-nrepeat:], cpu)] if nrepeat else []
     rows = re.findall(r"^\s+\d+\s+\d+\s+([0-9.eE+-]+)\s*$", text, re.M)
     return timed, (float(rows[-1]) if rows else None)
 
