@@ -37,8 +37,8 @@ import sys
 RELAX = {"spheres": 10000, "hexapods_a3": 2000, "hexapods_a9": 2000, "crosses2d": 3333}
 
 
-def bench(args, extra):
-    cmd = [os.path.join(args.build, "capdem-bench"), "--threads", str(args.threads)] + extra
+def bench(args, extra, threads=None):
+    cmd = [os.path.join(args.build, "capdem-bench"), "--threads", str(threads or args.threads)] + extra
     env = dict(os.environ, OMP_WAIT_POLICY="PASSIVE")
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode:
@@ -51,7 +51,7 @@ def rungs(args, case):
     base = os.path.join(args.work, "ladder_%s_%d.h5" % (case, args.base))
     if not (args.reuse and os.path.exists(base)):
         bench(args, ["--case", case, "--n", str(args.base), "--friction-limit", "total", "--gravity", "490.5",
-                     "--seed", str(args.seed), "--repeat", "0", "--save-settled", base])
+                     "--seed", str(args.seed), "--repeat", "0", "--save-settled", base], args.prep_threads)
     out = []
     for tile in args.tiles.split(","):
         kx, kz = (int(k) for k in tile.split("x"))
@@ -62,7 +62,7 @@ def rungs(args, case):
         if not (args.reuse and os.path.exists(f)):
             bench(args, ["--load-settled", base, "--tile", "%d,%d" % (kx, kz), "--relax-steps",
                      str(RELAX[case] if args.relax is None else args.relax),
-                         "--repeat", "0", "--save-settled", f])
+                         "--repeat", "0", "--save-settled", f], args.prep_threads)
         out.append((tile, f))
     return out
 
@@ -104,6 +104,7 @@ def main():
     ap.add_argument("--relax", type=int, default=None, help="relaxation steps of a tiled rung (default: 20 ms)")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--prep-threads", type=int, default=2, help="threads of the untimed settling and relaxation")
     ap.add_argument("--target", type=float, default=2e6, help="particle-steps per timed segment")
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--work", default="build/bench-work")
