@@ -63,7 +63,7 @@ def ensure_liggghts():
 
 
 def liggghts_version():
-    out = subprocess.run(["liggghts", "-h"], capture_output=True, text=True).stdout
+    out = subprocess.run(["liggghts", "-log", "none", "-h"], capture_output=True, text=True).stdout  # no log.liggghts left behind
     m = re.search(r"LIGGGHTS \(Version ([^,)]*)", out)
     return m.group(1).strip() if m else "unknown"
 
