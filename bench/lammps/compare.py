@@ -1,13 +1,16 @@
 #!/usr/bin/python3
-"""capdem against LAMMPS on the same work, same machine, same cores, same N.
+"""capdem against LAMMPS (and LIGGGHTS for spheres) on the same work, same machine, same cores, same N.
 
     /usr/bin/python3 bench/lammps/compare.py [--build build] [--cases spheres:1000,hexapods_a3:1000:100]
-        [--threads 2] [--steps 1000] [--repeat 3] [--work build/bench-work] [--reuse]
+        [--peers lammps,liggghts] [--threads 2] [--steps 1000] [--repeat 3] [--peer-warm 200]
+        [--relax-steps 200] [--work build/bench-work] [--reuse]
 
-For each case:N[:LAMMPS_STEPS], in one invocation (LAMMPS_STEPS: the
-length of LAMMPS's timed segments, default --steps; shorter ones for the
-hexapods keep the two segments of a pair about as long, so that they see the
-same load):
+For each case:N[:PEER_STEPS][@KXxKZ], in one invocation (PEER_STEPS: the
+length of the peers' timed segments, default --steps; shorter ones for the
+hexapods keep the segments of a round about as long, so that they see the
+same load; @KXxKZ: the settled packing of N particles tiled KX x KZ times,
+capdem-bench --tile, relaxed by capdem for 20 ms (--relax-steps) and saved, and that one
+packing timed by every code):
   spheres      capdem-bench writes the initial lattice deposit (seed, N) and
                settles it under 50 g; LAMMPS reads the same initial state
                (capdem_to_lammps.py) and settles it for the same number of
@@ -20,7 +23,14 @@ same load):
                untimed steps to let the clusters find their contacts, then
                is timed the same way.  Settling the clusters from scratch in
                LAMMPS would cost ~10 x the timed segment and time nothing new.
-capdem runs with --threads T (OpenMP), LAMMPS with `mpirun -np T` (the
+  LIGGGHTS     (spheres only, bench/liggghts/) reads capdem's settled (or
+               tiled) packing with `gran model hooke/stiffness tangential
+               history` and capdem's law (liggghts_law.py), steps --peer-warm
+               untimed steps, then is timed like LAMMPS.
+Every code uses capdem's automatic skin, 0.1 x the smallest diameter, and
+rebuilds its list when a particle has moved half of it; the JSON lines give
+the rebuilds of each timed segment (`*_neighbor_builds`).
+capdem runs with --threads T (OpenMP), LAMMPS and LIGGGHTS with `mpirun -np T` (the
 Debian package has no OPENMP package; MPI is its parallel mode here).  Only
 the stepping is timed: capdem-bench's timed segment, LAMMPS's "Loop time of"
 of each timed `run`.  Throughput counts particles (a hexapod is one particle
@@ -28,11 +38,13 @@ in both codes, 13 or 49 LAMMPS atoms).  Prints one JSON line per case and
 a table; the ratio is capdem / LAMMPS of wall-clock throughput, taken per
 pair of segments (median and range over pairs).  The JSON lines also give
 the ratio of particle-steps per CPU second (capdem: the process's CPU time;
-LAMMPS: loop time x "% CPU use" x ranks), which other jobs on a shared
+LAMMPS: loop time x "% CPU use" x ranks; LIGGGHTS: rank 0's CPU time
+around the timed run, cpu_stamp.sh, x ranks), which other jobs on a shared
 machine disturb much less; with 2 ranks LAMMPS's CPU time includes MPI's
 busy waiting, so that ratio is clean with --threads 1 only.
 
-Installs LAMMPS (Debian package `lammps`) with apt-get if `lmp` is missing.
+Installs LAMMPS (Debian package `lammps`) with apt-get if `lmp` is missing,
+and LIGGGHTS (`liggghts`) if `liggghts` is missing and a sphere case asks for it.
 """
 import argparse
 import json
@@ -47,9 +59,16 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import lammps_law  # noqa: E402
 import capdem_to_lammps  # noqa: E402
+sys.path.insert(0, os.path.join(HERE, "..", "liggghts"))
+import liggghts_bench  # noqa: E402
+import liggghts_law  # noqa: E402
 
 MATERIAL = dict(kn=1e5, kt=5e4, eta_n=0.2, eta_t=0.2, mu=0.5)  # SPEC 3; walls frictionless
 SETTLE = {"spheres": 30000, "hexapods_a3": 15000, "hexapods_a9": 15000}
+# A tiled packing has lost its tangential springs (bench_tile.c): it slips and
+# springs back, and needs about 20 ms to find its contacts again (spheres: Z
+# 4.46 settled, 3.5 after 0.6 ms, 4.50 after 20 ms; hexapods 7.54, 7.12, 7.48)
+RELAX = {"spheres": 10000, "hexapods_a3": 2000, "hexapods_a9": 2000}  # steps of 20 ms
 
 
 def ensure_lammps():
@@ -79,7 +98,7 @@ def capdem_bench(args, extra):
 
 def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None, nrepeat=None, write_data=None,
                law=None):
-    """Runs in.capdem.lmp; returns [(loop seconds, steps)] of the timed runs
+    """Runs in.capdem.lmp; returns [(loop seconds, steps, CPU seconds, list builds)] of the timed runs
     and the mean contacts per atom at the end (compute contact/atom).  law:
     LAMMPS constants (lammps_law.py); default those of MATERIAL."""
     c = law or lammps_law.lammps_constants(**MATERIAL)
@@ -108,22 +127,34 @@ def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None
     loops = re.findall(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms\s+"
                        r"(?:Performance:[^\n]*\n)?\s*([0-9.]+)% CPU use", text)
     # (loop wall seconds, steps, CPU seconds of all ranks = wall x CPU use x ranks)
-    timed = [(float(t), int(s), float(t) * float(pct) / 100 * int(np_)) for t, np_, s, _, pct in loops
+    builds = [int(b) for b in re.findall(r"Neighbor list builds = (\d+)", text)]  # one per run, as the loops
+    timed = [(float(t), int(s), float(t) * float(pct) / 100 * int(np_), b) for (t, np_, s, _, pct), b in zip(loops, builds)
              if int(s) == var["nsteps"]][-var["nrepeat"]:] if var["nrepeat"] else []
     rows = re.findall(r"^\s+\d+\s+\d+\s+[0-9.eE+-]+\s+([0-9.eE+-]+)\s*$", text, re.M)
     return timed, (float(rows[-1]) if rows else None)
 
 
-def one_case(args, case, n, lammps_steps):
-    """Settles once, then alternates capdem and LAMMPS timed segments
-    (--repeat pairs): a load that drifts on the shared machine hits both
-    codes of a pair alike, and each pair gives one ratio."""
+def one_case(args, case, n, lammps_steps, tile=(1, 1)):
+    """Settles once, then alternates capdem and its peers' timed segments
+    (--repeat rounds: capdem, LAMMPS, LIGGGHTS, capdem, ...): a load that
+    drifts on the shared machine hits every code of a round alike, and each
+    round gives one ratio per peer.  With tile (KX, KZ) != (1, 1) the settled
+    packing of n particles is tiled (capdem-bench --tile), relaxed for
+    --relax-steps and saved, and every code times that one packing."""
     w = os.path.join(args.work, "%s_%d" % (case, n))
     settled = w + "_capdem.h5"
     common = ["--case", case, "--n", str(n), "--friction-limit", "total", "--gravity", "490.5", "--seed", str(args.seed)]
     if not (args.reuse and os.path.exists(settled)):
         capdem_bench(args, common + ["--settle-steps", str(SETTLE[case]), "--repeat", "0", "--save-settled", settled])
-    if case == "spheres":
+    tiled = tile != (1, 1)
+    if tiled:
+        w += "_tile%dx%d" % tile
+        if not (args.reuse and os.path.exists(w + "_capdem.h5")):
+            capdem_bench(args, ["--load-settled", settled, "--tile", "%d,%d" % tile, "--relax-steps",
+                                str(RELAX[case] if args.relax_steps is None else args.relax_steps),
+                                "--repeat", "0", "--save-settled", w + "_capdem.h5"])
+        settled = w + "_capdem.h5"
+    if case == "spheres" and not tiled:
         # LAMMPS settles the same initial state itself and times its own packing
         init, data = w + "_init.h5", w + "_lammps_settled.data"
         if not (args.reuse and os.path.exists(data)):
@@ -132,68 +163,112 @@ def one_case(args, case, n, lammps_steps):
             run_lammps(args, w + "_init.data", meta, w + "_settle.lammps.log", SETTLE[case], 0, nrepeat=0,
                        write_data=data)
         meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(init if os.path.exists(init) else settled), os.devnull)
-        nwarm = 200  # write_data keeps no tangential history: let the springs build up again
     else:
-        # LAMMPS times capdem's settled packing as glued-sphere clusters
+        # LAMMPS times capdem's settled packing (as glued-sphere clusters for hexapods)
         data = w + ".data"
         meta = capdem_to_lammps.convert(capdem_to_lammps.read_run(settled), data)
-        nwarm = 200
-    capdem, lammps, ratios, cpu_ratios, z_lammps = [], [], [], [], None
+    nwarm = args.peer_warm  # a data file keeps no tangential history: let the springs build up again
+    peers = [p for p in args.peers.split(",") if p and (p == "lammps" or case == "spheres")]
+    lig_meta = liggghts_bench.convert(capdem_to_lammps.read_run(settled), w + "_liggghts") if "liggghts" in peers else None
+    capdem, rates, ratios, builds, cpu_ratios, lig_cpu, z = [], {p: [] for p in peers}, {p: [] for p in peers}, {p: [] for p in peers}, [], [], {}
     for r in range(args.repeat):
         c = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps), "--repeat", "1"])[0]
-        timed, z_lammps = run_lammps(args, data, meta, w + ".lammps.log", 0, nwarm, nsteps=lammps_steps, nrepeat=1)
-        l_rate = n * timed[0][1] / timed[0][0]
         capdem.append(c)
-        lammps.append(l_rate)
-        ratios.append(c["particle_steps_per_s"] / l_rate)
-        # per CPU second: n steps / cpu_s, both codes
-        cpu_ratios.append((n * c["steps"] / c["cpu_s"]) / (n * timed[0][1] / timed[0][2]))
+        for peer in peers:
+            if peer == "lammps":
+                timed, z[peer] = run_lammps(args, data, meta, w + ".lammps.log", 0, nwarm, nsteps=lammps_steps, nrepeat=1)
+                # per CPU second: n steps / cpu_s, both codes
+                cpu_ratios.append((n * c["steps"] / c["cpu_s"]) / (n * timed[0][1] / timed[0][2]))
+                b = timed[0][3]
+            else:
+                timed, z[peer] = liggghts_bench.run(lig_meta, w + ".liggghts.log", args.threads, nwarm, lammps_steps, 1)
+                b = timed[0][2]
+                lig_cpu.append((n * c["steps"] / c["cpu_s"]) / (n * timed[0][1] / timed[0][3]))
+            rate = c["N"] * timed[0][1] / timed[0][0]
+            rates[peer].append(rate)
+            ratios[peer].append(c["particle_steps_per_s"] / rate)
+            builds[peer].append(b)
     c_rates = [c["particle_steps_per_s"] for c in capdem]
-    return {
-        "case": case, "N": n, "threads": args.threads, "steps": args.steps, "lammps_steps": lammps_steps,
-        "pairs": args.repeat,
+    out = {
+        "case": case, "N": capdem[-1]["N"], "settled_N": n, "tile": "%dx%d" % tile, "threads": args.threads,
+        "steps": args.steps, "lammps_steps": lammps_steps, "pairs": args.repeat,
+        "skin_m": 0.1 * meta["min_diameter"],
         "capdem_particle_steps_per_s": statistics.median(c_rates), "capdem_repeats": c_rates,
         "capdem_contacts_per_particle": capdem[-1]["contacts_per_particle"],
-        "lammps_particle_steps_per_s": statistics.median(lammps), "lammps_repeats": lammps,
-        "lammps_contacts_per_atom": z_lammps if case == "spheres" else None,
-        "lammps_atoms": meta["atoms"], "lammps_atom_steps_per_s": statistics.median(lammps) * meta["spheres_per_particle"],
-        "ratio_capdem_over_lammps": statistics.median(ratios), "ratios": ratios,
-        "cpu_ratio_capdem_over_lammps": statistics.median(cpu_ratios), "cpu_ratios": cpu_ratios,
-        "lammps_packing": "its own, settled from capdem's initial lattice" if case == "spheres" else "capdem's settled packing",
+        "capdem_neighbor_builds": [c["neighbor_builds_timed"] for c in capdem],
+        "packing": ("LAMMPS: its own, settled from capdem's initial lattice; LIGGGHTS: capdem's" if case == "spheres" and not tiled
+                    else "capdem's settled packing" + (", tiled and relaxed" if tiled else "")),
     }
+    for peer in peers:
+        out.update({
+            peer + "_particle_steps_per_s": statistics.median(rates[peer]), peer + "_repeats": rates[peer],
+            peer + "_neighbor_builds": builds[peer], peer + "_contacts_per_atom": z[peer] if case == "spheres" else None,
+            "ratio_capdem_over_" + peer: statistics.median(ratios[peer]), "ratios_" + peer: ratios[peer],
+        })
+    if "lammps" in peers:
+        out.update({
+            "ratios": ratios["lammps"], "ratio_capdem_over_lammps": statistics.median(ratios["lammps"]),
+            "lammps_atoms": meta["atoms"], "lammps_atom_steps_per_s": statistics.median(rates["lammps"]) * meta["spheres_per_particle"],
+            "cpu_ratio_capdem_over_lammps": statistics.median(cpu_ratios), "cpu_ratios": cpu_ratios,
+        })
+    if "liggghts" in peers:
+        out["liggghts_damping_rel_error_bound"] = lig_meta["damping_rel_error_bound"]
+        out.update(cpu_ratio_capdem_over_liggghts=statistics.median(lig_cpu), cpu_ratios_liggghts=lig_cpu)
+    return out
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", default="build")
-    ap.add_argument("--cases", default="spheres:1000,hexapods_a3:1000,hexapods_a9:1000")
+    ap.add_argument("--cases", default="spheres:1000,hexapods_a3:1000,hexapods_a9:1000",
+                    help="case:N[:PEER_STEPS][@KXxKZ], comma-separated")
+    ap.add_argument("--peers", default="lammps,liggghts", help="lammps, liggghts (spheres only) or both")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--steps", type=int, default=1000)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--relax-steps", type=int, default=None,
+                    help="steps a tiled packing relaxes (capdem) before timing (default: 20 ms, RELAX)")
+    ap.add_argument("--peer-warm", type=int, default=200, help="untimed steps of a peer before each timed segment")
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--work", default="build/bench-work")
     ap.add_argument("--reuse", action="store_true", help="time capdem on a settled packing left by an earlier run")
     args = ap.parse_args()
-    ensure_lammps()
-    os.makedirs(args.work, exist_ok=True)
-    version = lammps_version()
-    rows = []
+    cases = []
     for item in args.cases.split(","):
-        case, n, *ls = item.split(":")
+        spec, _, tile = item.partition("@")
+        case, n, *ls = spec.split(":")
         if case not in SETTLE:
             raise SystemExit("compare: case %s: expected one of %s (crosses2d has no LAMMPS twin)" % (case, ", ".join(SETTLE)))
-        r = one_case(args, case, int(float(n)), int(ls[0]) if ls else args.steps)
-        r["lammps_version"] = version
+        try:
+            kx, kz = (int(k) for k in tile.split("x")) if tile else (1, 1)
+        except ValueError:
+            raise SystemExit("compare: case %s: @%s: expected @KXxKZ, e.g. @5x2" % (item, tile))
+        cases.append((case, int(float(n)), int(ls[0]) if ls else args.steps, (kx, kz)))
+    ensure_lammps()
+    versions = {"lammps_version": lammps_version()}
+    if "liggghts" in args.peers and any(c[0] == "spheres" for c in cases):
+        liggghts_law.ensure_liggghts()
+        versions["liggghts_version"] = liggghts_law.liggghts_version()
+    os.makedirs(args.work, exist_ok=True)
+    rows = []
+    for case, n, peer_steps, tile in cases:
+        r = one_case(args, case, n, peer_steps, tile)
+        r.update(versions)
         print(json.dumps(r), flush=True)
         rows.append(r)
-    print("\n| case | N | threads | capdem p-steps/s | LAMMPS p-steps/s | capdem / LAMMPS wall (median, range) "
-          "| capdem / LAMMPS per CPU s (median, range) |")
-    print("|---|---|---|---|---|---|---|")
+    print("\n| case | N | threads | capdem p-steps/s | peer | peer p-steps/s | capdem / peer wall (median, range) "
+          "| capdem / peer per CPU s (median, range) | list builds capdem / peer (per segment) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %d | %d | %.3g | %.3g | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) |" % (
-            r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], r["lammps_particle_steps_per_s"],
-            r["ratio_capdem_over_lammps"], min(r["ratios"]), max(r["ratios"]),
-            r["cpu_ratio_capdem_over_lammps"], min(r["cpu_ratios"]), max(r["cpu_ratios"])))
+        for peer in ("lammps", "liggghts"):
+            if "ratios_" + peer not in r:
+                continue
+            q = r["ratios_" + peer]
+            qc = r["cpu_ratios" + ("" if peer == "lammps" else "_" + peer)]
+            print("| %s | %d | %d | %.3g | %s | %.3g | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) | %s / %s |" % (
+                r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], peer, r[peer + "_particle_steps_per_s"],
+                r["ratio_capdem_over_" + peer], min(q), max(q), r["cpu_ratio_capdem_over_" + peer], min(qc), max(qc),
+                r["capdem_neighbor_builds"], r[peer + "_neighbor_builds"]))
     return 0
 
 
