@@ -253,10 +253,10 @@ int main(int argc, char **argv)
             double moved = 0;
             char kernels[768];
             int at = 0;
-            for (int t = 0; t < CD_TRAFFIC_KERNELS; t++) {
-                moved += tr[t].read + tr[t].write;
-                at += snprintf(kernels + at, sizeof kernels - (size_t)at, "%s\"%s\": [%.0f, %.0f]", t ? ", " : "",
-                               tr[t].kernel, tr[t].read / (double)n, tr[t].write / (double)n);
+            for (int kk = 0; kk < CD_TRAFFIC_KERNELS; kk++) {
+                moved += tr[kk].read + tr[kk].write;
+                at += snprintf(kernels + at, sizeof kernels - (size_t)at, "%s\"%s\": [%.0f, %.0f]", kk ? ", " : "",
+                               tr[kk].kernel, tr[kk].read / (double)n, tr[kk].write / (double)n);
             }
             printf("{\"case\": \"%s\", \"N\": %ld, \"backend\": \"%s\", \"device\": \"%s\", \"threads\": %d, "
                    "\"steps\": %ld, \"wall_s\": %.6g, \"cpu_s\": %.6g, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
