@@ -42,16 +42,16 @@ void cd_an_wall_points(cd_an_snapshot *s)
  * config did not parse. */
 static cd_an_kind container_kind(const cd_an_snapshot *s, const cd_an_geometry *g)
 {
-    const char *d = s->cfg.domain;
+    enum cd_domain_kind d = s->cfg.domain_kind;
     int planes = 0, cyl = 0, sph = 0;
     for (int w = 0; w < s->n_walls; w++) {
         planes += s->walls[w].type == CD_WALL_PLANE;
         cyl += s->walls[w].type == CD_WALL_CYLINDER;
         sph += s->walls[w].type == CD_WALL_SPHERE;
     }
-    int box = s->cfg_ok ? !strcmp(d, "box") : planes >= 6 && !cyl && !sph;
-    if (s->cfg_ok ? !strcmp(d, "cylinder") : cyl > 0) return cyl ? CD_AN_CYLINDER : CD_AN_FREE;
-    if (s->cfg_ok ? !strcmp(d, "ball") : sph > 0) return sph ? CD_AN_BALL : CD_AN_FREE;
+    int box = s->cfg_ok ? d == CD_DOMAIN_BOX : planes >= 6 && !cyl && !sph;
+    if (s->cfg_ok ? d == CD_DOMAIN_CYLINDER : cyl > 0) return cyl ? CD_AN_CYLINDER : CD_AN_FREE;
+    if (s->cfg_ok ? d == CD_DOMAIN_BALL : sph > 0) return sph ? CD_AN_BALL : CD_AN_FREE;
     if (!box) return CD_AN_FREE;
     if (s->cfg.dimension == 2) return CD_AN_BOX2D;
     /* SPEC 5: pseudo-2D boxes are T = L or 2L thick; 3 L separates them
@@ -92,7 +92,7 @@ int cd_an_geometry_setup(const cd_an_snapshot *s, double margin_side_L, double m
     box_extents(s, g);
     /* A 2D box has no front and back walls (docs/motion.md): its slab is
      * [0, domain.thickness]. */
-    if (s->cfg_ok && s->cfg.dimension == 2 && !strcmp(s->cfg.domain, "box") && isinf(g->lo[2]) && isinf(g->hi[2])) {
+    if (s->cfg_ok && s->cfg.dimension == 2 && s->cfg.domain_kind == CD_DOMAIN_BOX && isinf(g->lo[2]) && isinf(g->hi[2])) {
         g->lo[2] = 0;
         g->hi[2] = s->cfg.box_thickness;
     }

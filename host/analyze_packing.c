@@ -322,7 +322,7 @@ int cd_an_modulus(const cd_an_input *in, cd_an_report *r, char *err, size_t errl
      * (docs/protocols.md).  All probes are the linear response (K agrees
      * within 1 % from 1e-9 to 1e-6); the smallest strains carry the most
      * noise of the base state, so K_measured is the median of the probes. */
-    int probes = s->n_control >= 32 && !strcmp(s->cfg.protocol, "bulk_modulus") ? (int)s->control[9] : 0;
+    int probes = s->n_control >= 32 && s->cfg.protocol_kind == CD_PROTOCOL_BULK ? (int)s->control[9] : 0;
     if (probes > 16) probes = 16;
     if (probes > 0) {
         double *c = cd_an_put_curve(grp, "probes", (size_t)probes, "strain,K", "1,Pa");

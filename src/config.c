@@ -272,6 +272,21 @@ static void derive(cd_config *c, yaml_node_t *const *seen, const cd_config_scrat
     }
 }
 
+/* The selectors of the text choices (validated by the schema). */
+static void set_selectors(cd_config *c)
+{
+    static const char *const domains[] = {"none", "box", "cylinder", "ball"};
+    static const char *const protocols[] = {"none", "deposit_compress", "radial_compaction", "bulk_modulus"};
+    c->domain_kind = CD_DOMAIN_NONE;
+    for (int k = 0; k < 4; k++)
+        if (!strcmp(c->domain, domains[k])) c->domain_kind = (enum cd_domain_kind)k;
+    c->protocol_kind = CD_PROTOCOL_NONE;
+    for (int k = 0; k < 4; k++)
+        if (!strcmp(c->protocol, protocols[k])) c->protocol_kind = (enum cd_protocol_kind)k;
+    c->random_placement = !strcmp(c->placement, "random");
+    c->exclude_by_shape = !strcmp(c->exclusion, "shape");
+}
+
 void cd_config_defaults(cd_config *c)
 {
     if (cd_config_nkeys > MAX_KEYS) {
@@ -283,6 +298,7 @@ void cd_config_defaults(cd_config *c)
         if (cd_config_keys[i].target == CD_TGT_CONFIG)
             apply_default(&cd_config_keys[i], c);
     derive(c, NULL, NULL);
+    set_selectors(c);
 }
 
 /* Checks that need more than one key. */
@@ -314,13 +330,13 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
     if (c->fill_ratio > 0 && !(c->fill_fraction > 0))
         return cd_cfg_fail(r, line_of(proto), "protocol.fill_fraction: missing; expected a number in (0, 1) (expected packing fraction), "
                            "needed for protocol.fill_ratio = %g", c->fill_ratio);
-    int ball = !strcmp(c->protocol, "radial_compaction") || !strcmp(c->protocol, "bulk_modulus");
+    int ball = c->protocol_kind == CD_PROTOCOL_RADIAL || c->protocol_kind == CD_PROTOCOL_BULK;
     if (ball && c->law == CD_LAW_HERTZ_MINDLIN && c->pressure == 0)
         return cd_cfg_fail(r, line_of(proto), "protocol.pressure: missing; expected a number > 0 (pressure, Pa), needed for "
                            "material.law = hertz_mindlin (protocol.pressure_ratio scales material.kn, which that law does not use)");
     yaml_node_t *dom = lookup(r->doc, root, "domain", NULL);
-    int tall = !strcmp(c->domain, "box") || !strcmp(c->domain, "cylinder");
-    double height = !strcmp(c->domain, "box") ? c->box_height : c->cyl_height;
+    int tall = c->domain_kind == CD_DOMAIN_BOX || c->domain_kind == CD_DOMAIN_CYLINDER;
+    double height = c->domain_kind == CD_DOMAIN_BOX ? c->box_height : c->cyl_height;
     if (tall && height == 0 && strcmp(c->placement, "lattice"))
         return cd_cfg_fail(r, line_of(dom), "domain.height: missing; expected a number > 0 (%s height, m): "
                            "only init.placement lattice can pick the height (init.placement = %s)", c->domain, c->placement);
@@ -363,9 +379,13 @@ static int parse_document(reader *r, cd_config *c, const char *text)
              p.problem ? p.problem : "out of memory");
         goto done;
     }
-    if (read_map(r, "", "", root, 1) != 0 || check_whole(r, c, root) != 0)
+    if (read_map(r, "", "", root, 1) != 0)
+        goto done;
+    set_selectors(c);
+    if (check_whole(r, c, root) != 0)
         goto done;
     derive(c, r->seen, &r->scratch);
+    set_selectors(c);
     rc = 0;
 done:
     yaml_document_delete(&d);

@@ -23,6 +23,14 @@ typedef struct {
     double polydispersity;   /* p: scale factor uniform in [1-p, 1+p] [1] */
 } cd_species_config;
 
+/* The choices of domain.type and protocol.type, as the code selects on
+ * them (the text stays for messages and the stored config). */
+enum cd_domain_kind { CD_DOMAIN_NONE, CD_DOMAIN_BOX, CD_DOMAIN_CYLINDER, CD_DOMAIN_BALL };
+enum cd_protocol_kind { CD_PROTOCOL_NONE, CD_PROTOCOL_DEPOSIT, CD_PROTOCOL_RADIAL, CD_PROTOCOL_BULK };
+/* Deposit and compress in a box or cylinder; radial compaction and the
+ * bulk probe in a ball. */
+#define CD_PROTOCOL_IN_BALL(k) ((k) == CD_PROTOCOL_RADIAL || (k) == CD_PROTOCOL_BULK)
+
 typedef struct {
     char source_path[CD_PATH_MAX]; /* file the config was read from */
     char *source_text;             /* the file verbatim (echoed into the output) */
@@ -61,6 +69,7 @@ typedef struct {
 
     /* domain: box | cylinder | ball | none, plus extra walls */
     char domain[16];
+    enum cd_domain_kind domain_kind; /* domain as a selector, set at load */
     double box_width, box_thickness, box_height;  /* x, z, y extents [m] */
     double cyl_diameter, cyl_height;              /* [m] */
     double ball_radius;                            /* [m] */
@@ -70,6 +79,8 @@ typedef struct {
     /* initial placement */
     char placement[16];            /* lattice | random */
     char exclusion[16];            /* random placement: bounding_sphere | shape */
+    int random_placement;          /* placement is random (set at load) */
+    int exclude_by_shape;          /* exclusion is shape (set at load) */
     double clearance;              /* lattice spacing / particle size [1] */
     double lattice_gap;            /* > 0: lattice spacing = particle size + this [m] (init.clearance not given) */
     double init_speed;             /* velocity components uniform in (-v, v) [m/s] */
@@ -79,6 +90,7 @@ typedef struct {
 
     /* protocol (SPEC section 6; src/protocol.c) */
     char protocol[24];             /* none | deposit_compress | radial_compaction | bulk_modulus */
+    enum cd_protocol_kind protocol_kind; /* protocol as a selector, set at load */
     double settle_time;            /* deposit: settling time [s] (0 = 3 sqrt(2 h / g)) */
     double piston_speed;           /* deposit: piston speed while compressing [m/s] */
     double piston_force;           /* deposit: target force on the piston [N] */

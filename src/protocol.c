@@ -34,21 +34,22 @@ const char *cd_protocol_phase_name(int phase)
 
 int cd_protocol_check(const cd_config *c, char *err, size_t errlen)
 {
-    const char *p = c->protocol;
-    if (!strcmp(p, "deposit_compress") && strcmp(c->domain, "box") && strcmp(c->domain, "cylinder")) {
+    enum cd_protocol_kind p = c->protocol_kind;
+    if (p == CD_PROTOCOL_DEPOSIT && c->domain_kind != CD_DOMAIN_BOX && c->domain_kind != CD_DOMAIN_CYLINDER) {
         snprintf(err, errlen, "%s: protocol.type = deposit_compress: expected domain.type box or cylinder, not %s",
                  c->source_path, c->domain);
         return -1;
     }
-    if ((!strcmp(p, "radial_compaction") || !strcmp(p, "bulk_modulus")) && strcmp(c->domain, "ball")) {
-        snprintf(err, errlen, "%s: protocol.type = %s: expected domain.type ball, not %s", c->source_path, p, c->domain);
+    if ((p == CD_PROTOCOL_RADIAL || p == CD_PROTOCOL_BULK) && c->domain_kind != CD_DOMAIN_BALL) {
+        snprintf(err, errlen, "%s: protocol.type = %s: expected domain.type ball, not %s", c->source_path, c->protocol,
+                 c->domain);
         return -1;
     }
-    if (!strcmp(p, "deposit_compress") && !(c->gravity[0] != 0 || c->gravity[1] != 0 || c->gravity[2] != 0)) {
+    if (p == CD_PROTOCOL_DEPOSIT && !(c->gravity[0] != 0 || c->gravity[1] != 0 || c->gravity[2] != 0)) {
         snprintf(err, errlen, "%s: physics.gravity = [0, 0, 0]: deposit_compress needs gravity to deposit", c->source_path);
         return -1;
     }
-    if (!strcmp(p, "bulk_modulus") && c->strain_min > c->strain_max) {
+    if (p == CD_PROTOCOL_BULK && c->strain_min > c->strain_max) {
         snprintf(err, errlen, "%s: protocol.strain_min = %g: expected at most protocol.strain_max = %g", c->source_path,
                  c->strain_min, c->strain_max);
         return -1;
@@ -145,15 +146,15 @@ static void remove_axial_rotation(cd_sim *sim)
 
 void cd_protocol_begin(cd_sim *sim)
 {
-    const char *p = sim->cfg.protocol;
+    enum cd_protocol_kind p = sim->cfg.protocol_kind;
     memset(sim->s.control, 0, sizeof sim->s.control);
-    if (!strcmp(p, "deposit_compress")) {
+    if (p == CD_PROTOCOL_DEPOSIT) {
         /* the piston is the last wall: the box's top wall, or the one added
          * over the cylinder */
-        sim->s.control[CTL_WALL] = !strcmp(sim->cfg.domain, "box") ? 1 : (double)(sim->s.n_walls - 1);
-        if (!strcmp(sim->cfg.domain, "cylinder") && sim->cfg.wall_friction == 0) remove_axial_rotation(sim);
+        sim->s.control[CTL_WALL] = sim->cfg.domain_kind == CD_DOMAIN_BOX ? 1 : (double)(sim->s.n_walls - 1);
+        if (sim->cfg.domain_kind == CD_DOMAIN_CYLINDER && sim->cfg.wall_friction == 0) remove_axial_rotation(sim);
         enter(sim, CD_PHASE_SETTLE, NULL);
-    } else if (!strcmp(p, "radial_compaction") || !strcmp(p, "bulk_modulus")) {
+    } else if (p == CD_PROTOCOL_RADIAL || p == CD_PROTOCOL_BULK) {
         sim->s.control[CTL_WALL] = 0;
         remove_net_motion(sim, sim->s.walls[0].point);
         enter(sim, CD_PHASE_COMPACT, NULL);
@@ -166,7 +167,7 @@ static double settle_time(const cd_sim *sim)
 {
     if (sim->cfg.settle_time > 0) return sim->cfg.settle_time;
     const double *g = sim->cfg.gravity;
-    double h = !strcmp(sim->cfg.domain, "box") ? sim->cfg.box_height : sim->cfg.cyl_height; /* [m] */
+    double h = sim->cfg.domain_kind == CD_DOMAIN_BOX ? sim->cfg.box_height : sim->cfg.cyl_height; /* [m] */
     return 3 * sqrt(2 * h / sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]));
 }
 
@@ -221,7 +222,7 @@ static int window_pressure(cd_sim *sim, double load, double *p)
 static double driven_wall_energy(const cd_sim *sim)
 {
     const cd_wall *w = &sim->s.walls[(int)sim->s.control[CTL_WALL]];
-    int deposit = !strcmp(sim->cfg.protocol, "deposit_compress");
+    int deposit = sim->cfg.protocol_kind == CD_PROTOCOL_DEPOSIT;
     double m = deposit && sim->cfg.piston_mass > 0 ? sim->cfg.piston_mass : sim->total_mass;
     double v2 = deposit ? cd_v3_norm2(w->velocity) : w->radial_velocity * w->radial_velocity;
     return 0.5 * m * v2;
@@ -285,10 +286,10 @@ static int lower_piston(cd_sim *sim, int w, char *err, size_t errlen)
 static void report_fill(const cd_sim *sim, FILE *log)
 {
     const cd_config *c = &sim->cfg;
-    double width = !strcmp(c->domain, "box") ? c->box_width : c->cyl_diameter; /* [m] */
+    double width = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter; /* [m] */
     double h = sim->s.walls[(int)sim->s.control[CTL_WALL]].point.y;          /* [m] */
     if (!log) return;
-    fprintf(log, "capdem: packing height %.6g m = %.3g x the %s\n", h, h / width, !strcmp(c->domain, "box") ? "width" : "diameter");
+    fprintf(log, "capdem: packing height %.6g m = %.3g x the %s\n", h, h / width, c->domain_kind == CD_DOMAIN_BOX ? "width" : "diameter");
     if (c->fill_ratio > 0 && h / width < c->fill_ratio)
         fprintf(log, "capdem: warning: below protocol.fill_ratio = %g: the packing is denser than protocol.fill_fraction = %g "
                 "expected; set fill_fraction to the packing_fraction this run reached (time series)\n", c->fill_ratio, c->fill_fraction);
@@ -439,7 +440,7 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
         s->walls[w].radial_velocity += a * dt;
         if (relaxed(sim, err, errlen, &done)) return -1;
         if (done) {
-            if (!strcmp(sim->cfg.protocol, "bulk_modulus")) {
+            if (sim->cfg.protocol_kind == CD_PROTOCOL_BULK) {
                 enter(sim, CD_PHASE_BASE, log);
                 s->walls[w].radial_velocity = 0;
                 s->control[CTL_R_BASE] = s->walls[w].radius;
@@ -500,11 +501,11 @@ static double container_volume(const cd_sim *sim)
     const cd_config *c = &sim->cfg;
     const cd_state *s = &sim->s;
     int w = (int)s->control[CTL_WALL];
-    int deposit = !strcmp(c->protocol, "deposit_compress");
-    if (!strcmp(c->domain, "box")) return c->box_width * c->box_thickness * (deposit ? s->walls[w].point.y : c->box_height);
-    if (!strcmp(c->domain, "cylinder"))
+    int deposit = c->protocol_kind == CD_PROTOCOL_DEPOSIT;
+    if (c->domain_kind == CD_DOMAIN_BOX) return c->box_width * c->box_thickness * (deposit ? s->walls[w].point.y : c->box_height);
+    if (c->domain_kind == CD_DOMAIN_CYLINDER)
         return CD_PI * 0.25 * c->cyl_diameter * c->cyl_diameter * (deposit ? s->walls[w].point.y : c->cyl_height);
-    if (!strcmp(c->domain, "ball")) return 4.0 / 3.0 * CD_PI * pow(s->walls[0].radius, 3);
+    if (c->domain_kind == CD_DOMAIN_BALL) return 4.0 / 3.0 * CD_PI * pow(s->walls[0].radius, 3);
     return 0;
 }
 
@@ -518,5 +519,5 @@ void cd_protocol_observables(const cd_sim *sim, const cd_observables *o, double 
     v[3] = s->control[CTL_LOAD];
     int w = (int)s->control[CTL_WALL];
     double R = s->n_walls ? s->walls[w].radius : 0;
-    v[4] = !strcmp(sim->cfg.domain, "ball") && R > 0 ? s->control[CTL_LOAD] / (4 * CD_PI * R * R) : 0;
+    v[4] = sim->cfg.domain_kind == CD_DOMAIN_BALL && R > 0 ? s->control[CTL_LOAD] / (4 * CD_PI * R * R) : 0;
 }

@@ -374,9 +374,9 @@ int cd_run(const cd_run_options *opt)
     if (cfg.fill_ratio > 0)
         fprintf(stderr, "capdem: protocol.fill_ratio %g at protocol.fill_fraction %g: %ld particles\n", cfg.fill_ratio,
                 cfg.fill_fraction, sim.cfg.species[0].count);
-    if ((!strcmp(cfg.domain, "box") && cfg.box_height == 0) || (!strcmp(cfg.domain, "cylinder") && cfg.cyl_height == 0))
+    if ((cfg.domain_kind == CD_DOMAIN_BOX && cfg.box_height == 0) || (cfg.domain_kind == CD_DOMAIN_CYLINDER && cfg.cyl_height == 0))
         fprintf(stderr, "capdem: domain.height %g m (the lowest that holds the init lattice)\n",
-                !strcmp(cfg.domain, "box") ? sim.cfg.box_height : sim.cfg.cyl_height);
+                cfg.domain_kind == CD_DOMAIN_BOX ? sim.cfg.box_height : sim.cfg.cyl_height);
 
     cd_observables o;
     long long last_snap = opt->resume_path ? sim.s.step : -1; /* step of the last snapshot committed */
@@ -474,7 +474,7 @@ int cd_run(const cd_run_options *opt)
         if (!opt->quiet) progress(&pg, &sim, cfg.steps, 0);
     }
     if (!opt->quiet && status == 0) progress(&pg, &sim, cfg.steps, 1);
-    if (status == 0 && strcmp(cfg.protocol, "none") && !protocol_done)
+    if (status == 0 && cfg.protocol_kind != CD_PROTOCOL_NONE && !protocol_done)
         fprintf(stderr, "capdem: warning: run.steps = %lld reached in protocol phase '%s'; continue with "
                 "`capdem run %s --resume %s --steps N`\n", cfg.steps, cd_protocol_phase_name((int)sim.s.control[0]),
                 opt->config_path, cfg.output);

@@ -54,7 +54,7 @@ static int make_walls(cd_sim *sim, char *err, size_t errlen)
     const cd_config *c = &sim->cfg;
     double mu = c->wall_friction;
     int rc = 0;
-    if (!strcmp(c->domain, "box")) {
+    if (c->domain_kind == CD_DOMAIN_BOX) {
         rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(0, 1, 0), mu), err, errlen);
         rc |= add_wall(sim, plane(cd_v3(0, c->box_height, 0), cd_v3(0, -1, 0), mu), err, errlen);
         rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(1, 0, 0), mu), err, errlen);
@@ -67,7 +67,7 @@ static int make_walls(cd_sim *sim, char *err, size_t errlen)
             rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(0, 0, 1), mu), err, errlen);
             rc |= add_wall(sim, plane(cd_v3(0, 0, c->box_thickness), cd_v3(0, 0, -1), mu), err, errlen);
         }
-    } else if (!strcmp(c->domain, "cylinder")) {
+    } else if (c->domain_kind == CD_DOMAIN_CYLINDER) {
         cd_wall w;
         memset(&w, 0, sizeof(w));
         w.type = CD_WALL_CYLINDER;
@@ -78,9 +78,9 @@ static int make_walls(cd_sim *sim, char *err, size_t errlen)
         rc |= add_wall(sim, w, err, errlen);
         rc |= add_wall(sim, plane(cd_v3(0, 0, 0), cd_v3(0, 1, 0), mu), err, errlen);
         /* deposit and compress: the top piston (the box has its top wall) */
-        if (!strcmp(c->protocol, "deposit_compress"))
+        if (c->protocol_kind == CD_PROTOCOL_DEPOSIT)
             rc |= add_wall(sim, plane(cd_v3(0, c->cyl_height, 0), cd_v3(0, -1, 0), mu), err, errlen);
-    } else if (!strcmp(c->domain, "ball")) {
+    } else if (c->domain_kind == CD_DOMAIN_BALL) {
         cd_wall w;
         memset(&w, 0, sizeof(w));
         w.type = CD_WALL_SPHERE;
@@ -99,12 +99,12 @@ static int make_walls(cd_sim *sim, char *err, size_t errlen)
 /* Is a ball of radius R at p inside the domain? */
 static int inside_domain(const cd_config *c, cd_vec3 p, double R)
 {
-    if (!strcmp(c->domain, "box"))
+    if (c->domain_kind == CD_DOMAIN_BOX)
         return p.x >= R && p.x <= c->box_width - R && p.y >= R && p.y <= c->box_height - R &&
                (c->dimension == 2 || (p.z >= R && p.z <= c->box_thickness - R));
-    if (!strcmp(c->domain, "cylinder"))
+    if (c->domain_kind == CD_DOMAIN_CYLINDER)
         return p.y >= R && p.y <= c->cyl_height - R && sqrt(p.x * p.x + p.z * p.z) <= 0.5 * c->cyl_diameter - R;
-    if (!strcmp(c->domain, "ball")) return cd_v3_norm(p) <= c->ball_radius - R;
+    if (c->domain_kind == CD_DOMAIN_BALL) return cd_v3_norm(p) <= c->ball_radius - R;
     return 1;
 }
 
@@ -114,12 +114,12 @@ static int inside_domain(const cd_config *c, cd_vec3 p, double R)
 static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out, size_t max)
 {
     double lo[3], hi[3];
-    if (!strcmp(c->domain, "box")) {
+    if (c->domain_kind == CD_DOMAIN_BOX) {
         lo[0] = 0; hi[0] = c->box_width; lo[1] = 0; hi[1] = c->box_height; lo[2] = 0; hi[2] = c->box_thickness;
-    } else if (!strcmp(c->domain, "cylinder")) {
+    } else if (c->domain_kind == CD_DOMAIN_CYLINDER) {
         double rc = 0.5 * c->cyl_diameter;
         lo[0] = -rc; hi[0] = rc; lo[1] = 0; hi[1] = c->cyl_height; lo[2] = -rc; hi[2] = rc;
-    } else if (!strcmp(c->domain, "ball")) {
+    } else if (c->domain_kind == CD_DOMAIN_BALL) {
         for (int k = 0; k < 3; k++) { lo[k] = -c->ball_radius; hi[k] = c->ball_radius; }
     } else {
         /* Free space: a cube of sites about the origin. */
@@ -135,7 +135,7 @@ static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out
         off[k] = lo[k] + 0.5 * (hi[k] - lo[k] - (double)(n[k] - 1) * a); /* centred rows */
     }
     if (c->dimension == 2) { n[2] = 1; off[2] = 0.5 * (lo[2] + hi[2]); }
-    if (!strcmp(c->domain, "box") && c->dimension == 3 && n[2] == 1) off[2] = 0.5 * c->box_thickness; /* pseudo-2D */
+    if (c->domain_kind == CD_DOMAIN_BOX && c->dimension == 3 && n[2] == 1) off[2] = 0.5 * c->box_thickness; /* pseudo-2D */
     size_t count = 0;
     for (long iy = 0; iy < n[1] && count < max; iy++)
         for (long iz = 0; iz < n[2] && count < max; iz++)
@@ -152,11 +152,11 @@ static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out
  * quarter of their own volume each. */
 static void sampling_box(const cd_config *c, double R, size_t max, double lo[3], double hi[3])
 {
-    if (!strcmp(c->domain, "box")) {
+    if (c->domain_kind == CD_DOMAIN_BOX) {
         lo[0] = 0; hi[0] = c->box_width; lo[1] = 0; hi[1] = c->box_height; lo[2] = 0; hi[2] = c->box_thickness;
-    } else if (!strcmp(c->domain, "cylinder")) {
+    } else if (c->domain_kind == CD_DOMAIN_CYLINDER) {
         lo[0] = lo[2] = -0.5 * c->cyl_diameter; hi[0] = hi[2] = 0.5 * c->cyl_diameter; lo[1] = 0; hi[1] = c->cyl_height;
-    } else if (!strcmp(c->domain, "ball")) {
+    } else if (c->domain_kind == CD_DOMAIN_BALL) {
         for (int k = 0; k < 3; k++) { lo[k] = -c->ball_radius; hi[k] = c->ball_radius; }
     } else {
         double side = 2 * R * cbrt(4.0 * (double)max) + 2 * R;
@@ -253,9 +253,9 @@ static size_t random_shape_placement(const cd_sim *sim, cd_state *s, cd_rng *r, 
 
 static void describe_domain(const cd_config *c, char *buf, size_t n)
 {
-    if (!strcmp(c->domain, "box")) snprintf(buf, n, "domain.width/height/thickness = %g/%g/%g m", c->box_width, c->box_height, c->box_thickness);
-    else if (!strcmp(c->domain, "cylinder")) snprintf(buf, n, "domain.diameter/height = %g/%g m", c->cyl_diameter, c->cyl_height);
-    else if (!strcmp(c->domain, "ball")) snprintf(buf, n, "domain.radius = %g m", c->ball_radius);
+    if (c->domain_kind == CD_DOMAIN_BOX) snprintf(buf, n, "domain.width/height/thickness = %g/%g/%g m", c->box_width, c->box_height, c->box_thickness);
+    else if (c->domain_kind == CD_DOMAIN_CYLINDER) snprintf(buf, n, "domain.diameter/height = %g/%g m", c->cyl_diameter, c->cyl_height);
+    else if (c->domain_kind == CD_DOMAIN_BALL) snprintf(buf, n, "domain.radius = %g m", c->ball_radius);
     else snprintf(buf, n, "domain.type = none");
 }
 
@@ -281,8 +281,8 @@ static void resolve_fill_count(cd_sim *sim)
 {
     cd_config *c = &sim->cfg;
     if (!(c->fill_ratio > 0) || c->n_species != 1 || c->species[0].count > 0) return;
-    double width = !strcmp(c->domain, "box") ? c->box_width : c->cyl_diameter; /* [m] */
-    double section = !strcmp(c->domain, "box") ? c->box_width * c->box_thickness
+    double width = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter; /* [m] */
+    double section = c->domain_kind == CD_DOMAIN_BOX ? c->box_width * c->box_thickness
                                                : 0.25 * CD_PI * c->cyl_diameter * c->cyl_diameter; /* [m^2] */
     double p = c->species[0].polydispersity;
     double v = sim->shapes[0].volume * (1 + p * p); /* mean particle volume [m^3] */
@@ -304,11 +304,11 @@ static double lattice_spacing(const cd_config *c, double R)
 static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
 {
     cd_config *c = &sim->cfg;
-    double *h = !strcmp(c->domain, "box") ? &c->box_height : !strcmp(c->domain, "cylinder") ? &c->cyl_height : NULL;
+    double *h = c->domain_kind == CD_DOMAIN_BOX ? &c->box_height : c->domain_kind == CD_DOMAIN_CYLINDER ? &c->cyl_height : NULL;
     if (!h || *h > 0) return 0;
     double R = largest_bounding_radius(sim), a = lattice_spacing(c, R); /* [m] */
-    double wx = !strcmp(c->domain, "box") ? c->box_width : c->cyl_diameter;    /* [m] */
-    double wz = !strcmp(c->domain, "box") ? c->box_thickness : c->cyl_diameter; /* [m] */
+    double wx = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter;    /* [m] */
+    double wz = c->domain_kind == CD_DOMAIN_BOX ? c->box_thickness : c->cyl_diameter; /* [m] */
     size_t N = sim->s.n_particles, row_max = (size_t)(floor(wx / a) + 1) * (size_t)(floor(wz / a) + 1);
     cd_vec3 *sites = malloc(row_max * sizeof(cd_vec3));
     if (!sites) return -1;
@@ -332,7 +332,7 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
     double R = largest_bounding_radius(sim); /* [m] */
     double a = lattice_spacing(c, R);         /* [m] */
     size_t N = s->n_particles, got;
-    int random = !strcmp(c->placement, "random"), by_shape = random && !strcmp(c->exclusion, "shape");
+    int random = c->random_placement, by_shape = random && c->exclude_by_shape;
     if (by_shape) {
         got = random_shape_placement(sim, s, rng, R, N);
     } else {

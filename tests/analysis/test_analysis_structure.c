@@ -28,6 +28,7 @@ static void box_snapshot(cd_an_snapshot *s, size_t n, double W, double H, double
     cd_config_defaults(&s->cfg);
     s->cfg_ok = 1;
     snprintf(s->cfg.domain, sizeof s->cfg.domain, "box");
+    s->cfg.domain_kind = CD_DOMAIN_BOX;
     s->cfg.dimension = dim;
     s->cfg.box_thickness = T;
     s->n_shapes = 1;
@@ -248,6 +249,7 @@ static void test_geometry_cylinder_ball(void **state)
     cd_an_snapshot s;
     box_snapshot(&s, 2, 1, 1, 1, 3, 0.1);
     snprintf(s.cfg.domain, sizeof s.cfg.domain, "cylinder");
+    s.cfg.domain_kind = CD_DOMAIN_CYLINDER;
     memset(s.walls, 0, 6 * sizeof(cd_wall));
     s.n_walls = 2;
     s.walls[0].type = CD_WALL_CYLINDER;
@@ -289,6 +291,7 @@ static void test_geometry_cylinder_ball(void **state)
     assert_non_null(strstr(err, "core"));
     /* ball */
     snprintf(s.cfg.domain, sizeof s.cfg.domain, "ball");
+    s.cfg.domain_kind = CD_DOMAIN_BALL;
     s.n_walls = 1;
     s.walls[0].type = CD_WALL_SPHERE;
     s.walls[0].point = cd_v3(1, 2, 3);
