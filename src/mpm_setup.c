@@ -6,8 +6,8 @@
 #include <string.h>
 #include "mpm.h"
 
-/* Offsets [m] of the points of one row of cells, relative to a node, that
- * lie within |offset| < r: k cells each side, pps points per cell. */
+/* Whether a point centred at (x, y) [m] from the disk's centre belongs to
+ * the disk of radius r [m]. */
 static int in_disk(double x, double y, double r) { return x * x + y * y < r * r; }
 
 int cd_mpm_setup(cd_mpm *m, const cd_config *c, char *err, size_t errlen)
