@@ -238,3 +238,29 @@ int cd_mpm_output_close(cd_mpm_output *o)
     free(o);
     return rc;
 }
+
+int cd_mpm_is_run_file(const char *path)
+{
+    H5E_BEGIN_TRY
+    {
+        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        int yes = 0;
+        if (f >= 0) {
+            if (H5Aexists(f, "solver") > 0) {
+                hid_t a = H5Aopen(f, "solver", H5P_DEFAULT), t = H5Aget_type(a);
+                char v[16] = "";
+                if (H5Tget_class(t) == H5T_STRING && !H5Tis_variable_str(t) && H5Tget_size(t) == 4) {
+                    hid_t m = H5Tcopy(H5T_C_S1);
+                    H5Tset_size(m, 4);
+                    yes = H5Aread(a, m, v) >= 0 && !strcmp(v, "mpm");
+                    H5Tclose(m);
+                }
+                H5Tclose(t);
+                H5Aclose(a);
+            }
+            H5Fclose(f);
+        }
+        return yes;
+    }
+    H5E_END_TRY
+}

@@ -20,4 +20,8 @@ int cd_mpm_output_series(cd_mpm_output *o, const cd_mpm *m, double kinetic, char
 /* Closes; 0 or -1. */
 int cd_mpm_output_close(cd_mpm_output *o);
 
+/* 1 when path is a readable HDF5 file written by solver: mpm (root
+ * attribute solver = "mpm"), else 0; prints nothing. */
+int cd_mpm_is_run_file(const char *path);
+
 #endif
