@@ -304,6 +304,32 @@ void cd_config_defaults(cd_config *c)
 /* Checks that need more than one key. */
 static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
 {
+    /* Each solver reads sections of its own: a section of the other is a
+     * mistake (a value that would be silently ignored), named as such. */
+    static const char *const dem_only[] = {"physics", "material", "domain", "init", "neighbor", "protocol",
+                                           "run.steps_per_collision", "run.max_overlap"};
+    int mpm = c->solver == 1;
+    for (size_t i = 0; i < sizeof dem_only / sizeof dem_only[0] + 1; i++) {
+        const char *name = i < sizeof dem_only / sizeof dem_only[0] ? dem_only[i] : "mpm";
+        if (mpm == !strcmp(name, "mpm"))
+            continue;
+        const char *dot = strchr(name, '.');
+        yaml_node_t *key = NULL, *v;
+        if (dot) {
+            char sect[16];
+            snprintf(sect, sizeof sect, "%.*s", (int)(dot - name), name);
+            v = lookup(r->doc, lookup(r->doc, root, sect, NULL), dot + 1, &key);
+        } else {
+            v = lookup(r->doc, root, name, &key);
+        }
+        if (v) {
+            char val[VALLEN];
+            cd_cfg_render(r->doc, v, val, sizeof val, 0);
+            return cd_cfg_fail(r, line_of(key), "%s = %s: does not apply to solver = %s; expected %s", name, val,
+                               mpm ? "mpm" : "dem", mpm ? "the keys of section mpm (docs/mpm.md) and run.*"
+                                                        : "solver: mpm for the mpm section (docs/mpm.md)");
+        }
+    }
     yaml_node_t *plist = lookup(r->doc, root, "particles", NULL);
     long long total = 0;
     for (int i = 0; i < c->n_species; i++) {

@@ -107,6 +107,22 @@ typedef struct {
     long long relax_sample;        /* steps between samples of the kinetic/elastic ratio between checks; 0: none */
     double strain_max, strain_min; /* bulk: largest and smallest volumetric strain dV/V [1] */
     long long probe_steps;         /* bulk: relaxation steps after each strain */
+
+    /* solver: which program runs the file (docs/mpm.md) */
+    int solver;                    /* 0 dem (rigid particles), 1 mpm (material point method) */
+    /* mpm (docs/mpm.md) */
+    int mpm_setup;                 /* 0 diametral: one disk between two plane walls */
+    double mpm_diameter;           /* disk diameter D [m] */
+    int mpm_cells;                 /* background cells across D [1] */
+    int mpm_points_per_side;       /* material points per cell and direction at start [1] */
+    double mpm_wall_speed;         /* speed of the top wall towards the bottom one [m/s] */
+    double mpm_wall_stiffness;     /* wall penalty k / E [1] */
+    int mpm_model;                 /* 0 elastic, 1 von_mises */
+    double mpm_density;            /* rho [kg/m^3] */
+    double mpm_young;              /* E [Pa] */
+    double mpm_poisson;            /* nu [1] */
+    double mpm_yield;              /* sigma_y [Pa] (von_mises) */
+    double mpm_hardening;          /* H [Pa] (von_mises) */
 } cd_config;
 
 /* Fills c with the documented defaults. */

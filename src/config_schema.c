@@ -22,6 +22,8 @@
 #define P_ANY (P_DEPOSIT | P_RADIAL | P_BULK)
 #define L_LINEAR 1u
 #define L_HERTZ 2u
+#define SOLVER_DEM 1u
+#define M_VON_MISES 2u
 
 _Static_assert(CD_WALL_PLANE == 0, "domain.walls[].type stores the index of \"plane\" in its choices");
 _Static_assert(CD_LAW_LINEAR == 0 && CD_LAW_HERTZ_MINDLIN == 1, "material.law stores the index of its choice");
@@ -39,6 +41,10 @@ _Static_assert(CD_LAW_LINEAR == 0 && CD_LAW_HERTZ_MINDLIN == 1, "material.law st
 #define ALWAYS .required = CD_ALL_CHOICES
 
 const cd_key cd_config_keys[] = {
+    /* which solver; the mpm section is docs/mpm.md */
+    {"solver", CD_KT_ENUM, "-", "dem", CFG(solver), .flags = CD_KF_SELECTOR, .choices = "dem|mpm",
+     .label = "solver", .meaning = "dem: rigid particles (the other sections); mpm: deformable particles by the material point method (section mpm)"},
+
     /* run */
     {"run.name", CD_KT_STRING, "-", "capdem", CFG_SIZED(name), .flags = CD_KF_NONEMPTY | CD_KF_RESUMABLE,
      .label = "run name", .meaning = "name of the run; the output file defaults to <name>.h5"},
@@ -108,7 +114,7 @@ const cd_key cd_config_keys[] = {
                 "closest points instead of jumping (docs/contacts.md); false: seed 000's rule"},
 
     /* particles */
-    {"particles", CD_KT_LIST, "-", NULL, CFG(species), ALWAYS, .min_items = 1, .max_items = CD_MAX_SPECIES,
+    {"particles", CD_KT_LIST, "-", NULL, CFG(species), ALWAYS, .applies = SOLVER_DEM, .min_items = 1, .max_items = CD_MAX_SPECIES,
      .item_target = CD_TGT_SPECIES, .count_offset = offsetof(cd_config, n_species),
      .item_size = sizeof(cd_species_config),
      .label = "particle species", .meaning = "one mapping per kind of particle (keys particles[].*)"},
@@ -216,6 +222,32 @@ const cd_key cd_config_keys[] = {
      .label = "smallest strain", .meaning = "bulk: smallest strain; one probe per decade from strain_max down"},
     {"protocol.probe_steps", CD_KT_INT, "-", "20000", CFG_SIZED(probe_steps), GE(1), .applies = P_BULK,
      .label = "probe relaxation steps", .meaning = "bulk: steps of relaxation after each strain before the pressure is read"},
+
+    /* material point method (solver: mpm; docs/mpm.md) */
+    {"mpm.setup", CD_KT_ENUM, "-", "diametral", CFG(mpm_setup), .choices = "diametral",
+     .label = "MPM set-up", .meaning = "diametral: one disk compressed between a fixed bottom wall and a top wall moving down"},
+    {"mpm.diameter", CD_KT_REAL, "m", "0.06", CFG(mpm_diameter), GT(0),
+     .label = "disk diameter", .meaning = "diameter D of the disk"},
+    {"mpm.cells_per_diameter", CD_KT_INT, "-", "30", CFG_SIZED(mpm_cells), GE(4), LE(2000),
+     .label = "cells per diameter", .meaning = "background mesh: square cells of side D / this"},
+    {"mpm.points_per_cell_side", CD_KT_INT, "-", "2", CFG_SIZED(mpm_points_per_side), GE(1), LE(4),
+     .label = "points per cell side", .meaning = "material points per cell and direction at start (2: four per cell, the paper's)"},
+    {"mpm.wall_speed", CD_KT_REAL, "m/s", "0.5", CFG(mpm_wall_speed), GE(0),
+     .label = "wall speed", .meaning = "speed of the top wall towards the fixed bottom wall"},
+    {"mpm.wall_stiffness", CD_KT_REAL, "1", "2", CFG(mpm_wall_stiffness), GT(0), LE(100),
+     .label = "wall penalty stiffness", .meaning = "wall contact penalty k / E (k: N/m per metre of thickness and per point)"},
+    {"mpm.material.model", CD_KT_ENUM, "-", "elastic", CFG(mpm_model), .flags = CD_KF_SELECTOR, .choices = "elastic|von_mises",
+     .label = "MPM material", .meaning = "elastic: linear isotropic; von_mises: plus von Mises plasticity, linear isotropic hardening"},
+    {"mpm.material.density", CD_KT_REAL, "kg/m^3", "1000", CFG(mpm_density), GT(0),
+     .label = "MPM density", .meaning = "density rho of the particles"},
+    {"mpm.material.young_modulus", CD_KT_REAL, "Pa", "1e7", CFG(mpm_young), GT(0),
+     .label = "Young's modulus", .meaning = "Young's modulus E"},
+    {"mpm.material.poisson_ratio", CD_KT_REAL, "1", "0.45", CFG(mpm_poisson), GT(-1), LT(0.5),
+     .label = "Poisson's ratio", .meaning = "Poisson's ratio nu (plane strain)"},
+    {"mpm.material.yield_stress", CD_KT_REAL, "Pa", NULL, CFG(mpm_yield), GT(0), .applies = M_VON_MISES, .required = M_VON_MISES,
+     .label = "yield stress", .meaning = "von_mises: initial yield stress sigma_y"},
+    {"mpm.material.hardening", CD_KT_REAL, "Pa", "0", CFG(mpm_hardening), GE(0), .applies = M_VON_MISES,
+     .label = "hardening modulus", .meaning = "von_mises: plastic modulus H = d sigma_y / d eps_p (uniaxial tangent E H / (E + H))"},
 };
 const size_t cd_config_nkeys = sizeof cd_config_keys / sizeof cd_config_keys[0];
 

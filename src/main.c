@@ -9,6 +9,7 @@
 #include "config.h"
 #include "export.h"
 #include "analyze.h"
+#include "mpm_output.h"
 #include "capdem_commit.h" /* CAPDEM_COMMIT, generated at build time (src/git_commit.cmake) */
 #ifdef _OPENMP
 #include <omp.h>
@@ -187,6 +188,13 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) { usage(stdout); return 0; }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "shape")) return cmd_shape(argc - 2, argv + 2);
+    if (!strcmp(cmd, "analyze") || !strcmp(cmd, "export") || !strcmp(cmd, "render"))
+        for (int i = 2; i < argc; i++)
+            if (argv[i][0] != '-' && cd_mpm_is_run_file(argv[i])) {
+                fprintf(stderr, "capdem %s: %s: a run file of solver mpm; `capdem %s` does not read those yet (docs/mpm.md)\n",
+                        cmd, argv[i], cmd);
+                return 2;
+            }
     if (!strcmp(cmd, "analyze")) return cd_cmd_analyze(argc - 2, argv + 2);
     if (!strcmp(cmd, "export")) return cd_cmd_export(argc - 2, argv + 2);
     if (!strcmp(cmd, "render")) return cd_cmd_render(argc - 2, argv + 2);

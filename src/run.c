@@ -15,6 +15,7 @@
 #include "io_h5.h"
 #include "protocol.h"
 #include "../kernels/rigid.h"
+#include "mpm_run.h"
 
 enum { OBS_KT, OBS_KR, OBS_KC, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
 
@@ -292,6 +293,11 @@ int cd_run(const cd_run_options *opt)
     if (check_files(opt, &cfg, &as_given)) {
         cd_config_free(&cfg);
         return 2;
+    }
+    if (cfg.solver == 1) { /* the material point method (docs/mpm.md) */
+        int rc = cd_mpm_run(opt, &cfg);
+        cd_config_free(&cfg);
+        return rc;
     }
 
     static cd_sim sim;

@@ -18,7 +18,7 @@ static const char *pile =
     "domain: {type: cylinder, diameter: 0.08, height: 0.2}\n"
     "init: {placement: lattice, clearance: 1.0, speed: 0.5}\n";
 
-static double norm(cd_vec3 v) { return sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+static double vnorm(cd_vec3 v) { return sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
 
 static void test_derived_contact_columns_match_the_applied_forces(void **state)
 {
@@ -34,13 +34,13 @@ static void test_derived_contact_columns_match_the_applied_forces(void **state)
         if (!s->pair_active[k]) continue;
         active++;
         cd_vec3 n = s->pair_normal[k], ft = s->pair_ft[k], f = s->pair_force[k];
-        double fn = s->pair_fn[k], scale = norm(f) + fabs(fn);
+        double fn = s->pair_fn[k], scale = vnorm(f) + fabs(fn);
         /* One rounding per operation on numbers of size |F|: 1e-14 |F| is
          * a hundred roundings of margin. */
-        assert_true(fabs(norm(n) - 1) < 1e-14);
+        assert_true(fabs(vnorm(n) - 1) < 1e-14);
         assert_true(fabs(cd_v3_dot(ft, n)) <= 1e-14 * scale);
         cd_vec3 back = cd_v3_axpy(ft, fn, n);
-        assert_true(norm(cd_v3_sub(back, f)) <= 1e-14 * scale);
+        assert_true(vnorm(cd_v3_sub(back, f)) <= 1e-14 * scale);
     }
     print_message("%zu active contacts among %zu pair rows\n", active, s->n_pairs);
     assert_true(active > 60); /* a pile, not a gas */
@@ -52,15 +52,15 @@ static void test_derived_contact_columns_match_the_applied_forces(void **state)
     double worst = 0;
     for (size_t q = 0; q < s->n_particles; q++) {
         cd_vec3 F = cd_v3_scale(sim.p.gravity, s->mass[q]), T = cd_v3_zero();
-        double fscale = norm(F), tscale = 0;
+        double fscale = vnorm(F), tscale = 0;
         for (cd_int i = s->prim_first[q]; i < s->prim_first[q] + s->prim_count[q]; i++)
             for (size_t w = 0; w < s->n_walls; w++) {
                 size_t row = (size_t)i * s->n_walls + w;
                 if (!s->wallc_active[row]) continue;
                 F = cd_v3_add(F, s->wallc_force[row]);
                 T = cd_v3_add(T, s->wallc_torque[row]);
-                fscale += norm(s->wallc_force[row]);
-                tscale += norm(s->wallc_torque[row]);
+                fscale += vnorm(s->wallc_force[row]);
+                tscale += vnorm(s->wallc_torque[row]);
             }
         for (size_t k = 0; k < s->n_pairs; k++) {
             if (!s->pair_active[k]) continue;
@@ -70,10 +70,10 @@ static void test_derived_contact_columns_match_the_applied_forces(void **state)
             F = is_j ? cd_v3_add(F, s->pair_force[k]) : cd_v3_sub(F, s->pair_force[k]);
             cd_vec3 t = is_j ? s->pair_torque_j[k] : s->pair_torque_i[k];
             T = cd_v3_add(T, t);
-            fscale += norm(s->pair_force[k]);
-            tscale += norm(t);
+            fscale += vnorm(s->pair_force[k]);
+            tscale += vnorm(t);
         }
-        double df = norm(cd_v3_sub(F, s->force[q])), dt = norm(cd_v3_sub(T, s->torque[q]));
+        double df = vnorm(cd_v3_sub(F, s->force[q])), dt = vnorm(cd_v3_sub(T, s->torque[q]));
         assert_true(df <= 1e-12 * fscale);
         assert_true(dt <= 1e-12 * tscale + 1e-300);
         if (tscale > 0 && dt / tscale > worst) worst = dt / tscale;

@@ -1,0 +1,266 @@
+/* HDF5 run file of the material point method (solver: mpm): the layout of
+ * docs/mpm.md ("Output").  Snapshots of the points and walls under
+ * /mpm/snapshots, a time series of the walls under /mpm/series, the config
+ * verbatim in /parameters/config. */
+#define _POSIX_C_SOURCE 200809L
+#include <hdf5.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "mpm_output.h"
+#include "capdem_commit.h" /* CAPDEM_COMMIT (src/git_commit.cmake) */
+
+struct cd_mpm_output {
+    hid_t file;
+    char path[CD_PATH_MAX];    /* the name the file gets */
+    char aside[CD_PATH_MAX + 16]; /* where it is written until the first snapshot ("" when path itself) */
+    hsize_t n_snap, n_series;
+    size_t n_points;
+    int n_walls;
+};
+
+static int fail(char *err, size_t errlen, const char *path, const char *what)
+{
+    snprintf(err, errlen, "%s: cannot write %s (HDF5)", path, what);
+    return -1;
+}
+
+static int attr_str(hid_t obj, const char *name, const char *value)
+{
+    hid_t t = H5Tcopy(H5T_C_S1), sp = H5Screate(H5S_SCALAR);
+    H5Tset_size(t, strlen(value) + 1);
+    hid_t a = H5Acreate2(obj, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
+    int rc = a >= 0 && H5Awrite(a, t, value) >= 0 ? 0 : -1;
+    if (a >= 0) H5Aclose(a);
+    H5Tclose(t);
+    H5Sclose(sp);
+    return rc;
+}
+
+/* A dataset of rank dims growing along its first axis (unlimited), in
+ * chunks of `rows` rows, with a unit attribute. */
+static int make_growing(hid_t file, const char *path, hid_t type, int rank, const hsize_t *tail, hsize_t rows,
+                        const char *unit)
+{
+    hsize_t dims[3] = {0, 0, 0}, maxd[3] = {H5S_UNLIMITED, 0, 0}, chunk[3] = {rows, 1, 1};
+    for (int k = 1; k < rank; k++) dims[k] = maxd[k] = chunk[k] = tail[k - 1];
+    hid_t sp = H5Screate_simple(rank, dims, maxd), dcpl = H5Pcreate(H5P_DATASET_CREATE), lcpl = H5Pcreate(H5P_LINK_CREATE);
+    H5Pset_chunk(dcpl, rank, chunk);
+    H5Pset_create_intermediate_group(lcpl, 1);
+    hid_t d = H5Dcreate2(file, path, type, sp, lcpl, dcpl, H5P_DEFAULT);
+    int rc = d >= 0 && attr_str(d, "unit", unit) == 0 ? 0 : -1;
+    if (d >= 0) H5Dclose(d);
+    H5Sclose(sp);
+    H5Pclose(dcpl);
+    H5Pclose(lcpl);
+    return rc;
+}
+
+/* Appends row `at` (rank-1 tail from the dataset) of memory type mtype. */
+static int append(hid_t file, const char *path, hid_t mtype, hsize_t at, const void *buf)
+{
+    hid_t d = H5Dopen2(file, path, H5P_DEFAULT);
+    if (d < 0) return -1;
+    hid_t fs = H5Dget_space(d);
+    int rank = H5Sget_simple_extent_ndims(fs);
+    hsize_t dims[3], start[3] = {at, 0, 0}, count[3];
+    H5Sget_simple_extent_dims(fs, dims, NULL);
+    H5Sclose(fs);
+    dims[0] = at + 1;
+    int rc = H5Dset_extent(d, dims) >= 0 ? 0 : -1;
+    fs = H5Dget_space(d);
+    count[0] = 1;
+    for (int k = 1; k < rank; k++) count[k] = dims[k];
+    hid_t ms = H5Screate_simple(rank, count, NULL);
+    if (rc == 0 && (H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
+                    H5Dwrite(d, mtype, ms, fs, H5P_DEFAULT, buf) < 0))
+        rc = -1;
+    H5Sclose(ms);
+    H5Sclose(fs);
+    H5Dclose(d);
+    return rc;
+}
+
+static int write_fixed(hid_t file, const char *path, hid_t ftype, hid_t mtype, int rank, const hsize_t *dims,
+                       const void *buf, const char *unit)
+{
+    hid_t sp = H5Screate_simple(rank, dims, NULL), lcpl = H5Pcreate(H5P_LINK_CREATE);
+    H5Pset_create_intermediate_group(lcpl, 1);
+    hid_t d = H5Dcreate2(file, path, ftype, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT);
+    int rc = d >= 0 && H5Dwrite(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 && (!unit || attr_str(d, "unit", unit) == 0)
+                 ? 0 : -1;
+    if (d >= 0) H5Dclose(d);
+    H5Sclose(sp);
+    H5Pclose(lcpl);
+    return rc;
+}
+
+cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_config *cfg, const cd_mpm *m, char *err,
+                                    size_t errlen)
+{
+    cd_mpm_output *o = calloc(1, sizeof *o);
+    if (!o) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        return NULL;
+    }
+    snprintf(o->path, sizeof o->path, "%s", path);
+    o->n_points = m->n;
+    o->n_walls = m->n_walls;
+    const char *target = path;
+    if (replace) { /* written aside, renamed over path at the first snapshot: the old file stays until then */
+        snprintf(o->aside, sizeof o->aside, "%s.XXXXXX", path);
+        int fd = mkstemp(o->aside);
+        if (fd < 0) {
+            snprintf(err, errlen, "%s: cannot create a file beside it to write the new run into", path);
+            free(o);
+            return NULL;
+        }
+        close(fd);
+        target = o->aside;
+    }
+    o->file = H5Fcreate(target, replace ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
+    if (o->file < 0) {
+        snprintf(err, errlen, "%s: cannot create the run file (HDF5)", path);
+        if (replace) unlink(o->aside);
+        free(o);
+        return NULL;
+    }
+    hsize_t n = m->n, w = (hsize_t)m->n_walls, one = 1;
+    hsize_t t2[2] = {n, 2}, t4[2] = {n, 4}, tw[2] = {w, 2};
+    const char *text = cfg->source_text ? cfg->source_text : "";
+    hid_t st = H5Tcopy(H5T_C_S1);
+    H5Tset_size(st, strlen(text) + 1);
+    int rc = attr_str(o->file, "solver", "mpm") | attr_str(o->file, "creator", "capdem " CAPDEM_VERSION " (commit " CAPDEM_COMMIT ")");
+    rc |= write_fixed(o->file, "/parameters/config", st, st, 1, &one, text, NULL);
+    H5Tclose(st);
+    rc |= write_fixed(o->file, "/mpm/points/particle", H5T_STD_I32LE, H5T_NATIVE_INT, 1, &n, m->particle, NULL);
+    rc |= write_fixed(o->file, "/mpm/points/mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &n, m->mass, "kg/m");
+    double normals[2 * CD_MPM_MAX_WALLS], vel[2 * CD_MPM_MAX_WALLS];
+    for (int k = 0; k < m->n_walls; k++) {
+        normals[2 * k] = m->walls[k].nx, normals[2 * k + 1] = m->walls[k].ny;
+        vel[2 * k] = m->walls[k].vx, vel[2 * k + 1] = m->walls[k].vy;
+    }
+    rc |= write_fixed(o->file, "/mpm/walls/normal", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, tw, normals, "1");
+    rc |= write_fixed(o->file, "/mpm/walls/velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, tw, vel, "m/s");
+    rc |= make_growing(o->file, "/mpm/snapshots/step", H5T_STD_I64LE, 1, NULL, 64, "1");
+    rc |= make_growing(o->file, "/mpm/snapshots/time", H5T_IEEE_F64LE, 1, NULL, 64, "s");
+    rc |= make_growing(o->file, "/mpm/snapshots/position", H5T_IEEE_F64LE, 3, t2, 1, "m");
+    rc |= make_growing(o->file, "/mpm/snapshots/velocity", H5T_IEEE_F64LE, 3, t2, 1, "m/s");
+    rc |= make_growing(o->file, "/mpm/snapshots/volume", H5T_IEEE_F64LE, 2, &n, 1, "m^3/m");
+    rc |= make_growing(o->file, "/mpm/snapshots/stress", H5T_IEEE_F64LE, 3, t4, 1, "Pa");
+    rc |= make_growing(o->file, "/mpm/snapshots/plastic_strain", H5T_IEEE_F64LE, 2, &n, 1, "1");
+    rc |= make_growing(o->file, "/mpm/snapshots/wall_position", H5T_IEEE_F64LE, 3, tw, 64, "m");
+    rc |= make_growing(o->file, "/mpm/snapshots/wall_force", H5T_IEEE_F64LE, 3, tw, 64, "N/m");
+    rc |= make_growing(o->file, "/mpm/series/step", H5T_STD_I64LE, 1, NULL, 1024, "1");
+    rc |= make_growing(o->file, "/mpm/series/time", H5T_IEEE_F64LE, 1, NULL, 1024, "s");
+    rc |= make_growing(o->file, "/mpm/series/wall_position", H5T_IEEE_F64LE, 3, tw, 1024, "m");
+    rc |= make_growing(o->file, "/mpm/series/wall_force", H5T_IEEE_F64LE, 3, tw, 1024, "N/m");
+    rc |= make_growing(o->file, "/mpm/series/kinetic_energy", H5T_IEEE_F64LE, 1, NULL, 1024, "J/m");
+    if (rc) {
+        fail(err, errlen, path, "the file header");
+        cd_mpm_output_close(o);
+        return NULL;
+    }
+    return o;
+}
+
+static void walls_rows(const cd_mpm *m, double *pos, double *force)
+{
+    for (int k = 0; k < m->n_walls; k++) {
+        pos[2 * k] = m->walls[k].px, pos[2 * k + 1] = m->walls[k].py;
+        force[2 * k] = m->walls[k].fx, force[2 * k + 1] = m->walls[k].fy;
+    }
+}
+
+int cd_mpm_output_snapshot(cd_mpm_output *o, const cd_mpm *m, char *err, size_t errlen)
+{
+    size_t n = m->n;
+    double *buf = malloc((4 * n + 1) * sizeof(double));
+    if (!buf) return fail(err, errlen, o->path, "a snapshot (out of memory)");
+    hid_t f = o->file, D = H5T_NATIVE_DOUBLE;
+    hsize_t at = o->n_snap;
+    long long step = m->step;
+    int rc = append(f, "/mpm/snapshots/step", H5T_NATIVE_LLONG, at, &step);
+    rc |= append(f, "/mpm/snapshots/time", D, at, &m->time);
+    for (size_t p = 0; p < n; p++) buf[2 * p] = m->x[p], buf[2 * p + 1] = m->y[p];
+    rc |= append(f, "/mpm/snapshots/position", D, at, buf);
+    for (size_t p = 0; p < n; p++) buf[2 * p] = m->vx[p], buf[2 * p + 1] = m->vy[p];
+    rc |= append(f, "/mpm/snapshots/velocity", D, at, buf);
+    rc |= append(f, "/mpm/snapshots/volume", D, at, m->vol);
+    for (size_t p = 0; p < n; p++)
+        buf[4 * p] = m->sxx[p], buf[4 * p + 1] = m->syy[p], buf[4 * p + 2] = m->sxy[p], buf[4 * p + 3] = m->szz[p];
+    rc |= append(f, "/mpm/snapshots/stress", D, at, buf);
+    rc |= append(f, "/mpm/snapshots/plastic_strain", D, at, m->eps_p);
+    double pos[2 * CD_MPM_MAX_WALLS], force[2 * CD_MPM_MAX_WALLS];
+    walls_rows(m, pos, force);
+    rc |= append(f, "/mpm/snapshots/wall_position", D, at, pos);
+    rc |= append(f, "/mpm/snapshots/wall_force", D, at, force);
+    free(buf);
+    long long committed = (long long)at + 1;
+    hid_t sp = H5Screate(H5S_SCALAR);
+    hid_t a = H5Aexists(f, "n_snapshots") > 0 ? H5Aopen(f, "n_snapshots", H5P_DEFAULT)
+                                               : H5Acreate2(f, "n_snapshots", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
+    rc |= a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &committed) >= 0 ? 0 : -1;
+    if (a >= 0) H5Aclose(a);
+    H5Sclose(sp);
+    if (rc || H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) return fail(err, errlen, o->path, "a snapshot");
+    o->n_snap++;
+    if (o->aside[0]) { /* the first snapshot is on disk: the new file takes the name */
+        if (rename(o->aside, o->path) != 0) return fail(err, errlen, o->path, "the file over the old one (rename)");
+        o->aside[0] = 0;
+    }
+    return 0;
+}
+
+int cd_mpm_output_series(cd_mpm_output *o, const cd_mpm *m, double kinetic, char *err, size_t errlen)
+{
+    hid_t f = o->file, D = H5T_NATIVE_DOUBLE;
+    hsize_t at = o->n_series;
+    long long step = m->step;
+    double pos[2 * CD_MPM_MAX_WALLS], force[2 * CD_MPM_MAX_WALLS];
+    walls_rows(m, pos, force);
+    int rc = append(f, "/mpm/series/step", H5T_NATIVE_LLONG, at, &step);
+    rc |= append(f, "/mpm/series/time", D, at, &m->time);
+    rc |= append(f, "/mpm/series/wall_position", D, at, pos);
+    rc |= append(f, "/mpm/series/wall_force", D, at, force);
+    rc |= append(f, "/mpm/series/kinetic_energy", D, at, &kinetic);
+    if (rc) return fail(err, errlen, o->path, "a time-series row");
+    o->n_series++;
+    return 0;
+}
+
+int cd_mpm_output_close(cd_mpm_output *o)
+{
+    if (!o) return 0;
+    int rc = o->file >= 0 && H5Fclose(o->file) < 0 ? -1 : 0;
+    if (o->aside[0]) unlink(o->aside); /* never reached its first snapshot: the old file stays */
+    free(o);
+    return rc;
+}
+
+int cd_mpm_is_run_file(const char *path)
+{
+    H5E_BEGIN_TRY
+    {
+        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        int yes = 0;
+        if (f >= 0) {
+            if (H5Aexists(f, "solver") > 0) {
+                hid_t a = H5Aopen(f, "solver", H5P_DEFAULT), t = H5Aget_type(a);
+                char v[16] = "";
+                if (H5Tget_class(t) == H5T_STRING && !H5Tis_variable_str(t) && H5Tget_size(t) == 4) {
+                    hid_t m = H5Tcopy(H5T_C_S1);
+                    H5Tset_size(m, 4);
+                    yes = H5Aread(a, m, v) >= 0 && !strcmp(v, "mpm");
+                    H5Tclose(m);
+                }
+                H5Tclose(t);
+                H5Aclose(a);
+            }
+            H5Fclose(f);
+        }
+        return yes;
+    }
+    H5E_END_TRY
+}
