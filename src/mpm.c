@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mpm.h"
+#include "sim.h" /* CD_PARALLEL: small loops on one thread */
 #include "../kernels/mpm_shape.h"
 #include "../kernels/mpm_wall.h"
 
@@ -77,7 +78,7 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
 {
     size_t n = m->n, ncx = (size_t)(m->nx - 1), nc = ncx * (size_t)(m->ny - 1);
     long long bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : bad)
+#pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(n))
     for (size_t p = 0; p < n; p++) {
         int bx = cd_mpm_weights_1d((m->x[p] - m->ox) / m->h, m->h, m->wx + CD_MPM_STENCIL * p, m->dwx + CD_MPM_STENCIL * p);
         int by = cd_mpm_weights_1d((m->y[p] - m->oy) / m->h, m->h, m->wy + CD_MPM_STENCIL * p, m->dwy + CD_MPM_STENCIL * p);
@@ -156,7 +157,7 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
 static void to_grid(cd_mpm *m)
 {
     int nx = m->nx, ny = m->ny;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (CD_PARALLEL(nx * ny))
     for (int node = 0; node < nx * ny; node++) {
         int i = node % nx, j = node / nx;
         double gm = 0, px = 0, py = 0, fx = 0, fy = 0;
@@ -184,7 +185,7 @@ static void to_grid(cd_mpm *m)
 static void remap_velocity(cd_mpm *m)
 {
     int nx = m->nx, ny = m->ny;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (CD_PARALLEL(nx * ny))
     for (int node = 0; node < nx * ny; node++) {
         int i = node % nx, j = node / nx;
         double px = 0, py = 0;
@@ -206,7 +207,7 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
     if (prepare(m, err, errlen)) return -1;
     to_grid(m);
     /* node acceleration a = f / m into gf, new node velocity into gv */
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (CD_PARALLEL(nx * m->ny))
     for (int node = 0; node < nx * m->ny; node++) {
         double gm = m->gm[node];
         double ax = gm > 0 ? m->gfx[node] / gm : 0, ay = gm > 0 ? m->gfy[node] / gm : 0; /* [m/s^2] */
@@ -216,7 +217,7 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
         m->gvy[node] = gm > 0 ? m->gpy[node] / gm + dt * ay : 0;
     }
     /* points: velocity from the node accelerations (FLIP), position from the new node velocities */
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (CD_PARALLEL(m->n))
     for (size_t p = 0; p < m->n; p++) {
         double ax = 0, ay = 0, ux = 0, uy = 0;
         for (int b = 0; b < CD_MPM_STENCIL; b++)
@@ -236,7 +237,7 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
     remap_velocity(m);
     /* points: velocity gradient, stress, deformation gradient and volume */
     long long bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : bad)
+#pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(m->n))
     for (size_t p = 0; p < m->n; p++) {
         double lxx = 0, lxy = 0, lyx = 0, lyy = 0; /* dv_a/dx_b [1/s] */
         for (int b = 0; b < CD_MPM_STENCIL; b++)
