@@ -19,22 +19,34 @@
 
 #define CD_RENDER_PYTHON "/usr/bin/python3"
 
-/* Where render.py is: next to the sources the binary was built from
- * (CAPDEM_SOURCE_DIR, set by CMake), else where the environment variable
- * CAPDEM_SOURCE_DIR says (a moved source tree, or a build without the macro).
- * CAPDEM_RENDER_SCRIPT names the script itself, for trying a changed copy. */
+/* Where render.py is: in an installed prefix, P/share/capdem/host beside
+ * P/bin/capdem (`cmake --install`); else next to the sources the binary
+ * was built from (CAPDEM_SOURCE_DIR, set by CMake); else where the
+ * environment variable CAPDEM_SOURCE_DIR says (a moved source tree, or a
+ * build without the macro).  CAPDEM_RENDER_SCRIPT names the script itself,
+ * for trying a changed copy. */
 static int cd_render_find_script(char *dst, size_t n)
 {
-    const char *dirs[2] = {NULL, getenv("CAPDEM_SOURCE_DIR")};
+    char installed[4096] = "";
+    ssize_t len = readlink("/proc/self/exe", installed, sizeof installed - 1);
+    if (len > 0) {
+        installed[len] = 0;
+        char *slash = strrchr(installed, '/');
+        if (slash) *slash = 0; /* P/bin */
+        slash = strrchr(installed, '/');
+        if (slash) snprintf(slash, sizeof installed - (size_t)(slash - installed), "/share/capdem");
+        else installed[0] = 0;
+    }
+    const char *dirs[3] = {installed, NULL, getenv("CAPDEM_SOURCE_DIR")};
 #ifdef CAPDEM_SOURCE_DIR
-    dirs[0] = CAPDEM_SOURCE_DIR;
+    dirs[1] = CAPDEM_SOURCE_DIR;
 #endif
     const char *direct = getenv("CAPDEM_RENDER_SCRIPT");
     if (direct && direct[0] && access(direct, R_OK) == 0) {
         snprintf(dst, n, "%s", direct);
         return 0;
     }
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < 3; i++) {
         if (!dirs[i] || !dirs[i][0]) continue;
         snprintf(dst, n, "%s/host/render.py", dirs[i]);
         if (access(dst, R_OK) == 0) return 0;
