@@ -60,8 +60,8 @@ def rungs(args, case):
             continue
         f = os.path.join(args.work, "ladder_%s_%d_%s.h5" % (case, args.base, tile))
         if not (args.reuse and os.path.exists(f)):
-            bench(args, ["--load-settled", base, "--tile", "%d,%d" % (kx, kz), "--relax-steps",
-                     str(RELAX[case] if args.relax is None else args.relax),
+            relax = str(RELAX[case] if args.relax is None else args.relax)
+            bench(args, ["--load-settled", base, "--tile", "%d,%d" % (kx, kz), "--relax-steps", relax,
                          "--repeat", "0", "--save-settled", f], args.prep_threads)
         out.append((tile, f))
     return out

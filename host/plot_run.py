@@ -166,6 +166,7 @@ def plot_compaction(root, outdir, made):
     t = table(root.get("compaction"), "curve")
     if t is None:
         return "no /analysis/compaction"
+
     def varies(c):
         v = t[c][np.isfinite(t[c])]
         return v.size > 1 and v.max() > v.min()

@@ -450,7 +450,7 @@ def render_network(ax, d, proj_pos, cam, dim2):
             depth = cam.depth(0.5 * (d["pos"][ci] + d["pos"][cj]))
             order = np.lexsort((depth, fn))
         widths = 0.4 + 4.6 * np.clip(fn[order] / fmax, 0, 1)
-        lc = LineCollection(seg[order], linewidths=widths, colors=cmap(norm(fn[order])) , capstyle="round",
+        lc = LineCollection(seg[order], linewidths=widths, colors=cmap(norm(fn[order])), capstyle="round",
                             zorder=4)
         ax.add_collection(lc)
     return norm, cmap

@@ -18,6 +18,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ARM_D = 0.005  # arm diameter [m] (SPEC 3)
 PHASE_DONE = 7  # the protocols' last phase (/walls/control slot 0): the run is done
 
+
 def now():
     return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
 
@@ -279,4 +280,3 @@ def markdown_into(spec, table, default_marker):
 
 def parse_list(s, typ=float):
     return [typ(x) for x in s.split(",") if x.strip()] if s else []
-

@@ -313,8 +313,8 @@ def print_table(agg):
 def write_results(out, rows, agg):
     fs = finite_size(agg)
     with open(os.path.join(out, "results.json"), "w") as f:
-        json.dump({"generated": now(), "paper": {k: {str(a): v for a, v in t.items()} if isinstance(t, dict) else t
-                                                  for k, t in PAPER1.items()},
+        paper = {k: {str(a): v for a, v in t.items()} if isinstance(t, dict) else t for k, t in PAPER1.items()}
+        json.dump({"generated": now(), "paper": paper,
                    "runs": rows, "cases": agg, "finite_size": fs}, f, indent=1)
     for r in fs:
         print("finite size, alpha %g, N = %s (X = X_inf + c N^(-1/3)):" % (
@@ -371,6 +371,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
     ax.legend(fontsize=7)
     save(fig, "study1_phi.png")
     # interlocking and valence: one capdem series per friction against the paper's points
+
     def eta_figure(key, paper, paper_label, ylabel, fname):
         fig, ax = plt.subplots(figsize=(5.5, 4))
         paper_points(ax, paper, paper_label)
@@ -595,5 +596,3 @@ def study1(args):
             return 1
         return 0 if check_bands(rows) else 1
     return 0
-
-

@@ -57,7 +57,7 @@ def main():
     if meta["rigid"]:
         raise SystemExit("check_forces: spheres only (glued clusters are not capdem's shapes)")
     compare.run_lammps(a, base + ".data", meta, base + ".lammps.log", 0, 0, contacts=base + ".contacts", nrepeat=0,
-                        law=law_of(run["config"]))
+                       law=law_of(run["config"]))
     ci, cj, cf, _ = parity.capdem_contacts(a.run)
     li, lj, lf = parity.lammps_contacts(base + ".contacts")
     cd = {(min(p, q), max(p, q)): f for p, q, f in zip(ci, cj, cf)}
