@@ -149,7 +149,7 @@ case $OUT/ in "$ROOT"/*) git -C "$ROOT" check-ignore -q "$OUT" || die "$OUT is i
 # build, which share most of their code, pack 25 to 1.
 STAGE=$WORK/stage
 rm -rf "$OUT" "$STAGE"
-mkdir -p "$OUT/src/src" "$STAGE"/{bin,lib,lib.cxx,inputs}
+mkdir -p "$OUT/src" "$STAGE"/{bin,lib,lib.cxx,inputs}
 for v in "${VARIANTS[@]}"; do
     mkdir -p "$STAGE/bin/$v"
     cp "$WORK/$v/capdem" "$WORK/$v/capdem-bench" "$STAGE/bin/$v/"
@@ -229,7 +229,6 @@ pack payload-bin.tar.xz bin inputs
 # The part of the source tree the tests read through CAPDEM_SOURCE_DIR
 # (presets, example configs, kernels), unpacked: small, and readable there.
 cp -r "$ROOT/configs" "$ROOT/kernels" "$OUT/src/"
-cp "$ROOT/src/fields.def" "$OUT/src/src/"
 cp "$ROOT/bench/gpu/run_on_gpu.sh" "$OUT/"
 chmod +x "$OUT/run_on_gpu.sh"
 {

@@ -1,5 +1,5 @@
 /* Every structure-of-arrays column of the state as one struct of pointers,
- * generated from src/fields.def.  The per-item functions of step_items.h
+ * generated from kernels/fields.def.  The per-item functions of step_items.h
  * take it, so that the OpenMP loops (pointers into cd_state) and the OpenCL
  * kernels (pointers to __global buffers) run the same code: a column added
  * to fields.def reaches both backends without a second list.
@@ -14,7 +14,7 @@
 /* The device columns only (field_groups.h). */
 typedef struct {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_GLOBAL ctype *name;)
-#include "../src/fields.def"
+#include "fields.def"
 #undef CD_FIELD
 } cd_cols;
 

@@ -1,4 +1,4 @@
-/* Which groups of src/fields.def a device holds.  CD_ON_DEVICE_<group>(...)
+/* Which groups of kernels/fields.def a device holds.  CD_ON_DEVICE_<group>(...)
  * expands to its arguments for the groups the time step reads or writes,
  * and to nothing for PAIR_OUT, the per-contact output columns that the host
  * derives at sync (src/pair_output.c).  The column lists of the backends

@@ -25,12 +25,12 @@ enum cd_cl_kernel {
     CD_CLK_COUNT
 };
 
-/* Column indices: the order of src/fields.def, which is the order of
+/* Column indices: the order of kernels/fields.def, which is the order of
  * cd_fields[] and of the kernels' column parameters; the device columns
  * only, which come first in cd_fields[] (kernels/field_groups.h). */
 enum {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_CL_F_##name,)
-#include "fields.def"
+#include "../kernels/fields.def"
 #undef CD_FIELD
     CD_CL_N_FIELDS
 };

@@ -1,4 +1,4 @@
-/* OpenCL backend: device buffers.  Every column of src/fields.def gets one
+/* OpenCL backend: device buffers.  Every column of kernels/fields.def gets one
  * buffer, created once at start; only the pair columns grow (with
  * headroom) when the Verlet list outgrows them.  Uploads happen at start,
  * downloads at sync: between them the state lives on the device. */

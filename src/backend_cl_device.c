@@ -147,17 +147,17 @@ static char *read_file(const char *path)
 }
 
 /* Text of the source file `name` (no folder): from CAPDEM_KERNEL_DIR (a
- * source tree's kernels/ folder: name is looked up in it, in its cl/ and in
- * ../src/ for fields.def) or from the embedded table.  *owned is set when
+ * source tree's kernels/ folder: name is looked up in it and in its cl/)
+ * or from the embedded table.  *owned is set when
  * the caller must free the text. */
 static const char *source_text(const char *name, char **owned)
 {
     *owned = NULL;
     const char *dir = getenv("CAPDEM_KERNEL_DIR");
     if (dir && *dir) {
-        static const char *const sub[] = {"", "cl/", "../src/"};
+        static const char *const sub[] = {"", "cl/"};
         char path[4096];
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 2; i++) {
             snprintf(path, sizeof path, "%s/%s%s", dir, sub[i], name);
             if ((*owned = read_file(path))) return *owned;
         }

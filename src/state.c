@@ -13,7 +13,7 @@
 const cd_field_info cd_fields[] = {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) \
     {CD_GROUP_OF_##group, CD_KIND_OF_##h5type, ncomp, sizeof(ctype), offsetof(cd_state, name), #name, unit, meaning},
-#include "fields.def"
+#include "../kernels/fields.def"
 #undef CD_FIELD
 };
 const size_t cd_n_fields = sizeof(cd_fields) / sizeof(cd_fields[0]);

@@ -19,7 +19,7 @@ typedef struct cd_state {
     size_t n_particles, n_prims, n_pairs, n_walls;
     size_t cap_pairs;
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) ctype *name;
-#include "fields.def"
+#include "../kernels/fields.def"
 #undef CD_FIELD
     cd_wall walls[CD_MAX_WALLS];   /* current wall positions and motion */
     /* State of the protocol driving the run (phase, wall dynamics,

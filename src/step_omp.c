@@ -31,7 +31,7 @@ cd_cols cd_sim_host_cols(cd_state *s)
 {
     cd_cols c;
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = s->name;)
-#include "fields.def"
+#include "../kernels/fields.def"
 #undef CD_FIELD
     return c;
 }

@@ -2,5 +2,5 @@
  * col_params.h (no include guard: it expands at each use). */
 cd_cols c;
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = name;)
-#include "../../src/fields.def"
+#include "../fields.def"
 #undef CD_FIELD

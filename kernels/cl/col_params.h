@@ -1,10 +1,10 @@
 /* Kernel parameters: one __global pointer per device column of
- * src/fields.def (kernels/field_groups.h), in
+ * kernels/fields.def (kernels/field_groups.h), in
  * table order, each followed by a comma.  Included at the start of the
  * parameter list of every kernel that reads or writes the state, so that
  * the host binds columns by their index in cd_fields[] (no include guard:
  * it expands at each use). */
 #include "../field_groups.h"
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(__global ctype *name,)
-#include "../../src/fields.def"
+#include "../fields.def"
 #undef CD_FIELD

@@ -2,7 +2,7 @@
  * particle, primitive or pair, each a thin wrapper around the per-item
  * functions of kernels/step_items.h that the OpenMP loops of src/step_omp.c
  * call too.  Kernels that touch the state take the columns of
- * src/fields.def first (col_params.h), in table order. */
+ * kernels/fields.def first (col_params.h), in table order. */
 #include "../step_items.h"
 #include "../broadphase.h"
 

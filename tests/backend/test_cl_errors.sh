@@ -50,9 +50,8 @@ expect_refusal kernel_dir_missing "kernel source '.*' not found under CAPDEM_KER
   CAPDEM_KERNEL_DIR="$work/nowhere" --
 
 # A kernel that does not compile: the compiler's build log is printed.
-mkdir -p "$work/tree/src"
+mkdir -p "$work/tree"
 cp -r "$src/kernels" "$work/tree/kernels"
-cp "$src/src/fields.def" "$work/tree/src/"
 printf '\n__kernel void cd_cl_broken(void) { this is not C; }\n' >> "$work/tree/kernels/cl/step.cl"
 expect_refusal build_failure 'kernels failed to build' CAPDEM_KERNEL_DIR="$work/tree/kernels" POCL_CACHE_DIR="$work/pocl" --
 if ! grep -q 'OpenCL build log' "$work/err" || ! grep -q 'step.cl' "$work/err"; then
