@@ -234,6 +234,8 @@ int cd_neighbors_build(cd_sim *sim)
     /* Grid of particle centres; counting sort into cells, stable in particle order. */
     double lo[3], hi[3];
     double rmax = particle_bounds(s, nb->part_bound, lo, hi);
+    for (int k = 0; k < 3; k++)
+        if (!(hi[k] - lo[k] <= 1e12 * (2 * rmax + nb->skin))) return CD_NB_BLOWUP; /* NaN fails too */
     cd_grid g;
     cd_grid_make(&g, lo, hi, rmax, nb->skin, (cd_long)N);
     size_t ncell = (size_t)(g.dim[0] * g.dim[1] * g.dim[2]);

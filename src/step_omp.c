@@ -281,7 +281,8 @@ static int off_rebuild(cd_sim *sim)
     off_from(s->prim_b, s->n_prims * sizeof(cd_vec3));
     off_from(s->pair_active, s->n_pairs * sizeof(cd_int));
     off_from(s->pair_shear, s->n_pairs * sizeof(cd_vec3));
-    if (cd_neighbors_build(sim)) return -1;
+    int built = cd_neighbors_build(sim);
+    if (built) return built;
     /* Pair columns: re-mapped when the capacity grew (every old mapping
      * goes before any new one: a new block may reuse an old address),
      * otherwise the rows the build wrote go out. */
@@ -508,7 +509,13 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
     for (long long it = 0; it < n; it++) {
-        if (advance(sim) && rebuild(sim)) {
+        int rc = advance(sim) ? rebuild(sim) : 0;
+        if (rc == CD_NB_BLOWUP) {
+            snprintf(err, errlen, "particle centres spread beyond any container (or not finite) at step %lld (t = "
+                     "%.9g s): the run blew up; reduce run.dt or check the material parameters", s->step, s->time);
+            return -1;
+        }
+        if (rc) {
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }
