@@ -139,6 +139,27 @@ int main(int argc, char **argv)
         else { fprintf(stderr, "capdem-bench: unknown option %s\n", argv[i]); return 2; }
     }
 #undef INT_OPT
+    /* the backend list is checked before anything is set up */
+    char list[256], *save = NULL, *names[8];
+    int n_backends = 0;
+    snprintf(list, sizeof list, "%s", backends);
+    int round_threads[8];
+    for (char *b = strtok_r(list, ",", &save); b && n_backends < 8; b = strtok_r(NULL, ",", &save)) {
+        /* "omp:1" runs that round with 1 thread: thread counts compared on
+         * one packing in one invocation */
+        char *colon = strchr(b, ':');
+        round_threads[n_backends] = threads;
+        if (colon) {
+            if (cd_parse_cli_int("--backend NAME:THREADS", colon + 1, 1, 4096, &v, perr, sizeof perr)) return fail(perr, 2);
+            round_threads[n_backends] = (int)v;
+            *colon = 0;
+        }
+        names[n_backends++] = b;
+    }
+    if (n_backends == 0) {
+        fprintf(stderr, "capdem-bench: --backend: expected omp, opencl or a list of them\n");
+        return 2;
+    }
     omp_set_num_threads(threads);
     char yaml[2048], err[2048];
     cd_config cfg;
@@ -183,26 +204,6 @@ int main(int argc, char **argv)
             return fail(err, 2);
     }
     const char *case_label = case_name;
-    char list[256], *save = NULL, *names[8];
-    int n_backends = 0;
-    snprintf(list, sizeof list, "%s", backends);
-    int round_threads[8];
-    for (char *b = strtok_r(list, ",", &save); b && n_backends < 8; b = strtok_r(NULL, ",", &save)) {
-        /* "omp:1" runs that round with 1 thread: thread counts compared on
-         * one packing in one invocation */
-        char *colon = strchr(b, ':');
-        round_threads[n_backends] = threads;
-        if (colon) {
-            if (cd_parse_cli_int("--backend NAME:THREADS", colon + 1, 1, 4096, &v, perr, sizeof perr)) return fail(perr, 2);
-            round_threads[n_backends] = (int)v;
-            *colon = 0;
-        }
-        names[n_backends++] = b;
-    }
-    if (n_backends == 0) {
-        fprintf(stderr, "capdem-bench: --backend: expected omp, opencl or a list of them\n");
-        return 2;
-    }
     if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 ? 0 : 1, err, sizeof err))
         return fail(err, 2);
     double t0 = now();

@@ -46,12 +46,14 @@
  * (shared declarations: export_internal.h). */
 #define _XOPEN_SOURCE 700
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <sys/stat.h>
 #include <hdf5.h>
 #include "export.h"
 #include "io_h5.h"
@@ -213,10 +215,22 @@ static void cd_export_xml_contacts(FILE *o, const cd_export_ctx *x, int k)
 
 static int cd_export_write_xml(cd_export_ctx *x, const char *out)
 {
+    /* Written aside under a name nobody can guess (mkstemp: a new file,
+     * O_EXCL, never through a planted link), then renamed over out, which
+     * replaces a link there instead of writing through it. */
     char tmp[CD_EXPORT_PATH + 32];
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", out, (long)getpid());
-    FILE *o = fopen(tmp, "w");
-    if (!o) return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write (%s)", out, strerror(errno));
+    snprintf(tmp, sizeof tmp, "%s.XXXXXX", out);
+    int fd = mkstemp(tmp);
+    if (fd < 0) return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write (%s)", out, strerror(errno));
+    mode_t mask = umask(0); /* mkstemp makes it 0600; an .xmf is as readable as any new file */
+    umask(mask);
+    FILE *o = fchmod(fd, 0666 & ~mask) == 0 ? fdopen(fd, "w") : NULL;
+    if (!o) {
+        int e = errno;
+        close(fd);
+        remove(tmp);
+        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write (%s)", out, strerror(e));
+    }
     fprintf(o, "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
     fprintf(o, "<!-- Written by `capdem export` from ");
     /* "--" is not allowed inside an XML comment. */
@@ -295,6 +309,46 @@ static int cd_export_usage(FILE *f)
 }
 
 
+/* The sidecar of a read-only run file: a new one is created exclusively
+ * (O_EXCL: never through a link planted at its name); an existing one is
+ * used only when it is a regular file, not a link, that is an HDF5 file
+ * holding nothing but an earlier export's /visualization.  Anything else
+ * is refused (exit 2) and left as it is: export never truncates or writes
+ * into a file it did not write.  Returns 0, or -1 with x failed. */
+static int cd_export_open_sidecar(cd_export_ctx *x, const char *side, const char *why)
+{
+    struct stat before, opened;
+    if (lstat(side, &before) != 0) {
+        x->vf = H5Fcreate(side, H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
+        if (x->vf >= 0) return 0;
+        if (lstat(side, &before) != 0) /* not a link that appeared meanwhile: no room, no permission */
+            return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write into it (%s) nor create %s for the helper "
+                                  "datasets", x->path, why, side);
+    }
+    const char *refused = NULL;
+    if (S_ISLNK(before.st_mode)) refused = "is a symbolic link";
+    else if (!S_ISREG(before.st_mode)) refused = "is not a regular file";
+    else if ((x->vf = H5Fopen(side, H5F_ACC_RDWR, H5P_DEFAULT)) < 0) refused = "is not an HDF5 file export can write into";
+    if (!refused) {
+        /* the file opened must be the one looked at (no link swapped in) */
+        void *handle = NULL;
+        H5G_info_t info;
+        if (H5Fget_vfd_handle(x->vf, H5P_DEFAULT, &handle) < 0 || !handle || fstat(*(int *)handle, &opened) != 0 ||
+            lstat(side, &before) != 0 || !S_ISREG(before.st_mode) || opened.st_dev != before.st_dev ||
+            opened.st_ino != before.st_ino)
+            refused = "changed while it was opened";
+        else if (H5Gget_info(x->vf, &info) < 0 || info.nlinks > 1 ||
+                 (info.nlinks == 1 && H5Lexists(x->vf, "/visualization", H5P_DEFAULT) <= 0))
+            refused = "holds other data than an earlier export's /visualization";
+    }
+    if (!refused) return 0;
+    if (x->vf >= 0) H5Fclose(x->vf);
+    x->vf = -1;
+    return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s is read-only here (%s), and its sidecar %s %s: refused, the "
+                          "sidecar is left as it is (remove it, or export a writable copy of %s)", x->path, why, side,
+                          refused, x->path);
+}
+
 /* Opens the run file for writing the helpers, or falls back to a sidecar
  * file next to it when the run file is read-only. */
 static int cd_export_open(cd_export_ctx *x, const char *out)
@@ -316,11 +370,7 @@ static int cd_export_open(cd_export_ctx *x, const char *out)
     }
     char side[CD_EXPORT_PATH];
     cd_export_swap_suffix(side, sizeof side, x->path, ".viz.h5");
-    x->vf = access(side, F_OK) == 0 ? H5Fopen(side, H5F_ACC_RDWR, H5P_DEFAULT) : -1;
-    if (x->vf < 0) x->vf = H5Fcreate(side, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-    if (x->vf < 0)
-        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write into it (%s) nor create %s for the helper datasets",
-                              x->path, why, side);
+    if (cd_export_open_sidecar(x, side, why)) return -1;
     fprintf(stderr, "capdem export: %s is read-only here (%s); helper datasets go to %s\n", x->path, why, side);
     /* The sidecar lies next to the run file, and HDF5 looks for a relative
      * VDS source in the folder of the file holding the VDS. */

@@ -63,7 +63,7 @@ static int cd_render_python_has(const char *python, const char *code)
         /* The check's own traceback would only repeat what we say. */
         FILE *devnull = freopen("/dev/null", "w", stderr);
         (void)devnull;
-        execl(python, python, "-c", code, (char *)NULL);
+        execl(python, python, "-I", "-c", code, (char *)NULL);
         _exit(127);
     }
     int st;
@@ -97,11 +97,16 @@ int cd_cmd_render(int argc, char **argv)
                         "  apt-get install python3-matplotlib python3-numpy python3-h5py\n", python);
         return 2;
     }
-    char **args = calloc((size_t)argc + 3, sizeof *args);
+    /* Python isolated (-I): neither the current folder (for -c) or the
+     * script's folder nor PYTHON* variables or the user's site-packages
+     * enter its import path, so an h5py.py lying in the folder a run file
+     * came in cannot run as capdem. */
+    char **args = calloc((size_t)argc + 4, sizeof *args);
     if (!args) { fprintf(stderr, "capdem render: out of memory\n"); return 1; }
     args[0] = (char *)python;
-    args[1] = script;
-    for (int i = 0; i < argc; i++) args[i + 2] = argv[i];
+    args[1] = "-I";
+    args[2] = script;
+    for (int i = 0; i < argc; i++) args[i + 3] = argv[i];
     fflush(stdout);
     fflush(stderr);
     pid_t pid = fork();

@@ -72,7 +72,22 @@ CD_INLINE void cd_nb_item_grid(const CD_GLOBAL cd_real *partial, cd_int n_chunks
         if (partial[7 * g + 6] > rmax) rmax = partial[7 * g + 6];
     }
     cd_grid gr;
-    cd_grid_make(&gr, lo, hi, rmax, skin, n_particles);
+    /* Centres not finite, or spread over more than 1e12 cell sizes: the
+     * run blew up, and a grid of them would overflow its integer
+     * coordinates.  The grid is marked (dim[0] = -1: no cell, no pair) and
+     * the build reports the blow-up. */
+    int sane = 1;
+    for (int k = 0; k < 3; k++)
+        if (!(hi[k] - lo[k] <= CD_R(1e12) * (2 * rmax + skin))) sane = 0; /* NaN fails too */
+    if (sane) {
+        cd_grid_make(&gr, lo, hi, rmax, skin, n_particles);
+    } else {
+        for (int k = 0; k < 3; k++) {
+            gr.lo[k] = 0;
+            gr.dim[k] = k ? 1 : -1;
+        }
+        gr.cell = 1;
+    }
     grid[0] = gr;
 }
 

@@ -119,8 +119,10 @@ static void zero_ints(cd_int *dst, size_t n)
     for (size_t k = 0; k < n; k++) dst[k] = 0;
 }
 
-/* Passes 1-4: bounds, grid, particles binned by cell (CSR). */
-static void bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
+/* Passes 1-4: bounds, grid, particles binned by cell (CSR).  Returns 1
+ * when the grid says the run blew up (cd_nb_item_grid; the grid comes
+ * back, 56 bytes), 0 otherwise. */
+static int bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
 {
     cd_int N = (cd_int)sim->s.n_particles, cell_cap = (cd_int)sim->nb.cell_cap;
     cd_int chunk = CD_NB_CHUNK, n_chunks = (N + chunk - 1) / chunk;
@@ -130,6 +132,8 @@ static void bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
     for (cd_int g = 0; g < n_chunks; g++) cd_nb_item_bounds(c, g, chunk, N, d.part_bound, d.partial);
     CD_STEP_FOR(1, firstprivate(d))
     for (int one = 0; one < 1; one++) cd_nb_item_grid(d.partial, n_chunks, skin, N, d.grid);
+    cd_grid g;
+    if (cd_dev_get(&g, d.grid, sizeof g) == 0 && g.dim[0] < 0) return 1;
     zero_ints(d.cell_count, (size_t)cell_cap);
     CD_STEP_FOR(N, firstprivate(c, d))
     for (cd_int q = 0; q < N; q++) cd_nb_item_bin(c, q, d.grid, cell_cap, d.part_cell, d.cell_count);
@@ -137,6 +141,7 @@ static void bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
     copy_ints(d.cell_count, d.cell_start, (size_t)cell_cap);
     CD_STEP_FOR(N, firstprivate(d))
     for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, d.part_cell, d.cell_count, d.cell_parts);
+    return 0;
 }
 
 /* Pass 5 in slot mode (slot > 0; returns the longest row, which may exceed
@@ -225,7 +230,7 @@ int cd_neighbors_build(cd_sim *sim)
     cd_int P = (cd_int)s->n_prims;
     if (reserve(nb, s, s->n_pairs)) return -1;
     cd_cols c = cd_sim_step_cols(sim);
-    bin_particles(sim, c, nb->d);
+    if (bin_particles(sim, c, nb->d)) return CD_NB_BLOWUP;
     cd_int longest = collect(sim, c, nb->d, nb->slot);
     scan(nb->d.pair_count, P, nb->d.pair_offset, nb->d.chunk_sum);
     cd_int n_new = 0;

@@ -179,6 +179,10 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen);
 /* Neighbour list (neighbors.c). */
 void cd_neighbors_init(cd_neighbors *nb, double skin);
 void cd_neighbors_free(cd_neighbors *nb);
+/* 0, -1 (out of memory) or CD_NB_BLOWUP (particle centres not finite or
+ * spread over more than 1e12 particle sizes: the run blew up, and a cell
+ * grid of them would overflow its integer coordinates). */
+#define CD_NB_BLOWUP (-2)
 int cd_neighbors_build(cd_sim *sim);
 /* The bounding radii [m] of the last build, copied to out (n_particles);
  * 0, or -1 before the first build.  For tests. */

@@ -382,7 +382,13 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
     for (long long it = 0; it < n; it++) {
-        if (advance(sim) && cd_neighbors_build(sim)) {
+        int rc = advance(sim) ? cd_neighbors_build(sim) : 0;
+        if (rc == CD_NB_BLOWUP) {
+            snprintf(err, errlen, "particle centres spread beyond any container (or not finite) at step %lld (t = "
+                     "%.9g s): the run blew up; reduce run.dt or check the material parameters", s->step, s->time);
+            return -1;
+        }
+        if (rc) {
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }

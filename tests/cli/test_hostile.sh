@@ -7,7 +7,9 @@
 # A refusal is exit 2 with a message naming the dataset; a crash (exit
 # >= 128, e.g. 139 for SIGSEGV), any other exit or a missing name fails.
 # Cases marked "tolerated" may also exit 0 (the value is ignored), but
-# must never crash.
+# must never crash.  At the end, what capdem starts and writes: render's
+# Python runs isolated, export never writes through a planted link or into
+# a file it did not write (the XDMF's temporary name, the sidecar).
 # usage: test_hostile.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
@@ -109,6 +111,72 @@ craft shapes_count 'f["/parameters/shapes"].attrs["count"] = np.full(4096, 1, dt
 # /walls/value as plain doubles instead of wall records
 craft walls_float 're("/walls/value", np.zeros((2, 1)))' &&
   resume walls_float /walls/value refuse
+
+# ---- what capdem starts and writes (issue 18 item 8) ----
+# render starts Python isolated: an h5py.py in the current folder or on
+# PYTHONPATH never runs (it would leave "planted" behind).
+mkdir -p plant/cwd plant/path
+for d in cwd path; do
+  printf 'open(%s, "w").write("ran")\nraise ImportError("planted")\n' "'$work/plant/$d/ran'" > "plant/$d/h5py.py"
+done
+(cd plant/cwd && PYTHONPATH="$work/plant/path" "$capdem" render "$work/ref.h5" -o "$work/plant/r.png" > /dev/null 2> "$work/err")
+if [ ! -e plant/cwd/ran ] && [ ! -e plant/path/ran ]; then
+  ok; echo "ok   render: a planted h5py.py in the current folder or on PYTHONPATH does not run"
+else
+  bad "render ran a planted h5py.py ($(ls plant/*/ran))"
+fi
+# export's XDMF goes through an unpredictable temporary name: a link
+# planted at the name the process id would give is not written through.
+echo victim > victim.txt
+sh -c 'ln -s "$1/victim.txt" "$1/x.xmf.tmp$$"; exec "$2" export "$1/ref.h5" -o "$1/x.xmf"' sh "$work" "$capdem" \
+  > /dev/null 2> err
+if [ "$(cat victim.txt)" = victim ] && [ -f x.xmf ] && [ ! -L x.xmf ] && grep -q '<Xdmf' x.xmf; then
+  ok; echo "ok   export: a link at the predictable temporary name is not followed"
+else
+  bad "export wrote through a link at its temporary name (victim: $(head -c 40 victim.txt))"
+fi
+# The sidecar of a read-only run file (root writes any file: as root the
+# export runs as nobody): a link planted at its name, dangling or to a
+# writable file or HDF5 file, and an existing file that is not a sidecar,
+# are refused (exit 2, naming the sidecar) and nothing is written.
+runas=()
+if [ "$(id -u)" = 0 ]; then
+  runas=(setpriv --reuid="$(id -u nobody)" --regid="$(id -g nobody)" --clear-groups)
+  chmod 711 "$work"
+  "${runas[@]}" test -x "$capdem" || { bad "nobody cannot run $capdem (the sidecar cases need a user without root)"; runas=(false); }
+fi
+sidecar() {  # NAME SETUP: a read-only copy of ref.h5 in ro_NAME/, SETUP run there, export as nobody
+  local name=$1
+  mkdir -p "ro_$name" && chmod 777 "ro_$name" && cp ref.h5 "ro_$name/r.h5" && chmod 444 "ro_$name/r.h5"
+  (cd "ro_$name" && eval "$2")
+  "${runas[@]}" "$capdem" export "$work/ro_$name/r.h5" -o "$work/ro_$name/r.xmf" > out 2> err
+  local rc=$?
+  if [ $rc -eq 2 ] && grep -q 'r.viz.h5' err && [ ! -e "ro_$name/r.xmf" ]; then
+    ok; echo "ok   export sidecar $name: exit 2: $(head -n 1 err | head -c 200)"
+    return 0
+  fi
+  bad "export sidecar $name: exit $rc, expected a refusal (exit 2) naming r.viz.h5"
+  return 1
+}
+sidecar link_file 'echo victim > victim.txt; chmod 666 victim.txt; ln -s victim.txt r.viz.h5' &&
+  { [ "$(cat ro_link_file/victim.txt)" = victim ] || bad "export sidecar link_file: the link's target was written"; }
+sidecar link_dangling 'ln -s made_through_link.h5 r.viz.h5' &&
+  { [ ! -e ro_link_dangling/made_through_link.h5 ] || bad "export sidecar link_dangling: a file was made through the link"; }
+sidecar link_hdf5 'cp ../ref.h5 other.h5; chmod 666 other.h5; ln -s other.h5 r.viz.h5' &&
+  { cmp -s ro_link_hdf5/other.h5 ref.h5 || bad "export sidecar link_hdf5: the link's target was changed"; }
+sidecar not_sidecar 'echo notes > r.viz.h5; chmod 666 r.viz.h5' &&
+  { [ "$(cat ro_not_sidecar/r.viz.h5)" = notes ] || bad "export sidecar not_sidecar: the file was truncated"; }
+sidecar other_hdf5 'cp ../ref.h5 r.viz.h5; chmod 666 r.viz.h5' &&
+  { cmp -s ro_other_hdf5/r.viz.h5 ref.h5 || bad "export sidecar other_hdf5: the file was changed"; }
+# the intact case: a new sidecar, then the same sidecar used again
+mkdir -p ro_ok && chmod 777 ro_ok && cp ref.h5 ro_ok/r.h5 && chmod 444 ro_ok/r.h5
+for i in 1 2; do
+  if "${runas[@]}" "$capdem" export "$work/ro_ok/r.h5" > out 2> err && [ -s ro_ok/r.viz.h5 ] && grep -q 'r.viz.h5:/visualization' ro_ok/r.xmf; then
+    ok; echo "ok   export of a read-only run file, run $i: helpers in r.viz.h5"
+  else
+    bad "export of a read-only run file, run $i"
+  fi
+done
 
 echo "$pass passed, $fails failed"
 [ $fails -eq 0 ]
