@@ -1,8 +1,7 @@
-/* Broad phase of the Verlet list (docs/architecture.md; used by
- * src/neighbors.c on the host and kernels/cl/neighbors.cl on a device):
+/* Broad phase of the Verlet list (docs/architecture.md; used by the passes
+ * of kernels/neighbor_items.h, which every backend runs):
  * a uniform grid over the particles' centres with their bounding spheres,
- * the exact candidate test of two primitives, the scan of one primitive's
- * neighbour cells, the pair key
+ * the exact candidate test of two primitives, the pair key
  * and its binary search (history carry-over), and the skin criterion.
  * Written once so that both backends build the same list of pairs.
  * Device-safe: C11 and OpenCL C 1.2. */
@@ -108,66 +107,6 @@ CD_INLINE int cd_bp_is_candidate(cd_vec3 ai, cd_vec3 bi, cd_real ri, cd_vec3 aj,
     cd_segseg_closest(ai, bi, aj, bj, &u, &w);
     cd_vec3 d = cd_v3_sub(cd_v3_lerp(aj, bj, w), cd_v3_lerp(ai, bi, u));
     return cd_v3_norm2(d) <= reach * reach;
-}
-
-/* Writes of cd_bp_scan_prim without a bound. */
-#define CD_BP_UNBOUNDED 0x7fffffff
-
-/* Visits the candidates j > i of primitive i of particle p: the particles
- * q > p in the 27 cells around p's centre whose bounding spheres
- * (part_bound [m]) come within the skin, then each primitive j of q that
- * passes cd_bp_is_candidate; writes them to out (unless out is 0) in
- * ascending order and returns how many there are.  At most cap are written:
- * a return value above cap means out is incomplete (a device fills fixed
- * slots in one pass and re-scans the rare primitive that overflows its
- * slot).  cell_start/cell_parts: particles binned by cell (CSR, any order
- * inside a cell: the insertion below sorts the row).  The host builds the
- * same rows particle by particle (src/neighbors.c). */
-CD_INLINE cd_int cd_bp_scan_prim(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBAL cd_vec3 *prim_b,
-                                 const CD_GLOBAL cd_real *prim_radius, const CD_GLOBAL cd_particle_id *prim_particle,
-                                 const CD_GLOBAL cd_vec3 *position, const CD_GLOBAL cd_int *prim_first,
-                                 const CD_GLOBAL cd_int *prim_count, const CD_GLOBAL cd_real *part_bound,
-                                 const cd_grid *g, const CD_GLOBAL cd_int *cell_start,
-                                 const CD_GLOBAL cd_int *cell_parts, cd_prim_id i, cd_real skin,
-                                 CD_GLOBAL cd_prim_id *out, cd_int cap)
-{
-    cd_vec3 ai = prim_a[i], bi = prim_b[i];
-    cd_real ri = prim_radius[i];
-    cd_particle_id p = prim_particle[i];
-    cd_vec3 c = position[p];
-    cd_real reach0 = part_bound[p] + skin; /* [m] */
-    cd_long cx = cd_grid_coord(g, c.x, 0), cy = cd_grid_coord(g, c.y, 1), cz = cd_grid_coord(g, c.z, 2);
-    cd_int n = 0;
-    for (cd_long z = cz - 1; z <= cz + 1; z++) {
-        if (z < 0 || z >= g->dim[2]) continue;
-        for (cd_long y = cy - 1; y <= cy + 1; y++) {
-            if (y < 0 || y >= g->dim[1]) continue;
-            for (cd_long x = cx - 1; x <= cx + 1; x++) {
-                if (x < 0 || x >= g->dim[0]) continue;
-                cd_long cell = (z * g->dim[1] + y) * g->dim[0] + x;
-                for (cd_int k = cell_start[cell]; k < cell_start[cell + 1]; k++) {
-                    cd_particle_id q = cell_parts[k];
-                    if (q <= p) continue;
-                    cd_real reach = reach0 + part_bound[q];
-                    if (cd_v3_norm2(cd_v3_sub(position[q], c)) > reach * reach) continue;
-                    for (cd_prim_id j = prim_first[q]; j < prim_first[q] + prim_count[q]; j++) {
-                        if (!cd_bp_is_candidate(ai, bi, ri, prim_a[j], prim_b[j], prim_radius[j], skin)) continue;
-                        if (out && n < cap) {
-                            /* insertion keeps the row sorted by j */
-                            cd_int m = n;
-                            while (m > 0 && out[m - 1] > j) {
-                                out[m] = out[m - 1];
-                                m--;
-                            }
-                            out[m] = j;
-                        }
-                        n++;
-                    }
-                }
-            }
-        }
-    }
-    return n;
 }
 
 /* Key of a primitive pair, ordered by i then j. */

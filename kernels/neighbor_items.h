@@ -26,6 +26,9 @@
 #include "cols.h"
 #include "broadphase.h"
 
+/* The cap of a row written in place (fill mode of pass 5). */
+#define CD_BP_UNBOUNDED 0x7fffffff
+
 CD_DEVICE_BEGIN
 
 /* Pass 1: bounding radius [m] of each particle of chunk g, [g chunk,
