@@ -7,6 +7,7 @@
 #include "io_h5.h"
 #include "io_h5_check.h"
 #include <hdf5.h>
+#include "io_h5_journal.h"
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -329,8 +330,7 @@ int cd_an_read_snapshot(const char *path, int k, cd_an_snapshot *s, char *err, s
          * same way. */
         int S = cd_h5_snapshot_count(path, err, errlen);
         if (S >= 0 && rd_config(&r, s)) S = -1;
-        hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-        H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG);
+        hid_t fapl = cdh5_fapl(); /* as io_h5 opens run files */
         r.file = S < 0 ? H5I_INVALID_HID : H5Fopen(path, H5F_ACC_RDONLY, fapl);
         H5Pclose(fapl);
         rc = S < 0 ? 2 : r.file < 0 ? rd_fail(&r, 2, "cannot open the HDF5 file") : rd_all(&r, k, S, s);

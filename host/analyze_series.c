@@ -11,6 +11,7 @@
  * resume). */
 #include "analyze.h"
 #include <hdf5.h>
+#include "io_h5_journal.h"
 #include "io_h5_check.h"
 #include <math.h>
 #include <stdio.h>
@@ -60,8 +61,7 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
     H5Eget_auto2(H5E_DEFAULT, &func, &data);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     int rc = 0;
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG); /* as io_h5 opens run files */
+    hid_t fapl = cdh5_fapl(); /* as io_h5 opens run files */
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
     H5Pclose(fapl);
     if (f < 0 || H5Lexists(f, "/observables", H5P_DEFAULT) <= 0) {

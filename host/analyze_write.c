@@ -11,6 +11,7 @@
 #include "analyze.h"
 #include <cjson/cJSON.h>
 #include <hdf5.h>
+#include "io_h5_journal.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -83,8 +84,7 @@ int cd_an_write_h5(const char *path, const cd_an_report *rep, char *err, size_t 
     H5Eget_auto2(H5E_DEFAULT, &func, &data);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     int rc = -1;
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG); /* as io_h5 opens run files */
+    hid_t fapl = cdh5_fapl(); /* as io_h5 opens run files */
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, fapl), top = -1, snap = -1;
     H5Pclose(fapl);
     if (f < 0) {
@@ -109,11 +109,15 @@ int cd_an_write_h5(const char *path, const cd_an_report *rep, char *err, size_t 
     }
     for (int k = 0; k < rep->n_groups; k++)
         if (write_group(run_wide(rep->groups[k].name) ? top : snap, &rep->groups[k])) goto fail;
-    if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) goto fail;
+    /* the analysis goes in whole or not at all (an atomic commit) */
+    if (snap >= 0) H5Gclose(snap);
+    snap = -1;
+    if (cdh5_commit(f, path, err, errlen) < 0) goto fail;
     rc = 0;
     goto done;
 fail:
     snprintf(err, errlen, "%s: cannot write the /analysis group", path);
+    cdh5_drop_on_close(f);
 done:
     if (snap >= 0) H5Gclose(snap);
     if (top >= 0) H5Gclose(top);

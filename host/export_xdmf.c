@@ -55,6 +55,7 @@
 #include <unistd.h>
 #include <sys/stat.h>
 #include <hdf5.h>
+#include "io_h5_journal.h"
 #include "export.h"
 #include "io_h5.h"
 #include "export_internal.h"
@@ -354,16 +355,19 @@ static int cd_export_open_sidecar(cd_export_ctx *x, const char *side, const char
 static int cd_export_open(cd_export_ctx *x, const char *out)
 {
     char why[256];
-    x->f = H5Fopen(x->path, H5F_ACC_RDWR, H5P_DEFAULT);
+    hid_t fapl = cdh5_fapl(); /* as io_h5 opens run files: journaled, atomic commits */
+    x->f = H5Fopen(x->path, H5F_ACC_RDWR, fapl);
     if (x->f >= 0) {
         x->vf = x->f;
         snprintf(x->vds_src, sizeof x->vds_src, ".");
         cd_export_ref(x->h5_ref, sizeof x->h5_ref, x->path, out);
         snprintf(x->viz_ref, sizeof x->viz_ref, "%s", x->h5_ref);
+        H5Pclose(fapl);
         return 0;
     }
     cd_export_h5_reason(why);
-    x->f = H5Fopen(x->path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    x->f = H5Fopen(x->path, H5F_ACC_RDONLY, fapl);
+    H5Pclose(fapl);
     if (x->f < 0) {
         cd_export_h5_reason(why);
         return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot open (HDF5: %s; is a run still writing it?)", x->path, why);
@@ -425,14 +429,16 @@ int cd_cmd_export(int argc, char **argv)
                        locked ? " (is a run still writing it? export it when the run has ended)" : "");
     } else if (!cd_export_open(x, out) && !cd_export_read_run(x) && !cd_export_discover(x) && !cd_export_helpers(x)) {
         if (x->viz >= 0) { H5Gclose(x->viz); x->viz = -1; }
-        if (H5Fflush(x->vf, H5F_SCOPE_GLOBAL) < 0) {
+        if (cdh5_commit(x->vf, run, err, sizeof err) < 0) {
             char why[256];
+            cdh5_drop_on_close(x->vf); /* the run file keeps its last commit */
             cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot flush the helper datasets (HDF5: %s)", run, cd_export_h5_reason(why));
         } else {
             cd_export_write_xml(x, out);
         }
     }
     if (x->viz >= 0) H5Gclose(x->viz);
+    if (x->status && x->f >= 0) cdh5_drop_on_close(x->f); /* a failed export adds nothing to the run file */
     if (x->vf >= 0 && x->vf != x->f) H5Fclose(x->vf);
     if (x->f >= 0) H5Fclose(x->f);
     H5Eset_auto2(H5E_DEFAULT, old_func, old_data);

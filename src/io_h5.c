@@ -185,7 +185,11 @@ static void output_free(cd_output *o)
         cdh5_close_dset(&o->obs[i].value);
         free(o->obs[i].name);
     }
-    if (o->file >= 0) H5Fclose(o->file);
+    if (o->file >= 0) {
+        /* a failed write keeps the file at its last commit */
+        if (o->io_failed) cdh5_drop_on_close(o->file);
+        H5Fclose(o->file);
+    }
     /* CD_OUTPUT_REPLACE closed before its first snapshot: the old file stays */
     if (o->tmp_path[0] && o->n_snap == 0) unlink(o->tmp_path);
     if (o->old_fd >= 0) close(o->old_fd);
@@ -198,15 +202,14 @@ static void output_free(cd_output *o)
     free(o);
 }
 
+/* capdem's journaled driver (atomic commits, io_h5_journal.h), and the
+ * default (earliest) file format on purpose: the 1.10 format would
+ * checksum the metadata too, but it marks a file open for writing in its
+ * superblock, so a killed run would leave a file that HDF5 refuses to open
+ * (tests/unit/test_io_h5.c, killed writer). */
 static hid_t file_access(void)
 {
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG);
-    /* The default (earliest) file format on purpose: the 1.10 format would
-     * checksum the metadata too, but it marks a file open for writing in
-     * its superblock, so a killed run would leave a file that HDF5 refuses
-     * to open (tests/unit/test_io_h5.c, killed writer). */
-    return fapl;
+    return cdh5_fapl();
 }
 
 /* Opens the file that o will write: path itself, created exclusively, or
@@ -268,8 +271,9 @@ cd_output *cd_output_create_mode(const char *path, enum cd_output_mode how, cons
     if (!rc) rc = obs_check(o, obs, n_obs);
     if (!rc) rc = cdh5_write_header(o, cfg, shapes, n_shapes);
     if (!rc) rc = obs_setup(o, obs, n_obs);
-    if (!rc && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", path);
+    if (!rc) rc = cdh5_commit_output(o);
     if (rc) {
+        o->io_failed = 1; /* the file keeps its last commit (a resumed one: as it was before) */
         snprintf(err, errlen, "%s", o->err);
         output_free(o);
         o = NULL;
@@ -286,7 +290,7 @@ int cd_output_close(cd_output *o)
     /* After a failed write nothing more is written (and nothing more said):
      * the file keeps what its last commit left. */
     int rc = o->io_failed ? -1 : cdh5_obs_flush(o);
-    if (!o->io_failed && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
+    if (!o->io_failed && cdh5_commit_output(o)) rc = -1;
     output_free(o);
     cdh5_quiet_end(&q);
     return rc;
@@ -333,10 +337,8 @@ static int truncate_snapshots(cd_output *o, long long resume_step)
         read_ll(o, o->w_offset, CDH5_W_OFFSET, (hsize_t)keep, &wend))
         return -1;
     hsize_t n = (hsize_t)keep;
-    /* Commit the smaller count before cutting, so that a crash in between
-     * never leaves a counted snapshot without its rows. */
+    /* the smaller count and the cut rows go into the file in one commit (cd_output_reopen) */
     if (cdh5_write_commit(o, n)) return -1;
-    if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) return FAIL("%s: cannot flush", o->path);
     for (size_t k = 0; k < cd_n_fields; k++) {
         enum cdh5_store st = cdh5_store_of(&cd_fields[k]);
         if (st == CDH5_FIXED) continue;
@@ -416,8 +418,9 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
         rc = (cdh5_layout_open(o) || truncate_snapshots(o, resume_step)) ? -1 : 0;
     if (!rc) rc = truncate_observables(o, resume_step);
     if (!rc) rc = obs_setup(o, obs, n_obs);
-    if (!rc && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", path);
+    if (!rc) rc = cdh5_commit_output(o);
     if (rc) {
+        o->io_failed = 1; /* the file keeps its last commit (a resumed one: as it was before) */
         snprintf(err, errlen, "%s", o->err);
         output_free(o);
         o = NULL;

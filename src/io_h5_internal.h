@@ -9,6 +9,7 @@
 #include "config.h"
 #include "shapes.h"
 #include "io_h5.h"
+#include "io_h5_journal.h"
 
 /* Snapshot clock, hard-linked into every snapshot-indexed group. */
 #define CDH5_SNAP_STEP "/walls/step"
@@ -156,6 +157,9 @@ int cdh5_target_publish(cd_output *o);
 /* Every writer failure goes through FAIL: message into o->err (with the
  * HDF5 detail), printed to stderr, value -1. */
 int cdh5_report(cd_output *o);
+/* Flush and atomic commit of everything written (io_h5_journal.h); -1
+ * with the message reported and o->io_failed set when it fails. */
+int cdh5_commit_output(cd_output *o);
 #define FAIL(...) (cdh5_msg(o->err, sizeof o->err, __VA_ARGS__), cdh5_report(o))
 
 void cdh5_close_id(hid_t *id);   /* group or any object */

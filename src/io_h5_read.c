@@ -234,8 +234,7 @@ void cdh5_quiet_end(const cdh5_quiet *q)
 
 hid_t cdh5_open_ro(const char *path, char *err, size_t errlen)
 {
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG);
+    hid_t fapl = cdh5_fapl(); /* replays a killed writer's journal in memory */
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
     if (f < 0) cdh5_msg(err, errlen, "%s: cannot open the run file", path);
     H5Pclose(fapl);

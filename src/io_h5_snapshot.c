@@ -388,11 +388,8 @@ static int snapshot(cd_output *o, const cd_state *s)
         cdh5_append(o, o->time, CDH5_SNAP_TIME, n, 1, H5T_NATIVE_DOUBLE, &s->time) ||
         cdh5_append(o, o->step, CDH5_SNAP_STEP, n, 1, H5T_NATIVE_LLONG, &s->step) || cdh5_obs_flush(o))
         return -1;
-    /* Two flushes: first everything of the snapshot, then the commit record,
-     * a single small rewrite of the root object header. */
-    if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) return FAIL("%s: cannot flush", o->path);
-    if (cdh5_write_commit(o, n + 1)) return -1;
-    if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) return FAIL("%s: cannot flush", o->path);
+    /* the snapshot and its count become the file's content in one atomic commit */
+    if (cdh5_write_commit(o, n + 1) || cdh5_commit_output(o)) return -1;
     o->n_snap = n + 1;
     o->c_rows += m;
     o->w_rows += wm;

@@ -12,6 +12,15 @@
 #define CAPDEM_VERSION "unknown"
 #endif
 
+int cdh5_commit_output(cd_output *o)
+{
+    if (cdh5_commit(o->file, o->path, o->err, sizeof o->err) == 0) return 0;
+    o->io_failed = 1;
+    /* the usual cause when the journal beside it cannot be made: the file and its folder were deleted */
+    if (cdh5_check_linked(o)) return -1;
+    return cdh5_report(o);
+}
+
 int cdh5_report(cd_output *o)
 {
     fprintf(stderr, "capdem: %s\n", o->err);
@@ -259,7 +268,7 @@ int cd_output_note_resume(cd_output *o, long long step, const cd_config *cfg)
     }
     cdh5_close_dset(&d);
     H5Tclose(t);
-    if (!rc && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) rc = FAIL("%s: cannot flush", o->path);
+    if (!rc) rc = cdh5_commit_output(o);
     if (rc) o->io_failed = 1;
     cdh5_quiet_end(&q);
     return rc;

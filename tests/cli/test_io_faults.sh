@@ -21,6 +21,8 @@ if [ $rc -eq 1 ] && [ "$(grep -c 'no room to write' err)" -eq 1 ] && grep -q 'Fi
    && grep -q "keeps its complete snapshots, the last at step $(( (n - 1) * 100 ))" err && [ -n "$n" ] && [ "$n" -ge 2 ] \
    && [ "$n" -lt 61 ]; then ok; else bad "file size limit: exit $rc, $n snapshots, expected exit 1, one message, 2..60 snapshots"; fi
 h5dump -H full.h5 > /dev/null 2>&1 && ok || bad "file size limit: h5dump cannot read the file"
+"$capdem" recover full.h5 | grep -q 'nothing to recover' && ok || bad "recover after the file size limit: the commit was not whole"
+"$capdem" recover no_such.h5 2> /dev/null; [ $? -eq 2 ] && ok || bad "recover of a missing file: exit 2 expected"
 if "$capdem" run run.yaml --quiet --resume full.h5 2> err && [ "$(snapshots full.h5)" = 61 ]; then ok
 else bad "resume after the file size limit: $(snapshots full.h5) snapshots, expected 61"; fi
 

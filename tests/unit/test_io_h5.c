@@ -18,216 +18,7 @@
 #include <hdf5.h>
 
 #include "io_h5.h"
-
-#define NP 5     /* particles */
-#define NPRIM 10 /* primitives, two per particle */
-#define NW 2     /* walls */
-#define NPAIR 9  /* rows of the pair list */
-
-static const cd_observable_info OBS[2] = {{"energy", "J", 1}, {"momentum", "kg m/s", 3}};
-static const char *CONFIG_TEXT =
-    "run:\n  name: \"io test\"\t# t\xc3\xa4" "b, quote ' and \\\n\nphysics: {dt: 1e-6}\n  \n";
-
-/* ---- deterministic random contents ------------------------------------- */
-
-static uint64_t rng;
-static uint64_t next_u64(void)
-{
-    uint64_t z = (rng += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-/* Mostly ordinary values, and negative zero, subnormals and arbitrary bit
- * patterns (NaN payloads, infinities) that a conversion would disturb. */
-static double rand_double(void)
-{
-    uint64_t u = next_u64(), bits;
-    double d;
-    switch (u % 8) {
-    case 0: return -0.0;
-    case 1: bits = (next_u64() & 0x800FFFFFFFFFFFFFULL) | 1; break; /* subnormal */
-    case 2: bits = next_u64(); break;
-    default: return ((double)(next_u64() >> 11) * 0x1.0p-53) * 20.0 - 10.0;
-    }
-    memcpy(&d, &bits, sizeof d);
-    return d;
-}
-
-static void fill_random(void *col, size_t rows, const cd_field_info *f)
-{
-    size_t n = rows * (size_t)f->ncomp;
-    for (size_t i = 0; i < n; i++) {
-        if (f->kind == CD_KIND_REAL) ((double *)col)[i] = rand_double();
-        else ((int32_t *)col)[i] = (int32_t)next_u64();
-    }
-}
-
-static int is_fixed(const char *name)
-{
-    static const char *fixed[] = {"mass", "inertia", "scale", "shape", "prim_first", "prim_count",
-                                  "prim_particle", "prim_a_body", "prim_b_body", "prim_radius"};
-    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
-        if (!strcmp(name, fixed[i])) return 1;
-    return 0;
-}
-
-/* State of snapshot j of a run: columns that never change come from one
- * seed, the rest from j.  Snapshot 1 has no active contact. */
-static void fill_state(cd_state *s, int j)
-{
-    for (size_t k = 0; k < cd_n_fields; k++) {
-        const cd_field_info *f = &cd_fields[k];
-        rng = is_fixed(f->name) ? 1000 + k : (uint64_t)j * 7919 + k;
-        size_t rows = cd_group_pair_rows(f->group) ? NPAIR : cd_state_rows(s, f->group);
-        fill_random(*cd_field_ptr(s, f), rows, f);
-    }
-    rng = (uint64_t)j * 104729 + 17;
-    s->n_pairs = NPAIR;
-    for (int p = 0; p < NPRIM; p++) s->prim_particle[p] = p / 2;
-    for (int r = 0; r < NPAIR; r++) {
-        s->pair_prim_i[r] = r % NPRIM;
-        s->pair_prim_j[r] = (r + 3 + j) % NPRIM;
-        s->pair_active[r] = j == 1 ? 0 : (int)(next_u64() % 2) || r == 0;
-    }
-    for (size_t r = 0; r < NPRIM * NW; r++) s->wallc_active[r] = (int)(next_u64() % 3 == 0) || r == 4;
-    memset(s->walls, 0, sizeof s->walls);
-    for (int w = 0; w < NW; w++) {
-        cd_wall *wl = &s->walls[w];
-        wl->type = (cd_int)(next_u64() % 3);
-        double *v[] = {&wl->point.x, &wl->point.y, &wl->point.z, &wl->normal.x, &wl->normal.y, &wl->normal.z,
-                       &wl->velocity.x, &wl->velocity.y, &wl->velocity.z, &wl->radius, &wl->radial_velocity,
-                       &wl->friction};
-        for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) *v[i] = rand_double();
-    }
-    s->time = j == 0 ? 0.0 : rand_double();
-    s->step = 100LL * j;
-}
-
-static void alloc_state(cd_state *s, size_t np, size_t nprim, size_t nw, size_t cap)
-{
-    assert_int_equal(cd_state_alloc(s, np, nprim, nw, cap), 0);
-}
-
-/* A state to read into, full of garbage so that every byte must be written. */
-static void alloc_garbage(cd_state *s)
-{
-    alloc_state(s, NP, NPRIM, NW, 1);
-    rng = 424242;
-    for (size_t k = 0; k < cd_n_fields; k++) {
-        const cd_field_info *f = &cd_fields[k];
-        fill_random(*cd_field_ptr(s, f), cd_group_pair_rows(f->group) ? 1 : cd_state_rows(s, f->group), f);
-    }
-    s->n_pairs = 1;
-    memset(s->walls, 0x5a, sizeof s->walls);
-    s->time = 1.5;
-    s->step = -7;
-}
-
-/* What reading a snapshot of `want` must give, compared byte for byte. */
-static void expect_snapshot(const cd_state *want, const cd_state *got)
-{
-    cd_state *w = (cd_state *)want, *g = (cd_state *)got;
-    size_t active = 0;
-    for (size_t r = 0; r < want->n_pairs; r++) active += want->pair_active[r] != 0;
-    assert_int_equal(got->n_pairs, active);
-    for (size_t k = 0; k < cd_n_fields; k++) {
-        const cd_field_info *f = &cd_fields[k];
-        const char *a = *cd_field_ptr(w, f), *b = *cd_field_ptr(g, f);
-        size_t e = f->elem_size;
-        if (f->group == CD_GROUP_PARTICLE || f->group == CD_GROUP_PRIM) {
-            assert_memory_equal(a, b, cd_state_rows(want, f->group) * e);
-        } else if (cd_group_pair_rows(f->group)) {
-            for (size_t r = 0, j = 0; r < want->n_pairs; r++)
-                if (want->pair_active[r]) assert_memory_equal(a + r * e, b + (j++) * e, e);
-        } else {
-            static const char zero[64];
-            for (size_t r = 0; r < cd_state_rows(want, f->group); r++)
-                assert_memory_equal(want->wallc_active[r] ? a + r * e : zero, b + r * e, e);
-        }
-    }
-    assert_memory_equal(want->walls, got->walls, want->n_walls * sizeof(cd_wall));
-    assert_memory_equal(&want->time, &got->time, sizeof want->time);
-    assert_int_equal(want->step, got->step);
-}
-
-static void check_snapshot(const char *path, int k, const cd_state *want)
-{
-    char err[1024] = "";
-    cd_state g;
-    alloc_garbage(&g);
-    int rc = cd_h5_read_snapshot(path, k, &g, err, sizeof err);
-    if (rc) print_error("%s\n", err);
-    assert_int_equal(rc, 0);
-    expect_snapshot(want, &g);
-    cd_state_free(&g);
-}
-
-static void test_path(char *buf, size_t len, const char *what)
-{
-    snprintf(buf, len, "test_io_h5_%ld_%s.h5", (long)getpid(), what);
-}
-
-static cd_output *create(const char *path)
-{
-    cd_config cfg;
-    memset(&cfg, 0, sizeof cfg);
-    cfg.source_text = (char *)CONFIG_TEXT;
-    strcpy(cfg.source_path, "/runs/io test/run.yaml");
-    cd_shape sh[2];
-    memset(sh, 0, sizeof sh);
-    strcpy(sh[0].kind, "cross");
-    sh[0].n_prims = 2;
-    sh[0].a[0] = (cd_vec3){-1e-3, 0, 0};
-    sh[0].b[0] = (cd_vec3){1e-3, 0, 0};
-    sh[0].a[1] = (cd_vec3){0, -1e-3, 0};
-    sh[0].b[1] = (cd_vec3){0, 1e-3, 0};
-    sh[0].radius[0] = sh[0].radius[1] = 2.5e-4;
-    sh[0].volume = 1.23e-9;
-    sh[0].principal[0] = 1e-12;
-    strcpy(sh[1].kind, "sphere");
-    sh[1].n_prims = 1;
-    sh[1].radius[0] = 5e-4;
-    char err[1024] = "";
-    cd_output *o = cd_output_create(path, &cfg, sh, 2, OBS, 2, err, sizeof err);
-    if (!o) print_error("%s\n", err);
-    assert_non_null(o);
-    return o;
-}
-
-static void thermo(cd_output *o, long long step)
-{
-    double v[4] = {(double)step * 0.5, (double)step, -(double)step, 1.0 / ((double)step + 1)};
-    assert_int_equal(cd_output_thermo(o, step, (double)step * 1e-6, v), 0);
-}
-
-/* Writes snapshots 0..n-1 (steps 0, 100, ...) with time-series rows at
- * every 50 steps up to 100 n - 50. */
-static void write_run(const char *path, int n, cd_state *s)
-{
-    cd_output *o = create(path);
-    for (int j = 0; j < n; j++) {
-        fill_state(&s[j], j);
-        thermo(o, 100LL * j);
-        assert_int_equal(cd_output_snapshot(o, &s[j]), 0);
-        thermo(o, 100LL * j + 50);
-    }
-    assert_int_equal(cd_output_close(o), 0);
-}
-
-static long long read_ll_dataset(hid_t f, const char *path, long long *v, size_t cap)
-{
-    hid_t d = H5Dopen2(f, path, H5P_DEFAULT);
-    assert_true(d >= 0);
-    hid_t sp = H5Dget_space(d);
-    hssize_t n = H5Sget_simple_extent_npoints(sp);
-    assert_true(n >= 0 && (size_t)n <= cap);
-    if (n) assert_true(H5Dread(d, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0);
-    H5Sclose(sp);
-    H5Dclose(d);
-    return (long long)n;
-}
+#include "unit/io_h5_fixture.h"
 
 static void test_io_h5_snapshots_round_trip_bit_for_bit(void **state)
 {
@@ -281,7 +72,7 @@ static void test_io_h5_snapshots_round_trip_bit_for_bit(void **state)
         if (s[0].pair_active[r]) assert_int_equal(pi[j++], s[0].prim_particle[s[0].pair_prim_i[r]]);
     H5Fclose(f);
     for (int j = 0; j < 3; j++) cd_state_free(&s[j]);
-    remove(path);
+    remove_run(path);
 }
 
 static void test_io_h5_reopen_truncates_after_resume_step(void **state)
@@ -322,7 +113,7 @@ static void test_io_h5_reopen_truncates_after_resume_step(void **state)
     assert_int_equal(read_ll_dataset(f, "/wall_contacts/index", idx, 64), off[3]);
     H5Fclose(f);
     for (int j = 0; j < 4; j++) cd_state_free(&s[j]);
-    remove(path);
+    remove_run(path);
 }
 
 static void test_io_h5_reopen_before_first_snapshot(void **state)
@@ -343,7 +134,7 @@ static void test_io_h5_reopen_before_first_snapshot(void **state)
     assert_int_equal(cd_output_close(o), 0);
     check_snapshot(path, 0, &s);
     cd_state_free(&s);
-    remove(path);
+    remove_run(path);
 }
 
 /* Child: 3 snapshots, tell the parent, then keep writing (mode 0) until
@@ -430,7 +221,7 @@ static void test_io_h5_killed_writer_leaves_readable_file(void **state)
         test_path(path, sizeof path, "kill");
         run_child(path, 0, delays[i]);
         check_killed_file(path, 0);
-        remove(path);
+        remove_run(path);
     }
     test_path(path, sizeof path, "exit");
     run_child(path, 1, 0);
@@ -440,7 +231,7 @@ static void test_io_h5_killed_writer_leaves_readable_file(void **state)
     long long v[8];
     assert_int_equal(read_ll_dataset(f, "/observables/energy/step", v, 8), 3);
     H5Fclose(f);
-    remove(path);
+    remove_run(path);
 }
 
 static void test_io_h5_wrong_counts_are_refused(void **state)
@@ -480,7 +271,7 @@ static void test_io_h5_wrong_counts_are_refused(void **state)
     assert_int_equal(cd_output_close(o), 0);
     assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 1);
     cd_state_free(&s[0]);
-    remove(path);
+    remove_run(path);
 }
 
 static void test_io_h5_missing_file_is_named(void **state)
@@ -517,7 +308,7 @@ static void test_io_h5_bad_observables_are_refused(void **state)
     assert_null(cd_output_reopen(path, 0, twice, 2, err, sizeof err));
     assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 2); /* refused before truncating */
     for (int j = 0; j < 2; j++) cd_state_free(&s[j]);
-    remove(path);
+    remove_run(path);
 }
 
 /* The bytes of a file (malloc'd, *n its size), or NULL when it cannot be read. */
@@ -559,7 +350,7 @@ static void test_io_h5_replace_keeps_old_file_until_first_snapshot(void **state)
     snprintf(aside, sizeof aside, ".%s.", path);
     cd_state s[3];
     for (int j = 0; j < 3; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
-    remove(path);
+    remove_run(path);
     assert_int_equal(cd_output_check_target(path, CD_OUTPUT_NEW, NULL, 0, err, sizeof err), 0);
     write_run(path, 3, s);
     size_t n0, n1;
@@ -609,7 +400,7 @@ static void test_io_h5_replace_keeps_old_file_until_first_snapshot(void **state)
     free(after);
 
     /* CD_OUTPUT_REPLACE of a path that does not exist creates it */
-    remove(path);
+    remove_run(path);
     o = cd_output_create_mode(path, CD_OUTPUT_REPLACE, &cfg, NULL, 0, OBS, 2, err, sizeof err);
     assert_non_null(o);
     assert_int_equal(cd_output_check_target(path, CD_OUTPUT_RESUME, NULL, 0, err, sizeof err), -1);
@@ -617,7 +408,7 @@ static void test_io_h5_replace_keeps_old_file_until_first_snapshot(void **state)
     assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 0);
     assert_int_equal(cd_output_check_target(path, CD_OUTPUT_RESUME, NULL, 0, err, sizeof err), 0);
     for (int j = 0; j < 3; j++) cd_state_free(&s[j]);
-    remove(path);
+    remove_run(path);
 }
 
 /* Every function closes what it opened. */
