@@ -203,6 +203,24 @@ int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double w
     if (b0 < -1) b0 = -1;
     double p0[3] = {a0, b0, beta_guess > 0 ? beta_guess : 1};
     int rc = nl_fit(mueth, centre, y, w, n, 3, p0, 1, out);
+    /* Weights from the observed counts (Neyman's chi^2) pull the fit
+     * towards bins that fell short, which biases beta: its 95% interval
+     * covered the truth in 173 of 200 samples of 5,000 forces
+     * (tests/analysis/test_analysis_fits.c).  Reweighting with the
+     * model's expected counts until the parameters settle is Poisson
+     * maximum likelihood for the histogram (the score equations of the
+     * Poisson likelihood are the fixed point of these weights). */
+    for (int it = 0; rc == 0 && it < 20; it++) {
+        double before[3] = {out->p[0], out->p[1], out->p[2]};
+        for (size_t k = 0; k < n; k++) {
+            double mu = mueth(centre[k], out->p) * norm; /* expected count of bin k */
+            w[k] = norm * norm / (mu > 0 ? mu : 1); /* 1 / variance of the density [1] */
+        }
+        rc = nl_fit(mueth, centre, y, w, n, 3, before, 1, out);
+        double change = 0;
+        for (int k = 0; rc == 0 && k < 3; k++) change = fmax(change, fabs(out->p[k] - before[k]) / out->se[k]);
+        if (change < 1e-3) break;
+    }
     free(y);
     return rc;
 }
