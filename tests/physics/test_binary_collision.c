@@ -12,7 +12,7 @@ static const char *two_spheres =
     "domain: {type: none}\n"
     "init: {speed: 0}\n";
 
-typedef struct { double e, duration; } collision_t;
+typedef struct { double e, duration, dt; } collision_t; /* duration, dt [s] */
 
 /* Fires the spheres at each other with relative speed v0 [m/s] along x. */
 static collision_t collide(int clip_normal, double v0, double *t_col_out, double *eta_out)
@@ -36,6 +36,7 @@ static collision_t collide(int clip_normal, double v0, double *t_col_out, double
     collision_t c;
     c.e = (sim.s.velocity[1].x - sim.s.velocity[0].x) / v0;
     c.duration = (double)in_contact * sim.p.dt;
+    c.dt = sim.p.dt;
     double m_eff = cd_law_effective_mass(sim.s.mass[0], sim.s.mass[1]);
     *t_col_out = cd_law_collision_time(cfg.kn, m_eff, cfg.eta_n);
     *eta_out = cfg.eta_n;
@@ -45,18 +46,24 @@ static collision_t collide(int clip_normal, double v0, double *t_col_out, double
 }
 
 /* Without the max(0, .) cut the contact is the textbook damped oscillator:
- * e = exp(-pi eta / sqrt(1 - eta^2)) and the duration is t_col exactly.  The
- * step is about t_col/800, so the sampling error of the duration is ~1e-3
- * and Verlet's error in e is O((omega dt)^2) ~ 1e-6: 1% and 2% are the
- * tolerances the issue asks for and hold with a wide margin. */
+ * e = exp(-pi eta / sqrt(1 - eta^2)) and the duration is t_col exactly.
+ * Error budget (docs/testing.md, "The binary collision"): the force
+ * switches on at first touch and off at separation inside a step, so each
+ * end contributes an error of at most one step to the impulse's timing,
+ * first order in dt (Verlet's smooth error, (omega dt)^2 ~ 1.5e-5, is far
+ * below); and the duration is counted in whole steps, one at each end.
+ * Hence |de/e| <= 2 dt/t_col and |d duration| <= 2 dt.  The step is
+ * t_col/820, so both bounds are 2.4e-3 relative; measured 1.3e-3 and
+ * 1.6e-3 (the issue's ceilings were 1% and 2%). */
 static void test_restitution_and_duration_linear_dashpot(void **state)
 {
     (void)state;
     double t_col, eta;
     collision_t c = collide(0, 0.5, &t_col, &eta);
     double e_theory = exp(-CD_PI * eta / sqrt(1 - eta * eta));
-    assert_true(fabs(c.e - e_theory) / e_theory < 0.01);
-    assert_true(fabs(c.duration - t_col) / t_col < 0.02);
+    double steps = c.dt / t_col; /* [1] */
+    assert_true(fabs(c.e - e_theory) / e_theory < 2 * steps);
+    assert_true(fabs(c.duration - t_col) < 2 * c.dt);
     /* The linear law makes e independent of the impact speed. */
     collision_t slow = collide(0, 0.05, &t_col, &eta);
     assert_true(fabs(slow.e - c.e) < 1e-4);
@@ -81,14 +88,14 @@ static double clipped_restitution(double eta)
 
 /* SPEC section 3 clips F_n at zero: the rebound is faster than the textbook
  * e (0.572 instead of 0.527 for eta = 0.2).  Checked against the exact
- * clipped solution with the same 1% tolerance. */
+ * clipped solution with the same budget of 2 dt/t_col (measured 5.9e-4). */
 static void test_restitution_with_clipped_normal_force(void **state)
 {
     (void)state;
     double t_col, eta;
     collision_t c = collide(1, 0.5, &t_col, &eta);
     double e_clip = clipped_restitution(eta);
-    assert_true(fabs(c.e - e_clip) / e_clip < 0.01);
+    assert_true(fabs(c.e - e_clip) / e_clip < 2 * c.dt / t_col);
     assert_true(c.duration < t_col);
 }
 
