@@ -210,6 +210,18 @@ static void test_cascade_binned_matches(void **state)
     free(f);
 }
 
+/* n states evenly spread over Phi in [0.55, 0.70]: Z = Z_c + A sqrt(Phi -
+ * Phi_c) plus Gaussian noise of sd above jamming, loose (Z < 0.5) below. */
+static void jamming_sample(cd_rng *r, double phic, double zc, double A, double sd, int n, double *phi, double *z)
+{
+    for (int i = 0; i < n; i++) {
+        phi[i] = 0.55 + 0.15 * i / (n - 1);
+        /* Box-Muller */
+        double g = sqrt(-2 * log1p(-cd_rng_uniform(r))) * cos(2 * CD_PI * cd_rng_uniform(r));
+        z[i] = phi[i] > phic ? zc + A * sqrt(phi[i] - phic) + sd * g : 0.5 * cd_rng_uniform(r);
+    }
+}
+
 /* Z = Z_c + A sqrt(Phi - Phi_c) above jamming plus Gaussian noise, and
  * loose states below jamming with small Z: the fit finds the jammed branch
  * and recovers the three parameters within 1.5 half-widths of their 95%
@@ -222,12 +234,7 @@ static void test_jamming_fit(void **state)
     double phi[n], z[n];
     cd_rng r;
     cd_rng_seed(&r, 17);
-    for (int i = 0; i < n; i++) {
-        phi[i] = 0.55 + 0.15 * i / (n - 1);
-        /* Box-Muller */
-        double g = sqrt(-2 * log1p(-cd_rng_uniform(&r))) * cos(2 * CD_PI * cd_rng_uniform(&r));
-        z[i] = phi[i] > phic ? zc + A * sqrt(phi[i] - phic) + sd * g : 0.5 * cd_rng_uniform(&r);
-    }
+    jamming_sample(&r, phic, zc, A, sd, n, phi, z);
     cd_an_nlfit fit;
     assert_int_equal(cd_an_fit_jamming(phi, z, n, &fit), 0);
     const double truth[3] = {phic, zc, A};
@@ -286,11 +293,7 @@ static void test_jamming_coverage(void **state)
     cd_rng_seed(&r, 20);
     int covered[3] = {0, 0, 0};
     for (int t = 0; t < reps; t++) {
-        for (int i = 0; i < n; i++) {
-            phi[i] = 0.55 + 0.15 * i / (n - 1);
-            double g = sqrt(-2 * log1p(-cd_rng_uniform(&r))) * cos(2 * CD_PI * cd_rng_uniform(&r));
-            z[i] = phi[i] > phic ? zc + A * sqrt(phi[i] - phic) + sd * g : 0.5 * cd_rng_uniform(&r);
-        }
+        jamming_sample(&r, phic, zc, A, sd, n, phi, z);
         cd_an_nlfit fit;
         assert_int_equal(cd_an_fit_jamming(phi, z, n, &fit), 0);
         for (int k = 0; k < 3; k++) covered[k] += fit.lo[k] <= truth[k] && truth[k] <= fit.hi[k];

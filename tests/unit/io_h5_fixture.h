@@ -176,6 +176,20 @@ static inline void remove_run(const char *path)
     remove(journal);
 }
 
+/* fork() with a pipe from the child to the parent: in the child (0
+ * returned) *fd is the pipe's write end, in the parent its read end. */
+static inline pid_t fork_with_pipe(int *fd)
+{
+    int p[2];
+    assert_int_equal(pipe(p), 0);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    close(p[pid == 0 ? 0 : 1]);
+    *fd = p[pid == 0 ? 1 : 0];
+    return pid;
+}
+
 static inline cd_output *create(const char *path)
 {
     cd_config cfg;

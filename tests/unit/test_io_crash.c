@@ -159,22 +159,17 @@ static void check_plain_hdf5(const char *path, int n)
  * returns its marks, and whether it was killed in *killed. */
 static int run_writer(enum scenario sc, const char *path, long long k, char *marks, int cap, int *killed)
 {
-    int fd[2];
-    assert_int_equal(pipe(fd), 0);
-    fflush(NULL);
-    pid_t pid = fork();
-    assert_true(pid >= 0);
+    int fd;
+    pid_t pid = fork_with_pipe(&fd);
     if (pid == 0) {
-        close(fd[0]);
         cdh5_fault_after(k);
-        writer(sc, path, fd[1]);
+        writer(sc, path, fd);
         _exit(0);
     }
-    close(fd[1]);
     int n = 0;
     ssize_t r;
-    while (n < cap && (r = read(fd[0], marks + n, (size_t)(cap - n))) > 0) n += (int)r;
-    close(fd[0]);
+    while (n < cap && (r = read(fd, marks + n, (size_t)(cap - n))) > 0) n += (int)r;
+    close(fd);
     int status;
     assert_int_equal(waitpid(pid, &status, 0), pid);
     *killed = WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;

@@ -185,20 +185,15 @@ static void check_killed_file(const char *path, int exact_count)
 
 static void run_child(const char *path, int mode, long delay_us)
 {
-    int fd[2];
-    assert_int_equal(pipe(fd), 0);
-    fflush(NULL);
-    pid_t pid = fork();
-    assert_true(pid >= 0);
+    int fd;
+    pid_t pid = fork_with_pipe(&fd);
     if (pid == 0) {
-        close(fd[0]);
-        child_writer(path, fd[1], mode);
+        child_writer(path, fd, mode);
         _exit(7);
     }
-    close(fd[1]);
     char c;
-    assert_int_equal(read(fd[0], &c, 1), 1);
-    close(fd[0]);
+    assert_int_equal(read(fd, &c, 1), 1);
+    close(fd);
     int status;
     if (mode == 0) {
         struct timespec ts = {0, (long)delay_us * 1000};
