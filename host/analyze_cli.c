@@ -11,19 +11,46 @@
 #include <string.h>
 #include <time.h>
 
+typedef int (*measure_fn)(const cd_an_input *, cd_an_report *, char *, size_t);
+
+/* The measures of the run's time series take the run file's path. */
+static int compaction(const cd_an_input *in, cd_an_report *rep, char *msg, size_t len)
+{
+    return cd_an_compaction(in->s->path, in->s, in->g, in->opt, rep, msg, len);
+}
+
+static int jamming(const cd_an_input *in, cd_an_report *rep, char *msg, size_t len)
+{
+    return cd_an_jamming(in->s->path, in->opt, rep, msg, len);
+}
+
+/* Every measure, once, in the order they run and report: its --measures
+ * name, its bit (analyze.h), whether it needs the snapshot's particle
+ * contacts, and the function (docs/architecture.md, "How to add a
+ * measure"). */
 static const struct {
     const char *name;
     unsigned bit;
-} measure_names[] = {
-    {"forces", CD_AN_FORCES},   {"bonds", CD_AN_BONDS},         {"stress", CD_AN_STRESS},
-    {"rdf", CD_AN_RDF},         {"branch", CD_AN_BRANCH},       {"network", CD_AN_NETWORK},
-    {"packing", CD_AN_PACKING}, {"modulus", CD_AN_MODULUS},     {"compaction", CD_AN_COMPACTION},
-    {"jamming", CD_AN_JAMMING},
+    int needs_contacts;
+    measure_fn fn;
+} measures[] = {
+    {"forces", CD_AN_FORCES, 1, cd_an_forces},     {"bonds", CD_AN_BONDS, 1, cd_an_bond_forces},
+    {"stress", CD_AN_STRESS, 1, cd_an_stress},     {"rdf", CD_AN_RDF, 0, cd_an_rdf},
+    {"branch", CD_AN_BRANCH, 1, cd_an_branch},     {"network", CD_AN_NETWORK, 1, cd_an_network},
+    {"packing", CD_AN_PACKING, 0, cd_an_packing},  {"modulus", CD_AN_MODULUS, 1, cd_an_modulus},
+    {"compaction", CD_AN_COMPACTION, 0, compaction}, {"jamming", CD_AN_JAMMING, 0, jamming},
 };
-#define N_MEASURES (sizeof measure_names / sizeof measure_names[0])
+#define N_MEASURES (sizeof measures / sizeof measures[0])
 
-/* Measures that need the contacts of the snapshot. */
-#define CONTACT_MEASURES (CD_AN_FORCES | CD_AN_BONDS | CD_AN_STRESS | CD_AN_BRANCH | CD_AN_NETWORK | CD_AN_MODULUS)
+/* The measures' names, comma-separated, into buf. */
+static const char *measure_list(char *buf, size_t len)
+{
+    size_t at = 0;
+    buf[0] = 0;
+    for (size_t k = 0; k < N_MEASURES && at < len; k++)
+        at += (size_t)snprintf(buf + at, len - at, "%s%s", k ? ", " : "", measures[k].name);
+    return buf;
+}
 
 void cd_an_options_defaults(cd_an_options *o)
 {
@@ -38,22 +65,22 @@ void cd_an_options_defaults(cd_an_options *o)
 unsigned cd_an_measure_bit(const char *name)
 {
     for (size_t k = 0; k < N_MEASURES; k++)
-        if (!strcmp(measure_names[k].name, name)) return measure_names[k].bit;
+        if (!strcmp(measures[k].name, name)) return measures[k].bit;
     return 0;
 }
 
 static void usage(FILE *f)
 {
+    char names[256];
     fprintf(f,
             "usage: capdem analyze RUN.h5 [--snapshot last|N] [--json] [--measures LIST] [--no-write]\n"
             "                      [--margins SIDE,END] [--rdf-max R] [--rdf-bin DR] [--mc-points M]\n"
             "                      [--phi-series NAME] [--z-series NAME] [--quiet] [--timings]\n"
             "  --snapshot N     snapshot index (0 first, -1 or last: the last; default last)\n"
             "  --json           print one JSON object on stdout (keys: docs/analysis.md)\n"
-            "  --measures LIST  comma-separated subset, each of which must succeed (else exit 2):\n"
-            "                   forces, bonds, stress, rdf, branch, network, packing, modulus,\n"
-            "                   compaction, jamming (default: all, skipping with a warning what\n"
-            "                   the file cannot give)\n"
+            "  --measures LIST  comma-separated subset, each of which must succeed (else exit 2), of\n"
+            "                   %s\n"
+            "                   (default: all, skipping with a warning what the file cannot give)\n"
             "  --no-write       do not write /analysis into the run file\n"
             "  --margins S,E    core region: S L from side walls, E L from floor and top\n"
             "                   (default 10,10 in 2D and pseudo-2D, 3,10 in 3D, 3 for a ball)\n"
@@ -62,7 +89,8 @@ static void usage(FILE *f)
             "  --mc-points M    Monte Carlo points for the core packing fraction (default 1e6)\n"
             "  --phi-series, --z-series  observables for the jamming fit\n"
             "  --quiet          no summary and no warnings;  --timings  time of each phase on stderr\n"
-            "exit status: 0 done, 2 bad input (missing file or data), 1 other failure\n");
+            "exit status: 0 done, 2 bad input (missing file or data), 1 other failure\n",
+            measure_list(names, sizeof names));
 }
 
 static void warn(const cd_an_options *opt, const char *msg)
@@ -88,8 +116,6 @@ static void lap(const cd_an_options *opt, const char *what, double *t0)
     c0 = c;
 }
 
-typedef int (*measure_fn)(const cd_an_input *, cd_an_report *, char *, size_t);
-
 /* Runs one measure; a missing input is an error in strict mode, else a
  * warning recorded in the report's "skipped" group. */
 static int run_measure(unsigned bit, int rc, const char *msg, const cd_an_options *opt, cd_an_report *rep)
@@ -98,7 +124,7 @@ static int run_measure(unsigned bit, int rc, const char *msg, const cd_an_option
     if (rc == 2 && !opt->strict) {
         warn(opt, msg);
         for (size_t k = 0; k < N_MEASURES; k++)
-            if (measure_names[k].bit == bit) cd_an_put_text(cd_an_group_get(rep, "skipped"), measure_names[k].name, "%s", msg);
+            if (measures[k].bit == bit) cd_an_put_text(cd_an_group_get(rep, "skipped"), measures[k].name, "%s", msg);
         return 0;
     }
     return rc;
@@ -121,7 +147,10 @@ static int analyze_file(const char *path, const cd_an_options *opt, cd_an_report
     if (!s.cfg_ok)
         warn(opt, "the config echoed in /parameters/config does not parse; the container is inferred from the walls "
                   "and K_t is skipped");
-    if ((opt->measures & CONTACT_MEASURES) && s.nc == 0) {
+    unsigned contact_measures = 0;
+    for (size_t k = 0; k < N_MEASURES; k++)
+        if (measures[k].needs_contacts) contact_measures |= measures[k].bit;
+    if ((opt->measures & contact_measures) && s.nc == 0) {
         snprintf(err, errlen,
                  "%s: snapshot %d (step %lld) has no particle contacts: P(f), bond forces, stresses, branch vectors, "
                  "connectivity and K_t need them (pick a later snapshot with --snapshot, or --measures rdf,packing)",
@@ -149,32 +178,12 @@ static int analyze_file(const char *path, const cd_an_options *opt, cd_an_report
     cd_an_put_text(info, "container", "%s", cd_an_kind_name(g.kind));
     if (g.note[0]) cd_an_put_text(info, "container_note", "%s", g.note);
 
-    static const struct {
-        unsigned bit;
-        measure_fn fn;
-    } table[] = {
-        {CD_AN_FORCES, cd_an_forces}, {CD_AN_BONDS, cd_an_bond_forces}, {CD_AN_STRESS, cd_an_stress},
-        {CD_AN_RDF, cd_an_rdf},       {CD_AN_BRANCH, cd_an_branch},     {CD_AN_NETWORK, cd_an_network},
-        {CD_AN_PACKING, cd_an_packing}, {CD_AN_MODULUS, cd_an_modulus},
-    };
-    for (size_t k = 0; k < sizeof table / sizeof table[0] && rc == 0; k++) {
-        if (!(opt->measures & table[k].bit)) continue;
+    for (size_t k = 0; k < N_MEASURES && rc == 0; k++) {
+        if (!(opt->measures & measures[k].bit)) continue;
         char msg[1024] = "";
-        rc = run_measure(table[k].bit, table[k].fn(&in, rep, msg, sizeof msg), msg, opt, rep);
+        rc = run_measure(measures[k].bit, measures[k].fn(&in, rep, msg, sizeof msg), msg, opt, rep);
         if (rc) snprintf(err, errlen, "%s", msg);
-        for (size_t q = 0; q < N_MEASURES; q++)
-            if (measure_names[q].bit == table[k].bit) lap(opt, measure_names[q].name, &t0);
-    }
-    if (rc == 0 && (opt->measures & CD_AN_COMPACTION)) {
-        char msg[1024] = "";
-        rc = run_measure(CD_AN_COMPACTION, cd_an_compaction(path, &s, &g, opt, rep, msg, sizeof msg), msg, opt, rep);
-        if (rc) snprintf(err, errlen, "%s", msg);
-        lap(opt, "compaction", &t0);
-    }
-    if (rc == 0 && (opt->measures & CD_AN_JAMMING)) {
-        char msg[1024] = "";
-        rc = run_measure(CD_AN_JAMMING, cd_an_jamming(path, opt, rep, msg, sizeof msg), msg, opt, rep);
-        if (rc) snprintf(err, errlen, "%s", msg);
+        lap(opt, measures[k].name, &t0);
     }
     cd_an_bonds_free(&b);
     cd_an_snapshot_free(&s);
@@ -260,8 +269,9 @@ int cd_cmd_analyze(int argc, char **argv)
             for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
                 unsigned bit = cd_an_measure_bit(tok);
                 if (!bit) {
-                    fprintf(stderr, "capdem analyze: --measures: unknown measure '%s' (forces, bonds, stress, rdf, "
-                            "branch, network, packing, modulus, compaction, jamming)\n", tok);
+                    char names[256];
+                    fprintf(stderr, "capdem analyze: --measures: unknown measure '%s' (%s)\n", tok,
+                            measure_list(names, sizeof names));
                     return 2;
                 }
                 opt.measures |= bit;
