@@ -99,8 +99,6 @@ static hid_t wall_member_type(hid_t scalar, hsize_t ncomp)
     return ncomp == 1 ? H5Tcopy(scalar) : H5Tarray_create2(scalar, 1, &ncomp);
 }
 
-int64_t cd_h5_wall_type(void) { return cdh5_wall_mem_type(); }
-
 hid_t cdh5_wall_mem_type(void)
 {
     hid_t t = H5Tcreate(H5T_COMPOUND, sizeof(cd_wall)), m;
