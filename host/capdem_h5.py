@@ -15,6 +15,8 @@ tests/unit/test_runfile_layout.c checks against them; the functions after it
 are written by hand.  A tool outside host/ adds host/ to sys.path first.
 Needs h5py and numpy (Debian: python3-h5py python3-numpy).
 """
+import os
+
 import h5py
 import numpy as np
 
@@ -56,6 +58,7 @@ NAME = {
     "time": "time",
     "value": "value",
     "analysis_snapshot": "snapshot_",
+    "journal": "-journal",
 }
 # columns of fields.def: name -> (dataset, storage, group, components, unit); storage "fixed":
 # (rows, c) once, "series": (snapshots, rows, c), "rows": the active rows of every snapshot
@@ -129,7 +132,14 @@ class LayoutError(Exception):
 def open_run(path, locking=None):
     """The run file at path, open read-only: an h5py.File, to be used in a
     with block.  locking: h5py's file locking (None: HDF5's default; False
-    reads a file a running capdem is writing)."""
+    reads a file a running capdem is writing).  A commit journal that is not
+    empty beside the file (a capdem killed while committing, or a commit
+    under way) means the file alone may not be a commit: LayoutError, naming
+    `capdem recover` (docs/output.md, "Crash safety")."""
+    journal = path + NAME["journal"]
+    if os.path.exists(journal) and os.path.getsize(journal) > 0:
+        raise LayoutError("%s: %s is not empty (a capdem killed while committing, or a commit under way): "
+                          "run `capdem recover %s` first, or read it again" % (path, journal, path))
     if locking is None:
         return h5py.File(path, "r")
     return h5py.File(path, "r", locking=locking)

@@ -53,6 +53,8 @@ def render_read(path, snapshot):
     counted from the end) of the run file."""
     try:
         f = capdem_h5.open_run(path)
+    except capdem_h5.LayoutError as e:
+        raise BadInput(str(e))
     except OSError as e:
         raise BadInput("%s: cannot open (%s)" % (path, e))
     with f:

@@ -9,8 +9,10 @@
  *   after the tables changed; the rest of the module is written by hand.
  * - a file the writer wrote: every group the table says a file has, every
  *   dataset with its type and unit attribute, every column of fields.def
- *   where the table puts it, and the members of the /walls/value compound. */
+ *   where the table puts it, the members of the /walls/value compound, and
+ *   the commit journal beside the file while it is open. */
 #include "test_util.h"
+#include <unistd.h>
 #include "io_h5.h"
 #include "io_h5_layout.h"
 
@@ -194,6 +196,10 @@ static void test_written_file_matches_table(void **state)
     cd_output *o = cd_output_create(path, &cfg, sim.shapes, sim.n_shapes, NULL, 0, err, sizeof err);
     if (!o) fail_msg("%s", err);
     assert_int_equal(cd_output_snapshot(o, &sim.s), 0);
+    /* the commit journal beside the file, under the table's name, while the file is open */
+    char journal[CDH5_PATH_LEN];
+    snprintf(journal, sizeof journal, "%s%s", path, CDH5_NAME(JOURNAL));
+    if (access(journal, F_OK)) fail_msg("no commit journal %s beside the open run file", journal);
     assert_int_equal(cd_output_close(o), 0);
     hid_t f = cdh5_open_ro(path, err, sizeof err);
     if (f < 0) fail_msg("%s", err);
