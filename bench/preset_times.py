@@ -46,8 +46,10 @@ import subprocess
 import sys
 import tempfile
 
-import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "host"))  # capdem_h5
+import capdem_h5  # noqa: E402
 
 PHASE_DONE = 7
 
@@ -68,8 +70,9 @@ def run(cmd):
 
 def phases(path):
     """(steps, phases) of a run file's time series."""
-    with h5py.File(path, "r") as f:
-        return f["observables/phase/step"][:], f["observables/phase/value"][:]
+    with capdem_h5.open_run(path) as f:
+        st, _, value = capdem_h5.observable(f, "phase")
+        return st, value
 
 
 def shortened(build, cfg, steps, work):
@@ -94,11 +97,11 @@ def reference(spec, build, steps, work, kind):
     if kind == "deposit" and not done:
         sys.exit(f"preset_times: {path}: the deposit reference must be a complete run")
     settle_end = int(st[np.argmax(ph > 1)]) if kind == "deposit" else 0
-    with h5py.File(path, "r") as f:
-        text = f["parameters/config"][()]
+    with capdem_h5.open_run(path) as f:
+        text = capdem_h5.config_text(f)
     cfg = os.path.join(work, "reference.yaml")
     with open(cfg, "wb") as f:
-        f.write(text if isinstance(text, bytes) else text.encode())
+        f.write(text.encode())
     n, _, _, c_start = shortened(build, cfg, steps, work)
     n_fall = settle_end // 3
     c_dense = (cpu / n - n_fall * c_start) / (last - n_fall)

@@ -11,8 +11,8 @@
  * resume). */
 #include "analyze.h"
 #include <hdf5.h>
-#include "io_h5_journal.h"
 #include "io_h5_check.h"
+#include "io_h5_layout.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -56,26 +56,23 @@ static void series_free(series_set *set)
 static int series_read(const char *path, series_set *set, char *err, size_t errlen)
 {
     memset(set, 0, sizeof(*set));
-    H5E_auto2_t func;
-    void *data;
-    H5Eget_auto2(H5E_DEFAULT, &func, &data);
-    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
     int rc = 0;
-    hid_t fapl = cdh5_fapl(); /* as io_h5 opens run files */
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
-    H5Pclose(fapl);
-    if (f < 0 || H5Lexists(f, "/observables", H5P_DEFAULT) <= 0) {
-        snprintf(err, errlen, "%s: no /observables group", path);
+    const char *obs = CDH5_PATH(OBSERVABLES);
+    hid_t f = cdh5_open_ro(path, err, errlen);
+    if (f < 0 || !cdh5_exists(f, obs)) {
+        snprintf(err, errlen, "%s: no %s group", path, obs);
         rc = 2;
         goto done;
     }
-    hid_t g = H5Gopen2(f, "/observables", H5P_DEFAULT);
+    hid_t g = H5Gopen2(f, obs, H5P_DEFAULT);
     H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, NULL, collect_name, set);
     H5Gclose(g);
     for (int k = 0; k < set->n && !rc; k++) {
         series *s = &set->s[k];
         char p[160];
-        snprintf(p, sizeof p, "/observables/%s/value", s->name);
+        snprintf(p, sizeof p, "%s/%s/%s", obs, s->name, CDH5_NAME(VALUE));
         hid_t d = H5Dopen2(f, p, H5P_DEFAULT);
         if (d < 0) continue;
         /* value (rows[, ncomp]) of floats, time and step (rows) each: checked
@@ -103,10 +100,10 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
         s->value = malloc(vb);
         s->time = malloc(tb);
         s->step = malloc(sb);
-        if (H5Aexists(d, "unit") > 0) {
-            hid_t a = H5Aopen(d, "unit", H5P_DEFAULT), t = H5Aget_type(a);
+        if (H5Aexists(d, CDH5_NAME(UNIT)) > 0) {
+            hid_t a = H5Aopen(d, CDH5_NAME(UNIT), H5P_DEFAULT), t = H5Aget_type(a);
             char uerr[8];
-            if (cd_h5_check_string(a, 1, path, "unit", sizeof s->unit - 1, uerr, sizeof uerr)) {
+            if (cd_h5_check_string(a, 1, path, CDH5_NAME(UNIT), sizeof s->unit - 1, uerr, sizeof uerr)) {
                 /* not one short string: the unit is left empty */
             } else if (H5Tis_variable_str(t) > 0) {
                 char *u = NULL;
@@ -125,13 +122,13 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
         }
         H5Dclose(d);
         char pt[160], ps[160];
-        snprintf(pt, sizeof pt, "/observables/%s/time", s->name);
+        snprintf(pt, sizeof pt, "%s/%s/%s", obs, s->name, CDH5_NAME(TIME));
         hid_t dt = H5Dopen2(f, pt, H5P_DEFAULT);
-        snprintf(ps, sizeof ps, "/observables/%s/step", s->name);
+        snprintf(ps, sizeof ps, "%s/%s/%s", obs, s->name, CDH5_NAME(STEP));
         hid_t ds = H5Dopen2(f, ps, H5P_DEFAULT);
         hsize_t exact[1] = {dims[0]};
         if (!rc && s->rows && (dt < 0 || ds < 0)) {
-            snprintf(err, errlen, "%s: cannot open the clock of /observables/%s", path, s->name);
+            snprintf(err, errlen, "%s: cannot open the clock of %s/%s", path, obs, s->name);
             rc = 2;
         }
         if (!rc && s->rows &&
@@ -140,7 +137,7 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
             rc = 2;
         if (!rc && s->rows && (H5Dread(dt, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->time) < 0 ||
                                H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->step) < 0)) {
-            snprintf(err, errlen, "%s: cannot read the clock of /observables/%s", path, s->name);
+            snprintf(err, errlen, "%s: cannot read the clock of %s/%s", path, obs, s->name);
             rc = 2;
         }
         if (dt >= 0) H5Dclose(dt);
@@ -148,7 +145,7 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
     }
 done:
     if (f >= 0) H5Fclose(f);
-    H5Eset_auto2(H5E_DEFAULT, func, data);
+    cdh5_quiet_end(&q);
     if (rc) series_free(set);
     return rc;
 }

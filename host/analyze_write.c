@@ -12,6 +12,7 @@
 #include <cjson/cJSON.h>
 #include <hdf5.h>
 #include "io_h5_journal.h"
+#include "io_h5_layout.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -62,7 +63,7 @@ static int write_group(hid_t parent, const cd_an_group *g)
         hid_t sp = H5Screate_simple(2, dims, NULL);
         hid_t d = H5Dcreate2(grp, c->name, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         rc = d < 0 || (c->rows && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, c->data) < 0) ||
-             attr_string(d, "columns", c->columns) || attr_string(d, "unit", c->units);
+             attr_string(d, "columns", c->columns) || attr_string(d, CDH5_NAME(UNIT), c->units);
         if (d >= 0) H5Dclose(d);
         H5Sclose(sp);
     }
@@ -92,10 +93,10 @@ int cd_an_write_h5(const char *path, const cd_an_report *rep, char *err, size_t 
                  "is it read-only? --no-write skips this)", path);
         goto done;
     }
-    top = open_or_create(f, "analysis");
+    top = open_or_create(f, CDH5_PATH(ANALYSIS));
     if (top < 0) goto fail;
     char sname[64];
-    snprintf(sname, sizeof sname, "snapshot_%lld", rep->step);
+    snprintf(sname, sizeof sname, "%s%lld", CDH5_NAME(ANALYSIS_SNAPSHOT), rep->step);
     int any_snapshot = 0;
     for (int k = 0; k < rep->n_groups; k++) any_snapshot |= !run_wide(rep->groups[k].name);
     if (any_snapshot) {
@@ -116,13 +117,13 @@ int cd_an_write_h5(const char *path, const cd_an_report *rep, char *err, size_t 
     rc = 0;
     goto done;
 fail:
-    snprintf(err, errlen, "%s: cannot write the /analysis group", path);
+    snprintf(err, errlen, "%s: cannot write the %s group", path, CDH5_PATH(ANALYSIS));
     cdh5_drop_on_close(f);
 done:
     if (snap >= 0) H5Gclose(snap);
     if (top >= 0) H5Gclose(top);
     if (f >= 0 && H5Fclose(f) < 0 && rc == 0) {
-        snprintf(err, errlen, "%s: closing the file after writing /analysis failed", path);
+        snprintf(err, errlen, "%s: closing the file after writing %s failed", path, CDH5_PATH(ANALYSIS));
         rc = -1;
     }
     H5Eset_auto2(H5E_DEFAULT, func, data);

@@ -6,22 +6,7 @@
 #include <string.h>
 #include <hdf5.h>
 #include "export_internal.h"
-
-static int cd_export_exists(hid_t loc, const char *path)
-{
-    /* H5Lexists fails (instead of returning 0) when an intermediate group is
-     * missing, so walk the path one component at a time. */
-    char buf[CD_EXPORT_PATH];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *p = buf + (buf[0] == '/'); ; ) {
-        char *slash = strchr(p, '/');
-        if (slash) *slash = 0;
-        if (H5Lexists(loc, buf, H5P_DEFAULT) <= 0) return 0;
-        if (!slash) return 1;
-        *slash = '/';
-        p = slash + 1;
-    }
-}
+#include "io_h5_layout.h"
 
 /* Shape and XDMF number type of a dataset; -1 when it is missing or not a
  * plain integer or floating-point array of rank 1..3. */
@@ -29,7 +14,7 @@ static int cd_export_describe(hid_t f, const char *path, cd_export_field *fl)
 {
     memset(fl, 0, sizeof *fl);
     snprintf(fl->src, sizeof fl->src, "%s", path);
-    if (!cd_export_exists(f, path)) return -1;
+    if (!cdh5_exists(f, path)) return -1;
     hid_t o = H5Oopen(f, path, H5P_DEFAULT);
     if (o < 0) return -1;
     H5I_type_t type = H5Iget_type(o);
@@ -62,20 +47,8 @@ static int cd_export_read_all(cd_export_ctx *x, const char *path, hid_t memtype,
 {
     hid_t d = H5Dopen2(x->f, path, H5P_DEFAULT);
     if (d < 0) return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: missing dataset %s (is this a capdem run file?)", x->path, path);
-    hid_t fs = H5Dget_space(d);
-    hsize_t start = 0, count = n;
-    int rc = -1;
-    if (H5Sget_simple_extent_ndims(fs) == 1) {
-        hsize_t have;
-        H5Sget_simple_extent_dims(fs, &have, NULL);
-        if (have >= n) {
-            hid_t ms = H5Screate_simple(1, &count, NULL);
-            H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &count, NULL);
-            rc = n == 0 ? 0 : H5Dread(d, memtype, ms, fs, H5P_DEFAULT, buf);
-            H5Sclose(ms);
-        }
-    }
-    H5Sclose(fs);
+    hsize_t dims[3];
+    int rc = cdh5_dims(d, dims) == 1 && dims[0] >= n ? cdh5_read_rows(d, 0, n, memtype, buf) : -1;
     H5Dclose(d);
     if (rc < 0) return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: cannot read %llu values of %s", x->path, (unsigned long long)n, path);
     return 0;
@@ -166,7 +139,8 @@ static void cd_export_walk(cd_export_ctx *x, const char *base, const char *rel, 
             /* `capdem analyze` keeps per-snapshot summary tables (histograms,
              * fits: docs/analysis.md) in /analysis/snapshot_<step>; their
              * rows are bins, not particles, whatever their length. */
-            if (!strcmp(base, "/analysis") && depth == 0 && !strncmp(name, "snapshot_", 9)) continue;
+            const char *snap = CDH5_NAME(ANALYSIS_SNAPSHOT);
+            if (!strcmp(base, CDH5_PATH(ANALYSIS)) && depth == 0 && !strncmp(name, snap, strlen(snap))) continue;
             cd_export_walk(x, base, child, depth + 1);
             continue;
         }
@@ -175,21 +149,21 @@ static void cd_export_walk(cd_export_ctx *x, const char *base, const char *rel, 
          * names become a_b_c. */
         char label[96];
         snprintf(label, sizeof label, "%.95s", child);
-        size_t n = strlen(label);
-        if (n > 6 && !strcmp(label + n - 6, "/value")) label[n - 6] = 0;
+        size_t n = strlen(label), v = strlen(CDH5_NAME(VALUE));
+        if (n > v + 1 && label[n - v - 1] == '/' && !strcmp(label + n - v, CDH5_NAME(VALUE))) label[n - v - 1] = 0;
         for (char *p = label; *p; p++)
             if (*p == '/') *p = '_';
-        if (!strcmp(base, "/analysis")) {
+        if (!strcmp(base, CDH5_PATH(ANALYSIS))) {
             cd_export_classify(x, path, label, CD_EXPORT_ANALYSIS);
-        } else if (!strcmp(base, "/particles/all")) {
+        } else if (!strcmp(base, CDH5_PATH(PARTICLES))) {
             /* Time-dependent columns are <name>/value; position is the
              * geometry, not an attribute. */
-            if (strcmp(label, "position") && depth == 1 && !strcmp(name, "value"))
+            if (strcmp(label, "position") && depth == 1 && !strcmp(name, CDH5_NAME(VALUE)))
                 cd_export_classify(x, path, label, CD_EXPORT_PART_TIME);
             else if (depth == 0)
                 cd_export_classify(x, path, label, CD_EXPORT_PART_FIXED);
-        } else if (depth == 0 && strcmp(name, "offset") && strcmp(name, "step") && strcmp(name, "time") &&
-                   strcmp(name, "pair_active")) {
+        } else if (depth == 0 && strcmp(path, CDH5_PATH(C_OFFSET)) && strcmp(name, CDH5_NAME(STEP)) &&
+                   strcmp(name, CDH5_NAME(TIME)) && strcmp(name, "pair_active")) {
             /* /contacts without the clock, the offsets and the all-ones
              * active flag. */
             cd_export_classify(x, path, label, CD_EXPORT_CONTACT);
@@ -200,15 +174,16 @@ static void cd_export_walk(cd_export_ctx *x, const char *base, const char *rel, 
 
 int cd_export_discover(cd_export_ctx *x)
 {
-    static const char *bases[] = {"/particles/all", "/contacts", "/analysis"};
+    const char *bases[] = {CDH5_PATH(PARTICLES), CDH5_PATH(CONTACTS), CDH5_PATH(ANALYSIS)};
     for (int i = 0; i < 3; i++)
-        if (cd_export_exists(x->f, bases[i])) cd_export_walk(x, bases[i], "", 0);
-    if (cd_export_describe(x->f, "/particles/prims/prim_radius", &x->prim_radius) || x->prim_radius.rank != 1 ||
-        x->prim_radius.dims[0] != x->P ||
-        cd_export_describe(x->f, "/particles/prims/prim_particle", &x->prim_particle) || x->prim_particle.rank != 1 ||
-        x->prim_particle.dims[0] != x->P)
-        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: /particles/prims/prim_radius and prim_particle must be (%llu) datasets",
-                              x->path, (unsigned long long)x->P);
+        if (cdh5_exists(x->f, bases[i])) cd_export_walk(x, bases[i], "", 0);
+    char radius[CDH5_PATH_LEN], owner[CDH5_PATH_LEN];
+    if (cd_export_describe(x->f, cdh5_column_path("prim_radius", radius), &x->prim_radius) ||
+        x->prim_radius.rank != 1 || x->prim_radius.dims[0] != x->P ||
+        cd_export_describe(x->f, cdh5_column_path("prim_particle", owner), &x->prim_particle) ||
+        x->prim_particle.rank != 1 || x->prim_particle.dims[0] != x->P)
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s and %s must be (%llu) datasets", x->path, radius, owner,
+                              (unsigned long long)x->P);
     x->prim_radius.ncomp = x->prim_particle.ncomp = 1;
     return 0;
 }
@@ -219,13 +194,13 @@ int cd_export_discover(cd_export_ctx *x)
 int cd_export_read_run(cd_export_ctx *x)
 {
     cd_export_field *pos = &x->position, *pa = &x->prim_a, *pb = &x->prim_b;
-    if (cd_export_describe(x->f, "/particles/all/position/value", pos) || pos->rank != 3 || pos->dims[2] != 3 ||
-        cd_export_describe(x->f, "/particles/prims/prim_a/value", pa) || pa->rank != 3 || pa->dims[2] != 3 ||
-        cd_export_describe(x->f, "/particles/prims/prim_b/value", pb) || pb->rank != 3 || pb->dims[2] != 3 ||
+    char ppos[CDH5_PATH_LEN], pa_path[CDH5_PATH_LEN], pb_path[CDH5_PATH_LEN];
+    if (cd_export_describe(x->f, cdh5_column_path("position", ppos), pos) || pos->rank != 3 || pos->dims[2] != 3 ||
+        cd_export_describe(x->f, cdh5_column_path("prim_a", pa_path), pa) || pa->rank != 3 || pa->dims[2] != 3 ||
+        cd_export_describe(x->f, cdh5_column_path("prim_b", pb_path), pb) || pb->rank != 3 || pb->dims[2] != 3 ||
         pa->dims[1] != pb->dims[1])
-        return cd_export_fail(x, CD_EXPORT_BAD_INPUT,
-                              "%s: not a capdem run file (needs /particles/all/position/value (S, N, 3) and "
-                              "/particles/prims/prim_a/value, prim_b/value (S, P, 3))", x->path);
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: not a capdem run file (needs %s (S, N, 3) and %s, %s (S, P, 3))",
+                              x->path, ppos, pa_path, pb_path);
     snprintf(pos->name, sizeof pos->name, "position");
     pos->ncomp = 3;
     x->N = pos->dims[1];
@@ -240,18 +215,18 @@ int cd_export_read_run(cd_export_ctx *x)
     x->step = malloc(sizeof(long long) * (size_t)x->S);
     x->time = malloc(sizeof(double) * (size_t)x->S);
     if (!x->off || !x->step || !x->time) return cd_export_fail(x, CD_EXPORT_FAIL, "out of memory");
-    if (cd_export_read_all(x, "/contacts/offset", H5T_NATIVE_LLONG, (hsize_t)x->S + 1, x->off) ||
-        cd_export_read_all(x, "/walls/step", H5T_NATIVE_LLONG, (hsize_t)x->S, x->step) ||
-        cd_export_read_all(x, "/walls/time", H5T_NATIVE_DOUBLE, (hsize_t)x->S, x->time))
+    if (cd_export_read_all(x, CDH5_PATH(C_OFFSET), H5T_NATIVE_LLONG, (hsize_t)x->S + 1, x->off) ||
+        cd_export_read_all(x, CDH5_PATH(SNAP_STEP), H5T_NATIVE_LLONG, (hsize_t)x->S, x->step) ||
+        cd_export_read_all(x, CDH5_PATH(SNAP_TIME), H5T_NATIVE_DOUBLE, (hsize_t)x->S, x->time))
         return -1;
     for (int k = 0; k < x->S; k++)
         if (x->off[k + 1] < x->off[k] || x->off[k] < 0)
-            return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: /contacts/offset decreases at snapshot %d", x->path, k);
+            return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s decreases at snapshot %d", x->path, CDH5_PATH(C_OFFSET), k);
     cd_export_field pi, pj;
     if (x->off[x->S] > 0 &&
-        (cd_export_describe(x->f, "/contacts/particle_i", &pi) || cd_export_describe(x->f, "/contacts/particle_j", &pj) ||
+        (cd_export_describe(x->f, CDH5_PATH(C_PARTICLE_I), &pi) || cd_export_describe(x->f, CDH5_PATH(C_PARTICLE_J), &pj) ||
          pi.rank != 1 || pj.rank != 1 || pi.dims[0] < (hsize_t)x->off[x->S] || pj.dims[0] < (hsize_t)x->off[x->S]))
-        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: /contacts/particle_i and particle_j must hold the %lld contact rows",
-                              x->path, x->off[x->S]);
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s and %s must hold the %lld contact rows", x->path,
+                              CDH5_PATH(C_PARTICLE_I), CDH5_PATH(C_PARTICLE_J), x->off[x->S]);
     return 0;
 }

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <hdf5.h>
 #include "export_internal.h"
+#include "io_h5_layout.h"
 #include "io_h5_check.h"
 
 /* ---- helper datasets ---------------------------------------------------- */
@@ -232,22 +233,17 @@ static int cd_export_contact_cells(cd_export_ctx *x, hid_t g, long long c0, long
     }
     size_t ijb, colb;
     if (cd_h5_mul(&ijb, (size_t)C, 2, sizeof(int)) || cd_h5_mul(&colb, (size_t)C, sizeof(int), 1) || C > (hsize_t)SIZE_MAX)
-        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: /contacts/offset: %llu contact rows overflow a size; the file "
-                              "is refused", x->path, (unsigned long long)C);
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s: %llu contact rows overflow a size; the file is refused",
+                              x->path, CDH5_PATH(C_OFFSET), (unsigned long long)C);
     int *ij = malloc(ijb), *col = malloc(colb);
     if (!ij || !col) { free(ij); free(col); return cd_export_fail(x, CD_EXPORT_FAIL, "out of memory"); }
-    const char *names[2] = {"/contacts/particle_i", "/contacts/particle_j"};
+    const char *names[2] = {CDH5_PATH(C_PARTICLE_I), CDH5_PATH(C_PARTICLE_J)};
     int rc = 0;
     for (int e = 0; e < 2 && !rc; e++) {
         hid_t d = H5Dopen2(x->f, names[e], H5P_DEFAULT);
         if (d < 0) { rc = cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: missing %s", x->path, names[e]); break; }
-        hid_t fs = H5Dget_space(d), ms = H5Screate_simple(1, &C, NULL);
-        hsize_t start = (hsize_t)c0;
-        if (H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &C, NULL) < 0 ||
-            H5Dread(d, H5T_NATIVE_INT, ms, fs, H5P_DEFAULT, col) < 0)
+        if (cdh5_read_rows(d, (hsize_t)c0, C, H5T_NATIVE_INT, col) < 0)
             rc = cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: cannot read rows %lld..%lld of %s", x->path, c0, c1 - 1, names[e]);
-        H5Sclose(ms);
-        H5Sclose(fs);
         H5Dclose(d);
         for (hsize_t r = 0; r < C && !rc; r++) ij[2 * r + (hsize_t)e] = col[r];
     }

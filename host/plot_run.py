@@ -26,7 +26,7 @@ import argparse
 import os
 import sys
 
-import h5py
+import capdem_h5
 import matplotlib
 
 matplotlib.use("Agg")
@@ -216,18 +216,20 @@ def main(argv=None):
     outdir = a.outdir or os.path.splitext(a.run)[0] + "_plots"
     os.makedirs(outdir, exist_ok=True)
     made, notes = [], []
-    with h5py.File(a.run, "r") as f:
-        if "analysis" not in f:
-            print(f"plot_run.py: {a.run} has no /analysis group: run `capdem analyze {a.run}` first", file=sys.stderr)
+    prefix = capdem_h5.NAME["analysis_snapshot"]
+    with capdem_h5.open_run(a.run) as f:
+        root = capdem_h5.analysis(f)
+        if root is None:
+            print(f"plot_run.py: {a.run} has no {capdem_h5.PATH['analysis']} group: run `capdem analyze {a.run}` first",
+                  file=sys.stderr)
             return 2
-        root = f["analysis"]
-        steps = sorted(int(k.split("_", 1)[1]) for k in root if k.startswith("snapshot_"))
+        steps = sorted(int(k[len(prefix):]) for k in root if k.startswith(prefix))
         snap = None
         if a.step is not None and a.step not in steps:
-            print(f"plot_run.py: {a.run}: no /analysis/snapshot_{a.step} (analysed: {steps})", file=sys.stderr)
+            print(f"plot_run.py: {a.run}: no {root.name}/{prefix}{a.step} (analysed: {steps})", file=sys.stderr)
             return 2
         if steps:
-            snap = root[f"snapshot_{a.step if a.step is not None else steps[-1]}"]
+            snap = root[f"{prefix}{a.step if a.step is not None else steps[-1]}"]
             jobs = [
                 lambda: plot_pf(snap, outdir, made),
                 lambda: plot_bonds(snap, outdir, made),

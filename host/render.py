@@ -23,9 +23,12 @@ import argparse
 import os
 import sys
 
+# capdem render runs this script isolated (python3 -I), without its folder
+# on the import path: capdem_h5 lies beside it.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 try:
     import numpy as np
-    import h5py
+    import capdem_h5
     import matplotlib
     matplotlib.use("Agg")  # no display needed, and none is wanted in tests
     import matplotlib.pyplot as plt
@@ -49,20 +52,20 @@ def render_read(path, snapshot):
     """Everything one picture needs, from snapshot `snapshot` (negative:
     counted from the end) of the run file."""
     try:
-        f = h5py.File(path, "r")
+        f = capdem_h5.open_run(path)
+    except capdem_h5.LayoutError as e:
+        raise BadInput(str(e))
     except OSError as e:
         raise BadInput("%s: cannot open (%s)" % (path, e))
     with f:
-        need = ["particles/prims/prim_a/value", "particles/prims/prim_b/value",
-                "particles/prims/prim_radius", "particles/prims/prim_particle",
-                "particles/all/position/value", "walls/step", "walls/time", "contacts/offset"]
+        H = capdem_h5
+        need = [H.COLUMN[c][0] for c in ("prim_a", "prim_b", "prim_radius", "prim_particle", "position")]
+        need += [H.PATH[p] for p in ("snap_step", "snap_time", "c_offset", "w_offset")]
         for name in need:
             if name not in f:
-                raise BadInput("%s: not a capdem run file (no /%s)" % (path, name))
+                raise BadInput("%s: not a capdem run file (no %s)" % (path, name))
         # docs/output.md: the committed count, never rows beyond it.
-        n = min(int(f.attrs.get("n_snapshots", 0)), len(f["walls/step"]), len(f["walls/time"]),
-                len(f["contacts/offset"]) - 1, f["particles/prims/prim_a/value"].shape[0],
-                f["particles/all/position/value"].shape[0])
+        n = min(H.snapshot_count(f), H.column_dataset(f, "prim_a").shape[0], H.column_dataset(f, "position").shape[0])
         if n <= 0:
             raise BadInput("%s: the run file holds no complete snapshot" % path)
         k = snapshot if snapshot >= 0 else n + snapshot
@@ -70,25 +73,24 @@ def render_read(path, snapshot):
             raise BadInput("%s: --snapshot %d: the file holds snapshots 0..%d (or -1..-%d from the end)"
                            % (path, snapshot, n - 1, n))
         d = {"k": k, "n": n, "path": path}
-        d["a"] = f["particles/prims/prim_a/value"][k]
-        d["b"] = f["particles/prims/prim_b/value"][k]
-        d["radius"] = f["particles/prims/prim_radius"][:]
-        d["owner"] = f["particles/prims/prim_particle"][:].astype(np.int64)
-        d["pos"] = f["particles/all/position/value"][k]
-        d["vel"] = f["particles/all/velocity/value"][k] if "particles/all/velocity/value" in f else None
-        d["shape"] = f["particles/all/shape"][:] if "particles/all/shape" in f else None
-        d["time"] = float(f["walls/time"][k])
-        d["step"] = int(f["walls/step"][k])
-        c0, c1 = (int(v) for v in f["contacts/offset"][k:k + 2])
-        if c1 > c0 and "contacts/particle_i" in f:
-            d["ci"] = f["contacts/particle_i"][c0:c1].astype(np.int64)
-            d["cj"] = f["contacts/particle_j"][c0:c1].astype(np.int64)
-            d["fn"] = (f["contacts/pair_fn"][c0:c1] if "contacts/pair_fn" in f
-                       else np.ones(c1 - c0))
+        d["a"] = H.column(f, "prim_a", k)
+        d["b"] = H.column(f, "prim_b", k)
+        d["radius"] = H.column(f, "prim_radius")
+        d["owner"] = H.column(f, "prim_particle").astype(np.int64)
+        d["pos"] = H.column(f, "position", k)
+        d["vel"] = H.column(f, "velocity", k) if H.has_column(f, "velocity") else None
+        d["shape"] = H.column(f, "shape") if H.has_column(f, "shape") else None
+        d["time"] = H.time(f, k)
+        d["step"] = H.step(f, k)
+        c0, c1 = H.rows(f, k)
+        if c1 > c0 and H.PATH["c_particle_i"] in f:
+            d["ci"] = H.snapshot_rows(f, "c_particle_i", k).astype(np.int64)
+            d["cj"] = H.snapshot_rows(f, "c_particle_j", k).astype(np.int64)
+            d["fn"] = H.column(f, "pair_fn", k) if H.has_column(f, "pair_fn") else np.ones(c1 - c0)
         else:
             d["ci"] = d["cj"] = np.zeros(0, np.int64)
             d["fn"] = np.zeros(0)
-        d["walls"] = f["walls/value"][k] if "walls/value" in f else None
+        d["walls"] = H.walls(f, k)
         d["name"] = os.path.splitext(os.path.basename(path))[0]
     return d
 
@@ -230,14 +232,14 @@ def render_walls_3d(ax, cam, d, lo3, hi3, front):
     walls = d["walls"]
     floor = None
     for w in walls:
-        if int(w["type"]) == 0 and abs(w["normal"][1]) > 0.99 and w["normal"][1] > 0:
+        if int(w["type"]) == capdem_h5.WALL_PLANE and abs(w["normal"][1]) > 0.99 and w["normal"][1] > 0:
             floor = float(w["point"][1])
     phi = np.linspace(0, 2 * np.pi, 241)
     for w in walls:
         typ = int(w["type"])
         R = float(w["radius"])
         p = np.asarray(w["point"], float)
-        if typ == 1 and R > 0:  # vertical cylinder (axis along y in capdem's set-ups)
+        if typ == capdem_h5.WALL_CYLINDER and R > 0:  # vertical cylinder (axis along y in capdem's set-ups)
             ylo = floor if floor is not None else lo3[1]
             yhi = max(hi3[1], ylo)
             for y in (ylo, yhi):
@@ -258,7 +260,7 @@ def render_walls_3d(ax, cam, d, lo3, hi3, front):
                         e = p + s * R * side
                         seg = cam.project(np.array([[e[0], ylo, e[2]], [e[0], yhi, e[2]]]))
                         ax.plot(seg[:, 0], seg[:, 1], color="0.35", lw=0.8, alpha=0.55, zorder=3)
-        elif typ == 2 and R > 0 and front:
+        elif typ == capdem_h5.WALL_SPHERE and R > 0 and front:
             c = cam.project(p)
             ax.plot(c[0] + R * np.cos(phi), c[1] + R * np.sin(phi), color="0.35", lw=0.8, alpha=0.5, zorder=3)
             drawn.append(np.stack([c[0] + R * np.cos(phi), c[1] + R * np.sin(phi)], axis=1))
@@ -309,7 +311,7 @@ def render_walls_2d(ax, d, lo, hi):
     if d["walls"] is None:
         return
     for w in d["walls"]:
-        if int(w["type"]) != 0:
+        if int(w["type"]) != capdem_h5.WALL_PLANE:
             continue
         nx, ny, nz = (float(v) for v in w["normal"])
         if abs(nz) > 0.5:
@@ -361,7 +363,7 @@ def render_picture(d, args):
         vlo, vhi = lo.copy(), hi.copy()
         if d["walls"] is not None:
             for wl in d["walls"]:
-                if int(wl["type"]) == 0 and abs(wl["normal"][2]) < 0.5:
+                if int(wl["type"]) == capdem_h5.WALL_PLANE and abs(wl["normal"][2]) < 0.5:
                     p = wl["point"]
                     if abs(wl["normal"][0]) > 0.99:
                         vlo[0], vhi[0] = min(vlo[0], p[0]), max(vhi[0], p[0])

@@ -20,7 +20,7 @@ import os
 import string
 import subprocess
 
-import h5py
+import capdem_h5
 import numpy as np
 
 import validate_runs as vr
@@ -247,12 +247,10 @@ def end_state(case):
     of that ratio and the load's range [N] over the last END_WINDOW steps: a
     packing that still swings passes the test when a check falls where its
     kinetic energy goes through zero, and these say by how much it swings."""
-    with h5py.File(case.h5, "r") as f:
-        obs = f["observables"]
-        step = obs["elastic_energy/step"][:]
-        load = obs["wall_load/value"][:]
-        ke = obs["kinetic_energy_in_contact/value"][:]
-        eel = obs["elastic_energy/value"][:]
+    with capdem_h5.open_run(case.h5) as f:
+        step, _, eel = capdem_h5.observable(f, "elastic_energy")
+        load = capdem_h5.observable(f, "wall_load")[2]
+        ke = capdem_h5.observable(f, "kinetic_energy_in_contact")[2]
     last = step >= step[-1] - END_WINDOW
     ratio = np.where(eel > 0, ke / np.where(eel > 0, eel, 1), np.nan)
     return {"load_end": float(load[-1]), "ke_over_eel_end": float(ratio[-1]),

@@ -12,7 +12,7 @@ import subprocess
 import threading
 import time
 
-import h5py
+import capdem_h5
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ARM_D = 0.005  # arm diameter [m] (SPEC 3)
@@ -59,12 +59,13 @@ def run_state(h5path, locking=True):
     if not os.path.exists(h5path):
         return None
     try:
-        with h5py.File(h5path, "r", locking=locking) as f:
-            n = min(int(f.attrs["n_snapshots"]), len(f["walls/step"]), len(f["walls/control"]))
+        with capdem_h5.open_run(h5path, locking=locking) as f:
+            control = capdem_h5.dataset(f, "control_value")
+            n = min(capdem_h5.snapshot_count(f), len(control))
             if n == 0:
                 return (0, 0, -1)
-            return (n, int(f["walls/step"][n - 1]), int(round(float(f["walls/control"][n - 1][0]))))
-    except (OSError, KeyError, TypeError, ValueError) as e:
+            return (n, capdem_h5.step(f, n - 1), int(round(float(control[n - 1][0]))))
+    except (OSError, KeyError, TypeError, ValueError, capdem_h5.LayoutError) as e:
         if locking:
             print("  %s: unreadable (%s)" % (h5path, e), flush=True)
         return None

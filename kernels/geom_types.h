@@ -14,7 +14,12 @@ typedef struct {
     cd_int parallel;  /* 1 when the parallel-contact rule placed the point */
 } cd_contact_geom;
 
-enum { CD_WALL_PLANE = 0, CD_WALL_CYLINDER = 1, CD_WALL_SPHERE = 2 };
+/* Wall kinds, CD_WALL_PLANE, CD_WALL_CYLINDER, CD_WALL_SPHERE: declared in
+ * the run file's layout (runfile.def), which stores them as they are. */
+enum {
+#define CD_H5_WALL_KIND(id, value, name) CD_WALL_##id = value,
+#include "runfile.def"
+};
 
 /* A wall.  Plain struct so that it can live in an OpenCL buffer. */
 typedef struct {

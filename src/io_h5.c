@@ -33,7 +33,7 @@ static int obs_check(cd_output *o, const cd_observable_info *obs, int n_obs)
         for (int j = 0; j < i; j++)
             if (!strcmp(obs[j].name, name)) return FAIL("%s: observable \"%s\" given twice", o->path, name);
         char p[CDH5_PATH_LEN];
-        snprintf(p, sizeof p, "/observables/%s/value", name);
+        snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(VALUE));
         if (!cdh5_exists(o->file, p)) continue;
         hsize_t dims[3];
         hid_t d = cdh5_open_dset(o, p);
@@ -65,26 +65,26 @@ static int obs_setup(cd_output *o, const cd_observable_info *obs, int n_obs)
         strcpy(b->name, name);
         b->ncomp = obs[i].ncomp;
         o->width += b->ncomp;
-        snprintf(p, sizeof p, "/observables/%s", name);
+        snprintf(p, sizeof p, "%s/%s", CDH5_PATH(OBSERVABLES), name);
         if (cdh5_exists(o->file, p)) {
             hsize_t dims[3];
-            snprintf(p, sizeof p, "/observables/%s/value", name);
+            snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(VALUE));
             b->value = cdh5_open_dset(o, p);
             if (b->value < 0 || cdh5_dims(b->value, dims) < 1) return -1;
             b->rows = dims[0];
-            snprintf(p, sizeof p, "/observables/%s/step", name);
+            snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(STEP));
             b->step = cdh5_open_dset(o, p);
-            snprintf(p, sizeof p, "/observables/%s/time", name);
+            snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(TIME));
             b->time = cdh5_open_dset(o, p);
             if (b->step < 0 || b->time < 0) return -1;
         } else {
             hsize_t d[2] = {0, (hsize_t)b->ncomp}, m[2] = {H5S_UNLIMITED, (hsize_t)b->ncomp};
             hsize_t c[2] = {CDH5_CLOCK_CHUNK, (hsize_t)b->ncomp};
-            snprintf(p, sizeof p, "/observables/%s/step", name);
+            snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(STEP));
             b->step = cdh5_make_clock(o, p, 0);
-            snprintf(p, sizeof p, "/observables/%s/time", name);
+            snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(TIME));
             b->time = cdh5_make_clock(o, p, 1);
-            snprintf(p, sizeof p, "/observables/%s/value", name);
+            snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(VALUE));
             b->value = cdh5_make_dset(o, p, H5T_IEEE_F64LE, b->ncomp > 1 ? 2 : 1, d, m, c,
                                       obs[i].unit ? obs[i].unit : "1");
             if (b->step < 0 || b->time < 0 || b->value < 0) return -1;
@@ -348,8 +348,8 @@ static int truncate_snapshots(cd_output *o, long long resume_step)
     if (cdh5_set_rows(o, o->step, CDH5_SNAP_STEP, n) || cdh5_set_rows(o, o->time, CDH5_SNAP_TIME, n) ||
         cdh5_set_rows(o, o->walls, CDH5_WALLS_VALUE, n) || cdh5_set_rows(o, o->control, CDH5_CONTROL_VALUE, n) ||
         cdh5_set_rows(o, o->c_offset, CDH5_C_OFFSET, n + 1) ||
-        cdh5_set_rows(o, o->w_offset, CDH5_W_OFFSET, n + 1) || cdh5_set_rows(o, o->c_pi, "particle_i", (hsize_t)cend) ||
-        cdh5_set_rows(o, o->c_pj, "particle_j", (hsize_t)cend) ||
+        cdh5_set_rows(o, o->w_offset, CDH5_W_OFFSET, n + 1) || cdh5_set_rows(o, o->c_pi, CDH5_PATH(C_PARTICLE_I), (hsize_t)cend) ||
+        cdh5_set_rows(o, o->c_pj, CDH5_PATH(C_PARTICLE_J), (hsize_t)cend) ||
         cdh5_set_rows(o, o->w_index, CDH5_W_INDEX, (hsize_t)wend))
         return -1;
     o->n_snap = n;
@@ -362,8 +362,8 @@ static int truncate_snapshots(cd_output *o, long long resume_step)
  * steps > resume_step. */
 static int truncate_observables(cd_output *o, long long resume_step)
 {
-    hid_t g = H5Gopen2(o->file, "/observables", H5P_DEFAULT);
-    if (g < 0) return FAIL("%s: cannot open /observables", o->path);
+    hid_t g = H5Gopen2(o->file, CDH5_PATH(OBSERVABLES), H5P_DEFAULT);
+    if (g < 0) return FAIL("%s: cannot open %s", o->path, CDH5_PATH(OBSERVABLES));
     H5G_info_t info;
     int rc = H5Gget_info(g, &info) < 0 ? FAIL("%s: cannot list /observables", o->path) : 0;
     for (hsize_t i = 0; !rc && i < info.nlinks; i++) {
@@ -373,10 +373,10 @@ static int truncate_observables(cd_output *o, long long resume_step)
             break;
         }
         hid_t d[3];
-        static const char *parts[3] = {"step", "time", "value"};
+        const char *parts[3] = {CDH5_NAME(STEP), CDH5_NAME(TIME), CDH5_NAME(VALUE)};
         hsize_t n = (hsize_t)-1, dims[3];
         for (int j = 0; j < 3; j++) {
-            snprintf(p, sizeof p, "/observables/%s/%s", name, parts[j]);
+            snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, parts[j]);
             d[j] = cdh5_open_dset(o, p);
             if (d[j] < 0 || cdh5_dims(d[j], dims) < 1) rc = -1;
             else if (dims[0] < n) n = dims[0];
@@ -411,8 +411,8 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
         o->own_lock = open(path, O_RDONLY | O_NOCTTY | O_CLOEXEC);
         if (o->own_lock >= 0) cdh5_mark(o->own_lock);
     }
-    if (!rc && (!cdh5_exists(o->file, "/h5md") || !cdh5_exists(o->file, "/observables")))
-        rc = FAIL("%s: not a capdem run file (no /h5md or /observables)", path);
+    if (!rc && (!cdh5_exists(o->file, CDH5_PATH(H5MD)) || !cdh5_exists(o->file, CDH5_PATH(OBSERVABLES))))
+        rc = FAIL("%s: not a capdem run file (no %s or %s)", path, CDH5_PATH(H5MD), CDH5_PATH(OBSERVABLES));
     if (!rc) rc = obs_check(o, obs, n_obs);
     if (!rc && cdh5_exists(o->file, CDH5_SNAP_STEP))
         rc = (cdh5_layout_open(o) || truncate_snapshots(o, resume_step)) ? -1 : 0;

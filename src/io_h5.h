@@ -105,10 +105,6 @@ int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t 
  * appends to.  Returns 0, or -1 naming the corrupted dataset in err. */
 int cd_h5_check_tails(const char *path, char *err, size_t errlen);
 
-/* The HDF5 memory type of cd_wall, as /walls/value stores it (an hid_t the
- * caller closes with H5Tclose), for readers of run files. */
-int64_t cd_h5_wall_type(void);
-
 /* Reads the config text echoed in a run file (malloc'd, caller frees). */
 char *cd_h5_read_config_text(const char *path, char *err, size_t errlen);
 

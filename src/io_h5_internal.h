@@ -1,6 +1,7 @@
-/* Private to the io_h5*.c files: names of the run-file layout and
- * small HDF5 helpers shared by the writer and the reader.  The layout
- * itself is documented in docs/output.md. */
+/* Private to the io_h5*.c files: the writer's state and helpers.  The
+ * layout (kernels/runfile.def) and the read primitives the writer shares
+ * with every reader are in io_h5_layout.h; the layout is documented in
+ * docs/output.md. */
 #ifndef CD_IO_H5_INTERNAL_H
 #define CD_IO_H5_INTERNAL_H
 #include <stddef.h>
@@ -10,72 +11,29 @@
 #include "shapes.h"
 #include "io_h5.h"
 #include "io_h5_journal.h"
+#include "io_h5_layout.h"
 
-/* Snapshot clock, hard-linked into every snapshot-indexed group. */
-#define CDH5_SNAP_STEP "/walls/step"
-#define CDH5_SNAP_TIME "/walls/time"
-#define CDH5_WALLS_VALUE "/walls/value"
-#define CDH5_CONTROL_VALUE "/walls/control"
-#define CDH5_C_OFFSET "/contacts/offset"
-#define CDH5_W_OFFSET "/wall_contacts/offset"
-#define CDH5_W_INDEX "/wall_contacts/index"
+/* Short names of the table entries (kernels/runfile.def) the writer and
+ * the resume use most. */
+#define CDH5_SNAP_STEP CDH5_PATH(SNAP_STEP)
+#define CDH5_SNAP_TIME CDH5_PATH(SNAP_TIME)
+#define CDH5_WALLS_VALUE CDH5_PATH(WALLS_VALUE)
+#define CDH5_CONTROL_VALUE CDH5_PATH(CONTROL_VALUE)
+#define CDH5_C_OFFSET CDH5_PATH(C_OFFSET)
+#define CDH5_W_OFFSET CDH5_PATH(W_OFFSET)
+#define CDH5_W_INDEX CDH5_PATH(W_INDEX)
 /* Root attribute: snapshots completely on disk (the commit record). */
-#define CDH5_COMMIT_ATTR "n_snapshots"
-#define CDH5_PATH_LEN 512
+#define CDH5_COMMIT_ATTR CDH5_NAME(COMMIT)
 
-/* How a column of fields.def is stored. */
-enum cdh5_store {
-    CDH5_FIXED,    /* once, H5MD fixed data: <group>/<name> (rows[, ncomp]) */
-    CDH5_SERIES,   /* per snapshot: <group>/<name>/value (snapshots, rows[, ncomp]) */
-    CDH5_ROWS      /* active rows of all snapshots concatenated: <group>/<name> (rows[, ncomp]) */
-};
-
-enum cdh5_store cdh5_store_of(const cd_field_info *f);
-/* "/particles/all", "/particles/prims", "/contacts", "/wall_contacts". */
-const char *cdh5_group_path(enum cd_field_group g);
-/* Path of the dataset that holds the column's values. */
-void cdh5_field_path(const cd_field_info *f, char *buf, size_t len);
-/* H5T_NATIVE_DOUBLE or H5T_NATIVE_INT32 (not to be closed). */
-hid_t cdh5_mem_type(const cd_field_info *f);
 /* 0 when a row of f is ncomp scalars of its kind, else -1 with a message. */
 int cdh5_field_check(const cd_field_info *f, char *err, size_t errlen);
-
-/* Rows of column f in dataset d (FIXED: dims[0], SERIES: dims[1], ROWS:
- * dims[0]) after checking its rank, ncomp and number class; -1 with a
- * message naming file and dpath when they do not fit. */
-long long cdh5_field_rows(hid_t d, const cd_field_info *f, const char *dpath, const char *file, char *err,
-                          size_t errlen);
 
 /* Largest row of any column, and at least 8 (int64 scratch). */
 size_t cdh5_max_row_bytes(void);
 
-/* Compound type of cd_wall in memory (caller closes). */
-hid_t cdh5_wall_mem_type(void);
-
-/* snprintf into err, followed by the innermost message of HDF5's error
- * stack when it holds one. */
-void cdh5_msg(char *err, size_t errlen, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-/* 1 when every link of the absolute or relative path exists, else 0. */
-int cdh5_exists(hid_t loc, const char *path);
-/* Rank of the dataset, dims (up to 3) in dims; -1 on failure. */
-int cdh5_dims(hid_t dset, hsize_t dims[3]);
-/* Reads count0 rows from row start0 of a dataset of rank 1..3 into buf. */
-herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype, void *buf);
-/* Snapshots completely on disk: min(commit attribute, length of the
- * snapshot step and time); 0 when the file has no snapshot yet; -1 on error. */
-long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen);
-/* Opens a run file read-only (err names it on failure), or returns < 0. */
-hid_t cdh5_open_ro(const char *path, char *err, size_t errlen);
-
-/* Silences HDF5's automatic error printing inside a public function. */
-typedef struct { H5E_auto2_t func; void *data; } cdh5_quiet;
-void cdh5_quiet_begin(cdh5_quiet *q);
-void cdh5_quiet_end(const cdh5_quiet *q);
+/* The attribute units of /walls/value: "type 1, point m, ...", the wall
+ * members of runfile.def and their units. */
+void cdh5_wall_units(char *buf, size_t len);
 
 /* ---- writer: io_h5.c, io_h5_write.c, io_h5_snapshot.c ------------------- */
 

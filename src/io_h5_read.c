@@ -1,5 +1,7 @@
-/* Reading a run file back (snapshots for resume, the echoed config) and the
- * layout helpers shared with the writer (io_h5.c).  Layout: docs/output.md. */
+/* Reading a run file back (snapshots for resume, the echoed config), the
+ * layout of kernels/runfile.def as C tables, and the read primitives that
+ * the writer and every reader share (io_h5_layout.h).  Layout:
+ * docs/output.md. */
 #include "io_h5.h"
 #include "io_h5_internal.h"
 #include "io_h5_check.h"
@@ -10,12 +12,23 @@
 #include <stdlib.h>
 #include <string.h>
 
+const char *const cdh5_paths[CDH5_N_PATHS] = {
+#define CD_H5_GROUP(id, path, made, meaning) path,
+#define CD_H5_DATASET(id, path, type, unit, meaning) path,
+#include "../kernels/runfile.def"
+};
+
+const char *const cdh5_names[CDH5_N_NAMES] = {
+#define CD_H5_NAME(id, name, meaning) name,
+#include "../kernels/runfile.def"
+};
+
 /* Columns that a run never changes: stored once as H5MD fixed data.  Every
  * other PARTICLE and PRIM column is stored per snapshot, so a column added
- * to fields.def is a time series unless it is named here. */
+ * to fields.def is a time series unless runfile.def names it. */
 static const char *const fixed_columns[] = {
-    "mass", "inertia", "scale", "shape", "prim_first", "prim_count",
-    "prim_particle", "prim_a_body", "prim_b_body", "prim_radius",
+#define CD_H5_FIXED(column) column,
+#include "../kernels/runfile.def"
 };
 
 enum cdh5_store cdh5_store_of(const cd_field_info *f)
@@ -29,13 +42,25 @@ enum cdh5_store cdh5_store_of(const cd_field_info *f)
 const char *cdh5_group_path(enum cd_field_group g)
 {
     switch (g) {
-    case CD_GROUP_PARTICLE: return "/particles/all";
-    case CD_GROUP_PRIM: return "/particles/prims";
-    case CD_GROUP_PAIR:
-    case CD_GROUP_PAIR_OUT: return "/contacts";
-    case CD_GROUP_WALLC: return "/wall_contacts";
+#define CD_H5_COLUMN_GROUP(field_group, id) case CD_GROUP_##field_group: return CDH5_PATH(id);
+#include "../kernels/runfile.def"
     default: return "/unknown";
     }
+}
+
+const cd_field_info *cdh5_column(const char *name)
+{
+    for (size_t k = 0; k < cd_n_fields; k++)
+        if (!strcmp(cd_fields[k].name, name)) return &cd_fields[k];
+    return NULL;
+}
+
+const char *cdh5_column_path(const char *name, char *buf)
+{
+    const cd_field_info *f = cdh5_column(name);
+    if (f) cdh5_field_path(f, buf, CDH5_PATH_LEN);
+    else snprintf(buf, CDH5_PATH_LEN, "(no column %s in fields.def)", name);
+    return buf;
 }
 
 void cdh5_field_path(const cd_field_info *f, char *buf, size_t len)
@@ -68,22 +93,30 @@ size_t cdh5_max_row_bytes(void)
     return m;
 }
 
-int64_t cd_h5_wall_type(void) { return cdh5_wall_mem_type(); }
+/* HDF5 type of one member of /walls/value: a scalar, or an array of ncomp. */
+static hid_t wall_member_type(hid_t scalar, hsize_t ncomp)
+{
+    return ncomp == 1 ? H5Tcopy(scalar) : H5Tarray_create2(scalar, 1, &ncomp);
+}
 
 hid_t cdh5_wall_mem_type(void)
 {
-    hsize_t three = 3;
-    hid_t t = H5Tcreate(H5T_COMPOUND, sizeof(cd_wall));
-    hid_t v3 = H5Tarray_create2(H5T_NATIVE_DOUBLE, 1, &three);
-    H5Tinsert(t, "type", HOFFSET(cd_wall, type), H5T_NATIVE_INT32);
-    H5Tinsert(t, "point", HOFFSET(cd_wall, point), v3);
-    H5Tinsert(t, "normal", HOFFSET(cd_wall, normal), v3);
-    H5Tinsert(t, "velocity", HOFFSET(cd_wall, velocity), v3);
-    H5Tinsert(t, "radius", HOFFSET(cd_wall, radius), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "radial_velocity", HOFFSET(cd_wall, radial_velocity), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "friction", HOFFSET(cd_wall, friction), H5T_NATIVE_DOUBLE);
-    H5Tclose(v3);
+    hid_t t = H5Tcreate(H5T_COMPOUND, sizeof(cd_wall)), m;
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                                  \
+    m = wall_member_type(CD_KIND_##type == CD_KIND_INT ? H5T_NATIVE_INT32 : H5T_NATIVE_DOUBLE, ncomp); \
+    H5Tinsert(t, #name, HOFFSET(cd_wall, name), m);                                                 \
+    H5Tclose(m);
+#include "../kernels/runfile.def"
     return t;
+}
+
+void cdh5_wall_units(char *buf, size_t len)
+{
+    size_t at = 0;
+    buf[0] = 0;
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit) \
+    if (at < len) at += (size_t)snprintf(buf + at, len - at, "%s" #name " " unit, at ? ", " : "");
+#include "../kernels/runfile.def"
 }
 
 static herr_t innermost(unsigned n, const H5E_error2_t *e, void *data)
@@ -192,7 +225,7 @@ static long long rows_of_path(hid_t file, const char *path, const char *fname, c
 long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen)
 {
     if (!cdh5_exists(file, CDH5_SNAP_STEP)) return 0;
-    static const char *const clocks[4] = {CDH5_SNAP_STEP, CDH5_SNAP_TIME, CDH5_C_OFFSET, CDH5_W_OFFSET};
+    const char *const clocks[4] = {CDH5_SNAP_STEP, CDH5_SNAP_TIME, CDH5_C_OFFSET, CDH5_W_OFFSET};
     long long n = -1;
     for (int i = 0; i < 4; i++) {
         long long r = rows_of_path(file, clocks[i], path, err, errlen);
@@ -203,7 +236,9 @@ long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen)
     if (H5Aexists(file, CDH5_COMMIT_ATTR) > 0) {
         long long c = -1;
         hid_t a = H5Aopen(file, CDH5_COMMIT_ATTR, H5P_DEFAULT);
-        if (a >= 0 && cd_h5_check_number_attr(a, path, "/" CDH5_COMMIT_ATTR, err, errlen)) {
+        char what[64];
+        snprintf(what, sizeof what, "/%s", CDH5_COMMIT_ATTR);
+        if (a >= 0 && cd_h5_check_number_attr(a, path, what, err, errlen)) {
             H5Aclose(a);
             return -1;
         }
@@ -475,7 +510,7 @@ static char *read_text(const char *path, const char *dpath, char *err, size_t er
 
 char *cd_h5_read_config_text(const char *path, char *err, size_t errlen)
 {
-    return read_text(path, "/parameters/config", err, errlen);
+    return read_text(path, CDH5_PATH(CONFIG), err, errlen);
 }
 
 char *cd_h5_read_latest_config_text(const char *path, char *where, size_t wlen, char *err, size_t errlen)
@@ -486,15 +521,15 @@ char *cd_h5_read_latest_config_text(const char *path, char *where, size_t wlen, 
     int k = 0;
     char p[CDH5_PATH_LEN];
     while (f >= 0 && k < 1000000) {
-        snprintf(p, sizeof p, "/parameters/resumes/%d", k);
+        snprintf(p, sizeof p, "%s/%d", CDH5_PATH(RESUMES), k);
         if (!cdh5_exists(f, p)) break;
         k++;
     }
     if (f >= 0) H5Fclose(f);
     cdh5_quiet_end(&q);
     if (f < 0) return NULL;
-    if (k > 0) snprintf(where, wlen, "/parameters/resumes/%d", k - 1);
-    else snprintf(where, wlen, "/parameters/config");
+    if (k > 0) snprintf(where, wlen, "%s/%d", CDH5_PATH(RESUMES), k - 1);
+    else snprintf(where, wlen, "%s", CDH5_PATH(CONFIG));
     return read_text(path, where, err, errlen);
 }
 
@@ -502,15 +537,23 @@ static char *read_text(const char *path, const char *dpath, char *err, size_t er
 {
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
+    hid_t f = cdh5_open_ro(path, err, errlen);
+    char *out = f < 0 ? NULL : cdh5_read_string(f, path, dpath, (size_t)1 << 26, err, errlen);
+    if (f >= 0) H5Fclose(f);
+    cdh5_quiet_end(&q);
+    return out;
+}
+
+char *cdh5_read_string(hid_t f, const char *path, const char *dpath, size_t max_bytes, char *err, size_t errlen)
+{
     char *out = NULL;
-    hid_t f = cdh5_open_ro(path, err, errlen), d = -1, t = -1, mt = -1;
-    if (f < 0) goto done;
+    hid_t d = -1, t = -1, mt = -1;
     d = H5Dopen2(f, dpath, H5P_DEFAULT);
     if (d < 0) {
         cdh5_msg(err, errlen, "%s: cannot open dataset %s", path, dpath);
         goto done;
     }
-    if (cd_h5_check_string(d, 0, path, dpath, (size_t)1 << 26, err, errlen)) goto done;
+    if (cd_h5_check_string(d, 0, path, dpath, max_bytes, err, errlen)) goto done;
     t = H5Dget_type(d);
     mt = H5Tcopy(t);
     if (H5Tis_variable_str(t) > 0) {
@@ -539,7 +582,5 @@ done:
     if (mt >= 0) H5Tclose(mt);
     if (t >= 0) H5Tclose(t);
     if (d >= 0) H5Dclose(d);
-    if (f >= 0) H5Fclose(f);
-    cdh5_quiet_end(&q);
     return out;
 }

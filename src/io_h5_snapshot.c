@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-_Static_assert(sizeof(cd_wall) == 104, "cd_wall changed: update cdh5_wall_mem_type and docs/output.md");
+_Static_assert(sizeof(cd_wall) == 104, "cd_wall changed: update the wall members of kernels/runfile.def and docs/output.md");
 
 /* ---- snapshot layout ------------------------------------------------------ */
 
@@ -25,10 +25,10 @@ static size_t rows_of(const cd_output *o, enum cd_field_group g)
 static int link_clock(cd_output *o, const char *group)
 {
     char p[CDH5_PATH_LEN];
-    snprintf(p, sizeof p, "%s/step", group);
+    snprintf(p, sizeof p, "%s/%s", group, CDH5_NAME(STEP));
     if (H5Lcreate_hard(o->file, CDH5_SNAP_STEP, o->file, p, H5P_DEFAULT, H5P_DEFAULT) < 0)
         return FAIL("%s: cannot link %s", o->path, p);
-    snprintf(p, sizeof p, "%s/time", group);
+    snprintf(p, sizeof p, "%s/%s", group, CDH5_NAME(TIME));
     if (H5Lcreate_hard(o->file, CDH5_SNAP_TIME, o->file, p, H5P_DEFAULT, H5P_DEFAULT) < 0)
         return FAIL("%s: cannot link %s", o->path, p);
     return 0;
@@ -108,20 +108,20 @@ int cdh5_layout_create(cd_output *o, const cd_state *s)
     hsize_t wd[2] = {0, nw}, wm[2] = {H5S_UNLIMITED, nw1}, wc[2] = {64, nw1};
     o->walls = cdh5_make_dset(o, CDH5_WALLS_VALUE, ft, 2, wd, wm, wc, NULL);
     H5Tclose(ft);
-    if (o->walls < 0 || cdh5_attr_str(o, o->walls, CDH5_WALLS_VALUE, "units",
-                                 "type 1, point m, normal 1, velocity m/s, radius m, radial_velocity m/s, friction 1"))
-        return -1;
+    char units[256];
+    cdh5_wall_units(units, sizeof units);
+    if (o->walls < 0 || cdh5_attr_str(o, o->walls, CDH5_WALLS_VALUE, CDH5_NAME(WALL_UNITS), units)) return -1;
     hsize_t cd0[2] = {0, CD_CONTROL_SLOTS}, cdm[2] = {H5S_UNLIMITED, CD_CONTROL_SLOTS}, cdc[2] = {64, CD_CONTROL_SLOTS};
     o->control = cdh5_make_dset(o, CDH5_CONTROL_VALUE, H5T_IEEE_F64LE, 2, cd0, cdm, cdc, "mixed, see docs/protocols.md");
     if (o->control < 0) return -1;
-    if (link_clock(o, "/contacts") || link_clock(o, "/wall_contacts")) return -1;
+    if (link_clock(o, CDH5_PATH(CONTACTS)) || link_clock(o, CDH5_PATH(WALL_CONTACTS))) return -1;
     for (size_t k = 0; k < cd_n_fields; k++) {
         if (cdh5_field_check(&cd_fields[k], o->err, sizeof o->err)) return cdh5_report(o);
         if (create_col(o, s, k)) return -1;
     }
     hsize_t cr = clamp(4 * o->n_prims, 256, CDH5_LARGE_CHUNK / 4);
-    o->c_pi = cdh5_make_dset(o, "/contacts/particle_i", H5T_STD_I32LE, 1, &z, &unl, &cr, "1");
-    o->c_pj = cdh5_make_dset(o, "/contacts/particle_j", H5T_STD_I32LE, 1, &z, &unl, &cr, "1");
+    o->c_pi = cdh5_make_dset(o, CDH5_PATH(C_PARTICLE_I), H5T_STD_I32LE, 1, &z, &unl, &cr, "1");
+    o->c_pj = cdh5_make_dset(o, CDH5_PATH(C_PARTICLE_J), H5T_STD_I32LE, 1, &z, &unl, &cr, "1");
     o->c_offset = cdh5_make_dset(o, CDH5_C_OFFSET, H5T_STD_I64LE, 1, &z, &unl, &ch, "1");
     o->w_offset = cdh5_make_dset(o, CDH5_W_OFFSET, H5T_STD_I64LE, 1, &z, &unl, &ch, "1");
     hsize_t wr = clamp(o->n_prims, 256, CDH5_LARGE_CHUNK / 8);
@@ -140,7 +140,9 @@ int cdh5_layout_create(cd_output *o, const cd_state *s)
  * resumed run appends to it like to any other. */
 static int add_pair_force(cd_output *o, size_t k)
 {
-    static const char *const parts[3] = {"/contacts/pair_ft", "/contacts/pair_fn", "/contacts/pair_normal"};
+    static const char *const names[3] = {"pair_ft", "pair_fn", "pair_normal"};
+    char parts[3][CDH5_PATH_LEN];
+    for (int i = 0; i < 3; i++) cdh5_column_path(names[i], parts[i]);
     hsize_t dims[3];
     hid_t d[3];
     for (int i = 0; i < 3; i++) d[i] = -1;
@@ -184,8 +186,8 @@ int cdh5_layout_open(cd_output *o)
     o->time = cdh5_open_dset(o, CDH5_SNAP_TIME);
     o->walls = cdh5_open_dset(o, CDH5_WALLS_VALUE);
     o->c_offset = cdh5_open_dset(o, CDH5_C_OFFSET);
-    o->c_pi = cdh5_open_dset(o, "/contacts/particle_i");
-    o->c_pj = cdh5_open_dset(o, "/contacts/particle_j");
+    o->c_pi = cdh5_open_dset(o, CDH5_PATH(C_PARTICLE_I));
+    o->c_pj = cdh5_open_dset(o, CDH5_PATH(C_PARTICLE_J));
     o->w_offset = cdh5_open_dset(o, CDH5_W_OFFSET);
     o->w_index = cdh5_open_dset(o, CDH5_W_INDEX);
     o->control = cdh5_open_dset(o, CDH5_CONTROL_VALUE);
@@ -272,7 +274,7 @@ static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g
                 cd_int prim = side[e][idx[r]];
                 p[r] = prim >= 0 && (size_t)prim < s->n_prims ? s->prim_particle[prim] : -1;
             }
-            if (cdh5_append(o, ds[e], e ? "/contacts/particle_j" : "/contacts/particle_i", at, m, H5T_NATIVE_INT32, p))
+            if (cdh5_append(o, ds[e], e ? CDH5_PATH(C_PARTICLE_J) : CDH5_PATH(C_PARTICLE_I), at, m, H5T_NATIVE_INT32, p))
                 return -1;
         }
     } else {

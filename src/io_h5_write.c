@@ -205,10 +205,13 @@ static int write_h5md(cd_output *o)
     return rc;
 }
 
-static int write_box(cd_output *o, const char *path)
+/* The H5MD box of a particles group. */
+static int write_box(cd_output *o, const char *group)
 {
     static const int dim = 3;
     static const char boundary[3][5] = {"none", "none", "none"};
+    char path[CDH5_PATH_LEN];
+    snprintf(path, sizeof path, "%s/box", group);
     hid_t g = cdh5_make_group(o, path);
     if (g < 0) return -1;
     hid_t t = H5Tcopy(H5T_C_S1);
@@ -230,10 +233,11 @@ static int write_config(cd_output *o, const cd_config *cfg)
     hid_t t = H5Tcopy(H5T_C_S1);
     H5Tset_size(t, len ? len : 1);
     H5Tset_strpad(t, H5T_STR_NULLPAD);
-    hid_t d = cdh5_make_dset(o, "/parameters/config", t, 0, NULL, NULL, NULL, NULL);
-    int rc = cdh5_write_all(o, d, "/parameters/config", t, text);
-    if (!rc) rc = cdh5_attr_str(o, d, "/parameters/config", "source_path", cfg ? cfg->source_path : "");
-    if (!rc) rc = cdh5_attr_str(o, d, "/parameters/config", "format", "yaml");
+    const char *p = CDH5_PATH(CONFIG);
+    hid_t d = cdh5_make_dset(o, p, t, 0, NULL, NULL, NULL, NULL);
+    int rc = cdh5_write_all(o, d, p, t, text);
+    if (!rc) rc = cdh5_attr_str(o, d, p, "source_path", cfg ? cfg->source_path : "");
+    if (!rc) rc = cdh5_attr_str(o, d, p, "format", "yaml");
     cdh5_close_dset(&d);
     H5Tclose(t);
     return rc;
@@ -245,7 +249,7 @@ int cd_output_note_resume(cd_output *o, long long step, const cd_config *cfg)
     cdh5_quiet_begin(&q);
     char p[CDH5_PATH_LEN];
     int k = 0;
-    do snprintf(p, sizeof p, "/parameters/resumes/%d", k++);
+    do snprintf(p, sizeof p, "%s/%d", CDH5_PATH(RESUMES), k++);
     while (cdh5_exists(o->file, p) && k < 1000000);
     const char *text = cfg && cfg->source_text ? cfg->source_text : "";
     size_t len = strlen(text);
@@ -279,7 +283,7 @@ static int write_shape(cd_output *o, int k, const cd_shape *sh)
     char g[96], p[160];
     if (sh->n_prims < 0 || sh->n_prims > CD_MAX_ARMS)
         return FAIL("%s: shape %d has %d arms (0..%d allowed)", o->path, k, sh->n_prims, CD_MAX_ARMS);
-    snprintf(g, sizeof g, "/parameters/shapes/%d", k);
+    snprintf(g, sizeof g, "%s/%d", CDH5_PATH(SHAPES), k);
     hid_t gid = cdh5_make_group(o, g);
     if (gid < 0) return -1;
     cdh5_close_id(&gid);
@@ -291,7 +295,7 @@ static int write_shape(cd_output *o, int k, const cd_shape *sh)
     memcpy(kind, sh->kind, klen);
     kind[klen] = 0;
     H5Tset_size(t, klen + 1);
-    snprintf(p, sizeof p, "%s/kind", g);
+    snprintf(p, sizeof p, "%s/%s", g, CDH5_NAME(SHAPE_KIND));
     hid_t d = cdh5_make_dset(o, p, t, 0, NULL, NULL, NULL, NULL);
     int rc = cdh5_write_all(o, d, p, t, kind);
     cdh5_close_dset(&d);
@@ -304,26 +308,15 @@ static int write_shape(cd_output *o, int k, const cd_shape *sh)
         memcpy(arms[i], row, sizeof row);
     }
     hsize_t ad[2] = {(hsize_t)sh->n_prims, 7};
-    snprintf(p, sizeof p, "%s/arms", g);
+    snprintf(p, sizeof p, "%s/%s", g, CDH5_NAME(SHAPE_ARMS));
     d = cdh5_make_dset(o, p, H5T_IEEE_F64LE, 2, ad, NULL, NULL, "m");
     rc = sh->n_prims ? cdh5_write_all(o, d, p, H5T_NATIVE_DOUBLE, arms) : (d < 0 ? -1 : 0);
     if (!rc) rc = cdh5_attr_str(o, d, p, "columns", "a_x a_y a_z b_x b_y b_z radius");
     cdh5_close_dset(&d);
     if (rc) return rc;
     struct { const char *name, *unit; const double *v; int rank; hsize_t dims[2]; } items[] = {
-        {"aspect", "1", &sh->aspect, 0, {0, 0}},
-        {"tip_length", "m", &sh->tip_length, 0, {0, 0}},
-        {"diameter", "m", &sh->diameter, 0, {0, 0}},
-        {"bounding_radius", "m", &sh->bounding_radius, 0, {0, 0}},
-        {"density", "kg/m^3", &sh->density, 0, {0, 0}},
-        {"volume", "m^3", &sh->volume, 0, {0, 0}},
-        {"area", "m^2", &sh->area, 0, {0, 0}},
-        {"sphericity", "1", &sh->sphericity, 0, {0, 0}},
-        {"mass", "kg", &sh->mass, 0, {0, 0}},
-        {"principal_moments", "kg m^2", sh->principal, 1, {3, 0}},
-        {"inertia", "kg m^2", &sh->inertia[0][0], 2, {3, 3}},
-        {"volume_rel_error", "1", &sh->volume_rel_error, 0, {0, 0}},
-        {"area_rel_error", "1", &sh->area_rel_error, 0, {0, 0}},
+#define CD_H5_SHAPE_VALUE(name, member, rank, dim0, dim1, unit) {name, unit, &sh->member, rank, {dim0, dim1}},
+#include "../kernels/runfile.def"
     };
     for (size_t i = 0; i < sizeof items / sizeof items[0] && !rc; i++) {
         snprintf(p, sizeof p, "%s/%s", g, items[i].name);
@@ -334,20 +327,28 @@ static int write_shape(cd_output *o, int k, const cd_shape *sh)
 
 int cdh5_write_header(cd_output *o, const cd_config *cfg, const cd_shape *shapes, int n_shapes)
 {
-    static const char *groups[] = {"/particles/all", "/particles/prims", "/contacts", "/wall_contacts", "/walls",
-                                   "/observables", "/parameters/shapes"};
+    const char *groups[] = {
+#define CD_H5_GROUP(id, path, made, meaning) CD_H5_IF_##made(path)
+#define CD_H5_IF_HEADER(path) path,
+#define CD_H5_IF_WRITER(path)
+#define CD_H5_IF_OPTIONAL(path)
+#include "../kernels/runfile.def"
+#undef CD_H5_IF_HEADER
+#undef CD_H5_IF_WRITER
+#undef CD_H5_IF_OPTIONAL
+    };
     if (write_h5md(o) || write_config(o, cfg)) return -1;
     for (size_t i = 0; i < sizeof groups / sizeof groups[0]; i++) {
         hid_t g = cdh5_make_group(o, groups[i]);
         if (g < 0) return -1;
         cdh5_close_id(&g);
     }
-    hid_t g = H5Gopen2(o->file, "/parameters/shapes", H5P_DEFAULT);
-    int rc = cdh5_attr_ints(o, g, "/parameters/shapes", "count", &n_shapes, 0);
+    hid_t g = H5Gopen2(o->file, CDH5_PATH(SHAPES), H5P_DEFAULT);
+    int rc = cdh5_attr_ints(o, g, CDH5_PATH(SHAPES), CDH5_NAME(SHAPE_COUNT), &n_shapes, 0);
     cdh5_close_id(&g);
     for (int k = 0; k < n_shapes && !rc; k++) rc = write_shape(o, k, &shapes[k]);
-    if (!rc) rc = write_box(o, "/particles/all/box");
-    if (!rc) rc = write_box(o, "/particles/prims/box");
+    if (!rc) rc = write_box(o, CDH5_PATH(PARTICLES));
+    if (!rc) rc = write_box(o, CDH5_PATH(PRIMS));
     if (!rc) rc = cdh5_write_commit(o, 0);
     return rc;
 }

@@ -23,19 +23,14 @@ counts and the largest body extent (for LAMMPS's ghost cut-off).
 import argparse
 import json
 import math
+import os
 import re
 import sys
 
-import h5py
 import numpy as np
 
-
-def column(group, name):
-    """Last snapshot of a time-dependent column, or a fixed column."""
-    obj = group[name]
-    if isinstance(obj, h5py.Group):
-        return np.asarray(obj["value"][-1])
-    return np.asarray(obj[()])
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "host"))  # capdem_h5
+import capdem_h5  # noqa: E402
 
 
 def config_value(text, key):
@@ -46,17 +41,18 @@ def config_value(text, key):
 
 
 def read_run(path):
-    with h5py.File(path, "r") as f:
-        cfg = f["/parameters/config"][()]
-        cfg = cfg.decode() if isinstance(cfg, bytes) else str(cfg)
-        P = f["/particles/all"]
-        Q = f["/particles/prims"]
+    with capdem_h5.open_run(path) as f:
+        cfg = capdem_h5.config_text(f)
+        k = capdem_h5.snapshot_count(f) - 1  # the last snapshot
+
+        def column(name):
+            return capdem_h5.column(f, name, k)
         run = {
             "config": cfg,
-            "x": column(P, "position"), "v": column(P, "velocity"), "w": column(P, "angvel"),
-            "mass": column(P, "mass"), "prim_first": column(P, "prim_first"), "prim_count": column(P, "prim_count"),
-            "a": column(Q, "prim_a"), "b": column(Q, "prim_b"), "r": column(Q, "prim_radius").reshape(-1),
-            "step": int(f["/contacts/step"][-1]),
+            "x": column("position"), "v": column("velocity"), "w": column("angvel"),
+            "mass": column("mass"), "prim_first": column("prim_first"), "prim_count": column("prim_count"),
+            "a": column("prim_a"), "b": column("prim_b"), "r": column("prim_radius").reshape(-1),
+            "step": capdem_h5.step(f, k),
         }
     if "dimension: 2" in cfg:
         raise SystemExit("capdem_to_lammps: 2D runs are not converted (the comparison runs 3D cases)")

@@ -33,11 +33,12 @@ import os
 import subprocess
 import sys
 
-import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, "..", "..", "host"))  # capdem_h5
+import capdem_h5  # noqa: E402
 import capdem_to_lammps  # noqa: E402
 import compare  # noqa: E402
 
@@ -64,12 +65,12 @@ def measures(i, j, fn, n, rng):
 
 
 def capdem_contacts(path):
-    with h5py.File(path, "r") as f:
-        C = f["/contacts"]
-        off = C["offset"][:]
-        a, b = off[-2], off[-1]
-        n = f["/particles/all/mass"].shape[0]
-        return C["particle_i"][a:b], C["particle_j"][a:b], C["pair_fn"][a:b], n
+    """Particle ids and F_n of the contacts of the last snapshot, and N."""
+    with capdem_h5.open_run(path) as f:
+        n = capdem_h5.column_dataset(f, "mass").shape[0]
+        k = capdem_h5.snapshot_count(f) - 1
+        return (capdem_h5.snapshot_rows(f, "c_particle_i", k), capdem_h5.snapshot_rows(f, "c_particle_j", k),
+                capdem_h5.column(f, "pair_fn", k), n)
 
 
 def lammps_contacts(path):

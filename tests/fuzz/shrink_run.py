@@ -7,8 +7,13 @@ kept: groups, datasets with their types, shapes, maximum shapes and
 Fletcher-32 checksums, attributes.
 usage: shrink_run.py IN.h5 OUT.h5 [LIBVER]  (LIBVER: earliest, the default, or latest:
 the newer, smaller object headers and chunk indexes)"""
+import os
 import sys
+
 import h5py
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "host"))  # capdem_h5
+import capdem_h5  # noqa: E402
 
 LIBVER = sys.argv[3] if len(sys.argv) > 3 else "earliest"
 
@@ -36,5 +41,5 @@ def copy(src, dst):
             copy_attrs(obj, d)
 
 
-with h5py.File(sys.argv[1], "r") as src, h5py.File(sys.argv[2], "w", libver=LIBVER) as dst:
+with capdem_h5.open_run(sys.argv[1]) as src, h5py.File(sys.argv[2], "w", libver=LIBVER) as dst:
     copy(src, dst)
