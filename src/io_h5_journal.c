@@ -13,6 +13,7 @@
  *   and last u32 crc32 of everything before it, "END!". */
 #define _GNU_SOURCE /* flock */
 #include "io_h5_journal.h"
+#include "io_h5_layout.h"
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -26,7 +27,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
-#define JOURNAL_SUFFIX "-journal"
+#define JOURNAL_SUFFIX CDH5_NAME(JOURNAL) /* "-journal" (kernels/runfile.def) */
 #define JOURNAL_MAGIC "CAPDEMJ1"
 #define JOURNAL_END "END!"
 #define HEAD_BYTES (8 + 3 * 8)
@@ -328,7 +329,7 @@ static const H5FD_class_t journal_class;
 static H5FD_t *j_open(const char *name, unsigned flags, hid_t fapl, haddr_t maxaddr)
 {
     (void)fapl;
-    if (!name || !*name || !maxaddr || maxaddr == HADDR_UNDEF || strlen(name) + sizeof JOURNAL_SUFFIX > PATH_MAX)
+    if (!name || !*name || !maxaddr || maxaddr == HADDR_UNDEF || strlen(name) + strlen(JOURNAL_SUFFIX) >= PATH_MAX)
         return NULL;
     int oflags = (flags & H5F_ACC_RDWR) ? O_RDWR : O_RDONLY;
     if (flags & H5F_ACC_TRUNC) oflags |= O_TRUNC;
