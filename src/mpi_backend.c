@@ -126,10 +126,26 @@ static double interaction_range(const cd_sim *sim)
     return (2 * bmax + sim->nb.skin) * (1 + 1e-6);
 }
 
+/* Rank 0's summary of the decomposition: migrations, and the owned
+ * particles and ghosts per rank now (the halo's share of the work).
+ * Collective: every rank stops the run at the same point. */
+static void report(const cd_mpi_ctx *x)
+{
+    long mine[2] = {(long)x->n_owned, (long)(x->loc.s.n_particles - x->n_owned)}, lo[2], hi[2], sum[2];
+    MPI_Reduce(mine, lo, 2, MPI_LONG, MPI_MIN, 0, x->comm);
+    MPI_Reduce(mine, hi, 2, MPI_LONG, MPI_MAX, 0, x->comm);
+    MPI_Reduce(mine, sum, 2, MPI_LONG, MPI_SUM, 0, x->comm);
+    if (x->rank == 0)
+        fprintf(stderr, "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
+                "ghosts (%.3g ghosts per owned particle)\n", x->size, x->migrations, lo[0], hi[0], lo[1], hi[1],
+                sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0);
+}
+
 static void mpi_stop(cd_sim *sim)
 {
     cd_mpi_ctx *x = sim->backend_data;
     if (!x) return;
+    if (x->started) report(x);
     cd_sim_free(&x->loc);
     cd_mpi_halo_free(x);
     free(x);
@@ -141,6 +157,7 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     cd_mpi_ctx *x = sim->backend_data;
     cd_sim_free(&x->loc);
     cd_mpi_halo_free(x);
+    x->started = 0;
     const cd_state *s = &sim->s;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t q = 0; q < s->n_particles; q++) {
@@ -181,6 +198,7 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     if (rc) snprintf(err, errlen, "out of memory while distributing the particles over %d MPI ranks", x->size);
     if (!rc) rc = x->inner->start(loc, compute, err, errlen);
     if (agree_failure(x, rc, err, errlen)) return -1;
+    x->started = 1;
     /* the ghosts' forces from their owners (a start computes them from
      * the pairs this rank sees) */
     return cd_mpi_refresh_ghosts(x) ? (MPI_Abort(x->comm, 1), -1) : 0;

@@ -23,6 +23,7 @@ typedef struct {
     int *send_list, *recv_list;
     double *send_buf, *recv_buf;
     long long migrations;     /* times the particles went to new owners */
+    int started;              /* the local state runs (start succeeded on every rank) */
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,
