@@ -21,7 +21,8 @@ typedef struct {
 } rec_head;
 
 typedef struct {
-    long long gi, gj;
+    long long gi, gj; /* global primitives */
+    long long rank_in_row; /* gather: the row's place among the rows of primitive gi (0 in a migration) */
 } pair_head;
 
 /* A record found in a received buffer. */
@@ -87,9 +88,9 @@ static void unpack_particle(cd_state *s, size_t l, size_t pl, const char *rec)
     for (size_t k = 0; k < n; k++) s->prim_particle[pl + k] = (cd_int)l;
 }
 
-static char *pack_pair(cd_state *s, size_t k, long long gi, long long gj, char *b)
+static char *pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b)
 {
-    pair_head h = {gi, gj};
+    pair_head h = {gi, gj, rank_in_row};
     memcpy(b, &h, sizeof h);
     return rows_io(s, CD_GROUP_PAIR, k, 1, b + sizeof h, 1);
 }
@@ -137,17 +138,16 @@ static long long local_prim(const long long *gprim, size_t n, long long g)
 }
 
 /* The pair records (sorted by key, a key given twice taken once) whose two
- * primitives s holds (gprim: its global primitive ids, NULL when s is the
- * global state) into s's pair rows, in key order: the order the serial
- * build keeps them in, which is also local key order. */
+ * primitives the local state s holds (gprim: their global ids) into its
+ * pair rows, in key order: the order the serial build keeps them in, which
+ * is also local key order (the history the next build carries over). */
 static int place_pairs(cd_state *s, const rec_ref *r, size_t n, const long long *gprim)
 {
     if (cd_state_reserve_pairs(s, n + 16)) return -1;
     size_t m = 0;
     for (size_t k = 0; k < n; k++) {
         if (k > 0 && r[k].a == r[k - 1].a && r[k].b == r[k - 1].b) continue;
-        long long i = gprim ? local_prim(gprim, s->n_prims, r[k].a) : r[k].a;
-        long long j = gprim ? local_prim(gprim, s->n_prims, r[k].b) : r[k].b;
+        long long i = local_prim(gprim, s->n_prims, r[k].a), j = local_prim(gprim, s->n_prims, r[k].b);
         if (i < 0 || j < 0) continue;
         rows_io(s, CD_GROUP_PAIR, m, 1, (char *)r[k].at + sizeof(pair_head), 0);
         s->pair_prim_i[m] = (cd_int)i;
@@ -287,7 +287,7 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
     size_t plen = rc ? 0 : (size_t)(at - pbuf);
     at = cbuf;
     for (size_t k = 0; !rc && k < global->n_pairs; k++)
-        if (global->pair_active[k]) at = pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], at);
+        if (global->pair_active[k]) at = pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
     if (!rc) rc = assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
     free(ranks); free(pbuf); free(cbuf);
     return rc;
@@ -407,7 +407,7 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
     for (size_t k = 0; !rc && k < s->n_pairs; k++)
         if (s->pair_active[k])
             FOR_PAIR_DESTS(x, &d, k, r, {
-                char *end = pack_pair(s, k, x->gprim[s->pair_prim_i[k]], x->gprim[s->pair_prim_j[k]], cbuf + co[r]);
+                char *end = pack_pair(s, k, x->gprim[s->pair_prim_i[k]], x->gprim[s->pair_prim_j[k]], 0, cbuf + co[r]);
                 co[r] = (size_t)(end - cbuf);
             });
     if (!rc) rc = exchange_bytes(x, pbuf, pc, &prec, &plen);
@@ -485,27 +485,78 @@ static int gather_bytes(cd_mpi_ctx *x, const char *buf, int n, char **all, size_
     return fail ? -1 : 0;
 }
 
+/* Rank 0: the serial program's list rebuilt from the rows each primitive
+ * has (counts: global primitive, rows; as many as n_counts) and the active
+ * rows at their place among them: the same row numbers as the serial list
+ * (the same build, at the same step), inactive rows marked so.  The
+ * observables sum the pair rows in blocks of row numbers
+ * (kernels/observe_items.h), so they get the serial bits. */
+static int place_serial_rows(cd_state *g, const long long *counts, size_t n_counts, const rec_ref *r, size_t n)
+{
+    size_t P = g->n_prims;
+    long long *first = calloc(P + 1, sizeof *first);
+    if (!first) return -1;
+    for (size_t e = 0; e < n_counts; e++) first[counts[2 * e] + 1] = counts[2 * e + 1];
+    for (size_t i = 0; i < P; i++) first[i + 1] += first[i];
+    size_t rows = (size_t)first[P];
+    int rc = cd_state_reserve_pairs(g, rows + 16);
+    for (size_t k = 0; !rc && k < rows; k++) {
+        g->pair_active[k] = 0;
+        g->pair_prim_i[k] = g->pair_prim_j[k] = 0;
+    }
+    for (size_t k = 0; !rc && k < n; k++) {
+        pair_head h;
+        memcpy(&h, r[k].at, sizeof h);
+        long long row = first[h.gi] + h.rank_in_row;
+        if (row >= first[h.gi + 1]) { rc = -1; break; } /* cannot happen: the row is among its primitive's */
+        rows_io(g, CD_GROUP_PAIR, (size_t)row, 1, (char *)r[k].at + sizeof h, 0);
+        g->pair_prim_i[row] = (cd_int)h.gi;
+        g->pair_prim_j[row] = (cd_int)h.gj;
+    }
+    if (!rc) g->n_pairs = rows;
+    free(first);
+    return rc;
+}
+
 int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
 {
     cd_state *s = &x->loc.s;
-    size_t pb = 0, cb = 0;
-    for (size_t q = 0; q < s->n_particles; q++)
-        if (x->owned[q]) pb += particle_bytes(s->prim_count[q], s->n_walls);
+    size_t pb = 0, cb = 0, nc = 0, P = s->n_prims;
+    /* the rows of each primitive: contiguous, the list being in key order */
+    long long *row0 = malloc((P + 1) * sizeof *row0), *rows = calloc(P + 1, sizeof *rows);
+    long long *counts = malloc((2 * P + 1) * sizeof *counts);
+    if (!row0 || !rows || !counts) MPI_Abort(x->comm, 1); /* the other ranks are about to wait in the gather */
+    for (size_t k = s->n_pairs; k-- > 0;) {
+        row0[s->pair_prim_i[k]] = (long long)k;
+        rows[s->pair_prim_i[k]]++;
+    }
+    for (size_t q = 0; q < s->n_particles; q++) {
+        if (!x->owned[q]) continue;
+        pb += particle_bytes(s->prim_count[q], s->n_walls);
+        for (cd_int i = s->prim_first[q]; i < s->prim_first[q] + s->prim_count[q]; i++)
+            if (rows[i]) {
+                counts[2 * nc] = x->gprim[i];
+                counts[2 * nc + 1] = rows[i];
+                nc++;
+            }
+    }
     for (size_t k = 0; k < s->n_pairs; k++) /* each row once: by the owner of its particle i */
         if (s->pair_active[k] && x->owned[s->prim_particle[s->pair_prim_i[k]]]) cb += pair_bytes();
-    char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *pall = NULL, *call = NULL;
-    int rc = pbuf && cbuf ? 0 : -1;
-    if (rc) MPI_Abort(x->comm, 1); /* the other ranks are about to wait in the gather */
+    char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *pall = NULL, *call = NULL, *nall = NULL;
+    if (!pbuf || !cbuf) MPI_Abort(x->comm, 1);
     char *at = pbuf;
     for (size_t q = 0; q < s->n_particles; q++)
         if (x->owned[q]) at = pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], at);
     at = cbuf;
-    for (size_t k = 0; k < s->n_pairs; k++)
-        if (s->pair_active[k] && x->owned[s->prim_particle[s->pair_prim_i[k]]])
-            at = pack_pair(s, k, x->gprim[s->pair_prim_i[k]], x->gprim[s->pair_prim_j[k]], at);
-    size_t plen, clen;
-    rc |= gather_bytes(x, pbuf, (int)pb, &pall, &plen);
+    for (size_t k = 0; k < s->n_pairs; k++) {
+        cd_int i = s->pair_prim_i[k];
+        if (s->pair_active[k] && x->owned[s->prim_particle[i]])
+            at = pack_pair(s, k, x->gprim[i], x->gprim[s->pair_prim_j[k]], (long long)k - row0[i], at);
+    }
+    size_t plen, clen, nlen;
+    int rc = gather_bytes(x, pbuf, (int)pb, &pall, &plen);
     rc |= gather_bytes(x, cbuf, (int)cb, &call, &clen);
+    rc |= gather_bytes(x, (const char *)counts, (int)(2 * nc * sizeof *counts), &nall, &nlen);
     copy_scalars(global, s);
     if (x->rank == 0 && !rc) {
         size_t N, K;
@@ -516,11 +567,12 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
             memcpy(&h, pr[q].at, sizeof h);
             unpack_particle(global, (size_t)h.gid, (size_t)h.gprim_first, pr[q].at);
         }
-        if (!rc) rc = place_pairs(global, cr, K, NULL);
+        if (!rc) rc = place_serial_rows(global, (const long long *)nall, nlen / (2 * sizeof(long long)), cr, K);
         free(pr);
         free(cr);
     }
-    free(pbuf); free(cbuf); free(pall); free(call);
+    free(row0); free(rows); free(counts);
+    free(pbuf); free(cbuf); free(pall); free(call); free(nall);
     return rc;
 }
 
