@@ -29,10 +29,23 @@ static int world(int *rank)
     return size;
 }
 
+/* Started by an MPI launcher (mpirun, mpiexec, srun)?  Without one the
+ * run is the serial program and MPI is not started at all: nothing of the
+ * MPI library's start (a singleton's daemon, its files) can get in the way
+ * of a plain `capdem run`. */
+static int launched(void)
+{
+    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "MPI_LOCALNRANKS"};
+    for (size_t k = 0; k < sizeof vars / sizeof vars[0]; k++)
+        if (getenv(vars[k])) return 1;
+    return 0;
+}
+
 int cd_mpi_begin(void)
 {
     int on = 0, rank;
     MPI_Initialized(&on);
+    if (!on && !launched()) return 0;
     if (!on) {
         if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return -1;
         began_here = 1;
