@@ -115,12 +115,16 @@ static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = loc->rebuild_hook_data;
     int any = 0;
+    double t0 = MPI_Wtime();
     MPI_Allreduce(&rebuild, &any, 1, MPI_INT, MPI_LOR, x->comm);
+    double t1 = MPI_Wtime();
+    x->t_decide += t1 - t0;
     if (!any) return 0;
     if (cd_mpi_migrate(x)) {
         snprintf(err, errlen, "out of memory while moving particles to their new MPI ranks");
         MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
     }
+    x->t_migrate += MPI_Wtime() - t1;
     return 1;
 }
 
@@ -148,10 +152,13 @@ static void report(const cd_mpi_ctx *x)
     MPI_Reduce(mine, lo, 2, MPI_LONG, MPI_MIN, 0, x->comm);
     MPI_Reduce(mine, hi, 2, MPI_LONG, MPI_MAX, 0, x->comm);
     MPI_Reduce(mine, sum, 2, MPI_LONG, MPI_SUM, 0, x->comm);
+    double t[4] = {x->t_step, x->t_decide, x->t_migrate, x->t_ghosts}, tmax[4]; /* [s] */
+    MPI_Reduce(t, tmax, 4, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     if (x->rank == 0)
         fprintf(stderr, "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
-                "ghosts (%.3g ghosts per owned particle)\n", x->size, x->migrations, lo[0], hi[0], lo[1], hi[1],
-                sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0);
+                "ghosts (%.3g ghosts per owned particle); slowest rank's seconds: step %.3g, rebuild decision %.3g, "
+                "migration %.3g, ghost refresh %.3g\n", x->size, x->migrations, lo[0], hi[0], lo[1], hi[1],
+                sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0, tmax[0], tmax[1], tmax[2], tmax[3]);
 }
 
 static void mpi_stop(cd_sim *sim)
@@ -221,10 +228,15 @@ static int mpi_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
     for (long long it = 0; it < n; it++) {
+        double t0 = MPI_Wtime(), hook = x->t_decide + x->t_migrate;
         int rc = x->inner->step(&x->loc, 1, err, errlen);
         scalars_back(sim, &x->loc.s);
-        if (agree_failure(x, rc, err, errlen)) return -1;
-        if (cd_mpi_refresh_ghosts(x)) MPI_Abort(x->comm, 1);
+        double t1 = MPI_Wtime();
+        x->t_step += t1 - t0 - (x->t_decide + x->t_migrate - hook);
+        int failed = agree_failure(x, rc, err, errlen);
+        if (!failed && cd_mpi_refresh_ghosts(x)) MPI_Abort(x->comm, 1);
+        x->t_ghosts += MPI_Wtime() - t1;
+        if (failed) return -1;
     }
     return 0;
 }

@@ -24,6 +24,10 @@ typedef struct {
     double *send_buf, *recv_buf;
     long long migrations;     /* times the particles went to new owners */
     int started;              /* the local state runs (start succeeded on every rank) */
+    /* wall-clock seconds of this rank (MPI_Wtime): in the serial step (the
+     * decision and migration taken out), deciding the rebuild (waits for
+     * the slowest rank included), migrating, refreshing ghosts */
+    double t_step, t_decide, t_migrate, t_ghosts;
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,
