@@ -114,9 +114,11 @@ static int agree_failure(cd_mpi_ctx *x, int rc, char *err, size_t errlen)
 static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = loc->rebuild_hook_data;
-    int any = 0;
+    /* A rank without particles (a sub-domain the pile left) builds no list,
+     * so its skin test knows no reference walls: it has no say. */
+    int any = 0, vote = loc->s.n_particles ? rebuild : 0;
     double t0 = MPI_Wtime();
-    MPI_Allreduce(&rebuild, &any, 1, MPI_INT, MPI_LOR, x->comm);
+    MPI_Allreduce(&vote, &any, 1, MPI_INT, MPI_LOR, x->comm);
     double t1 = MPI_Wtime();
     x->t_decide += t1 - t0;
     if (!any) return 0;
@@ -125,6 +127,10 @@ static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
         MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
     }
     x->t_migrate += MPI_Wtime() - t1;
+    if (!loc->s.n_particles) { /* still none: no list to build (the build needs a particle) */
+        loc->nb.force_rebuild = 0;
+        return 0;
+    }
     return 1;
 }
 
@@ -216,7 +222,8 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     int rc = x->send_count && x->send_displ && x->recv_count && x->recv_displ ? 0 : -1;
     if (!rc) rc = cd_mpi_distribute(x, &sim->s);
     if (rc) snprintf(err, errlen, "out of memory while distributing the particles over %d MPI ranks", x->size);
-    if (!rc) rc = x->inner->start(loc, compute, err, errlen);
+    /* (a rank without particles has no list to build and no forces) */
+    if (!rc) rc = x->inner->start(loc, compute && loc->s.n_particles > 0, err, errlen);
     if (agree_failure(x, rc, err, errlen)) return -1;
     x->started = 1;
     /* the ghosts' forces from their owners (a start computes them from

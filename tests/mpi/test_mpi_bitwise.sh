@@ -4,7 +4,8 @@
 # a 2D cross deposit (a box: sub-domains across x) on 1 process and on 2,
 # 3 and 4 ranks; h5diff finds every snapshot (particles, primitives,
 # contacts with their history, wall contacts), every observable and the
-# echoed config equal.  The runs must have contacts at the last snapshot,
+# echoed config equal; and sub-domains stacked along gravity, one of which
+# the settling pile leaves empty.  The runs must have contacts at the last snapshot,
 # particles that changed owner, and ghosts, or the comparison proves
 # little.
 # usage: test_mpi_bitwise.sh CAPDEM SOURCE_DIR
@@ -31,5 +32,13 @@ for case in hexapod_pile crosses_2d; do
   done
   rm -f ./*.h5
 done
+# Sub-domains stacked along gravity (mpi.grid [1, 3, 1]): the top one
+# empties as the crosses settle; a rank without particles builds no list
+# and has no say in the rebuild, and the run still has the serial bits.
+{ printf 'mpi:\n  grid: [1, 3, 1]\n'; cat "$src/tests/mpi/crosses_2d.yaml"; } > stacked.yaml
+"$capdem" run stacked.yaml --output serial.h5 --quiet 2> err || bad "stacked: the serial run failed"
+if mpi 3 run stacked.yaml --output mpi3.h5 --quiet 2> err && same serial.h5 mpi3.h5; then ok
+else bad "stacked: 3 ranks: failed or differs from the serial run"; head -20 diff.txt; fi
+if grep -q 'per rank now 0\.\.' err; then ok; else bad "stacked: expected a rank without particles: $(grep 'MPI:' err)"; fi
 echo "test_mpi_bitwise: $pass passed, $fails failed"
 [ $fails -eq 0 ]

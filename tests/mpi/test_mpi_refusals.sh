@@ -3,6 +3,7 @@
 # written, with exit status 2 and one message (rank 0's) that names the
 # file, the key or the limit, and without a hang (every rank reads the
 # same input and refuses at the same point; mpi() times out otherwise).
+# A run that blows up stops on every rank as the serial one does.
 # usage: test_mpi_refusals.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
@@ -40,5 +41,14 @@ refused protocol 2 'protocol\.yaml: protocol\.type = deposit_compress does not r
 # the same configs are fine on one process (the refusals are the decomposition's)
 if "$capdem" run too_many_ranks.yaml --output one.h5 --steps 10 --quiet 2> err; then ok
 else bad "too_many_ranks.yaml: refused on one process too"; fi
+# A run that blows up (dt far above t_col/5, forced) stops on every rank
+# at once with the serial program's exit status 3 and its diagnosis, once.
+sed 's/^  dt: .*/  dt: 1.5e-4\n  force_dt: true/' "$base" > blowup.yaml
+"$capdem" run blowup.yaml --output serial.h5 --quiet 2> serial.err
+mpi 3 run blowup.yaml --output mpi3.h5 --quiet > out 2> err
+rc=$?
+stop_serial=$(grep 'run stopped' serial.err) stop_mpi=$(grep 'run stopped' err)
+if [ $rc -eq 3 ] && [ -n "$stop_serial" ] && [ "$stop_serial" = "$stop_mpi" ]; then ok
+else bad "blowup: exit status $rc (expected 3), serial says '$stop_serial', 3 ranks say '$stop_mpi'"; fi
 echo "test_mpi_refusals: $pass passed, $fails failed"
 [ $fails -eq 0 ]
