@@ -95,15 +95,21 @@ static void scalars_back(cd_sim *sim, const cd_state *loc)
     memcpy(sim->s.control, loc->control, sizeof sim->s.control);
 }
 
-/* Whether any rank failed (rc != 0): then the message of the lowest such
- * rank, in err on every rank, and -1. */
+/* After the ranks learned the lowest rank that failed (first; the rank
+ * count: none): its message in err on every rank, and -1. */
+static int failure_of(cd_mpi_ctx *x, int first, char *err, size_t errlen)
+{
+    if (first == x->size) return 0;
+    MPI_Bcast(err, (int)errlen, MPI_CHAR, first, x->comm);
+    return -1;
+}
+
+/* Whether any rank failed (rc != 0), as failure_of says. */
 static int agree_failure(cd_mpi_ctx *x, int rc, char *err, size_t errlen)
 {
     int who = rc ? x->rank : x->size, first;
     MPI_Allreduce(&who, &first, 1, MPI_INT, MPI_MIN, x->comm);
-    if (first == x->size) return 0;
-    MPI_Bcast(err, (int)errlen, MPI_CHAR, first, x->comm);
-    return -1;
+    return failure_of(x, first, err, errlen);
 }
 
 /* The step's rebuild decision for all ranks (the serial program's: some
@@ -228,7 +234,8 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     x->started = 1;
     /* the ghosts' forces from their owners (a start computes them from
      * the pairs this rank sees) */
-    return cd_mpi_refresh_ghosts(x) ? (MPI_Abort(x->comm, 1), -1) : 0;
+    cd_mpi_refresh_ghosts(x, 0);
+    return 0;
 }
 
 static int mpi_step(cd_sim *sim, long long n, char *err, size_t errlen)
@@ -240,10 +247,11 @@ static int mpi_step(cd_sim *sim, long long n, char *err, size_t errlen)
         scalars_back(sim, &x->loc.s);
         double t1 = MPI_Wtime();
         x->t_step += t1 - t0 - (x->t_decide + x->t_migrate - hook);
-        int failed = agree_failure(x, rc, err, errlen);
-        if (!failed && cd_mpi_refresh_ghosts(x)) MPI_Abort(x->comm, 1);
+        /* one exchange per step: the ghosts, and whether every rank's step
+         * went well (a failed rank's ghosts are not used: all stop) */
+        int first = cd_mpi_refresh_ghosts(x, rc != 0);
         x->t_ghosts += MPI_Wtime() - t1;
-        if (failed) return -1;
+        if (failure_of(x, first, err, errlen)) return -1;
     }
     return 0;
 }

@@ -199,8 +199,9 @@ static int plan_refresh(cd_mpi_ctx *x)
             free(x->send_list); free(x->recv_list); free(x->send_buf); free(x->recv_buf);
             x->send_list = malloc(((size_t)ns + 1) * sizeof(int));
             x->recv_list = malloc(((size_t)nr + 1) * sizeof(int));
-            x->send_buf = malloc(((size_t)ns + 1) * CD_MPI_GHOST_DOUBLES * sizeof(double));
-            x->recv_buf = malloc(((size_t)nr + 1) * CD_MPI_GHOST_DOUBLES * sizeof(double));
+            /* (one status per rank ahead of each rank's ghosts: cd_mpi_refresh_ghosts) */
+            x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
+            x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
             if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) { free(ranks); return -1; }
         }
         for (size_t q = 0; q < s->n_particles; q++) {
@@ -433,27 +434,32 @@ static void ghost_io(cd_state *s, size_t q, double *b, int pack)
     }
 }
 
-int cd_mpi_refresh_ghosts(cd_mpi_ctx *x)
+int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
 {
     cd_state *s = &x->loc.s;
     int R = x->size, G = CD_MPI_GHOST_DOUBLES;
     int *sc = calloc((size_t)R * 4, sizeof(int));
-    if (!sc) return -1;
+    if (!sc) MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
     int *sd = sc + R, *rcv = sc + 2 * R, *rd = sc + 3 * R;
+    /* to every rank: this rank's status, then the ghosts it owns there */
     for (int r = 0; r < R; r++) {
-        sc[r] = x->send_count[r] * G;
-        sd[r] = x->send_displ[r] * G;
-        rcv[r] = x->recv_count[r] * G;
-        rd[r] = x->recv_displ[r] * G;
+        sc[r] = 1 + x->send_count[r] * G;
+        sd[r] = r + x->send_displ[r] * G;
+        rcv[r] = 1 + x->recv_count[r] * G;
+        rd[r] = r + x->recv_displ[r] * G;
+        x->send_buf[sd[r]] = failed;
         for (int k = 0; k < x->send_count[r]; k++)
-            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + k], x->send_buf + (size_t)(sd[r] + k * G), 1);
+            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + k], x->send_buf + (size_t)(sd[r] + 1 + k * G), 1);
     }
     MPI_Alltoallv(x->send_buf, sc, sd, MPI_DOUBLE, x->recv_buf, rcv, rd, MPI_DOUBLE, x->comm);
-    for (int r = 0; r < R; r++)
+    int first = R;
+    for (int r = 0; r < R; r++) {
+        if (x->recv_buf[rd[r]] != 0 && r < first) first = r;
         for (int k = 0; k < x->recv_count[r]; k++)
-            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + k], x->recv_buf + (size_t)(rd[r] + k * G), 0);
+            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + k], x->recv_buf + (size_t)(rd[r] + 1 + k * G), 0);
+    }
     free(sc);
-    return 0;
+    return first;
 }
 
 /* Gatherv of n bytes from every rank to rank 0 (*all, *alen there). */

@@ -44,9 +44,11 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global);
  * Collective.  0, or -1 (out of memory). */
 int cd_mpi_migrate(cd_mpi_ctx *x);
 /* The ghosts' pose, velocities, force and torque from their owners, after
- * a step (the serial step leaves them computed from partial forces).
- * Collective. */
-int cd_mpi_refresh_ghosts(cd_mpi_ctx *x);
+ * a step (the serial step leaves them computed from partial forces), and
+ * with them every rank's status (failed: 0 or 1), so that the ranks agree
+ * to go on or stop in the same message.  Collective.  Returns the lowest
+ * rank that failed, or the rank count when none did. */
+int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
 /* The owned rows of every rank into global (rank 0): particles, primitives
  * and wall-contact rows at their global row, the active pair rows in key
  * order; the scalars (step, time, walls, control) on every rank.
