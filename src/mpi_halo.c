@@ -359,8 +359,8 @@ static int goes_to(const dest_lists *d, size_t q, int r)
     return 0;
 }
 
-/* Pair row k goes to every rank that an owned particle of it goes to
- * (each rank once); for each such rank, f(rank). */
+/* Pair row k goes to every rank that an owned particle of it goes to,
+ * each rank once: body runs with r set to each of them. */
 #define FOR_PAIR_DESTS(x, d, k, r, body)                                                                     \
     do {                                                                                                     \
         cd_state *s_ = &(x)->loc.s;                                                                          \
