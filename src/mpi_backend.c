@@ -5,8 +5,9 @@
  * rebuild decided by all ranks together (the serial program's decision)
  * and the particles migrating to their new owners right before each
  * rebuild, then refreshes the ghosts; sync and observe gather the owned
- * rows to rank 0, where output, observables and wall loads come from the
- * serial functions, in the serial order. */
+ * rows on every rank, where output (rank 0), observables and protocols
+ * use the serial functions, in the serial order; wall loads are summed
+ * from the nonzero rows in the serial order. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -241,6 +242,10 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
 static int mpi_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
+    /* the walls and protocol slots as the protocol left them (the same on
+     * every rank: it decides from the same loads and observables) */
+    memcpy(x->loc.s.walls, sim->s.walls, sizeof x->loc.s.walls);
+    memcpy(x->loc.s.control, sim->s.control, sizeof x->loc.s.control);
     for (long long it = 0; it < n; it++) {
         double t0 = MPI_Wtime(), hook = x->t_decide + x->t_migrate;
         int rc = x->inner->step(&x->loc, 1, err, errlen);
@@ -266,23 +271,22 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
 }
 
 /* The observables of the serial program: the state gathered in global
- * order on rank 0 and summed there (kernels/observe_items.h), the sums
- * sent to every rank (the run's decisions on them are every rank's). */
+ * order on every rank and summed there as in one process
+ * (kernels/observe_items.h): the run's decisions on them are every
+ * rank's. */
 static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
-    cd_mpi_ctx *x = sim->backend_data;
     if (mpi_sync(sim, err, errlen)) return -1;
-    if (x->rank == 0) cd_observables_slots(sim, slots);
-    MPI_Bcast(slots, CD_OBS_SLOTS, MPI_DOUBLE, 0, x->comm);
+    cd_observables_slots(sim, slots);
     return 0;
 }
 
+/* The load a protocol asks for at every control call: the nonzero wall
+ * rows only, summed in the serial order (cd_mpi_wall_load). */
 static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
-    cd_mpi_ctx *x = sim->backend_data;
-    if (mpi_sync(sim, err, errlen)) return -1;
-    if (x->rank == 0) *load = cd_sim_wall_load_host(sim, w);
-    MPI_Bcast(load, 1, MPI_DOUBLE, 0, x->comm);
+    (void)err; (void)errlen;
+    *load = cd_mpi_wall_load(sim->backend_data, w, sim->s.n_prims);
     return 0;
 }
 
@@ -302,7 +306,7 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
 {
     if (!cd_mpi_decomposed()) return 0;
     const cd_config *c = &sim->cfg;
-    if (c->protocol_kind != CD_PROTOCOL_NONE) {
+    if (c->protocol_kind == CD_PROTOCOL_BULK) { /* it copies and restores the whole state between probes */
         snprintf(err, errlen, "%s: protocol.type = %s does not run on several MPI ranks yet (docs/mpi.md, \"Not done "
                  "yet\"): run it with one rank", c->source_path, c->protocol);
         return -1;

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mpi_halo.h"
+#include "../kernels/step_items.h"
 
 typedef struct {
     long long gid, gprim_first, n_prims, pad;
@@ -462,36 +463,29 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
     return first;
 }
 
-/* Gatherv of n bytes from every rank to rank 0 (*all, *alen there). */
-static int gather_bytes(cd_mpi_ctx *x, const char *buf, int n, char **all, size_t *alen)
+/* Allgatherv of n bytes from every rank: all of them, in rank order, in
+ * *all (*alen bytes) on every rank.  0, or -1 (out of memory: aborts the
+ * run, the other ranks being in the exchange). */
+static int allgather_bytes(cd_mpi_ctx *x, const void *buf, int n, char **all, size_t *alen)
 {
-    int R = x->size, *cnt = NULL, *dsp = NULL;
-    *all = NULL;
-    *alen = 0;
-    int fail = 0;
-    if (x->rank == 0) {
-        cnt = malloc((size_t)R * sizeof(int));
-        dsp = malloc((size_t)R * sizeof(int));
-        fail = !cnt || !dsp;
+    int R = x->size, *cnt = malloc((size_t)R * sizeof(int)), *dsp = malloc((size_t)R * sizeof(int));
+    if (!cnt || !dsp) MPI_Abort(x->comm, 1);
+    MPI_Allgather(&n, 1, MPI_INT, cnt, 1, MPI_INT, x->comm);
+    size_t t = 0;
+    for (int r = 0; r < R; r++) {
+        dsp[r] = (int)t;
+        t += (size_t)cnt[r];
     }
-    MPI_Gather(&n, 1, MPI_INT, cnt, 1, MPI_INT, 0, x->comm);
-    if (x->rank == 0 && !fail) {
-        size_t t = 0;
-        for (int r = 0; r < R; r++) {
-            dsp[r] = (int)t;
-            t += (size_t)cnt[r];
-        }
-        *all = malloc(t + 1);
-        *alen = t;
-        fail = !*all;
-    }
-    MPI_Gatherv(buf, n, MPI_BYTE, *all, cnt, dsp, MPI_BYTE, 0, x->comm);
+    *all = malloc(t + 1);
+    *alen = t;
+    if (!*all) MPI_Abort(x->comm, 1);
+    MPI_Allgatherv(buf, n, MPI_BYTE, *all, cnt, dsp, MPI_BYTE, x->comm);
     free(cnt);
     free(dsp);
-    return fail ? -1 : 0;
+    return 0;
 }
 
-/* Rank 0: the serial program's list rebuilt from the rows each primitive
+/* The serial program's list rebuilt from the rows each primitive
  * has (counts: global primitive, rows; as many as n_counts) and the active
  * rows at their place among them: the same row numbers as the serial list
  * (the same build, at the same step), inactive rows marked so.  The
@@ -531,7 +525,7 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
     /* the rows of each primitive: contiguous, the list being in key order */
     long long *row0 = malloc((P + 1) * sizeof *row0), *rows = calloc(P + 1, sizeof *rows);
     long long *counts = malloc((2 * P + 1) * sizeof *counts);
-    if (!row0 || !rows || !counts) MPI_Abort(x->comm, 1); /* the other ranks are about to wait in the gather */
+    if (!row0 || !rows || !counts) MPI_Abort(x->comm, 1); /* the other ranks are about to wait in the exchange */
     for (size_t k = s->n_pairs; k-- > 0;) {
         row0[s->pair_prim_i[k]] = (long long)k;
         rows[s->pair_prim_i[k]]++;
@@ -560,11 +554,11 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
             at = pack_pair(s, k, x->gprim[i], x->gprim[s->pair_prim_j[k]], (long long)k - row0[i], at);
     }
     size_t plen, clen, nlen;
-    int rc = gather_bytes(x, pbuf, (int)pb, &pall, &plen);
-    rc |= gather_bytes(x, cbuf, (int)cb, &call, &clen);
-    rc |= gather_bytes(x, (const char *)counts, (int)(2 * nc * sizeof *counts), &nall, &nlen);
-    copy_scalars(global, s);
-    if (x->rank == 0 && !rc) {
+    int rc = allgather_bytes(x, pbuf, (int)pb, &pall, &plen);
+    rc |= allgather_bytes(x, cbuf, (int)cb, &call, &clen);
+    rc |= allgather_bytes(x, counts, (int)(2 * nc * sizeof *counts), &nall, &nlen);
+    /* (the scalars not: the global ones lead between steps, where a protocol sets walls and slots) */
+    if (!rc) {
         size_t N, K;
         rec_ref *pr = parse(pall, plen, 0, s->n_walls, &N), *cr = parse(call, clen, 1, s->n_walls, &K);
         rc = pr && cr ? 0 : -1;
@@ -580,6 +574,49 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
     free(row0); free(rows); free(counts);
     free(pbuf); free(cbuf); free(pall); free(call); free(nall);
     return rc;
+}
+
+/* A wall row's normal force with its global primitive. */
+typedef struct {
+    long long prim;
+    double fn; /* [N] */
+} prim_load;
+
+static int cmp_prim_load(const void *pa, const void *pb)
+{
+    const prim_load *a = pa, *b = pb;
+    return a->prim < b->prim ? -1 : a->prim > b->prim;
+}
+
+double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
+{
+    cd_state *s = &x->loc.s;
+    size_t W = s->n_walls, n = 0;
+    prim_load *mine = malloc((s->n_prims + 1) * sizeof *mine);
+    if (!mine) MPI_Abort(x->comm, 1);
+    for (size_t q = 0; q < s->n_particles; q++)
+        for (cd_int i = s->prim_first[q]; x->owned[q] && i < s->prim_first[q] + s->prim_count[q]; i++)
+            if (s->wallc_fn[(size_t)i * W + (size_t)w] != 0)
+                mine[n++] = (prim_load){x->gprim[i], s->wallc_fn[(size_t)i * W + (size_t)w]};
+    char *all;
+    size_t len;
+    allgather_bytes(x, mine, (int)(n * sizeof *mine), &all, &len);
+    size_t m = len / sizeof(prim_load);
+    prim_load *e = (prim_load *)all;
+    qsort(e, m, sizeof *e, cmp_prim_load);
+    /* kernels/step_items.h, CD_LOAD_CHUNK: per chunk of primitives the sum
+     * in primitive order, the chunks' sums in order.  The rows left out
+     * hold exact zeros: adding one changes no sum that starts at +0. */
+    double load = 0;
+    size_t k = 0;
+    for (size_t ch = 0; ch * CD_LOAD_CHUNK < n_prims_global; ch++) {
+        double acc = 0;
+        for (; k < m && (size_t)e[k].prim < (ch + 1) * CD_LOAD_CHUNK; k++) acc += e[k].fn;
+        load += acc;
+    }
+    free(mine);
+    free(all);
+    return load;
 }
 
 void cd_mpi_halo_free(cd_mpi_ctx *x)

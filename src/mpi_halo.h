@@ -49,11 +49,17 @@ int cd_mpi_migrate(cd_mpi_ctx *x);
  * to go on or stop in the same message.  Collective.  Returns the lowest
  * rank that failed, or the rank count when none did. */
 int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
-/* The owned rows of every rank into global (rank 0): particles, primitives
- * and wall-contact rows at their global row, the active pair rows in key
- * order; the scalars (step, time, walls, control) on every rank.
- * Collective.  0, or -1 (out of memory). */
+/* The owned rows of every rank into global, on every rank: particles,
+ * primitives and wall-contact rows at their global row, the pair rows at
+ * the serial list's row numbers (inactive ones marked); the scalars (step,
+ * time, walls, control).  Every rank then holds the serial program's
+ * state, so that protocols, observables and output read it as they do in
+ * one process.  Collective.  0, or -1 (out of memory). */
 int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global);
+/* Normal load on wall w [N] with the serial program's bits (the sum of
+ * kernels/step_items.h, CD_LOAD_CHUNK, over n_prims_global primitives),
+ * from the nonzero rows alone: every rank's, on every rank.  Collective. */
+double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
 void cd_mpi_halo_free(cd_mpi_ctx *x);
 
 #endif

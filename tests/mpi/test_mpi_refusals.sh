@@ -35,8 +35,8 @@ refused grid_product 3 'grid_product\.yaml: mpi\.grid = \[2, 2, 1\] makes 4 sub-
 { printf 'mpi:\n  grid: [1, 1, 2]\n'; cat "$base"; } > grid_2d.yaml
 refused grid_2d 2 'grid_2d\.yaml: mpi\.grid = \[1, 1, 2\]: 2 sub-domains along z.*at most 1 along z in 2D'
 
-cp "$src/configs/protocols/ci/deposit_2d_crosses.yaml" protocol.yaml
-refused protocol 2 'protocol\.yaml: protocol\.type = deposit_compress does not run on several MPI ranks yet'
+cp "$src/configs/protocols/ci/bulk_modulus_hexapods_a3.yaml" protocol.yaml
+refused protocol 2 'protocol\.yaml: protocol\.type = bulk_modulus does not run on several MPI ranks yet'
 
 # the same configs are fine on one process (the refusals are the decomposition's)
 if "$capdem" run too_many_ranks.yaml --output one.h5 --steps 10 --quiet 2> err; then ok

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Protocols on several MPI ranks (docs/mpi.md, "Protocols"): the walls
+# move under feedback from the wall load, which the ranks sum in the
+# serial order, and the deposit's piston starts from the packing's top,
+# which every rank reads from the gathered state.  Bit for bit the serial
+# run: the deposit on 2D crosses through settling, compression and hold
+# (2 and 3 ranks), radial compaction of the spheres' CI twin for 6000
+# steps (3 ranks), and a deposit written with 3 ranks in its compression
+# phase and resumed with 2, against the serial resume.
+# usage: test_mpi_protocols.sh CAPDEM SOURCE_DIR
+set -u
+capdem=$1 src=$2
+. "$src/tests/mpi/mpi_common.sh"
+deposit="$src/tests/mpi/deposit_2d.yaml" radial="$src/configs/protocols/ci/radial_spheres.yaml"
+
+"$capdem" run "$deposit" --output serial.h5 --quiet 2> err || bad "deposit: the serial run failed"
+if grep -q "reached in protocol phase 'hold'" err; then ok; else bad "deposit: the serial run did not reach the hold phase"; fi
+for np in 2 3; do
+  if mpi "$np" run "$deposit" --output "mpi$np.h5" --quiet 2> err && same serial.h5 "mpi$np.h5"; then ok
+  else bad "deposit: $np ranks: failed or differs from the serial run"; head -20 diff.txt; fi
+done
+
+"$capdem" run "$radial" --output radial1.h5 --steps 6000 --quiet 2> err || bad "radial: the serial run failed"
+if mpi 3 run "$radial" --output radial3.h5 --steps 6000 --quiet 2> err && same radial1.h5 radial3.h5; then ok
+else bad "radial: 3 ranks: failed or differs from the serial run"; head -20 diff.txt; fi
+
+"$capdem" run "$deposit" --output resumed1.h5 --steps 11000 --quiet 2> err &&
+  "$capdem" run "$deposit" --resume resumed1.h5 --quiet 2> err || bad "deposit: the serial resume failed"
+if mpi 3 run "$deposit" --output resumed3.h5 --steps 11000 --quiet 2> err &&
+   mpi 2 run "$deposit" --resume resumed3.h5 --quiet 2> err && same resumed1.h5 resumed3.h5; then ok
+else bad "deposit: 3 ranks, resumed with 2: failed or differs from the serial resume"; head -20 diff.txt; fi
+echo "test_mpi_protocols: $pass passed, $fails failed"
+[ $fails -eq 0 ]
