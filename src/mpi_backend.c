@@ -17,6 +17,11 @@
 #include "../kernels/observe_items.h"
 
 static int began_here; /* MPI_Init was called by cd_mpi_begin */
+/* The decomposition of this process's run (cd_mpi_wrap): it outlives the
+ * backend's stop, which a protocol calls to restart from a state it put
+ * back (the bulk probe), and reports at cd_mpi_end. */
+static cd_mpi_ctx *the_ctx;
+static void report(const cd_mpi_ctx *x);
 
 static int world(int *rank)
 {
@@ -67,6 +72,11 @@ int cd_mpi_agree(int status)
 
 int cd_mpi_end(int status)
 {
+    if (the_ctx) {
+        if (the_ctx->ran) report(the_ctx);
+        free(the_ctx);
+        the_ctx = NULL;
+    }
     status = cd_mpi_agree(status);
     if (began_here) MPI_Finalize();
     began_here = 0;
@@ -157,11 +167,11 @@ static double interaction_range(const cd_sim *sim)
 }
 
 /* Rank 0's summary of the decomposition: migrations, and the owned
- * particles and ghosts per rank now (the halo's share of the work).
- * Collective: every rank stops the run at the same point. */
+ * particles and ghosts per rank at the end (the halo's share of the
+ * work).  Collective: every rank ends the run at the same point. */
 static void report(const cd_mpi_ctx *x)
 {
-    long mine[2] = {(long)x->n_owned, (long)(x->loc.s.n_particles - x->n_owned)}, lo[2], hi[2], sum[2];
+    long mine[2] = {x->last_owned, x->last_ghosts}, lo[2], hi[2], sum[2];
     MPI_Reduce(mine, lo, 2, MPI_LONG, MPI_MIN, 0, x->comm);
     MPI_Reduce(mine, hi, 2, MPI_LONG, MPI_MAX, 0, x->comm);
     MPI_Reduce(mine, sum, 2, MPI_LONG, MPI_SUM, 0, x->comm);
@@ -174,15 +184,19 @@ static void report(const cd_mpi_ctx *x)
                 sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0, tmax[0], tmax[1], tmax[2], tmax[3]);
 }
 
+/* Ends the local state; the context stays for a restart (cd_mpi_end
+ * frees it). */
 static void mpi_stop(cd_sim *sim)
 {
     cd_mpi_ctx *x = sim->backend_data;
     if (!x) return;
-    if (x->started) report(x);
+    if (x->started) {
+        x->last_owned = (long)x->n_owned;
+        x->last_ghosts = (long)(x->loc.s.n_particles - x->n_owned);
+    }
     cd_sim_free(&x->loc);
     cd_mpi_halo_free(x);
-    free(x);
-    sim->backend_data = NULL;
+    x->started = 0;
 }
 
 static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
@@ -203,7 +217,10 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     }
     for (int a = 0; a < 3; a++)
         if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0;
-    if (cd_decomp_choose(&x->grid, &sim->cfg, x->size, lo, hi, interaction_range(sim), 0, err, errlen))
+    /* The grid is chosen at the first start and kept for a restart (the
+     * bulk probe's, from a compacted packing that it might not split as
+     * well): the bits do not depend on it. */
+    if (!x->ran && cd_decomp_choose(&x->grid, &sim->cfg, x->size, lo, hi, interaction_range(sim), 0, err, errlen))
         return -1; /* every rank: the same data, the same refusal */
 
     cd_sim *loc = &x->loc;
@@ -232,7 +249,7 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     /* (a rank without particles has no list to build and no forces) */
     if (!rc) rc = x->inner->start(loc, compute && loc->s.n_particles > 0, err, errlen);
     if (agree_failure(x, rc, err, errlen)) return -1;
-    x->started = 1;
+    x->started = x->ran = 1;
     /* the ghosts' forces from their owners (a start computes them from
      * the pairs this rank sees) */
     cd_mpi_refresh_ghosts(x, 0);
@@ -305,12 +322,6 @@ static const cd_backend cd_backend_mpi = {"mpi", mpi_start, mpi_step, mpi_sync, 
 int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
 {
     if (!cd_mpi_decomposed()) return 0;
-    const cd_config *c = &sim->cfg;
-    if (c->protocol_kind == CD_PROTOCOL_BULK) { /* it copies and restores the whole state between probes */
-        snprintf(err, errlen, "%s: protocol.type = %s does not run on several MPI ranks yet (docs/mpi.md, \"Not done "
-                 "yet\"): run it with one rank", c->source_path, c->protocol);
-        return -1;
-    }
     if (strcmp(backend, "omp")) {
         snprintf(err, errlen, "--backend %s: several MPI ranks run the omp backend only so far (docs/mpi.md)", backend);
         return -1;
@@ -331,5 +342,7 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     x->inner = sim->backend ? sim->backend : &cd_backend_omp;
     sim->backend = &cd_backend_mpi;
     sim->backend_data = x;
+    free(the_ctx);
+    the_ctx = x;
     return 0;
 }

@@ -24,6 +24,8 @@ typedef struct {
     double *send_buf, *recv_buf;
     long long migrations;     /* times the particles went to new owners */
     int started;              /* the local state runs (start succeeded on every rank) */
+    int ran;                  /* it ran at least once (the closing report) */
+    long last_owned, last_ghosts; /* particles of this rank when it last stopped */
     /* wall-clock seconds of this rank (MPI_Wtime): in the serial step (the
      * decision and migration taken out), deciding the rebuild (waits for
      * the slowest rank included), migrating, refreshing ghosts */

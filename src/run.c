@@ -371,8 +371,9 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        if (cd_protocol_resume(&sim, opt->resume_path, err, sizeof err)) {
-            fprintf(stderr, "capdem: --resume %s\n", err);
+        int refused = cd_protocol_resume(&sim, opt->resume_path, err, sizeof err) != 0;
+        if (refused) fprintf(stderr, "capdem: --resume %s\n", err);
+        if (cd_mpi_agree(refused)) { /* (under MPI: every rank has read the file before rank 0 reopens it) */
             status = 2;
             goto done;
         }

@@ -6,7 +6,10 @@
 # run: the deposit on 2D crosses through settling, compression and hold
 # (2 and 3 ranks), radial compaction of the spheres' CI twin for 6000
 # steps (3 ranks), and a deposit written with 3 ranks in its compression
-# phase and resumed with 2, against the serial resume.
+# phase and resumed with 2, against the serial resume; the bulk-modulus
+# probe (shortened: tests/mpi/bulk_hexapods.yaml), whose every window
+# restarts from the base state, on 3 ranks and resumed in a probe window
+# with 2.
 # usage: test_mpi_protocols.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
@@ -29,5 +32,15 @@ else bad "radial: 3 ranks: failed or differs from the serial run"; head -20 diff
 if mpi 3 run "$deposit" --output resumed3.h5 --steps 11000 --quiet 2> err &&
    mpi 2 run "$deposit" --resume resumed3.h5 --quiet 2> err && same resumed1.h5 resumed3.h5; then ok
 else bad "deposit: 3 ranks, resumed with 2: failed or differs from the serial resume"; head -20 diff.txt; fi
+bulk="$src/tests/mpi/bulk_hexapods.yaml"
+"$capdem" run "$bulk" --output bulk1.h5 --quiet 2> err || bad "bulk: the serial run failed"
+if ! grep -q "reached in protocol phase" err; then ok; else bad "bulk: the serial run did not finish its probes"; fi
+if mpi 3 run "$bulk" --output bulk3.h5 --quiet 2> err && same bulk1.h5 bulk3.h5; then ok
+else bad "bulk: 3 ranks: failed or differs from the serial run"; head -20 diff.txt; fi
+"$capdem" run "$bulk" --output bulkr1.h5 --steps 20700 --quiet 2> err &&
+  "$capdem" run "$bulk" --resume bulkr1.h5 --quiet 2> err || bad "bulk: the serial resume failed"
+if mpi 3 run "$bulk" --output bulkr3.h5 --steps 20700 --quiet 2> err &&
+   mpi 2 run "$bulk" --resume bulkr3.h5 --quiet 2> err && same bulkr1.h5 bulkr3.h5; then ok
+else bad "bulk: 3 ranks, resumed in a probe with 2: failed or differs from the serial resume"; head -20 diff.txt; fi
 echo "test_mpi_protocols: $pass passed, $fails failed"
 [ $fails -eq 0 ]

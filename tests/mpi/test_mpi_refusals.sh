@@ -35,8 +35,11 @@ refused grid_product 3 'grid_product\.yaml: mpi\.grid = \[2, 2, 1\] makes 4 sub-
 { printf 'mpi:\n  grid: [1, 1, 2]\n'; cat "$base"; } > grid_2d.yaml
 refused grid_2d 2 'grid_2d\.yaml: mpi\.grid = \[1, 1, 2\]: 2 sub-domains along z.*at most 1 along z in 2D'
 
-cp "$src/configs/protocols/ci/bulk_modulus_hexapods_a3.yaml" protocol.yaml
-refused protocol 2 'protocol\.yaml: protocol\.type = bulk_modulus does not run on several MPI ranks yet'
+# (an OpenCL build refuses the backend under MPI; a build without it, the name)
+cp "$base" backend.yaml
+mpi 2 run backend.yaml --output backend.h5 --backend opencl --quiet > out 2> err
+if [ $? -eq 2 ] && [ "$(grep -Ec -- '--backend opencl: (several MPI ranks run the omp backend only|expected omp or opencl)' err)" -eq 1 ] &&
+   [ ! -e backend.h5 ]; then ok; else bad "backend: --backend opencl on 2 ranks not refused once with exit 2"; fi
 
 # the same configs are fine on one process (the refusals are the decomposition's)
 if "$capdem" run too_many_ranks.yaml --output one.h5 --steps 10 --quiet 2> err; then ok
