@@ -27,20 +27,22 @@ done
 if mpi 3 run "$radial" --output radial3.h5 --steps 6000 --quiet 2> err && same radial1.h5 radial3.h5; then ok
 else bad "radial: 3 ranks: failed or differs from the serial run"; head -20 diff.txt; fi
 
-"$capdem" run "$deposit" --output resumed1.h5 --steps 11000 --quiet 2> err &&
-  "$capdem" run "$deposit" --resume resumed1.h5 --quiet 2> err || bad "deposit: the serial resume failed"
-if mpi 3 run "$deposit" --output resumed3.h5 --steps 11000 --quiet 2> err &&
-   mpi 2 run "$deposit" --resume resumed3.h5 --quiet 2> err && same resumed1.h5 resumed3.h5; then ok
-else bad "deposit: 3 ranks, resumed with 2: failed or differs from the serial resume"; head -20 diff.txt; fi
+# resumed_equal NAME CONFIG STEP: written to STEP with 3 ranks and resumed
+# with 2 equals the serial run written to STEP and resumed
+resumed_equal() {
+  "$capdem" run "$2" --output "$1-1.h5" --steps "$3" --quiet 2> err &&
+    "$capdem" run "$2" --resume "$1-1.h5" --quiet 2> err || { bad "$1: the serial resume failed"; return; }
+  if mpi 3 run "$2" --output "$1-3.h5" --steps "$3" --quiet 2> err &&
+     mpi 2 run "$2" --resume "$1-3.h5" --quiet 2> err && same "$1-1.h5" "$1-3.h5"; then ok
+  else bad "$1: 3 ranks to step $3, resumed with 2: failed or differs from the serial resume"; head -20 diff.txt; fi
+}
+resumed_equal deposit "$deposit" 11000 # in the compression
+
 bulk="$src/tests/mpi/bulk_hexapods.yaml"
 "$capdem" run "$bulk" --output bulk1.h5 --quiet 2> err || bad "bulk: the serial run failed"
 if ! grep -q "reached in protocol phase" err; then ok; else bad "bulk: the serial run did not finish its probes"; fi
 if mpi 3 run "$bulk" --output bulk3.h5 --quiet 2> err && same bulk1.h5 bulk3.h5; then ok
 else bad "bulk: 3 ranks: failed or differs from the serial run"; head -20 diff.txt; fi
-"$capdem" run "$bulk" --output bulkr1.h5 --steps 20700 --quiet 2> err &&
-  "$capdem" run "$bulk" --resume bulkr1.h5 --quiet 2> err || bad "bulk: the serial resume failed"
-if mpi 3 run "$bulk" --output bulkr3.h5 --steps 20700 --quiet 2> err &&
-   mpi 2 run "$bulk" --resume bulkr3.h5 --quiet 2> err && same bulkr1.h5 bulkr3.h5; then ok
-else bad "bulk: 3 ranks, resumed in a probe with 2: failed or differs from the serial resume"; head -20 diff.txt; fi
+resumed_equal bulk "$bulk" 20700 # in the first strained window
 echo "test_mpi_protocols: $pass passed, $fails failed"
 [ $fails -eq 0 ]
