@@ -3,13 +3,16 @@
 # (tests/CMakeLists.txt), so that a missing dependency cannot drop tests
 # silently (OpenCL: the backend tests), and no test of BUILD's CTest log
 # was skipped (a check that could not run, SKIP_RETURN_CODE).
-# usage: .ci/check-tests.sh BUILD [CTEST_LOG]  (from the source root; BUILD with CAPDEM_OPENCL=ON)
+# usage: .ci/check-tests.sh BUILD [CTEST_LOG]  (from the source root; BUILD with CAPDEM_OPENCL=ON, and
+# CAPDEM_MPI=ON or not)
 set -euo pipefail
 build=$1 log=${2:-}
 names() { for f in "$@"; do [ -e "$f" ] && basename "${f%.*}"; done; }
 {
   names tests/{unit,physics,config,regression,analysis,protocols,offload,mpm}/test_*.c tests/cli/test_*.sh \
         tests/bench/test_*.sh tests/backend/test_*.c tests/backend/test_*.sh tests/mpm/test_*.sh
+  # the MPI tests in MPI builds only (-DCAPDEM_MPI=ON, docs/mpi.md)
+  grep -q '^CAPDEM_MPI:BOOL=ON$' "$build/CMakeCache.txt" && names tests/mpi/test_*.sh
   names tests/physics/test_*.c tests/regression/test_*.c | sed 's/$/_opencl/'
   names configs/protocols/ci/*.yaml | grep -vxE 'deposit_2d_crosses|radial_hexapods_a3|radial_spheres|bulk_modulus_hexapods_a3' |
     sed 's/^/preset_/'

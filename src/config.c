@@ -306,7 +306,7 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
 {
     /* Each solver reads sections of its own: a section of the other is a
      * mistake (a value that would be silently ignored), named as such. */
-    static const char *const dem_only[] = {"physics", "material", "domain", "init", "neighbor", "protocol",
+    static const char *const dem_only[] = {"physics", "material", "domain", "init", "neighbor", "protocol", "mpi",
                                            "run.steps_per_collision", "run.max_overlap"};
     int mpm = c->solver == 1;
     for (size_t i = 0; i < sizeof dem_only / sizeof dem_only[0] + 1; i++) {

@@ -88,6 +88,10 @@ typedef struct {
     /* neighbour list */
     double skin;                   /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
 
+    /* MPI domain decomposition (docs/mpi.md; read by the MPI build only) */
+    int mpi_decomposition;         /* 0: cartesian */
+    double mpi_grid[3];            /* sub-domains along x, y, z; [0, 0, 0]: chosen from the ranks and the domain */
+
     /* protocol (SPEC section 6; src/protocol.c) */
     char protocol[24];             /* none | deposit_compress | radial_compaction | bulk_modulus */
     enum cd_protocol_kind protocol_kind; /* protocol as a selector, set at load */

@@ -179,6 +179,13 @@ const cd_key cd_config_keys[] = {
     {"neighbor.skin", CD_KT_REAL, "m", "0", CFG(skin), GE(0),
      .label = "Verlet skin", .meaning = "neighbour-list skin; 0: automatic (0.1 x smallest arm diameter)"},
 
+    /* MPI domain decomposition (docs/mpi.md): how `mpirun -np R` splits space */
+    {"mpi.decomposition", CD_KT_ENUM, "-", "cartesian", CFG(mpi_decomposition), .flags = CD_KF_RESUMABLE,
+     .choices = "cartesian",
+     .label = "MPI decomposition", .meaning = "cartesian: a grid of sub-domains, one per rank (MPI build, docs/mpi.md)"},
+    {"mpi.grid", CD_KT_VEC3, "-", "[0, 0, 0]", CFG(mpi_grid), .flags = CD_KF_RESUMABLE,
+     .label = "MPI grid", .meaning = "sub-domains along x, y, z, their product the ranks; [0, 0, 0]: chosen from the ranks and the domain"},
+
     /* protocol */
     {"protocol.type", CD_KT_ENUM, "-", "none", CFG_SIZED(protocol), .flags = CD_KF_SELECTOR,
      .choices = "none|deposit_compress|radial_compaction|bulk_modulus",

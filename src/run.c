@@ -16,6 +16,7 @@
 #include "protocol.h"
 #include "../kernels/rigid.h"
 #include "mpm_run.h"
+#include "mpi_decomp.h"
 
 enum { OBS_KT, OBS_KR, OBS_KC, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
 
@@ -180,10 +181,18 @@ static void write_failed(const cd_run_options *opt, const cd_config *cfg, long l
                 opt->config_path, cfg->output);
 }
 
+/* Under MPI (docs/mpi.md) rank 0 alone holds the output (out is NULL on
+ * the others) and every rank learns whether a write failed, so that all
+ * stop together. */
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
 {
-    observable_row(sim, o, row);
-    return cd_output_thermo(out, sim->s.step, sim->s.time, row);
+    if (out) observable_row(sim, o, row);
+    return cd_mpi_agree(out ? cd_output_thermo(out, sim->s.step, sim->s.time, row) : 0);
+}
+
+static int write_snapshot(cd_output *out, const cd_state *s)
+{
+    return cd_mpi_agree(out ? cd_output_snapshot(out, s) : 0);
 }
 
 /* Whether paths a and b name the same file (device and inode; the same
@@ -270,7 +279,18 @@ static int check_files(const cd_run_options *opt, const cd_config *cfg, const cd
     return 0;
 }
 
+static int run(const cd_run_options *opt);
+
 int cd_run(const cd_run_options *opt)
+{
+    if (cd_mpi_begin()) {
+        fprintf(stderr, "capdem: MPI could not start\n");
+        return 1;
+    }
+    return cd_mpi_end(run(opt));
+}
+
+static int run(const cd_run_options *opt)
 {
     char err[2048];
     cd_config cfg;
@@ -290,7 +310,13 @@ int cd_run(const cd_run_options *opt)
     if (opt->output_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->output_path);
     if (!cfg.output[0]) snprintf(cfg.output, sizeof cfg.output, "%s.h5", cfg.name);
     if (opt->resume_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->resume_path);
-    if (check_files(opt, &cfg, &as_given)) {
+    /* (under MPI rank 0 looks, before any rank writes) */
+    if (cd_mpi_agree(cd_mpi_is_writer() ? check_files(opt, &cfg, &as_given) : 0)) {
+        cd_config_free(&cfg);
+        return 2;
+    }
+    if (cfg.solver == 1 && cd_mpi_decomposed()) {
+        fprintf(stderr, "capdem: %s: solver = mpm runs on one MPI rank only (docs/mpi.md)\n", cfg.source_path);
         cd_config_free(&cfg);
         return 2;
     }
@@ -306,7 +332,8 @@ int cd_run(const cd_run_options *opt)
         cd_config_free(&cfg);
         return 2;
     }
-    if (cd_sim_use_backend(&sim, opt->backend ? opt->backend : "omp", opt->device, err, sizeof err)) {
+    if (cd_sim_use_backend(&sim, opt->backend ? opt->backend : "omp", opt->device, err, sizeof err) ||
+        cd_mpi_wrap(&sim, opt->backend ? opt->backend : "omp", err, sizeof err)) {
         fprintf(stderr, "capdem: %s\n", err);
         cd_sim_free(&sim);
         cd_config_free(&cfg);
@@ -344,12 +371,13 @@ int cd_run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        if (cd_protocol_resume(&sim, opt->resume_path, err, sizeof err)) {
-            fprintf(stderr, "capdem: --resume %s\n", err);
+        int refused = cd_protocol_resume(&sim, opt->resume_path, err, sizeof err) != 0;
+        if (refused) fprintf(stderr, "capdem: --resume %s\n", err);
+        if (cd_mpi_agree(refused)) { /* (under MPI: every rank has read the file before rank 0 reopens it) */
             status = 2;
             goto done;
         }
-        out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
+        out = cd_mpi_is_writer() ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err) : NULL;
         if (out && cd_output_note_resume(out, sim.s.step, &cfg)) { /* (the writer says why) */
             cd_output_close(out);
             out = NULL;
@@ -367,10 +395,11 @@ int cd_run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg, sim.shapes,
-                                    sim.n_shapes, info, n_obs, err, sizeof err);
+        if (cd_mpi_is_writer())
+            out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg,
+                                        sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
     }
-    if (!out) { /* the writer printed why (cd_output_* report every failure on stderr) */
+    if (cd_mpi_agree(cd_mpi_is_writer() && !out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
         status = 1;
         goto done;
     }
@@ -393,7 +422,7 @@ int cd_run(const cd_run_options *opt)
             goto done;
         }
         cd_sim_observe(&sim, &o);
-        if (write_thermo(out, &sim, &o, row) || cd_output_snapshot(out, &sim.s)) {
+        if (write_thermo(out, &sim, &o, row) || write_snapshot(out, &sim.s)) {
             write_failed(opt, &cfg, -1);
             status = 1;
             goto done;
@@ -470,7 +499,7 @@ int cd_run(const cd_run_options *opt)
             }
         }
         if (snap_due || last) {
-            if (cd_output_snapshot(out, &sim.s)) {
+            if (write_snapshot(out, &sim.s)) {
                 write_failed(opt, &cfg, last_snap);
                 status = 1;
                 break;

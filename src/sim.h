@@ -98,6 +98,14 @@ typedef struct cd_sim {
     char device_request[16];  /* --device: cpu | gpu | auto (OpenCL) */
     cd_state probe_base;      /* bulk probe: the relaxed base state every probe starts from (zeroed until then) */
     int snapshot_request;     /* set by a protocol: write a snapshot of this step (then cleared by the run) */
+    /* A domain decomposition's say in the rebuild (src/mpi_backend.c,
+     * docs/mpi.md); NULL in one process.  The step calls it after its skin
+     * test with that test's answer for this process's particles (0/1) and
+     * rebuilds the neighbour list when it returns 1: the answer of every
+     * process, the particles already with their new owners; -1 with a
+     * message in err: the run stops. */
+    int (*rebuild_hook)(struct cd_sim *sim, int rebuild, char *err, size_t errlen);
+    void *rebuild_hook_data;
 } cd_sim;
 
 /* Builds a simulation from a validated config: shapes, particles placed as

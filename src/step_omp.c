@@ -382,7 +382,9 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
     for (long long it = 0; it < n; it++) {
-        int rc = advance(sim) ? cd_neighbors_build(sim) : 0;
+        int rebuild = advance(sim);
+        if (sim->rebuild_hook && (rebuild = sim->rebuild_hook(sim, rebuild, err, errlen)) < 0) return -1;
+        int rc = rebuild ? cd_neighbors_build(sim) : 0;
         if (rc == CD_NB_BLOWUP) {
             snprintf(err, errlen, "particle centres spread beyond any container (or not finite) at step %lld (t = "
                      "%.9g s): the run blew up; reduce run.dt or check the material parameters", s->step, s->time);

@@ -1,0 +1,114 @@
+/* The Cartesian grid of sub-domains of an MPI run (src/mpi_decomp.c,
+ * docs/mpi.md): the grid chosen from the ranks and the domain, refusals of
+ * grids the domain cannot hold, the owner of a point and the ranks whose
+ * halo holds it.  Plain C: runs in every build, with or without MPI. */
+#include "test_util.h"
+#include <math.h>
+#include "mpi_decomp.h"
+
+static cd_config config(int dimension, double gx, double gy, double gz)
+{
+    cd_config c;
+    memset(&c, 0, sizeof c);
+    snprintf(c.source_path, sizeof c.source_path, "test.yaml");
+    c.dimension = dimension;
+    c.gravity[0] = gx;
+    c.gravity[1] = gy;
+    c.gravity[2] = gz;
+    return c;
+}
+
+/* Auto grids: the gravity axis (y) stays whole; the cut area decides
+ * between x and z; 2D never splits z. */
+static void test_auto_grid(void **state)
+{
+    (void)state;
+    char err[512];
+    cd_decomp_grid g;
+    cd_config c = config(3, 0, -9.81, 0);
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0.5}; /* [m] */
+    assert_int_equal(cd_decomp_choose(&g, &c, 2, lo, hi, 0.1, 0, err, sizeof err), 0);
+    /* a cut across x has area 1 x 0.5, across z 1 x 1 */
+    assert_int_equal(g.dims[0], 2);
+    assert_int_equal(g.dims[1], 1);
+    assert_int_equal(g.dims[2], 1);
+    assert_int_equal(cd_decomp_choose(&g, &c, 4, lo, hi, 0.1, 0, err, sizeof err), 0);
+    assert_int_equal(g.dims[0] * g.dims[1] * g.dims[2], 4);
+    assert_int_equal(g.dims[1], 1);
+    assert_int_equal(g.dims[0], 2); /* 2 x 2 (area 1.5) beats 4 x 1 (1.5) by order, 1 x 4 (3) */
+    assert_true(g.width[0] == 0.5);
+    assert_true(g.halo == 0.1);
+    cd_config c2 = config(2, 0, -9.81, 0);
+    assert_int_equal(cd_decomp_choose(&g, &c2, 3, lo, hi, 0.1, 0, err, sizeof err), 0);
+    assert_int_equal(g.dims[0], 3);
+    assert_int_equal(g.dims[2], 1);
+}
+
+/* More ranks than sub-domains of at least the interaction range: refused,
+ * naming the file and the limits; a given grid checked the same way. */
+static void test_refusals(void **state)
+{
+    (void)state;
+    char err[512];
+    cd_decomp_grid g;
+    cd_config c = config(2, 0, -9.81, 0);
+    double lo[3] = {0, 0, 0}, hi[3] = {0.25, 0.15, 0}; /* [m]: 2 x 1 sub-domains of 0.1 m at most */
+    assert_int_equal(cd_decomp_choose(&g, &c, 2, lo, hi, 0.1, 0, err, sizeof err), 0);
+    assert_int_equal(cd_decomp_choose(&g, &c, 3, lo, hi, 0.1, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "test.yaml: 3 MPI ranks: more than the domain can be split into"));
+    assert_non_null(strstr(err, "at most 2 x 1 x 1"));
+    c.mpi_grid[0] = 1, c.mpi_grid[1] = 2, c.mpi_grid[2] = 1;
+    assert_int_equal(cd_decomp_choose(&g, &c, 2, lo, hi, 0.1, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "mpi.grid = [1, 2, 1]: 2 sub-domains along y"));
+    c.mpi_grid[0] = 2, c.mpi_grid[1] = 1, c.mpi_grid[2] = 1;
+    assert_int_equal(cd_decomp_choose(&g, &c, 3, lo, hi, 0.1, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "makes 2 sub-domains, but the run has 3 MPI ranks"));
+    c.mpi_grid[0] = 1.5;
+    assert_int_equal(cd_decomp_choose(&g, &c, 3, lo, hi, 0.1, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "expected three integers >= 1"));
+}
+
+/* Owners by the centre (outer sub-domains open to infinity, NaN to the
+ * first); ghosts in every sub-domain within the halo, corners by the
+ * Euclidean distance, ascending, never the owner. */
+static void test_owner_and_ghosts(void **state)
+{
+    (void)state;
+    char err[512];
+    cd_decomp_grid g;
+    cd_config c = config(3, 0, 0, 0);
+    c.mpi_grid[0] = 2, c.mpi_grid[1] = 1, c.mpi_grid[2] = 2;
+    double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 2};
+    assert_int_equal(cd_decomp_choose(&g, &c, 4, lo, hi, 0.1, 0.05, err, sizeof err), 0);
+    assert_true(fabs(g.halo - 0.15) < 1e-15);
+    double a[3] = {0.5, 0.5, 0.5}, b[3] = {1.5, 0.5, 0.5}, cc[3] = {0.5, 0.5, 1.5}, far[3] = {-7, 9, 30};
+    assert_int_equal(cd_decomp_owner(&g, a), 0);
+    assert_int_equal(cd_decomp_owner(&g, b), 1);
+    assert_int_equal(cd_decomp_owner(&g, cc), 2);
+    assert_int_equal(cd_decomp_owner(&g, far), 2);
+    double nan3[3] = {NAN, NAN, NAN};
+    assert_int_equal(cd_decomp_owner(&g, nan3), 0);
+    int r[4];
+    assert_int_equal(cd_decomp_ghost_ranks(&g, a, 0, r), 0);
+    double edge[3] = {0.9, 0.5, 0.5}; /* 0.1 m from the x cut */
+    assert_int_equal(cd_decomp_ghost_ranks(&g, edge, 0, r), 1);
+    assert_int_equal(r[0], 1);
+    double corner[3] = {0.9, 0.5, 0.9}; /* 0.1 m from both cuts, 0.141 m from the diagonal sub-domain */
+    assert_int_equal(cd_decomp_ghost_ranks(&g, corner, 0, r), 3);
+    assert_int_equal(r[0], 1);
+    assert_int_equal(r[1], 2);
+    assert_int_equal(r[2], 3);
+    double corner2[3] = {0.88, 0.5, 0.88}; /* 0.12 m from both cuts, 0.17 m from the diagonal one */
+    assert_int_equal(cd_decomp_ghost_ranks(&g, corner2, 0, r), 2);
+    assert_int_equal(r[1], 2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_auto_grid),
+        cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_owner_and_ghosts),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
