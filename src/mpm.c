@@ -418,3 +418,14 @@ double cd_mpm_strain_energy(const cd_mpm *m)
     }
     return e;
 }
+
+void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double *strain, double *z)
+{
+    double area = 0; /* [m^2 per m] */
+    for (size_t p = 0; p < m->n; p++) area += m->vol[p];
+    double w = m->walls[3].px - m->walls[2].px, h = m->walls[1].py - m->walls[0].py; /* box [m] */
+    *phi = area / (w * h);
+    *sigma = -m->walls[0].fy / w;
+    *strain = log(m->box_h0 / h);
+    *z = m->n_bodies > 0 ? 2.0 * (double)m->n_contacts / m->n_bodies : 0;
+}

@@ -60,16 +60,18 @@ typedef struct {
     size_t *cn_start;          /* per common node (nx * ny + 1): its body-nodes in cn_entry */
     size_t *cn_entry;          /* body-nodes sorted by common node, bodies ascending (cap_bnodes) */
     size_t *cn_list;           /* common nodes with >= 2 bodies (nx * ny) */
-    unsigned *cn_active;       /* per listed node: bit q set when its q-th body pair is in contact */
+    unsigned *cn_active;       /* per listed node: bit q set when its q-th body pair is in contact (gap <= contact_gap) */
     size_t n_cn;               /* listed nodes */
     long long *pair_keys;      /* scratch: k * n_bodies + l of the pairs in contact */
     size_t cap_pairs;
-    long n_contacts;           /* body pairs in contact in the last step */
-    double penetration;        /* deepest overlap of two bodies in the last step, from the contact nodes [m] */
+    double contact_gap;        /* two bodies' contact acts from this gap between them on [m] */
+    long n_contacts;           /* body pairs in contact (at a node within contact_gap) in the last step */
+    double penetration;        /* deepest overlap of two bodies in the last step, from the contact nodes [m]; 0 if none */
 
     int n_walls;
     cd_mpm_wall walls[CD_MPM_MAX_WALLS];
     double wall_k;             /* wall penalty stiffness per point [N/m per metre] */
+    double box_h0;             /* distance of walls 0 and 1 at start [m] */
 
     cd_mpm_material mat;
     double dt, time;           /* [s] */
@@ -106,6 +108,13 @@ double cd_mpm_kinetic_energy(const cd_mpm *m);
 /* Elastic strain energy sum V (sigma : C^-1 : sigma) / 2 (plane strain,
  * sigma_zz included) [J/m]: the elastic energy of an elastic material. */
 double cd_mpm_strain_energy(const cd_mpm *m);
+
+/* The packing's measures (set-up packing, docs/mpm.md): packing fraction
+ * phi, the points' area over the box's [1]; the applied stress, the bottom
+ * wall's force over the box width [Pa] (compression positive); the strain
+ * ln(h_i / h) of the box height h [1] (compression positive); the
+ * coordination number 2 N_c / N of the body pairs in contact [1]. */
+void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double *strain, double *z);
 
 /* Contact (src/mpm_contact.c, docs/mpm.md "Contact"): lists the common
  * nodes two or more bodies share; corrects the bodies' node velocities

@@ -2,10 +2,12 @@
  * through their common background mesh (docs/mpm.md, "Contact"): the
  * multi-mesh algorithm of Bardenhagen et al. (the paper's refs. [9-11]).
  * Each body has its own node values (src/mpm.c); where two bodies share a
- * common node and their material overlaps there, the normal component of
- * their relative velocity is removed when they approach, as a perfectly
- * inelastic collision of the two node masses along the contact normal:
- * momentum is conserved pair by pair, so exactly for any number of bodies.
+ * common node and, on the line through it along their normal, their
+ * material comes within contact_gap of each other (kernels/mpm_contact.h),
+ * the normal component of their relative velocity is removed when they
+ * approach, as a perfectly inelastic collision of the two node masses
+ * along the contact normal: momentum is conserved pair by pair, so exactly
+ * for any number of bodies.
  *
  * Deterministic: the common nodes' body lists come from a stable counting
  * sort, each listed node is handled by one thread and writes only its own
@@ -17,7 +19,7 @@
 #include "mpm.h"
 #include "sim.h" /* CD_PARALLEL */
 #include "../kernels/mpm_shape.h"
-#include "../kernels/mpm_wall.h"
+#include "../kernels/mpm_contact.h"
 
 static size_t common_node(const cd_mpm *m, size_t t)
 {
@@ -42,10 +44,10 @@ void cd_mpm_contact_nodes(cd_mpm *m)
         if (cs[g + 1] - cs[g] >= 2) m->cn_list[m->n_cn++] = g;
 }
 
-/* The extent of body k's material near common node (gi, gj), along the
- * unit vector n from the node at (xi, yi) [m]: the lowest and highest
- * reach (n . (x_p - x_i) -+ the point's reach) of the points whose
- * stencil holds the node [m]. */
+/* The extent of body k's material on the line through common node
+ * (gi, gj) at (xi, yi) [m] along the unit vector n: the lowest and highest
+ * s of the chords x_i + s n of the points whose stencil holds the node
+ * (kernels/mpm_contact.h) [m]; +inf and -inf when the line meets none. */
 static void extent(const cd_mpm *m, int k, int gi, int gj, double xi, double yi, double nx, double ny, double *lo,
                    double *hi)
 {
@@ -58,10 +60,12 @@ static void extent(const cd_mpm *m, int k, int gi, int gj, double xi, double yi,
             size_t c = m->win_off[k] + (size_t)cy * (size_t)wnx + (size_t)cx;
             for (size_t e = m->cell_start[c]; e < m->cell_start[c + 1]; e++) {
                 size_t p = m->order[e];
-                double s = nx * (m->x[p] - xi) + ny * (m->y[p] - yi);
-                double r = cd_mpm_point_reach(m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p], m->f_yy[p], nx, ny);
-                if (s - r < l) l = s - r;
-                if (s + r > u) u = s + r;
+                double s0, s1;
+                if (!cd_mpm_point_chord(m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p], m->f_yy[p], xi - m->x[p],
+                                        yi - m->y[p], nx, ny, &s0, &s1))
+                    continue;
+                if (s0 < l) l = s0;
+                if (s1 > u) u = s1;
             }
         }
     }
@@ -75,7 +79,8 @@ static int cmp_key(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Body pairs in contact, each counted once, from the contact bits. */
+/* Body pairs in contact (exchanging force), each counted once, from the
+ * contact bits. */
 static int count_pairs(cd_mpm *m, char *err, size_t errlen)
 {
     size_t n = 0;
@@ -131,12 +136,15 @@ int cd_mpm_contact_correct(cd_mpm *m, int phase, char *err, size_t errlen)
                 if (!(len > 0)) continue;
                 nx /= len;
                 ny /= len;
-                if (phase == 0) { /* in contact where a's material reaches past b's near this node */
+                if (phase == 0) { /* in contact where a's material comes within contact_gap of b's */
                     double lo_a, hi_a, lo_b, hi_b;
                     extent(m, m->bnode_body[ta], gi, gj, xi, yi, nx, ny, &lo_a, &hi_a);
                     extent(m, m->bnode_body[tb], gi, gj, xi, yi, nx, ny, &lo_b, &hi_b);
+                    /* on the line, a must lie before b along n: where the mass gradients' normal
+                     * disagrees with the order of the material (at the edge of the bodies' supports)
+                     * the node says nothing about this contact */
                     double gap = lo_b - hi_a; /* [m] */
-                    if (gap <= 0) {
+                    if (gap <= m->contact_gap && lo_a <= lo_b && hi_a <= hi_b) {
                         act |= 1u << q;
                         if (-gap > pen) pen = -gap;
                     }

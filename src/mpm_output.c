@@ -18,7 +18,17 @@ struct cd_mpm_output {
     hsize_t n_snap, n_series;
     size_t n_points;
     int n_walls;
+    int packing;               /* set-up packing: its measures in the series */
 };
+
+/* The packing's measures in the series (cd_mpm_packing_measures), and the
+ * deepest overlap of two bodies at their contact nodes. */
+enum { PACKING_SERIES = 5 };
+static const struct {
+    const char *name, *unit;
+} packing_series[PACKING_SERIES] = {
+    {"/mpm/series/packing_fraction", "1"}, {"/mpm/series/stress", "Pa"}, {"/mpm/series/strain", "1"},
+    {"/mpm/series/coordination", "1"}, {"/mpm/series/penetration", "m"}};
 
 static int fail(char *err, size_t errlen, const char *path, const char *what)
 {
@@ -107,6 +117,7 @@ cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_conf
     snprintf(o->path, sizeof o->path, "%s", path);
     o->n_points = m->n;
     o->n_walls = m->n_walls;
+    o->packing = m->n_walls == 4;
     const char *target = path;
     if (replace) { /* written aside, renamed over path at the first snapshot: the old file stays until then */
         snprintf(o->aside, sizeof o->aside, "%s.XXXXXX", path);
@@ -150,6 +161,7 @@ cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_conf
     rc |= make_growing(o->file, "/mpm/snapshots/volume", H5T_IEEE_F64LE, 2, &n, 1, "m^3/m");
     rc |= make_growing(o->file, "/mpm/snapshots/stress", H5T_IEEE_F64LE, 3, t4, 1, "Pa");
     rc |= make_growing(o->file, "/mpm/snapshots/plastic_strain", H5T_IEEE_F64LE, 2, &n, 1, "1");
+    rc |= make_growing(o->file, "/mpm/snapshots/deformation_gradient", H5T_IEEE_F64LE, 3, t4, 1, "1");
     rc |= make_growing(o->file, "/mpm/snapshots/wall_position", H5T_IEEE_F64LE, 3, tw, 64, "m");
     rc |= make_growing(o->file, "/mpm/snapshots/wall_force", H5T_IEEE_F64LE, 3, tw, 64, "N/m");
     rc |= make_growing(o->file, "/mpm/series/step", H5T_STD_I64LE, 1, NULL, 1024, "1");
@@ -157,6 +169,8 @@ cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_conf
     rc |= make_growing(o->file, "/mpm/series/wall_position", H5T_IEEE_F64LE, 3, tw, 1024, "m");
     rc |= make_growing(o->file, "/mpm/series/wall_force", H5T_IEEE_F64LE, 3, tw, 1024, "N/m");
     rc |= make_growing(o->file, "/mpm/series/kinetic_energy", H5T_IEEE_F64LE, 1, NULL, 1024, "J/m");
+    for (int k = 0; o->packing && k < PACKING_SERIES; k++)
+        rc |= make_growing(o->file, packing_series[k].name, H5T_IEEE_F64LE, 1, NULL, 1024, packing_series[k].unit);
     if (rc) {
         fail(err, errlen, path, "the file header");
         cd_mpm_output_close(o);
@@ -192,6 +206,9 @@ int cd_mpm_output_snapshot(cd_mpm_output *o, const cd_mpm *m, char *err, size_t 
         buf[4 * p] = m->sxx[p], buf[4 * p + 1] = m->syy[p], buf[4 * p + 2] = m->sxy[p], buf[4 * p + 3] = m->szz[p];
     rc |= append(f, "/mpm/snapshots/stress", D, at, buf);
     rc |= append(f, "/mpm/snapshots/plastic_strain", D, at, m->eps_p);
+    for (size_t p = 0; p < n; p++)
+        buf[4 * p] = m->f_xx[p], buf[4 * p + 1] = m->f_xy[p], buf[4 * p + 2] = m->f_yx[p], buf[4 * p + 3] = m->f_yy[p];
+    rc |= append(f, "/mpm/snapshots/deformation_gradient", D, at, buf);
     double pos[2 * CD_MPM_MAX_WALLS], force[2 * CD_MPM_MAX_WALLS];
     walls_rows(m, pos, force);
     rc |= append(f, "/mpm/snapshots/wall_position", D, at, pos);
@@ -225,6 +242,12 @@ int cd_mpm_output_series(cd_mpm_output *o, const cd_mpm *m, double kinetic, char
     rc |= append(f, "/mpm/series/wall_position", D, at, pos);
     rc |= append(f, "/mpm/series/wall_force", D, at, force);
     rc |= append(f, "/mpm/series/kinetic_energy", D, at, &kinetic);
+    if (o->packing) {
+        double v[PACKING_SERIES];
+        cd_mpm_packing_measures(m, &v[0], &v[1], &v[2], &v[3]);
+        v[4] = m->penetration;
+        for (int k = 0; k < PACKING_SERIES; k++) rc |= append(f, packing_series[k].name, D, at, &v[k]);
+    }
     if (rc) return fail(err, errlen, o->path, "a time-series row");
     o->n_series++;
     return 0;

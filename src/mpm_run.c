@@ -32,9 +32,17 @@ static void progress(const cd_mpm *m, const cd_config *c, double t0, long long s
     long long done = m->step - step0;
     double rate = done > 0 && t > t0 ? (double)done / (t - t0) : 0; /* steps/s */
     double eta = rate > 0 ? (double)(c->steps - m->step) / rate : 0;
-    nominal(m, c, &eps, &sig);
-    fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  eps_yy %.4f  sigma_yy %.4g Pa  %.3g point-steps/s  ETA %.0f s%s",
-            tty ? "\r" : "", m->step, c->steps, m->time, eps, sig, rate * (double)m->n, eta, tty ? (final ? "\n" : "   ") : "\n");
+    char what[128];
+    if (m->n_walls == 4) {
+        double phi, z;
+        cd_mpm_packing_measures(m, &phi, &sig, &eps, &z);
+        snprintf(what, sizeof what, "phi %.4f  sigma %.4g Pa  eps %.4f  Z %.2f", phi, sig, eps, z);
+    } else {
+        nominal(m, c, &eps, &sig);
+        snprintf(what, sizeof what, "eps_yy %.4f  sigma_yy %.4g Pa", eps, sig);
+    }
+    fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  %s  %.3g point-steps/s  ETA %.0f s%s", tty ? "\r" : "", m->step,
+            c->steps, m->time, what, rate * (double)m->n, eta, tty ? (final ? "\n" : "   ") : "\n");
     fflush(stderr);
 }
 

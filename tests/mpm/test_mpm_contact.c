@@ -58,6 +58,7 @@ static void two_disks(cd_mpm *m, double gap_cells, double dt)
                 p++;
             }
     m->mat = cd_mpm_material_make(E_, NU_, -1, 0);
+    m->contact_gap = 0.25 * h; /* the default mpm.contact_gap */
     m->dt = dt;
 }
 
