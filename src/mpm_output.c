@@ -106,8 +106,9 @@ static int write_fixed(hid_t file, const char *path, hid_t ftype, hid_t mtype, i
     return rc;
 }
 
-cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_config *cfg, const cd_mpm *m, char *err,
-                                    size_t errlen)
+/* A writer for path with m's counts, no file open yet; NULL with a
+ * message when out of memory. */
+static cd_mpm_output *output_new(const char *path, const cd_mpm *m, char *err, size_t errlen)
 {
     cd_mpm_output *o = calloc(1, sizeof *o);
     if (!o) {
@@ -115,9 +116,18 @@ cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_conf
         return NULL;
     }
     snprintf(o->path, sizeof o->path, "%s", path);
+    o->file = -1;
     o->n_points = m->n;
     o->n_walls = m->n_walls;
     o->packing = m->n_walls == 4;
+    return o;
+}
+
+cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_config *cfg, const cd_mpm *m, char *err,
+                                    size_t errlen)
+{
+    cd_mpm_output *o = output_new(path, m, err, errlen);
+    if (!o) return NULL;
     const char *target = path;
     if (replace) { /* written aside, renamed over path at the first snapshot: the old file stays until then */
         snprintf(o->aside, sizeof o->aside, "%s.XXXXXX", path);
@@ -388,16 +398,9 @@ static int truncate_rows(hid_t file, const char *path, hsize_t rows)
 
 cd_mpm_output *cd_mpm_output_reopen(const char *path, const cd_config *cfg, const cd_mpm *m, char *err, size_t errlen)
 {
-    cd_mpm_output *o = calloc(1, sizeof *o);
+    cd_mpm_output *o = output_new(path, m, err, errlen);
     long long *steps = NULL;
-    if (!o) {
-        snprintf(err, errlen, "%s: out of memory", path);
-        return NULL;
-    }
-    snprintf(o->path, sizeof o->path, "%s", path);
-    o->n_points = m->n;
-    o->n_walls = m->n_walls;
-    o->packing = m->n_walls == 4;
+    if (!o) return NULL;
     int rc = -1;
     H5E_BEGIN_TRY
     {

@@ -9,16 +9,7 @@ set -u
 capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 
-# expect_refusal NAME REGEX (config text on stdin): exit 2, file and /REGEX/ named, no output file
-expect_refusal() {
-  cat > "$1.yaml"
-  "$capdem" run "$1.yaml" --output "$1.h5" --quiet > out 2> err
-  local rc=$?
-  if [ $rc -ne 2 ]; then bad "$1: exit status $rc, expected 2"; return; fi
-  if ! grep -q "$1.yaml" err || ! grep -Eq "$2" err; then bad "$1: message does not name the file and /$2/"; return; fi
-  if [ -e "$1.h5" ]; then bad "$1: an output file was written"; return; fi
-  ok
-}
+. "$src/tests/mpm/expect_refusal.sh"
 good='solver: mpm
 run: {dt: 2.0e-6, steps: 100, snapshot_every: 50, thermo_every: 10}
 mpm: {cells_per_diameter: 8, wall_speed: 10, material: {model: von_mises, yield_stress: 4.0e5, hardening: 1.0e6}}'

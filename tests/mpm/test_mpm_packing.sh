@@ -64,15 +64,7 @@ h5dump -a /parameters/resumes/0/step part.h5 2> /dev/null | grep -q "(0): 400" &
   || bad "resume: no /parameters/resumes/0 with step 400"
 
 # bad input: exit 2 naming the file and the key, nothing written
-expect_refusal() {
-  cat > "$1.yaml"
-  "$capdem" run "$1.yaml" --output "$1.h5" --quiet > out 2> err
-  local rc=$?
-  if [ $rc -ne 2 ]; then bad "$1: exit status $rc, expected 2"; return; fi
-  if ! grep -q "$1.yaml" err || ! grep -Eq "$2" err; then bad "$1: message does not name the file and /$2/"; return; fi
-  if [ -e "$1.h5" ]; then bad "$1: an output file was written"; return; fi
-  ok
-}
+. "$src/tests/mpm/expect_refusal.sh"
 expect_refusal no_packing_file 'mpm\.packing = nothing\.h5: cannot open' <<< 'solver: mpm
 run: {dt: 5.0e-7, steps: 10}
 mpm: {setup: packing, packing: nothing.h5}'
