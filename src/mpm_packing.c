@@ -12,6 +12,22 @@
 #include <string.h>
 #include "mpm_packing.h"
 
+/* Reads row `row` of the (S, n, 3) dataset `name` as doubles into buf. */
+static int read_row3(hid_t f, const char *name, long long row, long long n, double *buf)
+{
+    hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    if (d < 0) return -1;
+    hid_t fs = H5Dget_space(d);
+    hsize_t start[3] = {(hsize_t)row, 0, 0}, count[3] = {1, (hsize_t)n, 3};
+    hid_t ms = H5Screate_simple(3, count, NULL);
+    int rc = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
+                     H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, buf) >= 0 ? 0 : -1;
+    H5Sclose(ms);
+    H5Sclose(fs);
+    H5Dclose(d);
+    return rc;
+}
+
 /* Reads the whole dataset `name` as doubles (or ints when ints != NULL)
  * after checking its rank and dimensions (dims[k] < 0: any, returned). */
 static int read_all(hid_t f, const char *name, int rank, long long *dims, double *dbl, int *ints)
@@ -61,9 +77,9 @@ int cd_mpm_read_packing(const char *path, const char *key_where, cd_mpm_packing 
         }
         n = dims[1];
         long long d1[1] = {n}, dp[1] = {-1}, de[2] = {-1, 3};
-        pos = malloc((size_t)(dims[0] * n * 3) * sizeof(double));
-        count = malloc((size_t)n * sizeof(int));
-        if (!pos || !count || read_all(f, "/particles/all/position/value", 3, dims, pos, NULL) ||
+        pos = malloc((size_t)(n * 3 + 1) * sizeof(double));
+        count = malloc((size_t)(n + 1) * sizeof(int));
+        if (!pos || !count || read_row3(f, "/particles/all/position/value", committed - 1, n, pos) ||
             read_all(f, "/particles/all/prim_count", 1, d1, NULL, count) ||
             read_all(f, "/particles/prims/prim_radius", 1, dp, NULL, NULL)) {
             snprintf(err, errlen, "%s: mpm.packing = %s: cannot read the particles' positions and primitives", key_where, path);
@@ -87,7 +103,7 @@ int cd_mpm_read_packing(const char *path, const char *key_where, cd_mpm_packing 
             snprintf(err, errlen, "%s: mpm.packing = %s: cannot read the primitives' radii and ends", key_where, path);
             goto out;
         }
-        const double *last = pos + (size_t)((committed - 1) * n * 3);
+        const double *last = pos;
         for (long long i = 0; i < n; i++) {
             double len = 0;
             for (int k = 0; k < 3; k++) len += fabs(ends[3 * i + k] - ends[3 * (n + i) + k]);
