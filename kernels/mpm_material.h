@@ -36,6 +36,15 @@ CD_INLINE cd_mpm_material cd_mpm_material_make(cd_real young, cd_real poisson, c
     return m;
 }
 
+/* Elastic energy per volume sigma : C^-1 : sigma / 2 [J/m^3] of a stress
+ * (sigma_zz included): s:s / (4 G) - lambda tr^2 / (4 G (3 lambda + 2 G)). */
+CD_INLINE cd_real cd_mpm_elastic_energy_density(cd_mpm_material m, cd_mpm_stress s)
+{
+    cd_real ss = s.xx * s.xx + s.yy * s.yy + s.zz * s.zz + CD_R(2) * s.xy * s.xy; /* [Pa^2] */
+    cd_real tr = s.xx + s.yy + s.zz;                                                /* [Pa] */
+    return ss / (CD_R(4) * m.shear) - m.lambda * tr * tr / (CD_R(4) * m.shear * (CD_R(3) * m.lambda + CD_R(2) * m.shear));
+}
+
 /* P-wave modulus lambda + 2 G [Pa]: the explicit step's wave speed is sqrt(it / rho). */
 CD_INLINE cd_real cd_mpm_pwave_modulus(cd_mpm_material m) { return m.lambda + CD_R(2) * m.shear; }
 

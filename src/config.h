@@ -115,12 +115,14 @@ typedef struct {
     /* solver: which program runs the file (docs/mpm.md) */
     int solver;                    /* 0 dem (rigid particles), 1 mpm (material point method) */
     /* mpm (docs/mpm.md) */
-    int mpm_setup;                 /* 0 diametral: one disk between two plane walls */
-    double mpm_diameter;           /* disk diameter D [m] */
+    int mpm_setup;                 /* 0 diametral: one disk between two plane walls; 1 packing: a DEM packing in a box */
+    double mpm_diameter;           /* disk diameter D [m] (diametral) */
+    char mpm_packing[CD_PATH_MAX]; /* the DEM run file of the packing (packing) */
     int mpm_cells;                 /* background cells across D [1] */
     int mpm_points_per_side;       /* material points per cell and direction at start [1] */
     double mpm_wall_speed;         /* speed of the top wall towards the bottom one [m/s] */
     double mpm_wall_stiffness;     /* wall penalty k / E [1] */
+    double mpm_contact_gap;        /* gap from which particles' contact acts, in cells [1] */
     int mpm_model;                 /* 0 elastic, 1 von_mises */
     double mpm_density;            /* rho [kg/m^3] */
     double mpm_young;              /* E [Pa] */

@@ -24,6 +24,8 @@
 #define L_HERTZ 2u
 #define SOLVER_DEM 1u
 #define M_VON_MISES 2u
+#define MPM_DIAMETRAL 1u
+#define MPM_PACKING 2u
 
 _Static_assert(CD_WALL_PLANE == 0, "domain.walls[].type stores the index of \"plane\" in its choices");
 _Static_assert(CD_LAW_LINEAR == 0 && CD_LAW_HERTZ_MINDLIN == 1, "material.law stores the index of its choice");
@@ -231,18 +233,25 @@ const cd_key cd_config_keys[] = {
      .label = "probe relaxation steps", .meaning = "bulk: steps of relaxation after each strain before the pressure is read"},
 
     /* material point method (solver: mpm; docs/mpm.md) */
-    {"mpm.setup", CD_KT_ENUM, "-", "diametral", CFG(mpm_setup), .choices = "diametral",
-     .label = "MPM set-up", .meaning = "diametral: one disk compressed between a fixed bottom wall and a top wall moving down"},
-    {"mpm.diameter", CD_KT_REAL, "m", "0.06", CFG(mpm_diameter), GT(0),
+    {"mpm.setup", CD_KT_ENUM, "-", "diametral", CFG(mpm_setup), .flags = CD_KF_SELECTOR, .choices = "diametral|packing",
+     .label = "MPM set-up", .meaning = "diametral: one disk compressed between a fixed bottom wall and a top wall moving down; "
+                                      "packing: the disks of a 2D DEM run file in a box, compressed by its top wall"},
+    {"mpm.diameter", CD_KT_REAL, "m", "0.06", CFG(mpm_diameter), GT(0), .applies = MPM_DIAMETRAL,
      .label = "disk diameter", .meaning = "diameter D of the disk"},
+    {"mpm.packing", CD_KT_STRING, "path", NULL, CFG_SIZED(mpm_packing), .applies = MPM_PACKING, .required = MPM_PACKING,
+     .label = "packing run file", .meaning = "capdem run file of a 2D deposit of spheres (disks): its last snapshot's centres "
+                                             "and radii; relative to the working folder"},
     {"mpm.cells_per_diameter", CD_KT_INT, "-", "30", CFG_SIZED(mpm_cells), GE(4), LE(2000),
-     .label = "cells per diameter", .meaning = "background mesh: square cells of side D / this"},
+     .label = "cells per diameter", .meaning = "background mesh: square cells of side D / this (packing: D the smallest disk's)"},
     {"mpm.points_per_cell_side", CD_KT_INT, "-", "2", CFG_SIZED(mpm_points_per_side), GE(1), LE(4),
      .label = "points per cell side", .meaning = "material points per cell and direction at start (2: four per cell, the paper's)"},
     {"mpm.wall_speed", CD_KT_REAL, "m/s", "0.5", CFG(mpm_wall_speed), GE(0),
      .label = "wall speed", .meaning = "speed of the top wall towards the fixed bottom wall"},
     {"mpm.wall_stiffness", CD_KT_REAL, "1", "2", CFG(mpm_wall_stiffness), GT(0), LE(100),
      .label = "wall penalty stiffness", .meaning = "wall contact penalty k / E (k: N/m per metre of thickness and per point)"},
+    {"mpm.contact_gap", CD_KT_REAL, "1", "0.25", CFG(mpm_contact_gap), GE(0), LE(2),
+     .label = "contact gap, cells",
+     .meaning = "two particles' contact acts from this gap between them on, in cells (docs/mpm.md: less interpenetration, earlier contact)"},
     {"mpm.material.model", CD_KT_ENUM, "-", "elastic", CFG(mpm_model), .flags = CD_KF_SELECTOR, .choices = "elastic|von_mises",
      .label = "MPM material", .meaning = "elastic: linear isotropic; von_mises: plus von Mises plasticity, linear isotropic hardening"},
     {"mpm.material.density", CD_KT_REAL, "kg/m^3", "1000", CFG(mpm_density), GT(0),

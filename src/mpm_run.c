@@ -32,19 +32,23 @@ static void progress(const cd_mpm *m, const cd_config *c, double t0, long long s
     long long done = m->step - step0;
     double rate = done > 0 && t > t0 ? (double)done / (t - t0) : 0; /* steps/s */
     double eta = rate > 0 ? (double)(c->steps - m->step) / rate : 0;
-    nominal(m, c, &eps, &sig);
-    fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  eps_yy %.4f  sigma_yy %.4g Pa  %.3g point-steps/s  ETA %.0f s%s",
-            tty ? "\r" : "", m->step, c->steps, m->time, eps, sig, rate * (double)m->n, eta, tty ? (final ? "\n" : "   ") : "\n");
+    char what[128];
+    if (m->n_walls == 4) {
+        double phi, z;
+        cd_mpm_packing_measures(m, &phi, &sig, &eps, &z);
+        snprintf(what, sizeof what, "phi %.4f  sigma %.4g Pa  eps %.4f  Z %.2f", phi, sig, eps, z);
+    } else {
+        nominal(m, c, &eps, &sig);
+        snprintf(what, sizeof what, "eps_yy %.4f  sigma_yy %.4g Pa", eps, sig);
+    }
+    fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  %s  %.3g point-steps/s  ETA %.0f s%s", tty ? "\r" : "", m->step,
+            c->steps, m->time, what, rate * (double)m->n, eta, tty ? (final ? "\n" : "   ") : "\n");
     fflush(stderr);
 }
 
 int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
 {
     char err[1024];
-    if (opt->resume_path) {
-        fprintf(stderr, "capdem: --resume %s: solver mpm cannot resume yet (docs/mpm.md); start a new run\n", opt->resume_path);
-        return 2;
-    }
     if (opt->backend && strcmp(opt->backend, "omp")) {
         fprintf(stderr, "capdem: --backend %s: solver mpm runs on the omp backend only so far (docs/mpm.md)\n", opt->backend);
         return 2;
@@ -54,18 +58,36 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
         fprintf(stderr, "capdem: %s\n", err);
         return 2;
     }
-    cd_mpm_output *out = cd_mpm_output_create(cfg->output, opt->overwrite, cfg, &m, err, sizeof err);
+    cd_mpm_output *out;
+    if (opt->resume_path) { /* as the DEM runs: the last committed snapshot, and run.steps is the step to reach */
+        if (cd_mpm_read_snapshot(opt->resume_path, &m, err, sizeof err)) {
+            fprintf(stderr, "capdem: --resume %s\n", err);
+            cd_mpm_free(&m);
+            return 2;
+        }
+        if (cfg->steps < m.step) {
+            fprintf(stderr, "capdem: %s: run.steps (or --steps) = %lld, but the run file %s is at step %lld already; on a "
+                    "resume it is the step to reach, counted from the start of the run: expected an integer >= %lld\n",
+                    cfg->source_path, cfg->steps, opt->resume_path, m.step, m.step);
+            cd_mpm_free(&m);
+            return 2;
+        }
+        out = cd_mpm_output_reopen(opt->resume_path, cfg, &m, err, sizeof err);
+    } else {
+        out = cd_mpm_output_create(cfg->output, opt->overwrite, cfg, &m, err, sizeof err);
+    }
     if (!out) {
         fprintf(stderr, "capdem: %s\n", err);
         cd_mpm_free(&m);
         return 1;
     }
+    if (opt->resume_path) fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, m.step, m.time);
     fprintf(stderr, "capdem: mpm: %zu material points, mesh %d x %d nodes (h = %g m), dt = %g s (stability limit / %.1f), "
             "output %s\n", m.n, m.nx, m.ny, m.h, m.dt, cd_mpm_dt_limit(&m) / m.dt, cfg->output);
     int status = 0;
     /* the walls' forces of step 0 come from the first step's contact pass */
-    if (cd_mpm_output_series(out, &m, cd_mpm_kinetic_energy(&m), err, sizeof err) ||
-        cd_mpm_output_snapshot(out, &m, err, sizeof err)) {
+    if (!opt->resume_path && (cd_mpm_output_series(out, &m, cd_mpm_kinetic_energy(&m), err, sizeof err) ||
+                              cd_mpm_output_snapshot(out, &m, err, sizeof err))) {
         fprintf(stderr, "capdem: %s\n", err);
         status = 1;
     }

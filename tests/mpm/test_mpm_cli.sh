@@ -2,22 +2,14 @@
 # solver: mpm from the command line (docs/mpm.md): bad configs refused with
 # exit status 2 naming the file, the key and the value, nothing written; a
 # short run of the CI disk writes the documented datasets with their units;
-# the run's own numbers (the walls' forces) are those of the time series.
+# the run's own numbers (the walls' forces) are those of the time series;
+# a resume gives the same bits.
 # usage: test_mpm_cli.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 
-# expect_refusal NAME REGEX (config text on stdin): exit 2, file and /REGEX/ named, no output file
-expect_refusal() {
-  cat > "$1.yaml"
-  "$capdem" run "$1.yaml" --output "$1.h5" --quiet > out 2> err
-  local rc=$?
-  if [ $rc -ne 2 ]; then bad "$1: exit status $rc, expected 2"; return; fi
-  if ! grep -q "$1.yaml" err || ! grep -Eq "$2" err; then bad "$1: message does not name the file and /$2/"; return; fi
-  if [ -e "$1.h5" ]; then bad "$1: an output file was written"; return; fi
-  ok
-}
+. "$src/tests/mpm/expect_refusal.sh"
 good='solver: mpm
 run: {dt: 2.0e-6, steps: 100, snapshot_every: 50, thermo_every: 10}
 mpm: {cells_per_diameter: 8, wall_speed: 10, material: {model: von_mises, yield_stress: 4.0e5, hardening: 1.0e6}}'
@@ -65,9 +57,13 @@ awk -v f="$fy" 'BEGIN { exit !(f > 0) }' && ok || bad "good run: top wall force 
 [ $rc = 2 ] && ok || bad "existing output: exit status $rc, expected 2"
 "$capdem" run good.yaml --output good.h5 --overwrite --quiet > out 2> err && [ "$(snapshots good.h5)" = 3 ] && ok \
   || bad "--overwrite: not replaced"
-# not yet: resume and the OpenCL backend, refused by name
-"$capdem" run good.yaml --resume good.h5 --quiet > out 2> err; rc=$?
-[ $rc = 2 ] && grep -q "cannot resume yet" err && ok || bad "--resume: exit status $rc, expected 2 with a reason"
+# resume (the packing's in test_mpm_packing): 50 steps, then on to 100, the same bits as good.h5
+"$capdem" run good.yaml --output half.h5 --steps 50 --quiet > out 2> err &&
+  "$capdem" run good.yaml --resume half.h5 --quiet > out 2> err && h5diff good.h5 half.h5 /mpm > out 2>&1 && ok \
+  || bad "--resume: not the same bits as the run without a stop"
+# a resume asked to go back is refused
+"$capdem" run good.yaml --resume half.h5 --steps 60 --quiet > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q "at step 100 already" err && ok || bad "--resume --steps 60: exit status $rc, expected 2"
 
 # analyze and export do not read mpm run files yet: refused by name, not misread
 for c in analyze export; do

@@ -16,6 +16,7 @@
 #include <omp.h>
 #endif
 #include "mpm.h"
+#include "sim.h" /* cd_parallel_min_rows */
 
 #define RHO 1000.0 /* [kg/m^3] */
 #define E_ 1.0e7   /* [Pa] */
@@ -202,12 +203,15 @@ static void test_threads_same_bits(void **state)
     char err[1024];
     load_config(&c, "configs/mpm/ci/disk_plastic_h1.yaml");
     c.mpm_wall_speed = 5; /* faster, so that 300 steps reach the plastic range */
+    long saved = cd_parallel_min_rows;
+    cd_parallel_min_rows = 1; /* the disk's 812 points would run on one thread (CD_PARALLEL) */
     for (int t = 0; t < 2; t++) {
         omp_set_num_threads(t + 1);
         if (cd_mpm_setup(&m[t], &c, err, sizeof err)) fail_msg("%s", err);
         for (int k = 0; k < 300; k++) step(&m[t]);
     }
     omp_set_num_threads(2);
+    cd_parallel_min_rows = saved;
     size_t n = m[0].n;
     double *cols[2][13];
     for (int t = 0; t < 2; t++) {
