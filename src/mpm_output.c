@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "mpm_output.h"
+#include "io_h5_journal.h"
 #include "capdem_commit.h" /* CAPDEM_COMMIT (src/git_commit.cmake) */
 
 struct cd_mpm_output {
@@ -140,7 +141,9 @@ cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_conf
         close(fd);
         target = o->aside;
     }
-    o->file = H5Fcreate(target, replace ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t fapl = cdh5_fapl(); /* atomic commits, as every run file (docs/output.md, "Crash safety") */
+    o->file = H5Fcreate(target, replace ? H5F_ACC_TRUNC : H5F_ACC_EXCL, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
     if (o->file < 0) {
         snprintf(err, errlen, "%s: cannot create the run file (HDF5)", path);
         if (replace) unlink(o->aside);
@@ -231,11 +234,15 @@ int cd_mpm_output_snapshot(cd_mpm_output *o, const cd_mpm *m, char *err, size_t 
     rc |= a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &committed) >= 0 ? 0 : -1;
     if (a >= 0) H5Aclose(a);
     H5Sclose(sp);
-    if (rc || H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) return fail(err, errlen, o->path, "a snapshot");
+    if (rc || cdh5_commit(f, o->path, err, errlen) < 0) {
+        cdh5_drop_on_close(f); /* the file keeps its last commit */
+        return fail(err, errlen, o->path, "a snapshot");
+    }
     o->n_snap++;
     if (o->aside[0]) { /* the first snapshot is on disk: the new file takes the name */
         if (rename(o->aside, o->path) != 0) return fail(err, errlen, o->path, "the file over the old one (rename)");
         o->aside[0] = 0;
+        if (cdh5_journal_follow(f, o->path, err, errlen)) return -1;
     }
     return 0;
 }
@@ -335,7 +342,9 @@ int cd_mpm_read_snapshot(const char *path, cd_mpm *m, char *err, size_t errlen)
     }
     H5E_BEGIN_TRY
     {
-        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT), D = H5T_NATIVE_DOUBLE;
+        hid_t fapl = cdh5_fapl();
+        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl), D = H5T_NATIVE_DOUBLE;
+        H5Pclose(fapl);
         long long k = f >= 0 ? committed_snapshots(f) - 1 : -1, step = 0;
         double pos[2 * CD_MPM_MAX_WALLS];
         if (f < 0 || k < 0) {
@@ -404,7 +413,9 @@ cd_mpm_output *cd_mpm_output_reopen(const char *path, const cd_config *cfg, cons
     int rc = -1;
     H5E_BEGIN_TRY
     {
-        o->file = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+        hid_t fapl = cdh5_fapl();
+        o->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
+        H5Pclose(fapl);
         if (o->file >= 0) {
             o->n_snap = (hsize_t)committed_snapshots(o->file);
             /* the series rows up to the resumed step stay; those the interrupted run wrote after it go */
@@ -450,12 +461,15 @@ cd_mpm_output *cd_mpm_output_reopen(const char *path, const cd_config *cfg, cons
             if (rc == 0) {
                 hid_t ds = H5Dopen2(o->file, p, H5P_DEFAULT), sp = H5Screate(H5S_SCALAR);
                 hid_t a = H5Acreate2(ds, "step", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
-                rc = a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &step) >= 0 && attr_str(ds, "source_path", cfg->source_path) == 0 &&
-                             H5Fflush(o->file, H5F_SCOPE_GLOBAL) >= 0 ? 0 : -1;
+                rc = a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &step) >= 0 && attr_str(ds, "source_path", cfg->source_path) == 0
+                         ? 0 : -1;
                 if (a >= 0) H5Aclose(a);
                 H5Sclose(sp);
                 H5Dclose(ds);
+                /* the cut and the resume's record in one commit */
+                if (rc == 0) rc = cdh5_commit(o->file, path, err, errlen);
             }
+            if (rc) cdh5_drop_on_close(o->file); /* a failed resume leaves the file as it was */
         }
     }
     H5E_END_TRY
@@ -472,7 +486,9 @@ int cd_mpm_is_run_file(const char *path)
 {
     H5E_BEGIN_TRY
     {
-        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        hid_t fapl = cdh5_fapl();
+        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+        H5Pclose(fapl);
         int yes = 0;
         if (f >= 0) {
             if (H5Aexists(f, "solver") > 0) {

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "io_h5_journal.h"
 #include "mpm_packing.h"
 
 /* Reads row `row` of the (S, n, 3) dataset `name` as doubles into buf. */
@@ -58,7 +59,9 @@ int cd_mpm_read_packing(const char *path, const char *key_where, cd_mpm_packing 
     int *count = NULL;
     H5E_BEGIN_TRY
     {
-        f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        hid_t fapl = cdh5_fapl(); /* replays a killed run's journal in memory */
+        f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+        H5Pclose(fapl);
         long long committed = 0, dims[3] = {-1, -1, 3}, n, np;
         if (f < 0) {
             snprintf(err, errlen, "%s: mpm.packing = %s: cannot open it as an HDF5 file; expected a capdem run file of a 2D "
