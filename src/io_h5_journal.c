@@ -435,7 +435,9 @@ static herr_t j_read(H5FD_t *file, H5FD_mem_t type, hid_t dxpl, haddr_t addr, si
     (void)type;
     (void)dxpl;
     cdj_file *f = (cdj_file *)file;
-    if (addr == HADDR_UNDEF || addr > MAX_ADDR || size > MAX_ADDR - addr) return -1;
+    /* nothing past HDF5's end of allocation: an address there comes from
+     * corrupted metadata, and refusing it keeps HDF5 from parsing zeros */
+    if (addr == HADDR_UNDEF || addr > MAX_ADDR || size > MAX_ADDR - addr || addr + size > f->eoa) return -1;
     if (read_all(f->fd, buf, size, (off_t)addr)) return -1;
     /* past a held truncation the file reads as zeros, as it will after it */
     if (f->cut != HADDR_UNDEF && addr + size > f->cut) {
@@ -451,7 +453,8 @@ static herr_t j_write(H5FD_t *file, H5FD_mem_t type, hid_t dxpl, haddr_t addr, s
     (void)type;
     (void)dxpl;
     cdj_file *f = (cdj_file *)file;
-    if (!f->writable || addr == HADDR_UNDEF || addr > MAX_ADDR || size > MAX_ADDR - addr) return -1;
+    if (!f->writable || addr == HADDR_UNDEF || addr > MAX_ADDR || size > MAX_ADDR - addr || addr + size > f->eoa)
+        return -1;
     const unsigned char *p = buf;
     if (addr < f->committed) {
         size_t part = addr + size <= f->committed ? size : (size_t)(f->committed - addr);
