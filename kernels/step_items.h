@@ -15,6 +15,7 @@
 #include "walls.h"
 #include "contact_law.h"
 #include "broadphase.h"
+#include "reorder_items.h"
 
 CD_DEVICE_BEGIN
 
@@ -268,12 +269,14 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
 #define CD_LOAD_CHUNK 4096
 
 /* Sum of the normal forces F_n [N] that the primitives of chunk ch exert
- * on wall w, in primitive order. */
-CD_INLINE cd_real cd_item_wall_load_chunk(cd_cols c, cd_long ch, cd_long n_prims, cd_int n_walls, cd_int w)
+ * on wall w, in user primitive order (prim_at: user id -> memory slot,
+ * null for the identity; kernels/reorder_items.h). */
+CD_INLINE cd_real cd_item_wall_load_chunk(cd_cols c, cd_long ch, cd_long n_prims, cd_int n_walls, cd_int w,
+                                          const CD_GLOBAL cd_int *prim_at)
 {
     cd_long end = (ch + 1) * CD_LOAD_CHUNK < n_prims ? (ch + 1) * CD_LOAD_CHUNK : n_prims;
     cd_real acc = 0;
-    for (cd_long i = ch * CD_LOAD_CHUNK; i < end; i++) acc += c.wallc_fn[i * n_walls + w];
+    for (cd_long u = ch * CD_LOAD_CHUNK; u < end; u++) acc += c.wallc_fn[cd_map(prim_at, u) * n_walls + w];
     return acc;
 }
 

@@ -12,6 +12,9 @@
 #define CD_PATH_MAX 1024
 
 /* One kind of particle in the run. */
+/* neighbor.reorder: the memory order of the particles (src/reorder.c). */
+enum { CD_REORDER_SFC = 0, CD_REORDER_NONE = 1 };
+
 typedef struct {
     char shape[32];          /* sphere | rod | cross | hexapod | segments */
     double aspect;           /* alpha = L / d_p [1] (named shapes) */
@@ -87,6 +90,7 @@ typedef struct {
 
     /* neighbour list */
     double skin;                   /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
+    int reorder;                   /* neighbor.reorder: CD_REORDER_SFC | CD_REORDER_NONE (src/reorder.c) */
 
     /* protocol (SPEC section 6; src/protocol.c) */
     char protocol[24];             /* none | deposit_compress | radial_compaction | bulk_modulus */

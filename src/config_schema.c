@@ -178,6 +178,9 @@ const cd_key cd_config_keys[] = {
     /* neighbour list */
     {"neighbor.skin", CD_KT_REAL, "m", "0", CFG(skin), GE(0),
      .label = "Verlet skin", .meaning = "neighbour-list skin; 0: automatic (0.1 x smallest arm diameter)"},
+    {"neighbor.reorder", CD_KT_ENUM, "-", "sfc", CFG(reorder), .choices = "sfc|none",
+     .label = "memory order", .meaning = "sfc: particles kept in space-filling-curve order in memory (rebuilds; omp "
+     "backend); none: the user's order. The same trajectory bits either way (docs/performance.md)"},
 
     /* protocol */
     {"protocol.type", CD_KT_ENUM, "-", "none", CFG_SIZED(protocol), .flags = CD_KF_SELECTOR,

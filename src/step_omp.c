@@ -202,6 +202,15 @@ int cd_sim_reserve_step_pairs(cd_sim *sim, size_t n)
     return cd_state_reserve_pairs(&sim->s, n);
 }
 
+void *cd_sim_step_field(cd_sim *sim, size_t f)
+{
+#if CD_OFFLOAD
+    cd_off *o = sim->backend_data;
+    if (o) return o->host[f] ? off_devptr(o->host[f]) : NULL;
+#endif
+    return *cd_field_ptr(&sim->s, &cd_fields[f]);
+}
+
 /* Columns the step loops work on: device addresses in the offload variant,
  * the host columns otherwise. */
 cd_cols cd_sim_step_cols(cd_sim *sim)
@@ -306,6 +315,8 @@ void cd_sim_refresh(cd_sim *sim)
     sim->nb.force_rebuild = 1;
 }
 
+/* bad: the memory slot of a particle that blew up (-1: none), named by
+ * its user id (uid: the slot's, read by the caller). */
 static int report_bad(const cd_state *s, long bad, char *err, size_t errlen)
 {
     if (bad < 0) return 0;
@@ -324,6 +335,10 @@ int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
     CD_HOST_FOR(n, reduction(max : bad))
     for (size_t q = 0; q < n; q++)
         if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
+#if !CD_OFFLOAD
+    /* host threads: the host columns may be in memory order */
+    if (bad >= 0) bad = (long)cd_map(cd_sim_step_order(sim).part_uid, bad);
+#endif
     return report_bad(s, bad, err, errlen);
 }
 
@@ -338,18 +353,25 @@ static int check_step_state(cd_sim *sim, char *err, size_t errlen)
     CD_STEP_FOR(n, firstprivate(c) reduction(max : bad) map(tofrom : bad))
     for (size_t q = 0; q < n; q++)
         if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
-    return report_bad(&sim->s, bad, err, errlen);
+    cd_int uid = (cd_int)bad;
+    if (bad >= 0 && sim->nb.ordered) cd_dev_get(&uid, sim->nb.d.part_uid + bad, sizeof uid);
+    return report_bad(&sim->s, uid, err, errlen);
 #else
     return cd_sim_check_state(sim, err, errlen);
 #endif
 }
 
+/* The backend lets go of the state: on host threads the host columns go
+ * back to user order (they are the current state); an offload device's
+ * state is dropped (the host keeps what the last sync brought). */
 static void omp_stop(cd_sim *sim)
 {
 #if CD_OFFLOAD
+    cd_reorder_forget(sim);
     off_release(sim);
 #else
-    (void)sim;
+    if (cd_reorder_to_user(sim)) fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
+    cd_reorder_forget(sim);
 #endif
 }
 
@@ -381,6 +403,11 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
+    /* host threads after a sync: the columns back in the lists' order */
+    if (cd_reorder_to_memory(sim)) {
+        snprintf(err, errlen, "out of memory putting the particles in memory order");
+        return -1;
+    }
     for (long long it = 0; it < n; it++) {
         int rc = advance(sim) ? cd_neighbors_build(sim) : 0;
         if (rc == CD_NB_BLOWUP) {
@@ -401,7 +428,6 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
 #if CD_OFFLOAD
     /* The only full copy back: every device column, rows in use. */
     cd_off *o = sim->backend_data;
@@ -417,9 +443,12 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
                 off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
                          cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
         }
-#else
-    (void)sim; /* the state lives in host memory */
 #endif
+    /* the host columns in user order (src/reorder.c) */
+    if (cd_reorder_to_user(sim)) {
+        snprintf(err, errlen, "out of memory putting the particles in user order");
+        return -1;
+    }
     return 0;
 }
 
@@ -453,10 +482,12 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     cd_cols c = o->dev;
     double *part = o->part;
     size_t P = sim->s.n_prims, W = sim->s.n_walls, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
     double sum = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(nch, firstprivate(c))
-    for (size_t ch = 0; ch < nch; ch++) part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w);
+    CD_STEP_FOR(nch, firstprivate(c) is_device_ptr(prim_at))
+    for (size_t ch = 0; ch < nch; ch++)
+        part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at);
 #pragma omp target map(tofrom : sum)
     for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
     *load = sum;
@@ -465,8 +496,24 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
 #define CD_OMP_WALL_LOAD omp_wall_load
 #define CD_OMP_OBSERVE cd_omp_observe_device /* src/observe.c */
 #else
-#define CD_OMP_OBSERVE NULL /* cd_sim_observe_step sums the host columns */
-#define CD_OMP_WALL_LOAD NULL /* cd_sim_wall_load sums the host columns */
+/* Host threads: the host columns are the step's, summed in user order
+ * whatever their memory order, without a sync (which would put them in
+ * user order and back). */
+static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    *load = cd_sim_wall_load_host(sim, w);
+    return 0;
+}
+
+static int omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    cd_observables_slots(sim, slots);
+    return 0;
+}
+#define CD_OMP_WALL_LOAD omp_wall_load
+#define CD_OMP_OBSERVE omp_observe
 #endif
 
 const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, CD_OMP_WALL_LOAD, CD_OMP_OBSERVE};
