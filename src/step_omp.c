@@ -5,7 +5,8 @@
  * identical for any thread count.  Four loops per step: advance (kick,
  * drift, primitive ends, skin test), pair forces, wall forces, gather with
  * the second kick; a neighbour-list rebuild between the first two when
- * the skin test asks for it.
+ * the skin test asks for it.  On host threads the last three and the next
+ * step's advance share one parallel region (forces_and_advance).
  *
  * Two variants of the same loops (src/omp_loops.h, docs/offload.md): on
  * host threads over the host columns of sim->s, or on an offload device
@@ -224,11 +225,10 @@ cd_cols cd_sim_step_cols(cd_sim *sim)
 /* ---- the loops of a step ------------------------------------------------ */
 
 /* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
- * world ends of its primitives and the skin test; the walls move on the
- * host.  Returns 1 when the neighbour list must be rebuilt (some end moved
- * more than half the skin, or a rebuild was asked for); on the offload
- * device one int comes back. */
-static int advance(cd_sim *sim)
+ * world ends of its primitives and the skin test.  Returns 1 when some end
+ * moved more than half the skin; on the offload device one int comes
+ * back. */
+static int advance_particles(cd_sim *sim)
 {
     cd_cols c = cd_sim_step_cols(sim);
     cd_real dt = sim->p.dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
@@ -237,7 +237,17 @@ static int advance(cd_sim *sim)
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c) reduction(| : moved) CD_DEV(map(tofrom : moved)))
     for (size_t q = 0; q < n; q++) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+    return moved;
+}
+
+/* The walls move on the host (after the particles' advance, moved: its
+ * skin test).  Returns 1 when the neighbour list must be rebuilt (some
+ * primitive end or wall moved more than half the skin, or a rebuild was
+ * asked for). */
+static int advance_walls(cd_sim *sim, int moved)
+{
     cd_state *s = &sim->s;
+    cd_real dt = sim->p.dt;
     for (size_t w = 0; w < s->n_walls; w++) {
         s->walls[w] = cd_wall_advanced(s->walls[w], dt);
         moved |= cd_bp_wall_moved(s->walls[w], sim->nb.walls_ref[w]) > CD_R(0.5) * sim->nb.skin;
@@ -302,6 +312,51 @@ static void compute_forces(cd_sim *sim, int kick)
     pair_forces(sim);
     wall_forces(sim);
     gather_kick(sim, kick);
+}
+
+/* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
+ * the next step (its advance; returns its skin test).
+ * Host threads: one parallel region, where four loops used to fork and
+ * join their threads each (docs/performance.md, "Two threads"): the pair
+ * loop without a barrier before the wall loop (they write different rows
+ * and read only the particles' state), one barrier before the gather,
+ * and the next step's advance of particle q in the same item as q's gather
+ * and kick (it reads only q's own rows).  Each item does the arithmetic it
+ * did in its own loop, in the same order: the same bits.  An offload
+ * device runs the loops one launch each, as before. */
+static int forces_and_advance(cd_sim *sim, int next)
+{
+#if CD_OFFLOAD
+    compute_forces(sim, 1);
+    return next ? advance_particles(sim) : 0;
+#else
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_real dt = sim->p.dt, h = 0.5 * sim->p.dt, sin_parallel = sim->p.sin_parallel;
+    cd_real limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    cd_int blend = sim->p.parallel_blend, dim = sim->p.dimension, W = (cd_int)sim->s.n_walls;
+    cd_vec3 g = sim->p.gravity;
+    const cd_wall *walls = sim->s.walls;
+    size_t n_pairs = sim->s.n_pairs, n_walls = W ? sim->nb.n_wall_rows : 0, n = sim->s.n_particles;
+    size_t most = n_pairs > n ? n_pairs : n;
+    int moved = 0;
+#pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
+    {
+#pragma omp for schedule(static) nowait
+        for (size_t k = 0; k < n_pairs; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
+#pragma omp for schedule(static)
+        for (size_t e = 0; e < n_walls; e++)
+            cd_item_wall_row(c, d.wall_rows[e], walls, W, wall_law, dt, sin_parallel, blend);
+#pragma omp for schedule(static)
+        for (size_t q = 0; q < n; q++) {
+            cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
+            cd_item_kick(c, (cd_particle_id)q, h);
+            if (next) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+        }
+    }
+    return moved;
+#endif
 }
 
 void cd_sim_refresh(cd_sim *sim)
@@ -408,8 +463,9 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory putting the particles in memory order");
         return -1;
     }
+    int moved = n > 0 ? advance_particles(sim) : 0;
     for (long long it = 0; it < n; it++) {
-        int rc = advance(sim) ? cd_neighbors_build(sim) : 0;
+        int rc = advance_walls(sim, moved) ? cd_neighbors_build(sim) : 0;
         if (rc == CD_NB_BLOWUP) {
             snprintf(err, errlen, "particle centres spread beyond any container (or not finite) at step %lld (t = "
                      "%.9g s): the run blew up; reduce run.dt or check the material parameters", s->step, s->time);
@@ -419,7 +475,7 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }
-        compute_forces(sim, 1);
+        moved = forces_and_advance(sim, it + 1 < n);
         s->step++;
         s->time += sim->p.dt;
     }
