@@ -113,9 +113,13 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
     cd_contact_geom g;
     int apart;
-    if (cd_segseg_is_point(ai, bi) && cd_segseg_is_point(aj, bj)) {
+    int point_i = cd_segseg_is_point(ai, bi), point_j = cd_segseg_is_point(aj, bj);
+    if (point_i && point_j) {
         /* two spheres: the same geometry without the segment machinery */
         apart = cd_segseg_point_contact(ai, ri, aj, rj, &g);
+    } else if (point_i || point_j) {
+        /* a sphere and an arm: the same, without the parallel rule */
+        apart = cd_segseg_point_segment_contact(ai, bi, ri, aj, bj, rj, &g);
     } else {
         cd_real s, t;
         cd_segseg_closest(ai, bi, aj, bj, &s, &t);
