@@ -91,13 +91,16 @@ CD_INLINE void cd_reorder_item_scatter(const CD_GLOBAL cd_ulong *keys, const CD_
     }
 }
 
-/* Group g of a column's rows, n 4-byte words (a group: one row, or the
- * n_walls wall rows of one primitive), moved by a map of groups: gather,
- * dst[g] = src[map[g]], or scatter, dst[map[g]] = src[g]. */
-CD_INLINE void cd_reorder_item_move(CD_GLOBAL cd_int *restrict dst, const CD_GLOBAL cd_int *restrict src,
+/* Group g of n 4-byte words (a row, or the n_walls wall rows of one
+ * primitive) moved by a map of groups: gather, dst group g = src group
+ * map[g], or scatter, dst group map[g] = src group g; groups start every
+ * dst_stride and src_stride words (n for a column moved whole, more for
+ * one wall's rows of the wall-row columns). */
+CD_INLINE void cd_reorder_item_move(CD_GLOBAL cd_int *restrict dst, cd_long dst_stride,
+                                    const CD_GLOBAL cd_int *restrict src, cd_long src_stride,
                                     const CD_GLOBAL cd_int *map, cd_long g, cd_long n, int scatter)
 {
-    cd_long other = (cd_long)map[g] * n, to = scatter ? other : g * n, from = scatter ? g * n : other;
+    cd_long to = (scatter ? (cd_long)map[g] : g) * dst_stride, from = (scatter ? g : (cd_long)map[g]) * src_stride;
     for (cd_long w = 0; w < n; w++) dst[to + w] = src[from + w];
 }
 

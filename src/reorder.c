@@ -72,17 +72,15 @@ void cd_reorder_forget(cd_sim *sim)
     sim->nb.pair_at_cap = 0;
 }
 
-/* Bytes of the largest column the reorder moves (particles, primitives,
- * wall rows). */
+/* Bytes of the largest column the reorder moves through its scratch
+ * (particles, primitives, and the wall rows one wall at a time). */
 static size_t largest_column(const cd_state *s)
 {
     size_t most = 0;
     for (size_t f = 0; f < cd_n_fields; f++) {
         enum cd_field_group g = cd_fields[f].group;
-        if (g == CD_GROUP_PARTICLE || g == CD_GROUP_PRIM || g == CD_GROUP_WALLC) {
-            size_t b = cd_state_rows(s, g) * cd_fields[f].elem_size;
-            if (b > most) most = b;
-        }
+        size_t rows = g == CD_GROUP_PARTICLE ? s->n_particles : g == CD_GROUP_PRIM || g == CD_GROUP_WALLC ? s->n_prims : 0;
+        if (rows * cd_fields[f].elem_size > most) most = rows * cd_fields[f].elem_size;
     }
     return most;
 }
@@ -110,18 +108,18 @@ static int begin(cd_sim *sim)
     return 0;
 }
 
-/* Moves the groups of rows of a column where the steps run (a group:
- * n_words 4-byte words) by map (gather), through the scratch d->move. */
-static void move_rows(cd_sim *sim, void *col, size_t groups, size_t n_words, const cd_int *map)
+/* Moves groups of n 4-byte words, one every `stride` words from col
+ * (where the steps run), by map (gather), through the scratch d->move. */
+static void move_rows(cd_sim *sim, cd_int *col, size_t groups, size_t n, size_t stride, const cd_int *map)
 {
-    cd_int *tmp = sim->nb.d.move, *src = col;
-    cd_long n = (cd_long)n_words;
-    size_t all = groups * n_words;
+    cd_int *tmp = sim->nb.d.move;
+    cd_long nw = (cd_long)n, sw = (cd_long)stride;
     CD_WIDE_MIN
-    CD_STEP_FOR(groups, CD_DEV(is_device_ptr(tmp, src, map)))
-    for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, src, map, (cd_long)g, n, 0);
-    CD_STEP_FOR(groups, CD_DEV(is_device_ptr(tmp, src)))
-    for (size_t w = 0; w < all; w++) src[w] = tmp[w];
+    CD_STEP_FOR(groups, CD_DEV(is_device_ptr(tmp, col, map)))
+    for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, nw, col, sw, map, (cd_long)g, nw, 0);
+    CD_STEP_FOR(groups, CD_DEV(is_device_ptr(tmp, col)))
+    for (size_t g = 0; g < groups; g++)
+        for (cd_long w = 0; w < nw; w++) col[(cd_long)g * sw + w] = tmp[(cd_long)g * nw + w];
 }
 
 /* The Morton keys of the particles in d.sort_keys (values: their slots in
@@ -214,14 +212,16 @@ int cd_reorder_build(cd_sim *sim, int *moved)
     for (size_t f = 0; f < cd_n_fields; f++) {
         enum cd_field_group grp = cd_fields[f].group;
         size_t words = cd_fields[f].elem_size / word;
+        cd_int *col = cd_sim_step_field(sim, f);
         if (!moves(&cd_fields[f])) continue;
-        if (grp == CD_GROUP_PARTICLE) move_rows(sim, cd_sim_step_field(sim, f), (size_t)N, words, d.part_src);
-        if (grp == CD_GROUP_PRIM) move_rows(sim, cd_sim_step_field(sim, f), (size_t)P, words, d.prim_src);
-        if (grp == CD_GROUP_WALLC && W) move_rows(sim, cd_sim_step_field(sim, f), (size_t)P, words * W, d.prim_src);
+        if (grp == CD_GROUP_PARTICLE) move_rows(sim, col, (size_t)N, words, words, d.part_src);
+        if (grp == CD_GROUP_PRIM) move_rows(sim, col, (size_t)P, words, words, d.prim_src);
+        for (cd_int w = 0; grp == CD_GROUP_WALLC && w < W; w++) /* one wall's rows at a time */
+            move_rows(sim, col + (size_t)w * words, (size_t)P, words, words * (size_t)W, d.prim_src);
     }
-    move_rows(sim, d.part_bound, (size_t)N, sizeof(cd_real) / word, d.part_src);
-    move_rows(sim, d.part_uid, (size_t)N, 1, d.part_src);
-    move_rows(sim, d.prim_uid, (size_t)P, 1, d.prim_src);
+    move_rows(sim, (cd_int *)d.part_bound, (size_t)N, sizeof(cd_real) / word, sizeof(cd_real) / word, d.part_src);
+    move_rows(sim, d.part_uid, (size_t)N, 1, 1, d.part_src);
+    move_rows(sim, d.prim_uid, (size_t)P, 1, 1, d.prim_src);
     CD_STEP_FOR(N, firstprivate(c, d))
     for (cd_int m = 0; m < N; m++) {
         cd_reorder_item_owner(c, m, d.new_first);
@@ -291,7 +291,7 @@ static void free_host_map(cd_int *h)
 static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const cd_int *pair, int pair_scatter,
                      const cd_int *prim_ids)
 {
-    size_t bytes = largest_column(s);
+    size_t bytes = largest_column(s) * (s->n_walls > 1 ? s->n_walls : 1);
     if (s->n_pairs * sizeof(cd_vec3) > bytes) bytes = s->n_pairs * sizeof(cd_vec3);
     cd_int *tmp = malloc(bytes + 8);
     if (!tmp) return -1;
@@ -306,7 +306,7 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
         cd_int *col = *cd_field_ptr(s, &cd_fields[f]);
         if (!groups) continue;
         CD_HOST_FOR(groups, firstprivate(tmp, col, map))
-        for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, col, map, (cd_long)g, n, scatter);
+        for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, n, col, n, map, (cd_long)g, n, scatter);
         memcpy(col, tmp, rows * cd_fields[f].elem_size);
     }
     free(tmp);
