@@ -4,7 +4,7 @@
  *                [--settle-steps S] [--relax-steps X] [--gravity G] [--steps M] [--repeat R]
  *                [--backend omp|opencl|omp:2,omp:1,...] [--device cpu|gpu|auto] [--seed K]
  *                [--friction-limit elastic|total] [--save-settled F.h5] [--load-settled F.h5]
- *                [--tile KX,KZ] [--reorder sfc|none]
+ *                [--tile KX,KZ] [--shuffle SEED] [--reorder sfc|none]
  *
  * A case (bench_cases.c) is a shape, a size distribution, a dimension and a
  * time step, with the SPEC 3 material.  N particles are deposited from a
@@ -29,6 +29,11 @@
  * settles.  --tile KX,KZ (with --load-settled) places KX x KZ copies of the
  * loaded packing side by side (bench_tile.c) and relaxes them for
  * --relax-steps before timing: a large packing without a tall settle.
+ *
+ * --shuffle SEED (with --load-settled) puts the loaded (and tiled)
+ * particles in a random order, the memory order of a random placement or a
+ * mixed flow, and drops their contact history (bench_tile.c): relax before
+ * timing.
  *
  * --reorder overrides the case's neighbor.reorder (src/reorder.c: the
  * memory order of the omp backend; the same bits either way).
@@ -95,6 +100,7 @@ int main(int argc, char **argv)
     const char *case_name = "hexapods_a3", *friction_limit = "elastic";
     const char *save_path = NULL, *load_path = NULL, *reorder = NULL;
     int tile_x = 1, tile_z = 1;
+    long shuffle = -1;
     long n = 10000, settle = -1, relax = 0, steps = 500, repeat = 3;
     unsigned seed = 5;
     double gravity = 490.5; /* [m/s^2] after settling: the settling load */
@@ -118,6 +124,7 @@ int main(int argc, char **argv)
         INT_OPT("--steps", 1, LLONG_MAX, steps)
         INT_OPT("--repeat", 0, LLONG_MAX, repeat)
         INT_OPT("--seed", 0, 4294967295LL, seed)
+        INT_OPT("--shuffle", 0, 4294967295LL, shuffle)
         else if (!strcmp(argv[i], "--gravity")) {
             if (cd_parse_cli_real(argv[i], argv[i + 1], 0, HUGE_VAL, &gravity, perr, sizeof perr)) return fail(perr, 2);
         }
@@ -170,6 +177,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "capdem-bench: --backend: expected omp, opencl or a list of them\n");
         return 2;
     }
+    if (shuffle >= 0 && !load_path) return fail("--shuffle: needs --load-settled", 2);
     omp_set_num_threads(threads);
     char yaml[2048], err[2048];
     cd_config cfg;
@@ -197,6 +205,7 @@ int main(int argc, char **argv)
             sim = big; /* the tiled simulation replaces the loaded one */
             cfg = big_cfg;
         }
+        if (shuffle >= 0 && cd_bench_shuffle_state(&sim.s, (unsigned)shuffle)) return fail("--shuffle: out of memory", 3);
         n = (long)sim.s.n_particles;
         const char *tag = strstr(cfg.source_text, "# case: ");
         if (tag && sscanf(tag + 8, "%63s", yaml) == 1) case_name = yaml;
@@ -215,7 +224,7 @@ int main(int argc, char **argv)
     }
     const char *case_label = case_name;
     if (reorder) sim.nb.reorder = !strcmp(reorder, "sfc");
-    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 ? 0 : 1, err, sizeof err))
+    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 && shuffle < 0 ? 0 : 1, err, sizeof err))
         return fail(err, 2);
     double t0 = now();
     if (!load_path && cd_sim_step(&sim, settle, err, sizeof err)) return fail(err, 3);
