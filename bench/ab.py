@@ -2,7 +2,7 @@
 """Two or more capdem-bench variants timed in turn on one settled packing.
 
     /usr/bin/python3 bench/ab.py --load F.h5 --variant old=build-old/capdem-bench \\
-        --variant "new=build/capdem-bench --reorder sfc" --variant "none=build/capdem-bench --reorder none" \\
+        --variant "new=build/capdem-bench --reorder cells" --variant "none=build/capdem-bench --reorder none" \\
         [--threads 1,2] [--rounds 5] [--steps 300] > ab.jsonl
 
 Each round runs every (variant, thread count) once, in the order given

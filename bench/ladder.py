@@ -3,7 +3,7 @@
 
     /usr/bin/python3 bench/ladder.py [--build build] [--cases spheres,hexapods_a3]
         [--tiles 1x1,3x1,5x2,6x5,10x10] [--base 1000] [--threads 1] [--rounds 3]
-        [--work build/bench-work] [--reuse] [--reorder sfc,none] > ladder.jsonl
+        [--work build/bench-work] [--reuse] [--reorder cells,none] > ladder.jsonl
     /usr/bin/python3 bench/ladder.py --plot ladder.jsonl -o ladder.png
 
 For each case, capdem-bench settles --base particles once (the case's
@@ -18,7 +18,7 @@ round, 20 untimed steps first): a load that drifts on a shared machine is
 spread over the rungs instead of falling on one.  The timed segment has
 about --target particle-steps (at least 20 steps).
 
---reorder sfc,none times every rung with each memory order in turn
+--reorder cells,none times every rung with each memory order in turn
 (capdem-bench --reorder; the same packing and bits, src/reorder.c), so
 that the two are compared in the same round.
 
@@ -115,7 +115,7 @@ def main():
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--work", default="build/bench-work")
     ap.add_argument("--reuse", action="store_true", help="reuse settled and tiled files of an earlier run")
-    ap.add_argument("--reorder", default=None, help="comma-separated memory orders to time each rung with (sfc, none)")
+    ap.add_argument("--reorder", default=None, help="comma-separated memory orders to time each rung with (cells, none)")
     ap.add_argument("--plot", nargs="+", metavar="JSONL", help="plot these results instead of measuring")
     ap.add_argument("-o", "--output", default="ladder.png")
     args = ap.parse_args()

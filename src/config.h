@@ -13,7 +13,7 @@
 
 /* One kind of particle in the run. */
 /* neighbor.reorder: the memory order of the particles (src/reorder.c). */
-enum { CD_REORDER_SFC = 0, CD_REORDER_NONE = 1 };
+enum { CD_REORDER_CELLS = 0, CD_REORDER_NONE = 1 };
 
 typedef struct {
     char shape[32];          /* sphere | rod | cross | hexapod | segments */
@@ -90,7 +90,7 @@ typedef struct {
 
     /* neighbour list */
     double skin;                   /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
-    int reorder;                   /* neighbor.reorder: CD_REORDER_SFC | CD_REORDER_NONE (src/reorder.c) */
+    int reorder;                   /* neighbor.reorder: CD_REORDER_CELLS | CD_REORDER_NONE (src/reorder.c) */
 
     /* protocol (SPEC section 6; src/protocol.c) */
     char protocol[24];             /* none | deposit_compress | radial_compaction | bulk_modulus */

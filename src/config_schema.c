@@ -178,9 +178,9 @@ const cd_key cd_config_keys[] = {
     /* neighbour list */
     {"neighbor.skin", CD_KT_REAL, "m", "0", CFG(skin), GE(0),
      .label = "Verlet skin", .meaning = "neighbour-list skin; 0: automatic (0.1 x smallest arm diameter)"},
-    {"neighbor.reorder", CD_KT_ENUM, "-", "sfc", CFG(reorder), .choices = "sfc|none",
-     .label = "memory order", .meaning = "sfc: particles kept in space-filling-curve order in memory (rebuilds; omp "
-     "backend); none: the user's order. The same trajectory bits either way (docs/performance.md)"},
+    {"neighbor.reorder", CD_KT_ENUM, "-", "cells", CFG(reorder), .choices = "cells|none",
+     .label = "memory order", .meaning = "cells: at rebuilds the omp backend keeps the particles in memory in the order "
+     "of their grid cells where that brings neighbours closer; none: the user's order. The same trajectory bits either way"},
 
     /* protocol */
     {"protocol.type", CD_KT_ENUM, "-", "none", CFG_SIZED(protocol), .flags = CD_KF_SELECTOR,

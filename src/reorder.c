@@ -1,7 +1,7 @@
 /* Memory order (docs/architecture.md, "Memory order"; items in
- * kernels/reorder_items.h).  With neighbor.reorder: sfc the omp backend
- * puts, at each neighbour-list rebuild, the particles in Morton order of
- * the grid cells of their centres, their primitives and wall rows with
+ * kernels/reorder_items.h).  With neighbor.reorder: cells the omp backend
+ * puts, at a neighbour-list rebuild, the particles in the order of the
+ * grid cells of their centres, their primitives and wall rows with
  * them, so that the pair loop, the gather and the wall loop read particles
  * that are close in memory (the caches see a neighbourhood, not a random
  * sample of the state).  The maps between memory slots and user ids live
@@ -122,7 +122,7 @@ static void move_rows(cd_sim *sim, cd_int *col, size_t groups, size_t n, size_t 
         for (cd_long w = 0; w < nw; w++) col[(cd_long)g * sw + w] = tmp[(cd_long)g * nw + w];
 }
 
-/* The Morton keys of the particles in d.sort_keys (values: their slots in
+/* The cell keys of the particles in d.sort_keys (values: their slots in
  * d.sort_vals), and how many slots hold a key below their predecessor's. */
 static long particle_keys(cd_sim *sim, cd_cols c)
 {
@@ -138,20 +138,19 @@ static long particle_keys(cd_sim *sim, cd_cols c)
     return descents;
 }
 
-/* Sorts the Morton keys of particle_keys (radix, stable); returns the
+/* Sorts the keys of particle_keys (radix, stable); returns the
  * sorted values (old memory slots in their new order). */
 static cd_int *sort_particles(cd_sim *sim, const cd_grid *g)
 {
     cd_nb_lists d = sim->nb.d;
     cd_int N = (cd_int)sim->s.n_particles, chunk = CD_SORT_CHUNK, n_chunks = (N + chunk - 1) / chunk;
-    cd_long most = g->dim[0] > g->dim[1] ? g->dim[0] : g->dim[1];
-    if (g->dim[2] > most) most = g->dim[2];
+    cd_long cells = g->dim[0] * g->dim[1] * g->dim[2];
     int bits = 0;
-    while (bits < 21 && ((cd_long)1 << bits) < most) bits++;
+    while (bits < 62 && ((cd_long)1 << bits) < cells) bits++;
     cd_ulong *kin = d.sort_keys, *kout = d.sort_keys + N;
     cd_int *vin = d.sort_vals, *vout = d.sort_vals + N, *hist = d.hist, *cursor = d.hist + CD_RADIX_BINS * n_chunks;
     CD_WIDE_MIN
-    for (int shift = 0; shift < 3 * bits; shift += 8) {
+    for (int shift = 0; shift < bits; shift += 8) {
         CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(kin, hist)))
         for (cd_int b = 0; b < n_chunks; b++) cd_reorder_item_hist(kin, N, chunk, n_chunks, b, shift, hist);
         cd_nb_scan(hist, CD_RADIX_BINS * n_chunks, cursor, d.chunk_sum);
@@ -187,18 +186,38 @@ int cd_reorder_build(cd_sim *sim, int *moved)
     if (cd_dev_get(&g, d.grid, sizeof g)) return -1;
     cd_int N = (cd_int)s->n_particles, P = (cd_int)s->n_prims, W = (cd_int)s->n_walls;
     /* Sorting and moving the state costs a few passes over it: done only
-     * when more than 1/CD_REORDER_DRIFT of the slots are out of curve
+     * when more than 1/CD_REORDER_DRIFT of the slots are out of cell
      * order (a settled packing keeps its order for many rebuilds). */
-    if (particle_keys(sim, c) * CD_REORDER_DRIFT <= (long)N) return 0;
-    cd_int *sorted = sort_particles(sim, &g), *src = d.part_src;
+    int forced = sim->nb.reorder == CD_NB_REORDER_ALWAYS;
+    if (particle_keys(sim, c) * CD_REORDER_DRIFT <= (long)N && !forced) return 0;
+    /* No pair rows yet (a new run, a start from a file without contacts):
+     * nothing tells whether the cells' order would beat the order at hand;
+     * the next rebuild will. */
+    if (s->n_pairs == 0 && !forced) return 0;
+    cd_int *sorted = sort_particles(sim, &g), *src = d.part_src, *slot_of = d.count;
     long changed = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(N, reduction(+ : changed) CD_DEV(is_device_ptr(sorted, src) map(tofrom : changed)))
+    CD_STEP_FOR(N, reduction(+ : changed) CD_DEV(is_device_ptr(sorted, src, slot_of) map(tofrom : changed)))
     for (cd_int m = 0; m < N; m++) {
         src[m] = sorted[m];
+        slot_of[sorted[m]] = m;
         changed += sorted[m] != m;
     }
     if (!changed) return 0;
+    /* The cells' order only where it brings the pair rows' particles
+     * closer in memory than the order at hand, by 1/8 of the summed bit
+     * lengths of their distances: a deposit from a lattice keeps its
+     * particles in a lattice order as good (docs/performance.md, "Memory
+     * order"), and moving the state for nothing costs a few passes. */
+    long span_now = 0, span_cells = 0;
+    size_t K = s->n_pairs;
+    CD_STEP_FOR(K, firstprivate(c) reduction(+ : span_now, span_cells)
+                       CD_DEV(is_device_ptr(slot_of) map(tofrom : span_now, span_cells)))
+    for (size_t k = 0; k < K; k++) {
+        span_now += cd_reorder_item_row_span(c, (cd_long)k, NULL);
+        span_cells += cd_reorder_item_row_span(c, (cd_long)k, slot_of);
+    }
+    if (8 * span_cells >= 7 * span_now && !forced) return 0;
 
     /* the primitives follow their particles: new first primitives, and
      * the old slot of each new primitive (before prim_first moves) */

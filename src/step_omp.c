@@ -317,11 +317,12 @@ static void compute_forces(cd_sim *sim, int kick)
 /* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
  * the next step (its advance; returns its skin test).
  * Host threads: one parallel region, where four loops used to fork and
- * join their threads each (docs/performance.md, "Two threads"): the pair
- * loop without a barrier before the wall loop (they write different rows
- * and read only the particles' state), one barrier before the gather,
- * and the next step's advance of particle q in the same item as q's gather
- * and kick (it reads only q's own rows).  Each item does the arithmetic it
+ * join their threads each (docs/performance.md, "One parallel region per
+ * step"): the pair loop without a barrier before the wall loop (they write
+ * different rows and read only the particles' state), one barrier before
+ * the gather, none after it but the region's end, and the next step's
+ * advance of particle q in the same item as q's gather and kick (it reads
+ * only q's own rows).  Each item does the arithmetic it
  * did in its own loop, in the same order: the same bits.  An offload
  * device runs the loops one launch each, as before. */
 #if !CD_OFFLOAD
@@ -350,7 +351,7 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
                                                           cd_real dt, cd_real limit2, int next)
 {
     int moved = 0;
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait /* the region's end is the barrier */
     for (size_t q = 0; q < n; q++) {
         cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
         cd_item_kick(c, (cd_particle_id)q, CD_R(0.5) * dt);
