@@ -314,17 +314,6 @@ static void compute_forces(cd_sim *sim, int kick)
     gather_kick(sim, kick);
 }
 
-/* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
- * the next step (its advance; returns its skin test).
- * Host threads: one parallel region, where four loops used to fork and
- * join their threads each (docs/performance.md, "One parallel region per
- * step"): the pair loop without a barrier before the wall loop (they write
- * different rows and read only the particles' state), one barrier before
- * the gather, none after it but the region's end, and the next step's
- * advance of particle q in the same item as q's gather and kick (it reads
- * only q's own rows).  Each item does the arithmetic it
- * did in its own loop, in the same order: the same bits.  An offload
- * device runs the loops one launch each, as before. */
 #if !CD_OFFLOAD
 /* The loops of forces_and_advance, each an orphaned `omp for` in a
  * function of its own (the region's threads share its rows) with every
@@ -361,6 +350,17 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 }
 #endif
 
+/* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
+ * the next step (its advance; returns its skin test).
+ * Host threads: one parallel region, where four loops used to fork and
+ * join their threads each (docs/performance.md, "One parallel region per
+ * step"): the pair loop without a barrier before the wall loop (they
+ * write different rows and read only the particles' state), one barrier
+ * before the gather, none after it but the region's end, and the next
+ * step's advance of particle q in the same item as q's gather and kick
+ * (it reads only q's own rows).  Each item does the arithmetic it did in
+ * its own loop, in the same order: the same bits.  An offload device runs
+ * the loops one launch each, as before. */
 static int forces_and_advance(cd_sim *sim, int next)
 {
 #if CD_OFFLOAD
@@ -398,8 +398,7 @@ void cd_sim_refresh(cd_sim *sim)
     sim->nb.force_rebuild = 1;
 }
 
-/* bad: the memory slot of a particle that blew up (-1: none), named by
- * its user id (uid: the slot's, read by the caller). */
+/* bad: the user id of a particle that blew up (-1: none). */
 static int report_bad(const cd_state *s, long bad, char *err, size_t errlen)
 {
     if (bad < 0) return 0;
