@@ -4,7 +4,7 @@
  *                [--settle-steps S] [--relax-steps X] [--gravity G] [--steps M] [--repeat R]
  *                [--backend omp|opencl|omp:2,omp:1,...] [--device cpu|gpu|auto] [--seed K]
  *                [--friction-limit elastic|total] [--save-settled F.h5] [--load-settled F.h5]
- *                [--tile KX,KZ]
+ *                [--tile KX,KZ] [--shuffle SEED] [--reorder cells|none]
  *
  * A case (bench_cases.c) is a shape, a size distribution, a dimension and a
  * time step, with the SPEC 3 material.  N particles are deposited from a
@@ -29,6 +29,14 @@
  * settles.  --tile KX,KZ (with --load-settled) places KX x KZ copies of the
  * loaded packing side by side (bench_tile.c) and relaxes them for
  * --relax-steps before timing: a large packing without a tall settle.
+ *
+ * --shuffle SEED (with --load-settled) puts the loaded (and tiled)
+ * particles in a random order, the memory order of a random placement or a
+ * mixed flow, and drops their contact history (bench_tile.c): relax before
+ * timing.
+ *
+ * --reorder overrides the case's neighbor.reorder (src/reorder.c: the
+ * memory order of the omp backend; the same bits either way).
  *
  * --backend takes a comma-separated list (an entry "omp:1" runs that round
  * with 1 thread, so thread counts are compared on one packing): the packing is settled on the
@@ -90,8 +98,9 @@ static int save_settled(const char *path, cd_sim *sim, const cd_config *cfg, cha
 int main(int argc, char **argv)
 {
     const char *case_name = "hexapods_a3", *friction_limit = "elastic";
-    const char *save_path = NULL, *load_path = NULL;
+    const char *save_path = NULL, *load_path = NULL, *reorder = NULL;
     int tile_x = 1, tile_z = 1;
+    long shuffle = -1;
     long n = 10000, settle = -1, relax = 0, steps = 500, repeat = 3;
     unsigned seed = 5;
     double gravity = 490.5; /* [m/s^2] after settling: the settling load */
@@ -115,6 +124,7 @@ int main(int argc, char **argv)
         INT_OPT("--steps", 1, LLONG_MAX, steps)
         INT_OPT("--repeat", 0, LLONG_MAX, repeat)
         INT_OPT("--seed", 0, 4294967295LL, seed)
+        INT_OPT("--shuffle", 0, 4294967295LL, shuffle)
         else if (!strcmp(argv[i], "--gravity")) {
             if (cd_parse_cli_real(argv[i], argv[i + 1], 0, HUGE_VAL, &gravity, perr, sizeof perr)) return fail(perr, 2);
         }
@@ -123,6 +133,13 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--friction-limit")) friction_limit = argv[i + 1];
         else if (!strcmp(argv[i], "--save-settled")) save_path = argv[i + 1];
         else if (!strcmp(argv[i], "--load-settled")) load_path = argv[i + 1];
+        else if (!strcmp(argv[i], "--reorder")) {
+            reorder = argv[i + 1];
+            if (strcmp(reorder, "cells") && strcmp(reorder, "none")) {
+                fprintf(stderr, "capdem-bench: --reorder %s: expected cells or none\n", reorder);
+                return 2;
+            }
+        }
         else if (!strcmp(argv[i], "--tile")) {
             char kx[32], *comma = strchr(argv[i + 1], ',');
             long long tx, tz;
@@ -160,6 +177,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "capdem-bench: --backend: expected omp, opencl or a list of them\n");
         return 2;
     }
+    if (shuffle >= 0 && !load_path) return fail("--shuffle: needs --load-settled", 2);
     omp_set_num_threads(threads);
     char yaml[2048], err[2048];
     cd_config cfg;
@@ -187,6 +205,7 @@ int main(int argc, char **argv)
             sim = big; /* the tiled simulation replaces the loaded one */
             cfg = big_cfg;
         }
+        if (shuffle >= 0 && cd_bench_shuffle_state(&sim.s, (unsigned)shuffle)) return fail("--shuffle: out of memory", 3);
         n = (long)sim.s.n_particles;
         const char *tag = strstr(cfg.source_text, "# case: ");
         if (tag && sscanf(tag + 8, "%63s", yaml) == 1) case_name = yaml;
@@ -204,7 +223,8 @@ int main(int argc, char **argv)
             return fail(err, 2);
     }
     const char *case_label = case_name;
-    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 ? 0 : 1, err, sizeof err))
+    if (reorder) sim.nb.reorder = !strcmp(reorder, "cells");
+    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 && shuffle < 0 ? 0 : 1, err, sizeof err))
         return fail(err, 2);
     double t0 = now();
     if (!load_path && cd_sim_step(&sim, settle, err, sizeof err)) return fail(err, 3);
@@ -236,10 +256,14 @@ int main(int argc, char **argv)
         } else if (load_path && cd_sim_step(&sim, 20, err, sizeof err)) {
             return fail(err, 3); /* warm-up of a loaded packing: first list build */
         }
+        /* one more build, now that the contact rows exist: the omp
+         * backend's memory order is chosen from them (src/reorder.c), and
+         * a loaded packing would otherwise time its first choice */
+        sim.nb.force_rebuild = 1;
+        if (cd_sim_step(&sim, 1, err, sizeof err)) return fail(err, 3);
         for (long r = 0; r < repeat; r++) {
-            cd_observables o;
-            if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
-            cd_sim_observe(&sim, &o);
+            cd_observables o; /* summed where the steps run: no sync, which would leave the columns in user order */
+            if (cd_sim_observe_step(&sim, &o, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
             double contacts = o.n_contacts + o.n_wall_contacts;
             long long builds0 = sim.nb.builds; /* rebuilds of the timed segment alone */
             double t = now(), c = clock_s(CLOCK_PROCESS_CPUTIME_ID);
@@ -263,11 +287,13 @@ int main(int argc, char **argv)
                    "\"steps\": %ld, \"wall_s\": %.6g, \"cpu_s\": %.6g, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
                    "\"contacts_per_particle\": %.3f, \"pairs_in_list\": %zu, \"bytes_per_particle\": %.0f, "
                    "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"neighbor_builds_timed\": %lld, \"dt\": %g, "
+                   "\"reorder\": \"%s\", \"reorders\": %lld, "
                    "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}, "
                    "\"rows\": {\"prims\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, \"walls\": %zu, \"wall_contacts\": %.0f}}\n",
                    case_label, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
                    round_threads[k], steps, wall, cpu, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
                    sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
+                   sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
                    moved / (double)n, kernels, sim.s.n_prims, sim.s.n_pairs, after.n_contacts, sim.s.n_walls,
                    after.n_wall_contacts);
             fflush(stdout);

@@ -7,8 +7,10 @@
  * 1e5-particle packing for the price of a 1e4 settle and a relaxation,
  * instead of settling a column ten times as tall. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "sim.h"
+#include "rng.h"
 #include "bench_tile.h"
 
 int cd_bench_tile_config(const char *text, int kx, int kz, char *out, size_t len)
@@ -57,4 +59,65 @@ int cd_bench_tile_state(cd_state *dst, const cd_state *src, int kx, int kz, doub
         }
     dst->n_pairs = 0;
     return 0;
+}
+
+/* Rows of the columns of group g moved by map (new row r = old row
+ * map[r]), groups of `per` rows from first[map[r]] (primitives), or one
+ * row each (first null). */
+static int move_group(cd_state *s, enum cd_field_group g, const cd_int *map, size_t rows, const cd_int *first,
+                      const cd_int *count)
+{
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group != g) continue;
+        size_t es = cd_fields[f].elem_size;
+        char *col = *(char **)cd_field_ptr(s, &cd_fields[f]), *tmp = malloc(rows * es + 1), *to = tmp;
+        if (!tmp) return -1;
+        for (size_t r = 0; r < (first ? s->n_particles : rows); r++) {
+            size_t n = first ? (size_t)count[map[r]] : 1, from = first ? (size_t)first[map[r]] : (size_t)map[r];
+            memcpy(to, col + from * es, n * es);
+            to += n * es;
+        }
+        memcpy(col, tmp, rows * es);
+        free(tmp);
+    }
+    return 0;
+}
+
+int cd_bench_shuffle_state(cd_state *s, unsigned seed)
+{
+    size_t N = s->n_particles;
+    cd_int *map = malloc((N + 1) * sizeof(cd_int)), *first = malloc((N + 1) * sizeof(cd_int)),
+           *count = malloc((N + 1) * sizeof(cd_int));
+    int rc = map && first && count ? 0 : -1;
+    if (!rc) {
+        cd_rng r;
+        cd_rng_seed(&r, seed);
+        for (size_t q = 0; q < N; q++) map[q] = (cd_int)q;
+        for (size_t q = N; q > 1; q--) { /* Fisher-Yates */
+            size_t k = (size_t)(cd_rng_next(&r) % q);
+            cd_int t = map[q - 1];
+            map[q - 1] = map[k];
+            map[k] = t;
+        }
+        memcpy(first, s->prim_first, N * sizeof(cd_int));
+        memcpy(count, s->prim_count, N * sizeof(cd_int));
+        rc = move_group(s, CD_GROUP_PRIM, map, s->n_prims, first, count) ||
+             move_group(s, CD_GROUP_PARTICLE, map, N, NULL, NULL);
+    }
+    if (!rc) {
+        cd_int at = 0;
+        for (size_t q = 0; q < N; q++) {
+            s->prim_first[q] = at;
+            for (cd_int t = 0; t < s->prim_count[q]; t++) s->prim_particle[at + t] = (cd_int)q;
+            at += s->prim_count[q];
+        }
+        s->n_pairs = 0;
+        for (size_t f = 0; f < cd_n_fields; f++)
+            if (cd_fields[f].group == CD_GROUP_WALLC)
+                memset(*cd_field_ptr(s, &cd_fields[f]), 0, s->n_prims * s->n_walls * cd_fields[f].elem_size);
+    }
+    free(map);
+    free(first);
+    free(count);
+    return rc;
 }

@@ -14,4 +14,11 @@ int cd_bench_tile_config(const char *text, int kx, int kz, char *out, size_t len
  * box's width and thickness.  Returns 0, or -1 if the counts do not match. */
 int cd_bench_tile_state(cd_state *dst, const cd_state *src, int kx, int kz, double width, double thickness);
 
+/* --shuffle SEED: the particles of s in a random order (a permutation of
+ * seed), their primitives with them; contact history is dropped (pair
+ * rows and wall rows), as by tiling, so the caller relaxes the result.
+ * The memory order of a packing made by random placement, or mixed by a
+ * flow, instead of the lattice order of a deposit.  0, or -1 out of memory. */
+int cd_bench_shuffle_state(cd_state *s, unsigned seed);
+
 #endif

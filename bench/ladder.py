@@ -3,7 +3,7 @@
 
     /usr/bin/python3 bench/ladder.py [--build build] [--cases spheres,hexapods_a3]
         [--tiles 1x1,3x1,5x2,6x5,10x10] [--base 1000] [--threads 1] [--rounds 3]
-        [--work build/bench-work] [--reuse] > ladder.jsonl
+        [--work build/bench-work] [--reuse] [--reorder cells,none] > ladder.jsonl
     /usr/bin/python3 bench/ladder.py --plot ladder.jsonl -o ladder.png
 
 For each case, capdem-bench settles --base particles once (the case's
@@ -17,6 +17,10 @@ round visiting every rung once (one capdem-bench process per rung and
 round, 20 untimed steps first): a load that drifts on a shared machine is
 spread over the rungs instead of falling on one.  The timed segment has
 about --target particle-steps (at least 20 steps).
+
+--reorder cells,none times every rung with each memory order in turn
+(capdem-bench --reorder; the same packing and bits, src/reorder.c), so
+that the two are compared in the same round.
 
 Prints one JSON line per timed segment: capdem-bench's line plus `tile`,
 `round`, `ns_per_particle_step` (wall) and `cpu_ns_per_particle_step`
@@ -78,13 +82,15 @@ def plot(paths, output):
         by = collections.defaultdict(list)
         for r in rows:
             if r["case"] == case:
-                by[r["N"]].append(r)
-        ns = sorted(by)
-        for key, label in (("ns_per_particle_step", "wall"), ("cpu_ns_per_particle_step", "CPU")):
-            med = [statistics.median(r[key] for r in by[n]) for n in ns]
-            lo = [m - min(r[key] for r in by[n]) for m, n in zip(med, ns)]
-            hi = [max(r[key] for r in by[n]) - m for m, n in zip(med, ns)]
-            ax.errorbar(ns, med, yerr=[lo, hi], marker="o", capsize=3, label=label)
+                by[(r.get("reorder", ""), r["N"])].append(r)
+        for order in sorted({o for o, n in by}):
+            ns = sorted(n for o, n in by if o == order)
+            for key, label in (("ns_per_particle_step", "wall"), ("cpu_ns_per_particle_step", "CPU")):
+                med = [statistics.median(r[key] for r in by[(order, n)]) for n in ns]
+                lo = [m - min(r[key] for r in by[(order, n)]) for m, n in zip(med, ns)]
+                hi = [max(r[key] for r in by[(order, n)]) - m for m, n in zip(med, ns)]
+                ax.errorbar(ns, med, yerr=[lo, hi], marker="o", capsize=3,
+                            label=label + (", reorder " + order if order else ""))
         ax.set_xscale("log")
         ax.set_ylim(bottom=0)
         ax.set_xlabel("particles N")
@@ -109,6 +115,7 @@ def main():
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--work", default="build/bench-work")
     ap.add_argument("--reuse", action="store_true", help="reuse settled and tiled files of an earlier run")
+    ap.add_argument("--reorder", default=None, help="comma-separated memory orders to time each rung with (cells, none)")
     ap.add_argument("--plot", nargs="+", metavar="JSONL", help="plot these results instead of measuring")
     ap.add_argument("-o", "--output", default="ladder.png")
     args = ap.parse_args()
@@ -121,10 +128,13 @@ def main():
         for case, tile, f in ladder:
             kx, kz = (int(k) for k in tile.split("x"))
             steps = max(20, int(args.target / (args.base * kx * kz)))
-            for line in bench(args, ["--load-settled", f, "--gravity", "490.5", "--steps", str(steps), "--repeat", "1"]):
-                line.update(tile=tile, round=r, ns_per_particle_step=1e9 * line["wall_s"] / (line["N"] * steps),
-                            cpu_ns_per_particle_step=1e9 * line["cpu_s"] / (line["N"] * steps))
-                print(json.dumps(line), flush=True)
+            for order in args.reorder.split(",") if args.reorder else [None]:
+                extra = ["--reorder", order] if order else []
+                for line in bench(args, ["--load-settled", f, "--gravity", "490.5", "--steps", str(steps), "--repeat",
+                                         "1"] + extra):
+                    line.update(tile=tile, round=r, ns_per_particle_step=1e9 * line["wall_s"] / (line["N"] * steps),
+                                cpu_ns_per_particle_step=1e9 * line["cpu_s"] / (line["N"] * steps))
+                    print(json.dumps(line), flush=True)
     return 0
 
 

@@ -25,6 +25,7 @@
 #define CD_NEIGHBOR_ITEMS_H
 #include "cols.h"
 #include "broadphase.h"
+#include "reorder_items.h"
 
 /* The cap of a row written in place (fill mode of pass 5). */
 #define CD_BP_UNBOUNDED 0x7fffffff
@@ -117,18 +118,21 @@ CD_INLINE void cd_nb_item_cell_fill(cd_particle_id q, const CD_GLOBAL cd_int *pa
 }
 
 /* Pass 5: the candidates (i, j) with i a primitive of particle p and j a
- * primitive of a particle q > p: the particles in the 27 cells around p's
+ * primitive of a particle q of a higher user id (o.part_uid: the row's
+ * orientation, and so the narrow phase's arithmetic, does not depend on
+ * the memory order): the particles in the 27 cells around p's
  * centre whose bounding spheres (part_bound [m]) come within the skin [m]
  * of p's, then each pair passing cd_bp_is_candidate.  The scan runs over
  * particles, so the arms of a hexapod share it.  Row i goes to
  * out + i slot (slot mode, offset = 0: at most slot entries written) or to
  * out + offset[i] (fill mode: the row's exact place); either way sorted by
- * j (insertion), and count[i] = the row's length, which in slot mode may
+ * the user id of j (insertion), and count[i] = the row's length, which in slot mode may
  * exceed slot (then the row is incomplete and the host runs fill mode). */
 CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL cd_grid *grid,
                                   const CD_GLOBAL cd_int *cell_start, const CD_GLOBAL cd_int *cell_parts,
                                   const CD_GLOBAL cd_real *part_bound, cd_real skin, CD_GLOBAL cd_prim_id *out,
-                                  cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count)
+                                  cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count,
+                                  cd_order o)
 {
     cd_grid g = grid[0];
     cd_int first = c.prim_first[p], last = first + c.prim_count[p];
@@ -136,6 +140,7 @@ CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL c
     for (cd_int i = first; i < last; i++) count[i] = 0;
     cd_vec3 x = c.position[p];
     cd_real reach0 = part_bound[p] + skin; /* [m] */
+    cd_long uid_p = cd_map(o.part_uid, p);
     cd_long cx = cd_grid_coord(&g, x.x, 0), cy = cd_grid_coord(&g, x.y, 1), cz = cd_grid_coord(&g, x.z, 2);
     for (cd_long z = cz - 1; z <= cz + 1; z++) {
         if (z < 0 || z >= g.dim[2]) continue;
@@ -146,7 +151,7 @@ CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL c
                 cd_long cell = (z * g.dim[1] + y) * g.dim[0] + xx;
                 for (cd_int k = cell_start[cell]; k < cell_start[cell + 1]; k++) {
                     cd_particle_id q = cell_parts[k];
-                    if (q <= p) continue;
+                    if (cd_map(o.part_uid, q) <= uid_p) continue;
                     cd_real reach = reach0 + part_bound[q];
                     if (cd_v3_norm2(cd_v3_sub(c.position[q], x)) > reach * reach) continue;
                     for (cd_int i = first; i < last; i++) {
@@ -157,9 +162,10 @@ CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL c
                             if (!cd_bp_is_candidate(ai, bi, ri, c.prim_a[j], c.prim_b[j], c.prim_radius[j], skin))
                                 continue;
                             cd_int n = count[i];
-                            if (n < cap) { /* insertion keeps the row sorted by j */
+                            if (n < cap) { /* insertion keeps the row sorted by the user id of j */
                                 cd_int m = n;
-                                while (m > 0 && row[m - 1] > j) {
+                                cd_long uj = cd_map(o.prim_uid, j);
+                                while (m > 0 && cd_map(o.prim_uid, row[m - 1]) > uj) {
                                     row[m] = row[m - 1];
                                     m--;
                                 }
@@ -174,42 +180,51 @@ CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL c
     }
 }
 
-/* Key of pair row k (ordered by prim_i, then prim_j). */
-CD_INLINE cd_ulong cd_nb_row_key(cd_cols c, cd_long k) { return cd_bp_pair_key(c.pair_prim_i[k], c.pair_prim_j[k]); }
+/* Key of pair row k, ascending along the rows: the memory slot of prim_i,
+ * then the user id of prim_j (the order of a primitive's rows, pass 5). */
+CD_INLINE cd_ulong cd_nb_row_key(cd_cols c, cd_long k, cd_order o)
+{
+    return cd_bp_pair_key(c.pair_prim_i[k], (cd_prim_id)cd_map(o.prim_uid, c.pair_prim_j[k]));
+}
 
 /* Before the rows are replaced: the key and history of old row k, kept for
  * the carry-over (pass 8). */
-CD_INLINE void cd_nb_item_keep(cd_cols c, cd_long k, CD_GLOBAL cd_ulong *old_keys, CD_GLOBAL cd_int *old_active,
-                               CD_GLOBAL cd_vec3 *old_shear)
+CD_INLINE void cd_nb_item_keep(cd_cols c, cd_long k, cd_order o, CD_GLOBAL cd_ulong *old_keys,
+                               CD_GLOBAL cd_int *old_active, CD_GLOBAL cd_vec3 *old_shear)
 {
-    old_keys[k] = cd_nb_row_key(c, k);
+    old_keys[k] = cd_nb_row_key(c, k, o);
     old_active[k] = c.pair_active[k];
     old_shear[k] = c.pair_shear[k];
 }
 
 /* Pass 7: the rows offset[i] .. offset[i+1] of primitive i from its slot
  * (slot > 0) or, after a fill-mode pass 5 (slot = 0), already in
- * pair_prim_j: prim_i set, and each row's key. */
+ * pair_prim_j: prim_i set, and each row's key (cd_nb_row_key). */
 CD_INLINE void cd_nb_item_place(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_int *offset,
-                                const CD_GLOBAL cd_prim_id *cand, cd_int slot, CD_GLOBAL cd_ulong *keys)
+                                const CD_GLOBAL cd_prim_id *cand, cd_int slot, CD_GLOBAL cd_ulong *keys, cd_order o)
 {
     cd_int first = offset[i], n = offset[i + 1] - first;
     for (cd_int m = 0; m < n; m++) {
         cd_prim_id j = slot > 0 ? cand[(cd_long)i * slot + m] : c.pair_prim_j[first + m];
         c.pair_prim_i[first + m] = i;
         c.pair_prim_j[first + m] = j;
-        keys[first + m] = cd_bp_pair_key(i, j);
+        keys[first + m] = cd_bp_pair_key(i, (cd_prim_id)cd_map(o.prim_uid, j));
     }
 }
 
 /* Pass 8: history of new row k: the old row with the same key keeps its
  * activity and tangential spring [m]; a pair new to the list starts
- * without history. */
+ * without history.  prim_src: the memory slot each primitive had when the
+ * old rows were made (null: the same; src/reorder.c), so that the key is
+ * looked up as the old rows wrote it. */
 CD_INLINE void cd_nb_item_carry(cd_cols c, cd_long k, const CD_GLOBAL cd_ulong *keys,
                                 const CD_GLOBAL cd_ulong *old_keys, cd_long n_old,
-                                const CD_GLOBAL cd_int *old_active, const CD_GLOBAL cd_vec3 *old_shear)
+                                const CD_GLOBAL cd_int *old_active, const CD_GLOBAL cd_vec3 *old_shear,
+                                const CD_GLOBAL cd_int *prim_src)
 {
-    cd_long o = cd_bp_find_key(old_keys, n_old, keys[k]);
+    cd_ulong key = keys[k];
+    if (prim_src) key = cd_bp_pair_key(prim_src[key >> 32], (cd_prim_id)(key & 0xffffffffUL));
+    cd_long o = cd_bp_find_key(old_keys, n_old, key);
     c.pair_active[k] = o >= 0 ? old_active[o] : 0;
     c.pair_shear[k] = o >= 0 ? old_shear[o] : cd_v3_zero();
 }
@@ -230,15 +245,27 @@ CD_INLINE void cd_nb_item_gather_fill(cd_cols c, cd_long k, CD_GLOBAL cd_int *cu
     rows[cd_atomic_inc(&cursor[c.prim_particle[c.pair_prim_j[k]]])] = (cd_pair_id)(2 * k + 1);
 }
 
-/* Pass 9c: particle q's entries in ascending order (insertion: a few tens),
- * the order in which the gather sums them. */
-CD_INLINE void cd_nb_item_gather_sort(cd_particle_id q, const CD_GLOBAL cd_int *start, CD_GLOBAL cd_pair_id *rows)
+/* User key of gather entry e (2 k + side): its row's primitives' user
+ * ids, i then j.  Without reordering, rows ascend with their keys. */
+CD_INLINE cd_ulong cd_nb_entry_key(cd_cols c, cd_order o, cd_pair_id e)
+{
+    if (!o.prim_uid) return (cd_ulong)(cd_uint)e;
+    cd_pair_id k = e >> 1;
+    return cd_bp_pair_key(o.prim_uid[c.pair_prim_i[k]], o.prim_uid[c.pair_prim_j[k]]);
+}
+
+/* Pass 9c: particle q's entries in ascending user key of their rows
+ * (insertion: a few tens), the order in which the gather sums them: the
+ * same order whatever the memory order. */
+CD_INLINE void cd_nb_item_gather_sort(cd_cols c, cd_order o, cd_particle_id q, const CD_GLOBAL cd_int *start,
+                                      CD_GLOBAL cd_pair_id *rows)
 {
     cd_int first = start[q], last = start[q + 1];
     for (cd_int a = first + 1; a < last; a++) {
         cd_pair_id v = rows[a];
+        cd_ulong kv = cd_nb_entry_key(c, o, v);
         cd_int b = a;
-        while (b > first && rows[b - 1] > v) {
+        while (b > first && cd_nb_entry_key(c, o, rows[b - 1]) > kv) {
             rows[b] = rows[b - 1];
             b--;
         }

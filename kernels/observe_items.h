@@ -1,7 +1,9 @@
 /* The observables of the state (energies, contact counts, momentum, wall
  * forces, largest overlap) as fixed-order reductions: rows in blocks of
  * CD_OBS_BLOCK, each block summed in row order into its own slots, then
- * the blocks merged in order (particles, pairs, wall rows).  src/observe.c
+ * the blocks merged in order (particles, pairs, wall rows).  Rows are
+ * visited in user order (cd_order, kernels/reorder_items.h; the identity
+ * when the memory order is the user's), so the sums do not depend on it.  src/observe.c
  * runs the items on host threads or, in the offload variant, on the device
  * (then only the merged slots come back), so the sums have the same bits
  * for every thread count and on every device.  Device-safe: C11 and
@@ -11,6 +13,7 @@
 #include "cols.h"
 #include "rigid.h"
 #include "contact_law.h"
+#include "reorder_items.h"
 
 #define CD_OBS_BLOCK 4096
 /* Slots of a partial sum: summed ... */
@@ -56,10 +59,11 @@ CD_INLINE cd_long cd_obs_block_end(cd_long b, cd_long n)
 /* Block b of the particles: kinetic and potential energy in gravity
  * [m/s^2], momentum. */
 CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 gravity,
-                                      const CD_GLOBAL cd_int *touch, CD_GLOBAL cd_real *acc)
+                                      const CD_GLOBAL cd_int *touch, CD_GLOBAL cd_real *acc, cd_order o)
 {
     cd_obs_clear(acc);
-    for (cd_long q = b * CD_OBS_BLOCK; q < cd_obs_block_end(b, n); q++) {
+    for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
+        cd_long q = cd_map(o.part_at, u);
         cd_vec3 v = c.velocity[q];
         cd_real m = c.mass[q];
         cd_real kt = CD_R(0.5) * m * cd_v3_norm2(v), kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], c.inertia[q]);
@@ -74,10 +78,12 @@ CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 g
 }
 
 /* Block b of the pair rows: elastic energy, contacts, largest overlap. */
-CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc)
+CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc,
+                                  cd_order o)
 {
     cd_obs_clear(acc);
-    for (cd_long k = b * CD_OBS_BLOCK; k < cd_obs_block_end(b, n); k++) {
+    for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
+        cd_long k = cd_map(o.pair_at, u);
         if (!c.pair_active[k]) continue;
         cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
         acc[CD_OBS_EL] += cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
@@ -90,20 +96,20 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
 /* Block b of the primitive-wall rows (n_walls per primitive): elastic
  * energy, contacts, the particles' force on each wall, largest overlap. */
 CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
-                                  CD_GLOBAL cd_real *acc)
+                                  CD_GLOBAL cd_real *acc, cd_order o)
 {
     cd_obs_clear(acc);
-    for (cd_long r = b * CD_OBS_BLOCK; r < cd_obs_block_end(b, n); r++) {
+    for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
+        cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
         if (!c.wallc_active[r]) continue;
-        cd_long w = r % n_walls;
-        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.prim_radius[r / n_walls], c.wallc_overlap[r],
+        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.prim_radius[i], c.wallc_overlap[r],
                                                      c.wallc_shear[r]);
         acc[CD_OBS_NW] += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
         acc[CD_OBS_WALL + 3 * w + 0] -= c.wallc_force[r].x;
         acc[CD_OBS_WALL + 3 * w + 1] -= c.wallc_force[r].y;
         acc[CD_OBS_WALL + 3 * w + 2] -= c.wallc_force[r].z;
-        cd_real ratio = c.wallc_overlap[r] / (2 * c.prim_radius[r / n_walls]);
+        cd_real ratio = c.wallc_overlap[r] / (2 * c.prim_radius[i]);
         if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
     }
 }

@@ -245,8 +245,10 @@ CD_INLINE cd_real cd_parallel_weight(cd_real cross2, cd_real norm2, cd_real sin_
  * between the cut-off and twice it, so that the point moves continuously
  * with the angle.  D, overlap and n stay those of the closest points so that the
  * force stays continuous. */
-CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
-                                    cd_real s, cd_real t, cd_real sin_parallel, cd_int blend, cd_contact_geom *g)
+/* The closest points' part of cd_segseg_contact_at (everything but the
+ * parallel rule). */
+CD_INLINE void cd_segseg_contact_closest(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
+                                         cd_real s, cd_real t, cd_contact_geom *g)
 {
     cd_real D;
     cd_vec3 a, b, n;
@@ -266,7 +268,14 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
     g->normal = n;
     g->point = cd_v3_scale(cd_v3_add(a, b), CD_R(0.5));
     g->parallel = 0;
+}
 
+CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
+                                    cd_real s, cd_real t, cd_real sin_parallel, cd_int blend, cd_contact_geom *g)
+{
+    cd_vec3 d1 = cd_v3_sub(p1, p0);
+    cd_vec3 d2 = cd_v3_sub(q1, q0);
+    cd_segseg_contact_closest(p0, p1, ri, q0, q1, rj, s, t, g);
     if (sin_parallel > CD_R(0)) {
         cd_real aa = cd_v3_dot(d1, d1);
         cd_real ee = cd_v3_dot(d2, d2);
@@ -354,6 +363,27 @@ CD_INLINE int cd_segseg_clearly_apart(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec
     cd_vec3 ab = cd_v3_sub(b, a);
     cd_real reach = ri + rj; /* [m] */
     return cd_v3_dot(ab, ab) > reach * reach * CD_R(1.000000001);
+}
+
+/* The narrow phase of a point and a segment (a sphere and an arm: p0 ==
+ * p1, or q0 == q1, not both): cd_segseg_closest's branch for a point,
+ * cd_segseg_clearly_apart and cd_segseg_contact_at with the same operations
+ * on the same values, so the same bits, less the parallel rule, which
+ * needs two axes of non-zero length (its weight is 0 for a point).
+ * Returns 1 when the two are clearly apart (g is then not filled), 0
+ * after filling g. */
+CD_INLINE int cd_segseg_point_segment_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1,
+                                              cd_real rj, cd_contact_geom *g)
+{
+    cd_vec3 d1 = cd_v3_sub(p1, p0), d2 = cd_v3_sub(q1, q0), w = cd_v3_sub(q0, p0);
+    cd_real a = cd_v3_dot(d1, d1), e = cd_v3_dot(d2, d2), s = CD_R(0), t = CD_R(0);
+    if (a <= CD_R(0)) /* i is the point: p0 projected onto j */
+        t = cd_clamp01(-cd_v3_dot(w, d2) / e);
+    else /* j is the point: q0 projected onto i */
+        s = cd_clamp01(cd_v3_dot(w, d1) / a);
+    if (cd_segseg_clearly_apart(p0, p1, ri, q0, q1, rj, s, t)) return 1;
+    cd_segseg_contact_closest(p0, p1, ri, q0, q1, rj, s, t, g);
+    return 0;
 }
 
 CD_DEVICE_END

@@ -15,6 +15,7 @@
 #include "walls.h"
 #include "contact_law.h"
 #include "broadphase.h"
+#include "reorder_items.h"
 
 CD_DEVICE_BEGIN
 
@@ -112,9 +113,13 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
     cd_contact_geom g;
     int apart;
-    if (cd_segseg_is_point(ai, bi) && cd_segseg_is_point(aj, bj)) {
+    int point_i = cd_segseg_is_point(ai, bi), point_j = cd_segseg_is_point(aj, bj);
+    if (point_i && point_j) {
         /* two spheres: the same geometry without the segment machinery */
         apart = cd_segseg_point_contact(ai, ri, aj, rj, &g);
+    } else if (point_i || point_j) {
+        /* a sphere and an arm: the same, without the parallel rule */
+        apart = cd_segseg_point_segment_contact(ai, bi, ri, aj, bj, rj, &g);
     } else {
         cd_real s, t;
         cd_segseg_closest(ai, bi, aj, bj, &s, &t);
@@ -268,12 +273,14 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
 #define CD_LOAD_CHUNK 4096
 
 /* Sum of the normal forces F_n [N] that the primitives of chunk ch exert
- * on wall w, in primitive order. */
-CD_INLINE cd_real cd_item_wall_load_chunk(cd_cols c, cd_long ch, cd_long n_prims, cd_int n_walls, cd_int w)
+ * on wall w, in user primitive order (prim_at: user id -> memory slot,
+ * null for the identity; kernels/reorder_items.h). */
+CD_INLINE cd_real cd_item_wall_load_chunk(cd_cols c, cd_long ch, cd_long n_prims, cd_int n_walls, cd_int w,
+                                          const CD_GLOBAL cd_int *prim_at)
 {
     cd_long end = (ch + 1) * CD_LOAD_CHUNK < n_prims ? (ch + 1) * CD_LOAD_CHUNK : n_prims;
     cd_real acc = 0;
-    for (cd_long i = ch * CD_LOAD_CHUNK; i < end; i++) acc += c.wallc_fn[i * n_walls + w];
+    for (cd_long u = ch * CD_LOAD_CHUNK; u < end; u++) acc += c.wallc_fn[cd_map(prim_at, u) * n_walls + w];
     return acc;
 }
 

@@ -12,6 +12,9 @@
 #define CD_PATH_MAX 1024
 
 /* One kind of particle in the run. */
+/* neighbor.reorder: the memory order of the particles (src/reorder.c). */
+enum { CD_REORDER_CELLS = 0, CD_REORDER_NONE = 1 };
+
 typedef struct {
     char shape[32];          /* sphere | rod | cross | hexapod | segments */
     double aspect;           /* alpha = L / d_p [1] (named shapes) */
@@ -87,6 +90,7 @@ typedef struct {
 
     /* neighbour list */
     double skin;                   /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
+    int reorder;                   /* neighbor.reorder: CD_REORDER_CELLS | CD_REORDER_NONE (src/reorder.c) */
 
     /* MPI domain decomposition (docs/mpi.md; read by the MPI build only) */
     int mpi_decomposition;         /* 0: cartesian */

@@ -180,6 +180,9 @@ const cd_key cd_config_keys[] = {
     /* neighbour list */
     {"neighbor.skin", CD_KT_REAL, "m", "0", CFG(skin), GE(0),
      .label = "Verlet skin", .meaning = "neighbour-list skin; 0: automatic (0.1 x smallest arm diameter)"},
+    {"neighbor.reorder", CD_KT_ENUM, "-", "cells", CFG(reorder), .choices = "cells|none",
+     .label = "memory order", .meaning = "cells: at rebuilds the omp backend keeps the particles in memory in the order "
+     "of their grid cells where that brings neighbours closer; none: the user's order. The same trajectory bits either way"},
 
     /* MPI domain decomposition (docs/mpi.md): how `mpirun -np R` splits space */
     {"mpi.decomposition", CD_KT_ENUM, "-", "cartesian", CFG(mpi_decomposition), .flags = CD_KF_RESUMABLE,

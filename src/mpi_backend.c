@@ -223,6 +223,7 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     if (!x->ran && cd_decomp_choose(&x->grid, &sim->cfg, x->size, lo, hi, interaction_range(sim), 0, err, errlen))
         return -1; /* every rank: the same data, the same refusal */
 
+    sim->nb.reorder = 0; /* the replicated state stays in global id order too */
     cd_sim *loc = &x->loc;
     memset(loc, 0, sizeof *loc);
     loc->cfg = sim->cfg; /* shallow: cd_sim_free leaves the config alone */
@@ -235,7 +236,8 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     loc->threads = sim->threads;
     loc->backend = x->inner;
     memcpy(loc->device_request, sim->device_request, sizeof loc->device_request);
-    cd_neighbors_init(&loc->nb, sim->nb.skin);
+    /* reorder off: the MPI layer keeps local order = global id order (docs/mpi.md) */
+    cd_neighbors_init(&loc->nb, sim->nb.skin, 0);
     loc->rebuild_hook = rebuild_hook;
     loc->rebuild_hook_data = x;
     size_t R = (size_t)x->size;

@@ -267,7 +267,7 @@ static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
     x->owned = owned;
     double skin = x->loc.nb.skin; /* [m] */
     cd_neighbors_free(&x->loc.nb); /* sized for the old rows */
-    cd_neighbors_init(&x->loc.nb, skin);
+    cd_neighbors_init(&x->loc.nb, skin, 0); /* local order = global id order (docs/mpi.md) */
     return plan_refresh(x);
 }
 

@@ -28,10 +28,11 @@
  * primitive overflows its slot. */
 #define CD_NB_SLOT 32
 
-void cd_neighbors_init(cd_neighbors *nb, double skin)
+void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder)
 {
     memset(nb, 0, sizeof(*nb));
     nb->skin = skin;
+    nb->reorder = reorder;
     nb->force_rebuild = 1;
     nb->slot = CD_NB_SLOT;
 }
@@ -42,7 +43,8 @@ void cd_neighbors_free(cd_neighbors *nb)
     void *all[] = {d->gather_start, d->gather_rows, d->wall_start, d->wall_rows, d->grid, d->part_bound,
                    d->partial, d->part_cell, d->cell_count, d->cell_start, d->cell_parts, d->pair_count,
                    d->pair_offset, d->cand, d->keys, d->old_keys, d->old_active, d->old_shear, d->count,
-                   d->chunk_sum};
+                   d->chunk_sum, d->part_uid, d->part_at, d->prim_uid, d->prim_at, d->pair_at, d->pair_ustart,
+                   d->part_src, d->prim_src, d->new_first, d->sort_keys, d->sort_vals, d->hist, d->move};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -92,7 +94,7 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
 }
 
 /* out[0] = 0, out[k+1] = out[k] + in[k] for k < n (kernels/neighbor_items.h). */
-static void scan(const cd_int *in, cd_int n, cd_int *out, cd_int *chunk_sum)
+void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *chunk_sum)
 {
     cd_int chunk = CD_SCAN_CHUNK, n_chunks = (n + chunk - 1) / chunk;
     CD_WIDE_MIN
@@ -119,12 +121,11 @@ static void zero_ints(cd_int *dst, size_t n)
     for (size_t k = 0; k < n; k++) dst[k] = 0;
 }
 
-/* Passes 1-4: bounds, grid, particles binned by cell (CSR).  Returns 1
- * when the grid says the run blew up (cd_nb_item_grid; the grid comes
- * back, 56 bytes), 0 otherwise. */
-static int bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
+/* Passes 1-2: bounds and grid.  Returns 1 when the grid says the run blew
+ * up (cd_nb_item_grid; the grid comes back, 56 bytes), 0 otherwise. */
+static int make_grid(cd_sim *sim, cd_cols c, cd_nb_lists d)
 {
-    cd_int N = (cd_int)sim->s.n_particles, cell_cap = (cd_int)sim->nb.cell_cap;
+    cd_int N = (cd_int)sim->s.n_particles;
     cd_int chunk = CD_NB_CHUNK, n_chunks = (N + chunk - 1) / chunk;
     cd_real skin = sim->nb.skin; /* [m] */
     CD_WIDE_MIN
@@ -133,15 +134,21 @@ static int bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
     CD_STEP_FOR(1, firstprivate(d))
     for (int one = 0; one < 1; one++) cd_nb_item_grid(d.partial, n_chunks, skin, N, d.grid);
     cd_grid g;
-    if (cd_dev_get(&g, d.grid, sizeof g) == 0 && g.dim[0] < 0) return 1;
+    return cd_dev_get(&g, d.grid, sizeof g) == 0 && g.dim[0] < 0;
+}
+
+/* Passes 3-4: particles binned by cell (CSR). */
+static void bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
+{
+    cd_int N = (cd_int)sim->s.n_particles, cell_cap = (cd_int)sim->nb.cell_cap;
+    CD_WIDE_MIN
     zero_ints(d.cell_count, (size_t)cell_cap);
     CD_STEP_FOR(N, firstprivate(c, d))
     for (cd_int q = 0; q < N; q++) cd_nb_item_bin(c, q, d.grid, cell_cap, d.part_cell, d.cell_count);
-    scan(d.cell_count, cell_cap, d.cell_start, d.chunk_sum);
+    cd_nb_scan(d.cell_count, cell_cap, d.cell_start, d.chunk_sum);
     copy_ints(d.cell_count, d.cell_start, (size_t)cell_cap);
     CD_STEP_FOR(N, firstprivate(d))
     for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, d.part_cell, d.cell_count, d.cell_parts);
-    return 0;
 }
 
 /* Pass 5 in slot mode (slot > 0; returns the longest row, which may exceed
@@ -151,15 +158,16 @@ static cd_int collect(cd_sim *sim, cd_cols c, cd_nb_lists d, cd_int slot)
 {
     cd_int N = (cd_int)sim->s.n_particles, longest = 0;
     cd_real skin = sim->nb.skin; /* [m] */
+    cd_order o = cd_sim_step_order(sim);
     CD_WIDE_MIN
-    CD_STEP_FOR(N, firstprivate(c, d) reduction(max : longest) CD_DEV(map(tofrom : longest)))
+    CD_STEP_FOR(N, firstprivate(c, d, o) reduction(max : longest) CD_DEV(map(tofrom : longest)))
     for (cd_int p = 0; p < N; p++) {
         if (slot > 0)
             cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, d.cand, slot, 0,
-                               d.pair_count);
+                               d.pair_count, o);
         else
             cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, c.pair_prim_j, 0,
-                               d.pair_offset, d.pair_count);
+                               d.pair_offset, d.pair_count, o);
         for (cd_int i = c.prim_first[p]; i < c.prim_first[p] + c.prim_count[p]; i++)
             if (d.pair_count[i] > longest) longest = d.pair_count[i];
     }
@@ -181,9 +189,10 @@ static int keep_history(cd_sim *sim, cd_cols c)
         nb->cap_old = cap;
     }
     cd_nb_lists d = nb->d;
+    cd_order o = cd_sim_step_order(sim);
     CD_WIDE_MIN
-    CD_STEP_FOR(n_old, firstprivate(c, d))
-    for (size_t k = 0; k < n_old; k++) cd_nb_item_keep(c, (cd_long)k, d.old_keys, d.old_active, d.old_shear);
+    CD_STEP_FOR(n_old, firstprivate(c, d, o))
+    for (size_t k = 0; k < n_old; k++) cd_nb_item_keep(c, (cd_long)k, o, d.old_keys, d.old_active, d.old_shear);
     return 0;
 }
 
@@ -200,16 +209,17 @@ static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
     zero_ints(d.count, (size_t)N);
     CD_STEP_FOR(n_pairs, firstprivate(c, d))
     for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_count(c, (cd_long)k, d.count);
-    scan(d.count, N, d.gather_start, d.chunk_sum);
+    cd_nb_scan(d.count, N, d.gather_start, d.chunk_sum);
     copy_ints(d.count, d.gather_start, (size_t)N);
     CD_STEP_FOR(n_pairs, firstprivate(c, d))
     for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_fill(c, (cd_long)k, d.count, d.gather_rows);
-    CD_STEP_FOR(N, firstprivate(d))
-    for (cd_int q = 0; q < N; q++) cd_nb_item_gather_sort(q, d.gather_start, d.gather_rows);
+    cd_order o = cd_sim_step_order(sim);
+    CD_STEP_FOR(N, firstprivate(c, d, o))
+    for (cd_int q = 0; q < N; q++) cd_nb_item_gather_sort(c, o, q, d.gather_start, d.gather_rows);
 
     CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
     for (cd_int q = 0; q < N; q++) d.count[q] = cd_item_wall_candidates(c, q, walls, W, skin, 0);
-    scan(d.count, N, d.wall_start, d.chunk_sum);
+    cd_nb_scan(d.count, N, d.wall_start, d.chunk_sum);
     CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
     for (cd_int q = 0; q < N; q++) cd_item_wall_candidates(c, q, walls, W, skin, d.wall_rows + d.wall_start[q]);
     cd_int n_rows = 0;
@@ -228,11 +238,17 @@ int cd_neighbors_build(cd_sim *sim)
     cd_state *s = &sim->s;
     cd_neighbors *nb = &sim->nb;
     cd_int P = (cd_int)s->n_prims;
-    if (reserve(nb, s, s->n_pairs)) return -1;
+    /* host threads after a sync: the columns back in the lists' order */
+    if (cd_reorder_to_memory(sim) || reserve(nb, s, s->n_pairs)) return -1;
     cd_cols c = cd_sim_step_cols(sim);
-    if (bin_particles(sim, c, nb->d)) return CD_NB_BLOWUP;
+    /* the old rows' history aside, keyed in the order they were made in */
+    if (keep_history(sim, c)) return -1;
+    if (make_grid(sim, c, nb->d)) return CD_NB_BLOWUP;
+    int moved = 0;
+    if (cd_reorder_build(sim, &moved)) return -1;
+    bin_particles(sim, c, nb->d);
     cd_int longest = collect(sim, c, nb->d, nb->slot);
-    scan(nb->d.pair_count, P, nb->d.pair_offset, nb->d.chunk_sum);
+    cd_nb_scan(nb->d.pair_count, P, nb->d.pair_offset, nb->d.chunk_sum);
     cd_int n_new = 0;
     if (cd_dev_get(&n_new, nb->d.pair_offset + P, sizeof n_new)) return -1;
     /* Gather entries are 2 k + 1 in a cd_int (cd_item_gather); a negative
@@ -242,8 +258,7 @@ int cd_neighbors_build(cd_sim *sim)
         return -1;
     }
 
-    /* Replace the rows: the old history aside, room for the new rows. */
-    if (keep_history(sim, c)) return -1;
+    /* Replace the rows: room for the new rows. */
     size_t n_old = s->n_pairs;
     if (cd_sim_reserve_step_pairs(sim, (size_t)n_new + (size_t)n_new / 4 + 16) || reserve(nb, s, (size_t)n_new))
         return -1;
@@ -257,13 +272,15 @@ int cd_neighbors_build(cd_sim *sim)
         if (realloc_dev((void **)&nb->d.cand, (size_t)P * (size_t)nb->slot + 1, sizeof(cd_prim_id))) return -1;
     }
     cd_nb_lists d = nb->d;
+    cd_order o = cd_sim_step_order(sim);
+    const cd_int *prim_src = moved ? d.prim_src : NULL; /* the slots the old rows' keys name */
     CD_WIDE_MIN
-    CD_STEP_FOR(P, firstprivate(c, d))
-    for (cd_int i = 0; i < P; i++) cd_nb_item_place(c, i, d.pair_offset, d.cand, slot, d.keys);
-    CD_STEP_FOR(n_new, firstprivate(c, d))
+    CD_STEP_FOR(P, firstprivate(c, d, o))
+    for (cd_int i = 0; i < P; i++) cd_nb_item_place(c, i, d.pair_offset, d.cand, slot, d.keys, o);
+    CD_STEP_FOR(n_new, firstprivate(c, d) CD_DEV(is_device_ptr(prim_src)))
     for (cd_int k = 0; k < n_new; k++) cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active,
-                                                        d.old_shear);
-    if (particle_lists(sim, c, d)) return -1;
+                                                        d.old_shear, prim_src);
+    if (particle_lists(sim, c, d) || cd_reorder_pair_rows(sim)) return -1;
     CD_STEP_FOR(P, firstprivate(c))
     for (cd_int i = 0; i < P; i++) {
         c.prim_a_ref[i] = c.prim_a[i];
@@ -276,6 +293,18 @@ int cd_neighbors_build(cd_sim *sim)
 
 int cd_neighbors_part_bounds(const cd_sim *sim, double *out)
 {
-    if (!sim->nb.d.part_bound) return -1;
-    return cd_dev_get(out, sim->nb.d.part_bound, sim->s.n_particles * sizeof(double));
+    size_t N = sim->s.n_particles;
+    if (!sim->nb.d.part_bound || cd_dev_get(out, sim->nb.d.part_bound, N * sizeof(double))) return -1;
+    if (!sim->nb.ordered) return 0;
+    /* the build's rows are in memory order: out in user order */
+    double *mem = malloc((N + 1) * sizeof(double));
+    cd_int *at = malloc((N + 1) * sizeof(cd_int));
+    int rc = mem && at ? cd_dev_get(at, sim->nb.d.part_at, N * sizeof(cd_int)) : -1;
+    if (!rc) {
+        memcpy(mem, out, N * sizeof(double));
+        for (size_t u = 0; u < N; u++) out[u] = mem[at[u]];
+    }
+    free(mem);
+    free(at);
+    return rc;
 }

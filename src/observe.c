@@ -49,6 +49,7 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     cd_int W = (cd_int)s->n_walls;
     cd_vec3 g = sim->p.gravity;
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_order o = cd_sim_host_order(sim);
     cd_int *touch = calloc((size_t)N + 1, sizeof(cd_int));
     double *part = malloc((size_t)(nb.particles + nb.pairs + nb.walls + 1) * CD_OBS_SLOTS * sizeof(double));
     if (!touch || !part) { /* without memory: what is known is nothing */
@@ -64,12 +65,12 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     CD_HOST_FOR(R, firstprivate(c))
     for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
     double *pp = part, *pk = part + nb.particles * CD_OBS_SLOTS, *pw = pk + nb.pairs * CD_OBS_SLOTS;
-    CD_HOST_FOR(N, firstprivate(c))
-    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, pp + b * CD_OBS_SLOTS);
-    CD_HOST_FOR(K, firstprivate(c))
-    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS);
-    CD_HOST_FOR(R, firstprivate(c))
-    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS);
+    CD_HOST_FOR(N, firstprivate(c, o))
+    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, pp + b * CD_OBS_SLOTS, o);
+    CD_HOST_FOR(K, firstprivate(c, o))
+    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS, o);
+    CD_HOST_FOR(R, firstprivate(c, o))
+    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS, o);
     cd_obs_merge(part, nb.particles + nb.pairs + nb.walls, total);
     free(touch);
     free(part);
@@ -123,12 +124,13 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
     CD_STEP_FOR(R, firstprivate(c) is_device_ptr(touch))
     for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
-    CD_STEP_FOR(N, firstprivate(c, g) is_device_ptr(touch, part))
-    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS);
-    CD_STEP_FOR(K, firstprivate(c, law) is_device_ptr(part))
-    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS);
-    CD_STEP_FOR(R, firstprivate(c, wall_law) is_device_ptr(part))
-    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS);
+    cd_order o = cd_sim_step_order(sim);
+    CD_STEP_FOR(N, firstprivate(c, g, o) is_device_ptr(touch, part))
+    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS, o);
+    CD_STEP_FOR(K, firstprivate(c, law, o) is_device_ptr(part))
+    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS, o);
+    CD_STEP_FOR(R, firstprivate(c, wall_law, o) is_device_ptr(part))
+    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS, o);
     CD_STEP_FOR(1, is_device_ptr(part, total))
     for (int one = 0; one < 1; one++) cd_obs_merge(part, n_blocks, total);
     return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;

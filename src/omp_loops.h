@@ -88,6 +88,13 @@ static inline int cd_dev_get(void *dst, const void *src, size_t bytes)
  * once the state is mapped, the host columns otherwise (src/step_omp.c). */
 cd_cols cd_sim_step_cols(cd_sim *sim);
 
+/* The column of field f (cd_fields) the loops work on (src/step_omp.c). */
+void *cd_sim_step_field(cd_sim *sim, size_t f);
+
+/* out[0] = 0, out[k+1] = out[k] + in[k] for k < n, where the loops run
+ * (src/neighbors.c); chunk_sum: the build's scratch. */
+void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *chunk_sum);
+
 /* Room for n pair rows in the columns the loops work on: the host columns
  * grow (cd_state_reserve_pairs, contents kept); in the offload variant the
  * device copies are re-mapped at their new size, contents not kept (the

@@ -488,7 +488,7 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
     }
     sp->wall_law = sp->law;
     sp->wall_law.mu = c->wall_friction;
-    cd_neighbors_init(&sim->nb, c->skin > 0 ? c->skin : 0.1 * dmin);
+    cd_neighbors_init(&sim->nb, c->skin > 0 ? c->skin : 0.1 * dmin, c->reorder == CD_REORDER_CELLS);
     sim->threads = 1;
 #ifdef _OPENMP
     sim->threads = omp_get_max_threads();

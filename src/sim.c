@@ -60,8 +60,9 @@ double cd_sim_wall_load_host(cd_sim *sim, int w)
     /* the order of every backend (kernels/step_items.h, CD_LOAD_CHUNK) */
     cd_cols c = cd_sim_host_cols(&sim->s);
     cd_long P = (cd_long)sim->s.n_prims, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    const cd_int *prim_at = cd_sim_host_order(sim).prim_at;
     double sum = 0;
-    for (cd_long ch = 0; ch < nch; ch++) sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w);
+    for (cd_long ch = 0; ch < nch; ch++) sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w, prim_at);
     return sum;
 }
 

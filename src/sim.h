@@ -9,6 +9,7 @@
 #include "../kernels/contact_law.h"
 #include "../kernels/cols.h"
 #include "../kernels/broadphase.h"
+#include "../kernels/reorder_items.h"
 #include "backend.h"
 
 /* Loops over fewer rows than this run on one thread: a parallel region
@@ -56,7 +57,21 @@ typedef struct {
     cd_vec3 *old_shear;       /* [m] */
     cd_int *count;            /* per particle: gather and wall counts, then cursors */
     cd_int *chunk_sum;        /* prefix sums' chunk totals */
+    /* memory order (kernels/reorder_items.h, src/reorder.c; allocated at
+     * the first build with neighbor.reorder: cells) */
+    cd_int *part_uid, *part_at; /* particle: memory slot -> user id, user id -> memory slot */
+    cd_int *prim_uid, *prim_at; /* the same for primitives */
+    cd_int *pair_at;          /* pair rows in user order -> memory row (pair_at_cap) */
+    cd_int *pair_ustart;      /* first place of each user primitive's rows in user order (n_prims + 1) */
+    cd_int *part_src, *prim_src; /* the reorder's permutation: old slot of each new slot */
+    cd_int *new_first;        /* prim_first in the new order (n_particles + 1) */
+    cd_ulong *sort_keys;      /* cell keys, twice n_particles (radix sort in and out) */
+    cd_int *sort_vals;        /* their slots, twice n_particles */
+    cd_int *hist;             /* radix sort: digit counts per chunk, then cursors */
+    void *move;               /* scratch of one column while it moves */
 } cd_nb_lists;
+
+#define CD_NB_REORDER_ALWAYS 2
 
 /* Neighbour-list workspace. */
 typedef struct {
@@ -70,6 +85,13 @@ typedef struct {
     size_t cap_old;           /* rows that old_keys, old_active, old_shear hold */
     size_t cell_cap;          /* cells the cell lists hold */
     cd_int slot;              /* candidate slot per primitive (doubles when one overflows) */
+    int reorder;              /* neighbor.reorder: 1 cells (the grid cells' order at rebuilds), 0 none;
+                                 CD_NB_REORDER_ALWAYS (tests): at every rebuild that changes the order */
+    int ordered;              /* the order maps of d are set (from the first build after start) */
+    int host_user;            /* host variant: a sync put the columns in user order; the next step
+                                 puts them back in memory order (src/reorder.c) */
+    long long reorders;       /* rebuilds that moved particles */
+    size_t pair_at_cap;       /* rows d.pair_at holds */
 } cd_neighbors;
 
 /* Scratch of the observables' reductions where the steps run (the offload
@@ -185,15 +207,38 @@ void cd_observables_slots(const cd_sim *sim, double *slots);
 int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen);
 
 /* Neighbour list (neighbors.c). */
-void cd_neighbors_init(cd_neighbors *nb, double skin);
+/* reorder: 1 for neighbor.reorder: cells (src/reorder.c) */
+void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder);
 void cd_neighbors_free(cd_neighbors *nb);
 /* 0, -1 (out of memory) or CD_NB_BLOWUP (particle centres not finite or
  * spread over more than 1e12 particle sizes: the run blew up, and a cell
  * grid of them would overflow its integer coordinates). */
 #define CD_NB_BLOWUP (-2)
 int cd_neighbors_build(cd_sim *sim);
-/* The bounding radii [m] of the last build, copied to out (n_particles);
- * 0, or -1 before the first build.  For tests. */
+/* The bounding radii [m] of the last build, copied to out (n_particles,
+ * user order); 0, or -1 before the first build.  For tests. */
 int cd_neighbors_part_bounds(const cd_sim *sim, double *out);
+
+/* Memory order (src/reorder.c, docs/architecture.md "Memory order"). */
+/* The maps the step columns are in now (the identity when not reordered),
+ * and those of the host columns (the same on host threads; the identity
+ * in the offload variant, whose host columns a sync leaves in user order). */
+cd_order cd_sim_step_order(const cd_sim *sim);
+cd_order cd_sim_host_order(const cd_sim *sim);
+/* At a rebuild, before the particles are binned: the particles, their
+ * primitives and wall rows put in the order of their grid cells (the
+ * grid of the build, d.grid), the maps updated; *moved = 1 when some
+ * particle moved (then d.prim_src holds the primitives' old slots).
+ * 0, or -1 out of memory. */
+int cd_reorder_build(cd_sim *sim, int *moved);
+/* At the end of a build: d.pair_at for the new rows.  0, or -1. */
+int cd_reorder_pair_rows(cd_sim *sim);
+/* The host columns in user order (a sync; rows copied back from a device
+ * are in memory order), and (host variant) back in memory order before
+ * the next step.  Both no-ops when not reordered.  0, or -1 out of memory. */
+int cd_reorder_to_user(cd_sim *sim);
+int cd_reorder_to_memory(cd_sim *sim);
+/* Frees the maps and forgets the order (backend start and stop). */
+void cd_reorder_forget(cd_sim *sim);
 
 #endif

@@ -5,7 +5,8 @@
  * identical for any thread count.  Four loops per step: advance (kick,
  * drift, primitive ends, skin test), pair forces, wall forces, gather with
  * the second kick; a neighbour-list rebuild between the first two when
- * the skin test asks for it.
+ * the skin test asks for it.  On host threads the last three and the next
+ * step's advance share one parallel region (forces_and_advance).
  *
  * Two variants of the same loops (src/omp_loops.h, docs/offload.md): on
  * host threads over the host columns of sim->s, or on an offload device
@@ -202,6 +203,15 @@ int cd_sim_reserve_step_pairs(cd_sim *sim, size_t n)
     return cd_state_reserve_pairs(&sim->s, n);
 }
 
+void *cd_sim_step_field(cd_sim *sim, size_t f)
+{
+#if CD_OFFLOAD
+    cd_off *o = sim->backend_data;
+    if (o) return o->host[f] ? off_devptr(o->host[f]) : NULL;
+#endif
+    return *cd_field_ptr(&sim->s, &cd_fields[f]);
+}
+
 /* Columns the step loops work on: device addresses in the offload variant,
  * the host columns otherwise. */
 cd_cols cd_sim_step_cols(cd_sim *sim)
@@ -215,11 +225,10 @@ cd_cols cd_sim_step_cols(cd_sim *sim)
 /* ---- the loops of a step ------------------------------------------------ */
 
 /* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
- * world ends of its primitives and the skin test; the walls move on the
- * host.  Returns 1 when the neighbour list must be rebuilt (some end moved
- * more than half the skin, or a rebuild was asked for); on the offload
- * device one int comes back. */
-static int advance(cd_sim *sim)
+ * world ends of its primitives and the skin test.  Returns 1 when some end
+ * moved more than half the skin; on the offload device one int comes
+ * back. */
+static int advance_particles(cd_sim *sim)
 {
     cd_cols c = cd_sim_step_cols(sim);
     cd_real dt = sim->p.dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
@@ -228,7 +237,17 @@ static int advance(cd_sim *sim)
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c) reduction(| : moved) CD_DEV(map(tofrom : moved)))
     for (size_t q = 0; q < n; q++) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+    return moved;
+}
+
+/* The walls move on the host (after the particles' advance, moved: its
+ * skin test).  Returns 1 when the neighbour list must be rebuilt (some
+ * primitive end or wall moved more than half the skin, or a rebuild was
+ * asked for). */
+static int advance_walls(cd_sim *sim, int moved)
+{
     cd_state *s = &sim->s;
+    cd_real dt = sim->p.dt;
     for (size_t w = 0; w < s->n_walls; w++) {
         s->walls[w] = cd_wall_advanced(s->walls[w], dt);
         moved |= cd_bp_wall_moved(s->walls[w], sim->nb.walls_ref[w]) > CD_R(0.5) * sim->nb.skin;
@@ -295,6 +314,79 @@ static void compute_forces(cd_sim *sim, int kick)
     gather_kick(sim, kick);
 }
 
+#if !CD_OFFLOAD
+/* The loops of forces_and_advance, each an orphaned `omp for` in a
+ * function of its own (the region's threads share its rows) with every
+ * call inside inlined (flatten): the items have two callers each (this
+ * region, and the separate loops of the start), and GCC then called
+ * them instead of inlining them, 1.15x the instructions of the step
+ * (callgrind). */
+__attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd_law_params law, cd_real dt,
+                                                 cd_real sin_parallel, cd_int blend)
+{
+#pragma omp for schedule(static) nowait
+    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
+}
+
+__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, size_t n, const cd_wall *walls,
+                                                 cd_int W, cd_law_params law, cd_real dt, cd_real sin_parallel,
+                                                 cd_int blend)
+{
+#pragma omp for schedule(static)
+    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], walls, W, law, dt, sin_parallel, blend);
+}
+
+__attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 g, cd_int dim,
+                                                          cd_real dt, cd_real limit2, int next)
+{
+    int moved = 0;
+#pragma omp for schedule(static) nowait /* the region's end is the barrier */
+    for (size_t q = 0; q < n; q++) {
+        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
+        cd_item_kick(c, (cd_particle_id)q, CD_R(0.5) * dt);
+        if (next) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+    }
+    return moved;
+}
+#endif
+
+/* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
+ * the next step (its advance; returns its skin test).
+ * Host threads: one parallel region, where four loops used to fork and
+ * join their threads each (docs/performance.md, "One parallel region per
+ * step"): the pair loop without a barrier before the wall loop (they
+ * write different rows and read only the particles' state), one barrier
+ * before the gather, none after it but the region's end, and the next
+ * step's advance of particle q in the same item as q's gather and kick
+ * (it reads only q's own rows).  Each item does the arithmetic it did in
+ * its own loop, in the same order: the same bits.  An offload device runs
+ * the loops one launch each, as before. */
+static int forces_and_advance(cd_sim *sim, int next)
+{
+#if CD_OFFLOAD
+    compute_forces(sim, 1);
+    return next ? advance_particles(sim) : 0;
+#else
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel, limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    cd_int blend = sim->p.parallel_blend, dim = sim->p.dimension, W = (cd_int)sim->s.n_walls;
+    cd_vec3 g = sim->p.gravity;
+    const cd_wall *walls = sim->s.walls;
+    size_t n_pairs = sim->s.n_pairs, n_walls = W ? sim->nb.n_wall_rows : 0, n = sim->s.n_particles;
+    size_t most = n_pairs > n ? n_pairs : n;
+    int moved = 0;
+#pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
+    {
+        pair_rows(c, n_pairs, law, dt, sin_parallel, blend);
+        wall_rows(c, d.wall_rows, n_walls, walls, W, wall_law, dt, sin_parallel, blend);
+        moved |= gather_kick_advance(c, d, n, g, dim, dt, limit2, next);
+    }
+    return moved;
+#endif
+}
+
 void cd_sim_refresh(cd_sim *sim)
 {
     cd_state *s = &sim->s;
@@ -306,6 +398,7 @@ void cd_sim_refresh(cd_sim *sim)
     sim->nb.force_rebuild = 1;
 }
 
+/* bad: the user id of a particle that blew up (-1: none). */
 static int report_bad(const cd_state *s, long bad, char *err, size_t errlen)
 {
     if (bad < 0) return 0;
@@ -324,6 +417,10 @@ int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
     CD_HOST_FOR(n, reduction(max : bad))
     for (size_t q = 0; q < n; q++)
         if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
+#if !CD_OFFLOAD
+    /* host threads: the host columns may be in memory order */
+    if (bad >= 0) bad = (long)cd_map(cd_sim_step_order(sim).part_uid, bad);
+#endif
     return report_bad(s, bad, err, errlen);
 }
 
@@ -338,18 +435,25 @@ static int check_step_state(cd_sim *sim, char *err, size_t errlen)
     CD_STEP_FOR(n, firstprivate(c) reduction(max : bad) map(tofrom : bad))
     for (size_t q = 0; q < n; q++)
         if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
-    return report_bad(&sim->s, bad, err, errlen);
+    cd_int uid = (cd_int)bad;
+    if (bad >= 0 && sim->nb.ordered) cd_dev_get(&uid, sim->nb.d.part_uid + bad, sizeof uid);
+    return report_bad(&sim->s, uid, err, errlen);
 #else
     return cd_sim_check_state(sim, err, errlen);
 #endif
 }
 
+/* The backend lets go of the state: on host threads the host columns go
+ * back to user order (they are the current state); an offload device's
+ * state is dropped (the host keeps what the last sync brought). */
 static void omp_stop(cd_sim *sim)
 {
 #if CD_OFFLOAD
+    cd_reorder_forget(sim);
     off_release(sim);
 #else
-    (void)sim;
+    if (cd_reorder_to_user(sim)) fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
+    cd_reorder_forget(sim);
 #endif
 }
 
@@ -381,8 +485,14 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
+    /* host threads after a sync: the columns back in the lists' order */
+    if (cd_reorder_to_memory(sim)) {
+        snprintf(err, errlen, "out of memory putting the particles in memory order");
+        return -1;
+    }
+    int moved = n > 0 ? advance_particles(sim) : 0;
     for (long long it = 0; it < n; it++) {
-        int rebuild = advance(sim);
+        int rebuild = advance_walls(sim, moved);
         if (sim->rebuild_hook && (rebuild = sim->rebuild_hook(sim, rebuild, err, errlen)) < 0) return -1;
         int rc = rebuild ? cd_neighbors_build(sim) : 0;
         if (rc == CD_NB_BLOWUP) {
@@ -394,7 +504,7 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
             snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
             return -1;
         }
-        compute_forces(sim, 1);
+        moved = forces_and_advance(sim, it + 1 < n);
         s->step++;
         s->time += sim->p.dt;
     }
@@ -403,7 +513,6 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
 #if CD_OFFLOAD
     /* The only full copy back: every device column, rows in use. */
     cd_off *o = sim->backend_data;
@@ -419,9 +528,12 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
                 off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
                          cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
         }
-#else
-    (void)sim; /* the state lives in host memory */
 #endif
+    /* the host columns in user order (src/reorder.c) */
+    if (cd_reorder_to_user(sim)) {
+        snprintf(err, errlen, "out of memory putting the particles in user order");
+        return -1;
+    }
     return 0;
 }
 
@@ -455,10 +567,12 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     cd_cols c = o->dev;
     double *part = o->part;
     size_t P = sim->s.n_prims, W = sim->s.n_walls, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
     double sum = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(nch, firstprivate(c))
-    for (size_t ch = 0; ch < nch; ch++) part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w);
+    CD_STEP_FOR(nch, firstprivate(c) is_device_ptr(prim_at))
+    for (size_t ch = 0; ch < nch; ch++)
+        part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at);
 #pragma omp target map(tofrom : sum)
     for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
     *load = sum;
@@ -467,8 +581,24 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
 #define CD_OMP_WALL_LOAD omp_wall_load
 #define CD_OMP_OBSERVE cd_omp_observe_device /* src/observe.c */
 #else
-#define CD_OMP_OBSERVE NULL /* cd_sim_observe_step sums the host columns */
-#define CD_OMP_WALL_LOAD NULL /* cd_sim_wall_load sums the host columns */
+/* Host threads: the host columns are the step's, summed in user order
+ * whatever their memory order, without a sync (which would put them in
+ * user order and back). */
+static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    *load = cd_sim_wall_load_host(sim, w);
+    return 0;
+}
+
+static int omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    cd_observables_slots(sim, slots);
+    return 0;
+}
+#define CD_OMP_WALL_LOAD omp_wall_load
+#define CD_OMP_OBSERVE omp_observe
 #endif
 
 const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, CD_OMP_WALL_LOAD, CD_OMP_OBSERVE};

@@ -56,7 +56,7 @@ __kernel void cd_cl_pair_collect(
     cd_int p = (cd_int)get_global_id(0);
     if (p >= n_particles) return;
     cd_nb_item_collect(c, p, grid, cell_start, cell_parts, part_bound, skin, cand, slot, (__global const cd_int *)0,
-                       pair_count);
+                       pair_count, cd_order_identity());
     for (cd_int i = c.prim_first[p]; i < c.prim_first[p] + c.prim_count[p]; i++)
         if (pair_count[i] > slot) flags[2] = 1;
 }
@@ -74,7 +74,7 @@ __kernel void cd_cl_pair_fill(
     cd_int p = (cd_int)get_global_id(0);
     if (p < n_particles)
         cd_nb_item_collect(c, p, grid, cell_start, cell_parts, part_bound, skin, c.pair_prim_j, 0, pair_offset,
-                           pair_count);
+                           pair_count, cd_order_identity());
 }
 
 /* Pass 7: primitive i's rows from its slot (slot 0: from pair_prim_j) and
@@ -86,7 +86,7 @@ __kernel void cd_cl_pair_place(
 {
 #include "col_bind.h"
     cd_int i = (cd_int)get_global_id(0);
-    if (i < n_prims) cd_nb_item_place(c, i, pair_offset, cand, slot, keys);
+    if (i < n_prims) cd_nb_item_place(c, i, pair_offset, cand, slot, keys, cd_order_identity());
 }
 
 /* Keys of rows that came from the host (a new run or a checkpoint). */
@@ -96,7 +96,7 @@ __kernel void cd_cl_pair_keys(
 {
 #include "col_bind.h"
     cd_int k = (cd_int)get_global_id(0);
-    if (k < n_pairs) keys[k] = cd_nb_row_key(c, k);
+    if (k < n_pairs) keys[k] = cd_nb_row_key(c, k, cd_order_identity());
 }
 
 /* Pass 8: history of new row k. */
@@ -107,7 +107,7 @@ __kernel void cd_cl_pair_carry(
 {
 #include "col_bind.h"
     cd_int k = (cd_int)get_global_id(0);
-    if (k < n_pairs) cd_nb_item_carry(c, k, keys, old_keys, n_old, old_active, old_shear);
+    if (k < n_pairs) cd_nb_item_carry(c, k, keys, old_keys, n_old, old_active, old_shear, (__global const cd_int *)0);
 }
 
 /* Pass 9: gather lists counted, filled (cursor starts as gather_start),
@@ -134,7 +134,10 @@ __kernel void cd_cl_gather_sort(cd_int n_particles, __global const cd_int *gathe
                                 __global cd_pair_id *gather_rows)
 {
     cd_int q = (cd_int)get_global_id(0);
-    if (q < n_particles) cd_nb_item_gather_sort(q, gather_start, gather_rows);
+    /* The OpenCL backend keeps the user's memory order (no reordering): the
+     * entries sort by value, and the columns are not read. */
+    cd_cols none;
+    if (q < n_particles) cd_nb_item_gather_sort(none, cd_order_identity(), q, gather_start, gather_rows);
 }
 
 /* Pass 10: wall candidates of particle q counted, then (after the scan of

@@ -75,7 +75,7 @@ __kernel void cd_cl_wall_load(
 {
 #include "col_bind.h"
     cd_int ch = (cd_int)get_global_id(0);
-    if (ch < n_chunks) part[ch] = cd_item_wall_load_chunk(c, ch, n_prims, n_walls, w);
+    if (ch < n_chunks) part[ch] = cd_item_wall_load_chunk(c, ch, n_prims, n_walls, w, (__global const cd_int *)0);
 }
 
 /* Pass 2, one work-item: the chunks' sums in chunk order, as every backend

@@ -1,0 +1,138 @@
+/* The memory order changes no bit (src/reorder.c, docs/architecture.md
+ * "Memory order"): a run with neighbor.reorder: cells (particles, primitives
+ * and wall rows kept in the order of their grid cells, re-sorted at
+ * rebuilds) and the same run with neighbor.reorder: none have the same
+ * particle, pair-row and wall-row columns after every sync (the rows in
+ * user order), the same observables summed where the steps run and the
+ * same wall loads, while the columns are in memory order.  On OpenCL (no
+ * reordering) both runs are the same run and the check is trivial. */
+#include "test_util.h"
+#include <omp.h>
+
+/* 300 alpha-3 hexapods poured under 50 g into a box (six walls, so the
+ * wall rows move in groups of six per primitive): a falling, then
+ * settling pile that rebuilds its list often (about 1,000 times in 4,000
+ * steps), with some 1,400 pair
+ * rows and wall contacts.  Every sum of the observables is then one block
+ * (kernels/observe_items.h), summed in user order.  Seconds on two
+ * threads. */
+static const char *pile =
+    "run: {dt: 8.5e-6, steps: 0, seed: 7}\n"
+    "physics: {gravity: [0, -490.5, 0]}\n"
+    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 300, polydispersity: 0.2}]\n"
+    "domain: {type: box, width: 0.06, thickness: 0.06, height: 0.3}\n"
+    "init: {placement: random, exclusion: shape, speed: 0.2}\n";
+
+/* Is column f one a pair row keeps while inactive?  (The point, force,
+ * overlap and F_n of an inactive row are whatever its memory row last
+ * held, in either order: nobody reads them, kernels/step_items.h.) */
+static int kept_inactive(const cd_field_info *f)
+{
+    return !strcmp(f->name, "pair_prim_i") || !strcmp(f->name, "pair_prim_j") || !strcmp(f->name, "pair_active") ||
+           !strcmp(f->name, "pair_shear");
+}
+
+/* Every column of group g (n rows) of a and b bit for bit (pair rows: the
+ * columns an inactive row keeps, and every column of the active rows). */
+static void assert_same_group(const cd_state *a, const cd_state *b, enum cd_field_group g, size_t n, long long step)
+{
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group != g) continue;
+        const char *pa = *(void *const *)((const char *)a + cd_fields[f].offset);
+        const char *pb = *(void *const *)((const char *)b + cd_fields[f].offset);
+        size_t e = cd_fields[f].elem_size;
+        for (size_t r = 0; r < n; r++) {
+            if (cd_group_pair_rows(g) && !a->pair_active[r] && !kept_inactive(&cd_fields[f])) continue;
+            if (memcmp(pa + r * e, pb + r * e, e))
+                fail_msg("step %lld: column %s, row %zu differs between reorder cells and none", step, cd_fields[f].name, r);
+        }
+    }
+}
+
+/* Runs the pile with reorder setting `reorder` in a and none in b. */
+static void check_reorder(int reorder)
+{
+    static cd_sim a, b;
+    cd_config ca, cb;
+    char err[512];
+    omp_set_num_threads(2);
+    cdt_setup(&a, &ca, pile);
+    cdt_setup(&b, &cb, pile);
+    assert_int_equal(a.nb.reorder, 1); /* the default */
+    a.nb.reorder = reorder;
+    b.nb.reorder = 0;
+    assert_int_equal(cd_sim_initial_forces(&a), 0);
+    assert_int_equal(cd_sim_initial_forces(&b), 0);
+    double contacts = 0, wall_contacts = 0;
+    for (int k = 0; k < 16; k++) {
+        cd_sim *sims[2] = {&a, &b};
+        cd_observables o[2];
+        double load[2];
+        for (int s = 0; s < 2; s++) {
+            /* no sync: the sums run over the columns in memory order */
+            if (cd_sim_step(sims[s], 250, err, sizeof err)) fail_msg("step: %s", err);
+            if (cd_sim_observe_step(sims[s], &o[s], err, sizeof err)) fail_msg("observe: %s", err);
+            if (cd_sim_wall_load(sims[s], 0, &load[s], err, sizeof err)) fail_msg("wall load: %s", err);
+        }
+        if (memcmp(&o[0], &o[1], sizeof o[0]))
+            fail_msg("step %lld: observables differ (elastic %.17g vs %.17g J, kinetic %.17g vs %.17g J)", a.s.step,
+                     o[0].elastic, o[1].elastic, o[0].kinetic_translational, o[1].kinetic_translational);
+        if (memcmp(&load[0], &load[1], sizeof load[0]))
+            fail_msg("step %lld: wall load %.17g vs %.17g N", a.s.step, load[0], load[1]);
+        /* every third round the host writes a velocity between sync and
+         * step, as a protocol does: it must reach the run in both orders */
+        for (int s = 0; s < 2; s++) {
+            if (cd_sim_sync(sims[s], err, sizeof err)) fail_msg("sync: %s", err);
+            if (k % 3 == 2) sims[s]->s.velocity[7] = cd_v3(0, 0.1, 0);
+        }
+        assert_int_equal(a.s.n_pairs, b.s.n_pairs);
+        assert_same_group(&a.s, &b.s, CD_GROUP_PARTICLE, a.s.n_particles, a.s.step);
+        assert_same_group(&a.s, &b.s, CD_GROUP_PRIM, a.s.n_prims, a.s.step);
+        assert_same_group(&a.s, &b.s, CD_GROUP_PAIR, a.s.n_pairs, a.s.step);
+        assert_same_group(&a.s, &b.s, CD_GROUP_PAIR_OUT, a.s.n_pairs, a.s.step);
+        assert_same_group(&a.s, &b.s, CD_GROUP_WALLC, a.s.n_prims * a.s.n_walls, a.s.step);
+        contacts += o[0].n_contacts;
+        wall_contacts += o[0].n_wall_contacts;
+    }
+    /* the user's order after a sync: each particle owns its primitives in
+     * order, and pair rows are sorted by (prim_i, prim_j), i < j */
+    for (size_t q = 0, first = 0; q < a.s.n_particles; first += (size_t)a.s.prim_count[q], q++)
+        assert_int_equal(a.s.prim_first[q], (cd_int)first);
+    for (size_t k = 1; k < a.s.n_pairs; k++)
+        assert_true(cd_bp_pair_key(a.s.pair_prim_i[k - 1], a.s.pair_prim_j[k - 1]) <
+                    cd_bp_pair_key(a.s.pair_prim_i[k], a.s.pair_prim_j[k]));
+    print_message("%s: %lld rebuilds, %lld of them reordered; %zu pair rows, %g contacts and %g wall contacts seen\n",
+                  cdt_backend(), a.nb.builds, a.nb.reorders, a.s.n_pairs, contacts, wall_contacts);
+    assert_true(contacts > 1000 && wall_contacts > 300);
+    assert_int_equal(b.nb.reorders, 0);
+    /* the particles did move in memory: once for the default (the random
+     * placement's order, then the cells', which the pile keeps), at
+     * every rebuild that changes the cells' order when forced */
+    if (!strcmp(cdt_backend(), "omp")) assert_true(a.nb.reorders >= (reorder == CD_NB_REORDER_ALWAYS ? 50 : 1));
+    cd_sim_free(&a); cd_sim_free(&b);
+    cd_config_free(&ca); cd_config_free(&cb);
+}
+
+static void test_reorder_changes_no_bit(void **state)
+{
+    (void)state;
+    check_reorder(1);
+}
+
+/* The same with a reorder at every rebuild that changes the order (not
+ * only where the cells' order shortens the rows' memory distances): many moves,
+ * history carried across each. */
+static void test_reorder_at_every_rebuild_changes_no_bit(void **state)
+{
+    (void)state;
+    check_reorder(CD_NB_REORDER_ALWAYS);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reorder_changes_no_bit),
+        cmocka_unit_test(test_reorder_at_every_rebuild_changes_no_bit),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
