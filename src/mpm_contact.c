@@ -104,7 +104,7 @@ static int count_pairs(cd_mpm *m, char *err, size_t errlen)
                     m->pair_keys[w++] = (long long)m->bnode_body[m->cn_entry[first + a]] * m->n_bodies +
                                         m->bnode_body[m->cn_entry[first + b]];
     }
-    qsort(m->pair_keys, w, sizeof(long long), cmp_key);
+    if (w) qsort(m->pair_keys, w, sizeof(long long), cmp_key); /* (no keys: pair_keys may be NULL) */
     long distinct = 0;
     for (size_t i = 0; i < w; i++) distinct += i == 0 || m->pair_keys[i] != m->pair_keys[i - 1];
     m->n_contacts = distinct;
