@@ -15,19 +15,8 @@
 #include "segseg.h"
 #include "walls.h"
 
-/* ---- fixed-seed PRNG (splitmix64) ------------------------------------- */
-static uint64_t rng_state = 0x5eed5e95e95e9ULL;
-static uint64_t rng_next(void)
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-/* uniform in [0, 1) */
-static double rng_u(void) { return (double)(rng_next() >> 11) * (1.0 / 9007199254740992.0); }
-static double rng_sym(void) { return 2.0 * rng_u() - 1.0; }
-static cd_vec3 rng_vec(double scale) { return cd_v3(scale * rng_sym(), scale * rng_sym(), scale * rng_sym()); }
+#include "unit/segseg_rng.h"
+
 /* dyadic numbers k/1024 in [-1, 1]: sums and small multiples are exact */
 static double rng_dyadic(void) { return (double)((int)(rng_next() % 2049) - 1024) / 1024.0; }
 static cd_vec3 rng_dyadic_vec(void) { return cd_v3(rng_dyadic(), rng_dyadic(), rng_dyadic()); }
@@ -626,89 +615,6 @@ static void test_headers_compile_as_opencl_c_1_2(void **state)
     assert_int_equal(rc, 0);
 }
 
-/* The general path of the pair kernel (closest points, pre-test, contact
- * with the blended parallel rule) into *want (zeroed first); returns the
- * pre-test's "apart". */
-static int general_contact(cd_vec3 p0, cd_vec3 p1, double ri, cd_vec3 q0, cd_vec3 q1, double rj, double sp,
-                           cd_contact_geom *want)
-{
-    double s, t;
-    memset(want, 0, sizeof *want);
-    cd_segseg_closest(p0, p1, q0, q1, &s, &t);
-    int apart = cd_segseg_clearly_apart(p0, p1, ri, q0, q1, rj, s, t);
-    if (!apart) cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, s, t, sp, 1, want);
-    return apart;
-}
-
-static void assert_same_geometry(const cd_contact_geom *got, const cd_contact_geom *want)
-{
-    assert_memory_equal(&got->normal, &want->normal, sizeof got->normal);
-    assert_memory_equal(&got->point, &want->point, sizeof got->point);
-    assert_memory_equal(&got->distance, &want->distance, sizeof got->distance);
-    assert_memory_equal(&got->overlap, &want->overlap, sizeof got->overlap);
-    assert_int_equal(got->parallel, want->parallel);
-}
-
-/* Two spheres (axes of zero length): the point path of the pair kernel
- * (cd_segseg_point_contact) gives the bits of the general one
- * (cd_segseg_closest, cd_segseg_clearly_apart, cd_segseg_contact_at) for
- * random pairs apart, touching and overlapping, coincident centres (the
- * touch normal) and centres with -0 coordinates. */
-static void test_point_contact_equals_general_path(void **state)
-{
-    (void)state;
-    double sp = sin(2.0 * CD_PI / 180.0);
-    int overlapping = 0;
-    rng_state = 4242;
-    for (int i = 0; i < 20000; i++) {
-        cd_vec3 p = rng_vec(0.01), q = cd_v3_add(p, rng_vec(0.006));
-        if (i % 97 == 0) q = p;                                /* coincident centres */
-        if (i % 89 == 0) p = cd_v3(-0.0, p.y, -0.0);           /* signed zeros */
-        double ri = 0.001 + 0.002 * rng_u(), rj = 0.001 + 0.002 * rng_u();
-        cd_contact_geom want, got;
-        memset(&got, 0, sizeof got);
-        int apart = general_contact(p, p, ri, q, q, rj, sp, &want);
-        assert_int_equal(cd_segseg_point_contact(p, ri, q, rj, &got), apart);
-        if (apart) continue;
-        overlapping += want.overlap > 0;
-        assert_same_geometry(&got, &want);
-    }
-    assert_true(overlapping > 1000);
-}
-
-/* A sphere and an arm (one axis of zero length): the point-segment path
- * of the pair kernel (cd_segseg_point_segment_contact) gives the bits of
- * the general one, with the sphere as i or as j, for random pairs apart,
- * touching and overlapping, the sphere's centre on the axis (the touch
- * normal) and beyond either end. */
-static void test_point_segment_contact_equals_general_path(void **state)
-{
-    (void)state;
-    double sp = sin(2.0 * CD_PI / 180.0);
-    int overlapping = 0, ends = 0;
-    rng_state = 777;
-    for (int k = 0; k < 40000; k++) {
-        cd_vec3 p = rng_vec(0.01), q0 = cd_v3_add(p, rng_vec(0.006)), q1 = cd_v3_add(q0, rng_vec(0.008));
-        if (k % 101 == 0) p = cd_v3_lerp(q0, q1, 0.25); /* on the axis */
-        double ri = 0.001 + 0.002 * rng_u(), rj = 0.001 + 0.002 * rng_u();
-        int sphere_j = k % 2; /* the sphere as primitive j every other pair */
-        cd_vec3 a0 = sphere_j ? q0 : p, a1 = sphere_j ? q1 : p, b0 = sphere_j ? p : q0, b1 = sphere_j ? p : q1;
-        double ra = sphere_j ? rj : ri, rb = sphere_j ? ri : rj;
-        cd_contact_geom want, got;
-        memset(&got, 0, sizeof got);
-        int apart = general_contact(a0, a1, ra, b0, b1, rb, sp, &want);
-        assert_int_equal(cd_segseg_point_segment_contact(a0, a1, ra, b0, b1, rb, &got), apart);
-        if (apart) continue;
-        overlapping += want.overlap > 0;
-        /* the sphere's projection beyond an end of the arm (clamped) */
-        cd_vec3 d = cd_v3_sub(q1, q0);
-        double u = cd_v3_dot(cd_v3_sub(p, q0), d) / cd_v3_dot(d, d);
-        ends += u < 0 || u > 1;
-        assert_same_geometry(&got, &want);
-    }
-    assert_true(overlapping > 1000 && ends > 100);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -722,8 +628,6 @@ int main(void)
         cmocka_unit_test(test_touching_axes_give_deterministic_unit_normal),
         cmocka_unit_test(test_extreme_scales_stay_finite),
         cmocka_unit_test(test_clearly_apart_never_hides_a_contact),
-        cmocka_unit_test(test_point_contact_equals_general_path),
-        cmocka_unit_test(test_point_segment_contact_equals_general_path),
         cmocka_unit_test(test_parallel_point_is_continuous_in_the_angle),
         cmocka_unit_test(test_headers_compile_as_opencl_c_1_2),
     };
