@@ -35,7 +35,7 @@
  * mixed flow, and drops their contact history (bench_tile.c): relax before
  * timing.
  *
- * --reorder overrides the case's neighbor.reorder (src/reorder.c: the
+ * --reorder overrides the case's neighbor.reorder (src/backend/omp/reorder.c: the
  * memory order of the omp backend; the same bits either way).
  *
  * --backend takes a comma-separated list (an entry "omp:1" runs that round
@@ -52,9 +52,9 @@
 #include <string.h>
 #include <time.h>
 #include <omp.h>
-#include "sim.h"
-#include "io_h5.h"
-#include "config.h"
+#include "core/sim.h"
+#include "io/io_h5.h"
+#include "config/config.h"
 #include "bench_cases.h"
 #include "bench_tile.h"
 #include "bench_traffic.h"
@@ -257,7 +257,7 @@ int main(int argc, char **argv)
             return fail(err, 3); /* warm-up of a loaded packing: first list build */
         }
         /* one more build, now that the contact rows exist: the omp
-         * backend's memory order is chosen from them (src/reorder.c), and
+         * backend's memory order is chosen from them (src/backend/omp/reorder.c), and
          * a loaded packing would otherwise time its first choice */
         sim.nb.force_rebuild = 1;
         if (cd_sim_step(&sim, 1, err, sizeof err)) return fail(err, 3);

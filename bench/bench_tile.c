@@ -9,8 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "sim.h"
-#include "rng.h"
+#include "core/sim.h"
+#include "core/rng.h"
 #include "bench_tile.h"
 
 int cd_bench_tile_config(const char *text, int kx, int kz, char *out, size_t len)

@@ -2,7 +2,7 @@
 #ifndef CD_BENCH_TILE_H
 #define CD_BENCH_TILE_H
 #include <stddef.h>
-#include "state.h"
+#include "core/state.h"
 
 /* The config text of a capdem-bench case with count x kx kz particles in a
  * box kx times as wide (x) and kz times as deep (z).  Returns 0, or -1 if

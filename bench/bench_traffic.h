@@ -1,12 +1,12 @@
 /* Bytes moved per time step, kernel by kernel: see bench_traffic.c. */
 #ifndef CD_BENCH_TRAFFIC_H
 #define CD_BENCH_TRAFFIC_H
-#include "sim.h"
+#include "core/sim.h"
 
 enum { CD_TRAFFIC_KERNELS = 5 };
 
 typedef struct {
-    const char *kernel; /* the loop of src/step_omp.c (one OpenCL kernel) */
+    const char *kernel; /* the loop of src/backend/omp/step_omp.c (one OpenCL kernel) */
     double read, write; /* bytes per step [B] */
 } cd_traffic;
 

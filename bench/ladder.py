@@ -19,7 +19,7 @@ spread over the rungs instead of falling on one.  The timed segment has
 about --target particle-steps (at least 20 steps).
 
 --reorder cells,none times every rung with each memory order in turn
-(capdem-bench --reorder; the same packing and bits, src/reorder.c), so
+(capdem-bench --reorder; the same packing and bits, src/backend/omp/reorder.c), so
 that the two are compared in the same round.
 
 Prints one JSON line per timed segment: capdem-bench's line plus `tile`,

@@ -43,7 +43,7 @@ CD_DEVICE_BEGIN
 CD_INLINE cd_vec3 cd_contact_force_on_j(cd_real fn, cd_vec3 n, cd_vec3 ft) { return cd_v3_axpy(ft, fn, n); }
 
 /* Its tangential part from the whole force [N]: F_j - F_n n, the law's F_t
- * up to one rounding of F_n n (src/pair_output.c). */
+ * up to one rounding of F_n n (src/io/pair_output.c). */
 CD_INLINE cd_vec3 cd_contact_tangential(cd_vec3 force_j, cd_real fn, cd_vec3 n) { return cd_v3_axpy(force_j, -fn, n); }
 
 /* Effective mass m_ij = m_i m_j / (m_i + m_j) [kg]. */

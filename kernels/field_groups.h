@@ -1,7 +1,7 @@
 /* Which groups of kernels/fields.def a device holds.  CD_ON_DEVICE_<group>(...)
  * expands to its arguments for the groups the time step reads or writes,
  * and to nothing for PAIR_OUT, the per-contact output columns that the host
- * derives at sync (src/pair_output.c).  The column lists of the backends
+ * derives at sync (src/io/pair_output.c).  The column lists of the backends
  * (cols.h, cl/col_params.h, cl/col_bind.h, the OpenCL column indices, the
  * offload mapping) expand fields.def through it, so a device never holds,
  * binds or copies an output-only column.  PAIR_OUT is the last group of

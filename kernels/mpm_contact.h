@@ -1,5 +1,5 @@
 /* Material point method: where the line through a node along a contact
- * normal crosses a material point (src/mpm_contact.c, docs/mpm.md
+ * normal crosses a material point (src/mpm/mpm_contact.c, docs/mpm.md
  * "Contact").  Device-safe: C11 and OpenCL C.
  *
  * A point stands for the parallelogram x_p + F [-l/2, l/2]^2 (l its initial

@@ -1,6 +1,6 @@
 /* One work item of each pass of the Verlet-list build (docs/architecture.md,
  * "Neighbour list").  The build exists once: the OpenMP loops of
- * src/neighbors.c (host threads, or an offload device) and the OpenCL
+ * src/backend/omp/neighbors.c (host threads, or an offload device) and the OpenCL
  * kernels of kernels/cl/neighbors.cl call these items in the same passes:
  *
  *   1. bounds    per chunk of particles: bounding radii, box of centres
@@ -215,7 +215,7 @@ CD_INLINE void cd_nb_item_place(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_int 
 /* Pass 8: history of new row k: the old row with the same key keeps its
  * activity and tangential spring [m]; a pair new to the list starts
  * without history.  prim_src: the memory slot each primitive had when the
- * old rows were made (null: the same; src/reorder.c), so that the key is
+ * old rows were made (null: the same; src/backend/omp/reorder.c), so that the key is
  * looked up as the old rows wrote it. */
 CD_INLINE void cd_nb_item_carry(cd_cols c, cd_long k, const CD_GLOBAL cd_ulong *keys,
                                 const CD_GLOBAL cd_ulong *old_keys, cd_long n_old,

@@ -3,7 +3,7 @@
  * CD_OBS_BLOCK, each block summed in row order into its own slots, then
  * the blocks merged in order (particles, pairs, wall rows).  Rows are
  * visited in user order (cd_order, kernels/reorder_items.h; the identity
- * when the memory order is the user's), so the sums do not depend on it.  src/observe.c
+ * when the memory order is the user's), so the sums do not depend on it.  src/backend/omp/observe.c
  * runs the items on host threads or, in the offload variant, on the device
  * (then only the merged slots come back), so the sums have the same bits
  * for every thread count and on every device.  Device-safe: C11 and

@@ -9,7 +9,7 @@
  *
  * cd_order holds the maps; a null map is the identity (no reordering: the
  * OpenCL backend, or a run with neighbor.reorder: none).  The items below
- * are the passes of the reorder (src/reorder.c), run where the steps run.
+ * are the passes of the reorder (src/backend/omp/reorder.c), run where the steps run.
  * Device-safe: C11 and OpenCL C 1.2. */
 #ifndef CD_REORDER_ITEMS_H
 #define CD_REORDER_ITEMS_H

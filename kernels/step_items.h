@@ -1,5 +1,5 @@
 /* One work item of each loop of the time step (docs/architecture.md, "A time
- * step"; SPEC sections 2-4).  The OpenMP loops of src/step_omp.c and the
+ * step"; SPEC sections 2-4).  The OpenMP loops of src/backend/omp/step_omp.c and the
  * OpenCL kernels of kernels/cl/ are thin wrappers that call these for one
  * particle, primitive or pair, so both backends run the same arithmetic in
  * the same order and can agree bit for bit.  No item writes a row another
@@ -80,7 +80,7 @@ CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real l
 
 /* Contact geometry of pair row k (SPEC 2): closest points of the two axes
  * and, from them, the contact point, normal and overlap.  Fills g always
- * (the host's output pass, src/pair_output.c, needs the normal of every
+ * (the host's output pass, src/io/pair_output.c, needs the normal of every
  * active row). */
 CD_INLINE void cd_pair_geometry(cd_cols c, cd_pair_id k, cd_real sin_parallel, cd_int parallel_blend,
                                 cd_contact_geom *g)

@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "sim.h"
+#include "core/sim.h"
 #include "../kernels/rigid.h"
 
 /* The backend under test: CAPDEM_TEST_BACKEND (CTest runs the physics and

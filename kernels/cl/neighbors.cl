@@ -1,6 +1,6 @@
 /* The Verlet list built on an OpenCL device (docs/opencl.md, "Neighbour
  * list"): one kernel per pass of kernels/neighbor_items.h, each a thin
- * wrapper of the item the OpenMP build (src/neighbors.c) runs, so both
+ * wrapper of the item the OpenMP build (src/backend/omp/neighbors.c) runs, so both
  * build the same list.  Integer atomics only fill counting sorts; what they
  * leave out of order is sorted again, so the result is the same on every
  * run. */

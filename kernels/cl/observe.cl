@@ -1,7 +1,7 @@
 /* The observables summed on the device (kernels/observe_items.h): marks of
  * the particles in contact, the block sums of particles, pair rows and wall
  * rows, and their merge in order by one work-item; only the merged slots
- * go back to the host.  The same items and order as src/observe.c. */
+ * go back to the host.  The same items and order as src/backend/omp/observe.c. */
 #include "../observe_items.h"
 
 __kernel void cd_cl_obs_touch_pairs(

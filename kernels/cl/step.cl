@@ -1,6 +1,6 @@
 /* The time step as OpenCL kernels (docs/opencl.md): one work-item per
  * particle, primitive or pair, each a thin wrapper around the per-item
- * functions of kernels/step_items.h that the OpenMP loops of src/step_omp.c
+ * functions of kernels/step_items.h that the OpenMP loops of src/backend/omp/step_omp.c
  * call too.  Kernels that touch the state take the columns of
  * kernels/fields.def first (col_params.h), in table order. */
 #include "../step_items.h"

@@ -1,4 +1,4 @@
-/* Fits of the analysis (host/analyze_fit.c) on synthetic samples with known
+/* Fits of the analysis (host/analysis/analyze_fit.c) on synthetic samples with known
  * answers: the exponential tail, Mueth's form, the cascade model of seed
  * 001, the jamming law of seed 002, and P(f) through the whole forces
  * measure.  Random numbers come from capdem's seeded generator, so every
@@ -12,8 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "analyze.h"
-#include "rng.h"
+#include "analysis/analyze.h"
+#include "core/rng.h"
 
 /* Exponential with rate k. */
 static double draw_exp(cd_rng *r, double k) { return -log1p(-cd_rng_uniform(r)) / k; }

@@ -1,6 +1,6 @@
 /* Contacts, bonds and particle stresses on hand-built snapshots whose
  * answers are worked out by hand: Z, Z_c, valence, P_c, P_b, P_k, bond
- * forces and F_k with several contacts per pair (host/analyze_network.c),
+ * forces and F_k with several contacts per pair (host/analysis/analyze_network.c),
  * branch vectors and interlocking (analyze_structure.c), the particle
  * stress tensor and its invariants (analyze_stress.c). */
 #include <stdarg.h>
@@ -12,7 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "analyze.h"
+#include "analysis/analyze.h"
 
 /* n particles of one shape (volume V, tip length L) and nc contacts, no
  * walls; positions and contacts are set by the caller. */

@@ -19,8 +19,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-#include "analyze.h"
-#include "run.h"
+#include "analysis/analyze.h"
+#include "core/run.h"
 
 #define RUN_FILE "analysis_e2e.h5"
 #define CONFIG_FILE "analysis_e2e.yaml"

@@ -1,4 +1,4 @@
-/* G(r) and the container geometry (host/analyze_structure.c,
+/* G(r) and the container geometry (host/analysis/analyze_structure.c,
  * analyze_geometry.c) on synthetic point sets with known answers: ideal
  * gases in 3D, 2D and pseudo-2D boxes (G = 1 within the statistical error)
  * and perfect lattices (peaks exactly at the lattice distances, with the
@@ -12,8 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "analyze.h"
-#include "rng.h"
+#include "analysis/analyze.h"
+#include "core/rng.h"
 
 /* A snapshot of n point-like spheres (one zero-length primitive of radius
  * rad each, tip length L = 1 m) in the box [0,W] x [0,H] x [0,T]: six plane

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Every number on the command line is parsed strictly (one helper,
-# cd_parse_cli_int / cd_parse_cli_real in src/config_cli.c): garbage,
+# cd_parse_cli_int / cd_parse_cli_real in src/config/config_cli.c): garbage,
 # negatives, trailing characters and overflow are refused with exit status 2
 # and a message naming the option, the value and what was expected; nothing
 # is written.  capdem run, capdem shape and capdem-bench.

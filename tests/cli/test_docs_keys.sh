@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The key table of docs/config.md is the one the code's key table prints
 # (`capdem run --help-markdown`): a key added, removed or changed in
-# src/config_schema.c without the documentation fails here.
+# src/config/config_schema.c without the documentation fails here.
 # usage: test_docs_keys.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2

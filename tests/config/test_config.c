@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "config.h"
+#include "config/config.h"
 
 #define FILE_NAME "configs/bad.yaml"
 #define PI 3.14159265358979323846

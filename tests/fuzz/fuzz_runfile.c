@@ -1,6 +1,6 @@
 /* libFuzzer target: the readers of run files on arbitrary bytes taken as
- * an HDF5 file -- what `capdem run --resume` (src/io_h5_read.c,
- * src/io_h5_check.c), `capdem analyze` (host/analyze_read.c,
+ * an HDF5 file -- what `capdem run --resume` (src/io/io_h5_read.c,
+ * src/io/io_h5_check.c), `capdem analyze` (host/analysis/analyze_read.c,
  * analyze_series.c) and `capdem export` (host/export_*.c) read.  The input
  * is written to a scratch file (HDF5's readers take a path; in tmpfs the
  * write costs microseconds), then every reader runs on it.  A refusal is
@@ -13,11 +13,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-#include "analyze.h"
-#include "config.h"
-#include "export.h"
-#include "io_h5.h"
-#include "sim.h"
+#include "analysis/analyze.h"
+#include "config/config.h"
+#include "export/export.h"
+#include "io/io_h5.h"
+#include "core/sim.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

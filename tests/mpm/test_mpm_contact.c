@@ -1,4 +1,4 @@
-/* Material point method, contact between bodies (src/mpm_contact.c): two
+/* Material point method, contact between bodies (src/mpm/mpm_contact.c): two
  * elastic disks colliding head-on without damping conserve momentum to
  * round-off, lose energy only to the contact and do not interpenetrate by
  * more than a cell; the same bits for 1 and 2 threads. */
@@ -14,8 +14,8 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-#include "mpm.h"
-#include "sim.h" /* cd_parallel_min_rows */
+#include "mpm/mpm.h"
+#include "core/sim.h" /* cd_parallel_min_rows */
 
 #define RHO 1000.0  /* [kg/m^3] */
 #define E_ 1.0e7    /* [Pa] */

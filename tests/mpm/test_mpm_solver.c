@@ -1,4 +1,4 @@
-/* Material point method, the explicit step (src/mpm.c): patch tests on a
+/* Material point method, the explicit step (src/mpm/mpm.c): patch tests on a
  * block of points, the volume update under pure dilation, the vibration of
  * an elastic bar against theory, the same bits for 1 and 2 threads, and
  * the diametral compression of the paper's disk against the elastic
@@ -15,8 +15,8 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-#include "mpm.h"
-#include "sim.h" /* cd_parallel_min_rows */
+#include "mpm/mpm.h"
+#include "core/sim.h" /* cd_parallel_min_rows */
 
 #define RHO 1000.0 /* [kg/m^3] */
 #define E_ 1.0e7   /* [Pa] */
@@ -193,7 +193,7 @@ static void load_config(cd_config *c, const char *rel)
 }
 
 /* Same bits for 1 and 2 threads: the point-to-node sums are gathers in a
- * fixed order (src/mpm.c).  The plastic disk, 300 steps, every column. */
+ * fixed order (src/mpm/mpm.c).  The plastic disk, 300 steps, every column. */
 static void test_threads_same_bits(void **state)
 {
     (void)state;

@@ -115,7 +115,7 @@ static collision_t collide(int wall, double eta, double v0, double dt)
 }
 
 /* Undamped: the contact lasts Hertz's t_c, the spheres leave with their
- * impact speed, and kinetic plus elastic energy (src/observe.c, Hertz's
+ * impact speed, and kinetic plus elastic energy (src/backend/omp/observe.c, Hertz's
  * (8/15) E* sqrt(R) delta^(5/2)) stays the impact's kinetic energy within
  * Verlet's O((dt/t_c)^2) ~ 1e-5 error (1e-4 allowed).  dt = 4e-7 s is t_c/1000 (t_c = 0.41 ms at 0.5 m/s):
  * counting steps in contact misses at most one step at each end (2e-3),

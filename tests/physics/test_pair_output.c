@@ -1,5 +1,5 @@
 /* The per-contact output columns (fields.def, PAIR_OUT) that the host
- * derives at sync (src/pair_output.c) from what the step keeps per pair
+ * derives at sync (src/io/pair_output.c) from what the step keeps per pair
  * row: they must describe the forces the step applied.  On a settling pile
  * of hexapods in a cylinder (many contacts, friction, walls):
  *  - the normal is a unit vector and F_t lies in the tangent plane;

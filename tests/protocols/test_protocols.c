@@ -4,9 +4,9 @@
 #include <float.h>
 #include <math.h>
 #include <unistd.h>
-#include "run.h"
-#include "io_h5.h"
-#include "protocol.h"
+#include "core/run.h"
+#include "io/io_h5.h"
+#include "protocols/protocol.h"
 #include <hdf5.h>
 
 static const char *preset(const char *name)

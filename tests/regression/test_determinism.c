@@ -4,8 +4,8 @@
 #include "test_util.h"
 #include <unistd.h>
 #include <omp.h>
-#include "run.h"
-#include "io_h5.h"
+#include "core/run.h"
+#include "io/io_h5.h"
 #include <hdf5.h>
 #include <math.h>
 

@@ -1,4 +1,4 @@
-/* The Verlet list of the backend under test (omp: src/neighbors.c;
+/* The Verlet list of the backend under test (omp: src/backend/omp/neighbors.c;
  * OpenCL, as test_neighbors_opencl: kernels/cl/neighbors.cl) against brute
  * force: every pair (i < j) of primitives of different particles whose
  * axes come within r_i + r_j + skin, in (i, j) order, and nothing else.

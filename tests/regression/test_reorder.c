@@ -1,4 +1,4 @@
-/* The memory order changes no bit (src/reorder.c, docs/architecture.md
+/* The memory order changes no bit (src/backend/omp/reorder.c, docs/architecture.md
  * "Memory order"): a run with neighbor.reorder: cells (particles, primitives
  * and wall rows kept in the order of their grid cells, re-sorted at
  * rebuilds) and the same run with neighbor.reorder: none have the same

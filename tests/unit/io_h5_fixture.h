@@ -15,7 +15,7 @@
 #include <unistd.h>
 #include <hdf5.h>
 
-#include "io_h5.h"
+#include "io/io_h5.h"
 
 #define NP 5     /* particles */
 #define NPRIM 10 /* primitives, two per particle */

@@ -9,7 +9,7 @@
 #include <signal.h>
 #include <sys/wait.h>
 
-#include "io_h5_journal.h"
+#include "io/io_h5_journal.h"
 #include "unit/io_h5_fixture.h"
 
 enum scenario { NEW_RUN, REPLACE_RUN, RESUME_RUN };

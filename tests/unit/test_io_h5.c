@@ -17,7 +17,7 @@
 #include <unistd.h>
 #include <hdf5.h>
 
-#include "io_h5.h"
+#include "io/io_h5.h"
 #include "unit/io_h5_fixture.h"
 
 static void test_io_h5_snapshots_round_trip_bit_for_bit(void **state)

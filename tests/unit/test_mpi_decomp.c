@@ -1,10 +1,10 @@
-/* The Cartesian grid of sub-domains of an MPI run (src/mpi_decomp.c,
+/* The Cartesian grid of sub-domains of an MPI run (src/mpi/mpi_decomp.c,
  * docs/mpi.md): the grid chosen from the ranks and the domain, refusals of
  * grids the domain cannot hold, the owner of a point and the ranks whose
  * halo holds it.  Plain C: runs in every build, with or without MPI. */
 #include "test_util.h"
 #include <math.h>
-#include "mpi_decomp.h"
+#include "mpi/mpi_decomp.h"
 
 static cd_config config(int dimension, double gx, double gy, double gz)
 {

@@ -13,8 +13,8 @@
  *   the commit journal beside the file while it is open. */
 #include "test_util.h"
 #include <unistd.h>
-#include "io_h5.h"
-#include "io_h5_layout.h"
+#include "io/io_h5.h"
+#include "io/io_h5_layout.h"
 
 #define BEGIN_MARK "# ---- BEGIN GENERATED"
 #define END_MARK "# ---- END GENERATED"

@@ -12,7 +12,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "shapes.h"
+#include "shapes/shapes.h"
 
 #define PI 3.14159265358979323846
 

@@ -1,0 +1,310 @@
+/* Broad phase: the Verlet list of primitive pairs with a skin, built where
+ * the step runs (host threads, or the offload device) by the passes of
+ * kernels/neighbor_items.h -- the same items the OpenCL kernels call
+ * (kernels/cl/neighbors.cl).  The list is rebuilt only when some primitive
+ * end has moved more than half the skin since the last build (every point
+ * of a segment moves at most as far as its farthest end, so no pair can
+ * come into contact unseen), or a wall more than half the skin.  Contact
+ * history is carried over by matching the sorted (primitive i, primitive j)
+ * keys of the new list against the old one.  Between steps only two
+ * integers come back to the host (the numbers of pair rows and of wall
+ * candidates) and one overflow bound; the result is the same for every
+ * thread count and device. */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include "backend/omp/omp_loops.h"
+#include "neighbor_items.h"
+#include "step_items.h"
+
+/* Particles per chunk of the bounds pass, entries per chunk of a prefix
+ * sum: a few thousand items at 1e6 particles, enough for any device. */
+#define CD_NB_CHUNK 256
+#define CD_SCAN_CHUNK 1024
+/* Candidate slots per primitive at the first build (a hexapod arm in a
+ * dense packing with a skin of 0.1 d has about 10); they double whenever a
+ * primitive overflows its slot. */
+#define CD_NB_SLOT 32
+
+void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder)
+{
+    memset(nb, 0, sizeof(*nb));
+    nb->skin = skin;
+    nb->reorder = reorder;
+    nb->force_rebuild = 1;
+    nb->slot = CD_NB_SLOT;
+}
+
+void cd_neighbors_free(cd_neighbors *nb)
+{
+    cd_nb_lists *d = &nb->d;
+    void *all[] = {d->gather_start, d->gather_rows, d->wall_start, d->wall_rows, d->grid, d->part_bound,
+                   d->partial, d->part_cell, d->cell_count, d->cell_start, d->cell_parts, d->pair_count,
+                   d->pair_offset, d->cand, d->keys, d->old_keys, d->old_active, d->old_shear, d->count,
+                   d->chunk_sum, d->part_uid, d->part_at, d->prim_uid, d->prim_at, d->pair_at, d->pair_ustart,
+                   d->part_src, d->prim_src, d->new_first, d->sort_keys, d->sort_vals, d->hist, d->move};
+    for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
+    memset(nb, 0, sizeof(*nb));
+}
+
+/* Allocates *p for n elements of elem bytes, contents discarded (0 or -1). */
+static int realloc_dev(void **p, size_t n, size_t elem)
+{
+    cd_dev_free(*p);
+    *p = cd_dev_alloc(n * elem);
+    return *p ? 0 : -1;
+}
+
+/* The lists whose size is fixed by the particle, primitive and wall counts
+ * (allocated at the first build), and room for rows pair rows. */
+static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
+{
+    cd_nb_lists *d = &nb->d;
+    size_t N = s->n_particles, P = s->n_prims;
+    if (!d->grid) {
+        nb->cell_cap = 8 * N + 65; /* cd_grid_make: at most 8 N + 64 cells */
+        size_t chunks = (nb->cell_cap > P ? nb->cell_cap : P) / CD_SCAN_CHUNK + 2;
+        if (realloc_dev((void **)&d->grid, 1, sizeof(cd_grid)) ||
+            realloc_dev((void **)&d->part_bound, N + 1, sizeof(cd_real)) ||
+            realloc_dev((void **)&d->partial, 7 * (N / CD_NB_CHUNK + 1), sizeof(cd_real)) ||
+            realloc_dev((void **)&d->part_cell, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cell_count, nb->cell_cap + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cell_start, nb->cell_cap + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cell_parts, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->pair_count, P + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->pair_offset, P + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->cand, P * (size_t)nb->slot + 1, sizeof(cd_prim_id)) ||
+            realloc_dev((void **)&d->count, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->chunk_sum, chunks, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->gather_start, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->wall_start, N + 1, sizeof(cd_int)) ||
+            realloc_dev((void **)&d->wall_rows, P * s->n_walls + 1, sizeof(cd_int)))
+            return -1;
+    }
+    if (rows > nb->cap_rows || !d->keys) {
+        size_t cap = rows + rows / 4 + 16;
+        if (realloc_dev((void **)&d->keys, cap, sizeof(cd_ulong)) ||
+            realloc_dev((void **)&d->gather_rows, 2 * cap, sizeof(cd_pair_id)))
+            return -1;
+        nb->cap_rows = cap;
+    }
+    return 0;
+}
+
+/* out[0] = 0, out[k+1] = out[k] + in[k] for k < n (kernels/neighbor_items.h). */
+void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *chunk_sum)
+{
+    cd_int chunk = CD_SCAN_CHUNK, n_chunks = (n + chunk - 1) / chunk;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(in, chunk_sum)))
+    for (cd_int g = 0; g < n_chunks; g++) cd_scan_item_sum(in, n, chunk, g, chunk_sum);
+    CD_STEP_FOR(1, CD_DEV(is_device_ptr(out, chunk_sum)))
+    for (int one = 0; one < 1; one++) cd_scan_item_top(chunk_sum, n_chunks, out, n);
+    CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(in, out, chunk_sum)))
+    for (cd_int g = 0; g < n_chunks; g++) cd_scan_item_fill(in, n, chunk, g, chunk_sum, out);
+}
+
+/* dst[k] = src[k] (k < n): a scan's output becomes the cursor of a fill. */
+static void copy_ints(cd_int *dst, const cd_int *src, size_t n)
+{
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, CD_DEV(is_device_ptr(dst, src)))
+    for (size_t k = 0; k < n; k++) dst[k] = src[k];
+}
+
+static void zero_ints(cd_int *dst, size_t n)
+{
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, CD_DEV(is_device_ptr(dst)))
+    for (size_t k = 0; k < n; k++) dst[k] = 0;
+}
+
+/* Passes 1-2: bounds and grid.  Returns 1 when the grid says the run blew
+ * up (cd_nb_item_grid; the grid comes back, 56 bytes), 0 otherwise. */
+static int make_grid(cd_sim *sim, cd_cols c, cd_nb_lists d)
+{
+    cd_int N = (cd_int)sim->s.n_particles;
+    cd_int chunk = CD_NB_CHUNK, n_chunks = (N + chunk - 1) / chunk;
+    cd_real skin = sim->nb.skin; /* [m] */
+    CD_WIDE_MIN
+    CD_STEP_FOR(n_chunks, firstprivate(c, d))
+    for (cd_int g = 0; g < n_chunks; g++) cd_nb_item_bounds(c, g, chunk, N, d.part_bound, d.partial);
+    CD_STEP_FOR(1, firstprivate(d))
+    for (int one = 0; one < 1; one++) cd_nb_item_grid(d.partial, n_chunks, skin, N, d.grid);
+    cd_grid g;
+    return cd_dev_get(&g, d.grid, sizeof g) == 0 && g.dim[0] < 0;
+}
+
+/* Passes 3-4: particles binned by cell (CSR). */
+static void bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
+{
+    cd_int N = (cd_int)sim->s.n_particles, cell_cap = (cd_int)sim->nb.cell_cap;
+    CD_WIDE_MIN
+    zero_ints(d.cell_count, (size_t)cell_cap);
+    CD_STEP_FOR(N, firstprivate(c, d))
+    for (cd_int q = 0; q < N; q++) cd_nb_item_bin(c, q, d.grid, cell_cap, d.part_cell, d.cell_count);
+    cd_nb_scan(d.cell_count, cell_cap, d.cell_start, d.chunk_sum);
+    copy_ints(d.cell_count, d.cell_start, (size_t)cell_cap);
+    CD_STEP_FOR(N, firstprivate(d))
+    for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, d.part_cell, d.cell_count, d.cell_parts);
+}
+
+/* Pass 5 in slot mode (slot > 0; returns the longest row, which may exceed
+ * the slot) or in fill mode (slot = 0: rows written in place into
+ * pair_prim_j at pair_offset). */
+static cd_int collect(cd_sim *sim, cd_cols c, cd_nb_lists d, cd_int slot)
+{
+    cd_int N = (cd_int)sim->s.n_particles, longest = 0;
+    cd_real skin = sim->nb.skin; /* [m] */
+    cd_order o = cd_sim_step_order(sim);
+    CD_WIDE_MIN
+    CD_STEP_FOR(N, firstprivate(c, d, o) reduction(max : longest) CD_DEV(map(tofrom : longest)))
+    for (cd_int p = 0; p < N; p++) {
+        if (slot > 0)
+            cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, d.cand, slot, 0,
+                               d.pair_count, o);
+        else
+            cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, c.pair_prim_j, 0,
+                               d.pair_offset, d.pair_count, o);
+        for (cd_int i = c.prim_first[p]; i < c.prim_first[p] + c.prim_count[p]; i++)
+            if (d.pair_count[i] > longest) longest = d.pair_count[i];
+    }
+    return longest;
+}
+
+/* The old rows' keys and history, before the rows are replaced (pass 8
+ * reads them). */
+static int keep_history(cd_sim *sim, cd_cols c)
+{
+    cd_neighbors *nb = &sim->nb;
+    size_t n_old = sim->s.n_pairs;
+    if (n_old > nb->cap_old || !nb->d.old_keys) {
+        size_t cap = n_old + n_old / 4 + 16;
+        if (realloc_dev((void **)&nb->d.old_keys, cap, sizeof(cd_ulong)) ||
+            realloc_dev((void **)&nb->d.old_active, cap, sizeof(cd_int)) ||
+            realloc_dev((void **)&nb->d.old_shear, cap, sizeof(cd_vec3)))
+            return -1;
+        nb->cap_old = cap;
+    }
+    cd_nb_lists d = nb->d;
+    cd_order o = cd_sim_step_order(sim);
+    CD_WIDE_MIN
+    CD_STEP_FOR(n_old, firstprivate(c, d, o))
+    for (size_t k = 0; k < n_old; k++) cd_nb_item_keep(c, (cd_long)k, o, d.old_keys, d.old_active, d.old_shear);
+    return 0;
+}
+
+/* Passes 9 (gather lists) and 10 (wall candidates; their number comes
+ * back). */
+static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
+{
+    cd_state *s = &sim->s;
+    cd_int N = (cd_int)s->n_particles, W = (cd_int)s->n_walls;
+    size_t n_pairs = s->n_pairs;
+    const cd_wall *walls = s->walls;
+    cd_real skin = sim->nb.skin; /* [m] */
+    CD_WIDE_MIN
+    zero_ints(d.count, (size_t)N);
+    CD_STEP_FOR(n_pairs, firstprivate(c, d))
+    for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_count(c, (cd_long)k, d.count);
+    cd_nb_scan(d.count, N, d.gather_start, d.chunk_sum);
+    copy_ints(d.count, d.gather_start, (size_t)N);
+    CD_STEP_FOR(n_pairs, firstprivate(c, d))
+    for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_fill(c, (cd_long)k, d.count, d.gather_rows);
+    cd_order o = cd_sim_step_order(sim);
+    CD_STEP_FOR(N, firstprivate(c, d, o))
+    for (cd_int q = 0; q < N; q++) cd_nb_item_gather_sort(c, o, q, d.gather_start, d.gather_rows);
+
+    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    for (cd_int q = 0; q < N; q++) d.count[q] = cd_item_wall_candidates(c, q, walls, W, skin, 0);
+    cd_nb_scan(d.count, N, d.wall_start, d.chunk_sum);
+    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    for (cd_int q = 0; q < N; q++) cd_item_wall_candidates(c, q, walls, W, skin, d.wall_rows + d.wall_start[q]);
+    cd_int n_rows = 0;
+    if (cd_dev_get(&n_rows, d.wall_start + N, sizeof n_rows)) return -1;
+    sim->nb.n_wall_rows = (size_t)n_rows;
+    memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
+    return 0;
+}
+
+/* The candidate pairs (i, j), i < j, of primitives of different particles
+ * whose axes come within r_i + r_j + skin, sorted by i then j, with their
+ * history carried over; the gather and wall lists; the primitive ends
+ * become the skin test's reference. */
+int cd_neighbors_build(cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    cd_neighbors *nb = &sim->nb;
+    cd_int P = (cd_int)s->n_prims;
+    /* host threads after a sync: the columns back in the lists' order */
+    if (cd_reorder_to_memory(sim) || reserve(nb, s, s->n_pairs)) return -1;
+    cd_cols c = cd_sim_step_cols(sim);
+    /* the old rows' history aside, keyed in the order they were made in */
+    if (keep_history(sim, c)) return -1;
+    if (make_grid(sim, c, nb->d)) return CD_NB_BLOWUP;
+    int moved = 0;
+    if (cd_reorder_build(sim, &moved)) return -1;
+    bin_particles(sim, c, nb->d);
+    cd_int longest = collect(sim, c, nb->d, nb->slot);
+    cd_nb_scan(nb->d.pair_count, P, nb->d.pair_offset, nb->d.chunk_sum);
+    cd_int n_new = 0;
+    if (cd_dev_get(&n_new, nb->d.pair_offset + P, sizeof n_new)) return -1;
+    /* Gather entries are 2 k + 1 in a cd_int (cd_item_gather); a negative
+     * total is a count that overflowed cd_int. */
+    if (n_new < 0 || (size_t)n_new > (size_t)(INT32_MAX - 1) / 2) {
+        fprintf(stderr, "capdem: the pair rows exceed the neighbour list's limit of %d\n", (INT32_MAX - 1) / 2);
+        return -1;
+    }
+
+    /* Replace the rows: room for the new rows. */
+    size_t n_old = s->n_pairs;
+    if (cd_sim_reserve_step_pairs(sim, (size_t)n_new + (size_t)n_new / 4 + 16) || reserve(nb, s, (size_t)n_new))
+        return -1;
+    c = cd_sim_step_cols(sim);
+    s->n_pairs = (size_t)n_new;
+    cd_int slot = nb->slot;
+    if (longest > nb->slot) { /* some row is incomplete in its slot: write the rows in place */
+        collect(sim, c, nb->d, 0);
+        slot = 0;
+        while (nb->slot < longest) nb->slot *= 2;
+        if (realloc_dev((void **)&nb->d.cand, (size_t)P * (size_t)nb->slot + 1, sizeof(cd_prim_id))) return -1;
+    }
+    cd_nb_lists d = nb->d;
+    cd_order o = cd_sim_step_order(sim);
+    const cd_int *prim_src = moved ? d.prim_src : NULL; /* the slots the old rows' keys name */
+    CD_WIDE_MIN
+    CD_STEP_FOR(P, firstprivate(c, d, o))
+    for (cd_int i = 0; i < P; i++) cd_nb_item_place(c, i, d.pair_offset, d.cand, slot, d.keys, o);
+    CD_STEP_FOR(n_new, firstprivate(c, d) CD_DEV(is_device_ptr(prim_src)))
+    for (cd_int k = 0; k < n_new; k++) cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active,
+                                                        d.old_shear, prim_src);
+    if (particle_lists(sim, c, d) || cd_reorder_pair_rows(sim)) return -1;
+    CD_STEP_FOR(P, firstprivate(c))
+    for (cd_int i = 0; i < P; i++) {
+        c.prim_a_ref[i] = c.prim_a[i];
+        c.prim_b_ref[i] = c.prim_b[i];
+    }
+    nb->force_rebuild = 0;
+    nb->builds++;
+    return 0;
+}
+
+int cd_neighbors_part_bounds(const cd_sim *sim, double *out)
+{
+    size_t N = sim->s.n_particles;
+    if (!sim->nb.d.part_bound || cd_dev_get(out, sim->nb.d.part_bound, N * sizeof(double))) return -1;
+    if (!sim->nb.ordered) return 0;
+    /* the build's rows are in memory order: out in user order */
+    double *mem = malloc((N + 1) * sizeof(double));
+    cd_int *at = malloc((N + 1) * sizeof(cd_int));
+    int rc = mem && at ? cd_dev_get(at, sim->nb.d.part_at, N * sizeof(cd_int)) : -1;
+    if (!rc) {
+        memcpy(mem, out, N * sizeof(double));
+        for (size_t u = 0; u < N; u++) out[u] = mem[at[u]];
+    }
+    free(mem);
+    free(at);
+    return rc;
+}

@@ -1,0 +1,159 @@
+/* Observables of the state: energies, momentum, wall forces, contact
+ * counts, largest overlap, as the fixed-order reductions of
+ * kernels/observe_items.h: on the host columns (cd_sim_observe, after a
+ * sync), or where the steps run (cd_sim_observe_step: on the offload
+ * device only the merged slots come back, so a thermo line or a
+ * relaxation check costs no state copy).  Both give the same bits. */
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include "backend/omp/omp_loops.h"
+#include "observe_items.h"
+
+/* Blocks of the three reductions, in merge order. */
+typedef struct {
+    cd_long particles, pairs, walls;
+} obs_blocks;
+
+static obs_blocks count_blocks(const cd_state *s)
+{
+    obs_blocks n;
+    n.particles = ((cd_long)s->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    n.pairs = ((cd_long)s->n_pairs + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    n.walls = ((cd_long)(s->n_prims * s->n_walls) + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    return n;
+}
+
+static void unpack(const cd_state *s, const double *t, cd_observables *o)
+{
+    memset(o, 0, sizeof(*o));
+    o->kinetic_translational = t[CD_OBS_KT];
+    o->kinetic_rotational = t[CD_OBS_KR];
+    o->kinetic_in_contact = t[CD_OBS_KC];
+    o->elastic = t[CD_OBS_EL];
+    o->potential = t[CD_OBS_PE];
+    o->n_contacts = t[CD_OBS_NC];
+    o->n_wall_contacts = t[CD_OBS_NW];
+    for (int k = 0; k < 3; k++) o->momentum[k] = t[CD_OBS_PX + k];
+    for (size_t w = 0; w < s->n_walls; w++)
+        for (int k = 0; k < 3; k++) o->wall_force[w][k] = t[CD_OBS_WALL + 3 * w + k];
+    o->max_overlap_ratio = t[CD_OBS_MAXOV];
+}
+
+void cd_observables_slots(const cd_sim *sim, double *total)
+{
+    const cd_state *s = &sim->s;
+    cd_cols c = cd_sim_host_cols((cd_state *)s); /* read only */
+    obs_blocks nb = count_blocks(s);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_int W = (cd_int)s->n_walls;
+    cd_vec3 g = sim->p.gravity;
+    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_order o = cd_sim_host_order(sim);
+    cd_int *touch = calloc((size_t)N + 1, sizeof(cd_int));
+    double *part = malloc((size_t)(nb.particles + nb.pairs + nb.walls + 1) * CD_OBS_SLOTS * sizeof(double));
+    if (!touch || !part) { /* without memory: what is known is nothing */
+        free(touch);
+        free(part);
+        for (int k = 0; k < CD_OBS_SLOTS; k++) total[k] = NAN;
+        return;
+    }
+    /* Rattlers move freely in their cages (without gravity and friction
+     * forever): relaxation criteria look at the particles that touch. */
+    CD_HOST_FOR(K, firstprivate(c))
+    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
+    CD_HOST_FOR(R, firstprivate(c))
+    for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
+    double *pp = part, *pk = part + nb.particles * CD_OBS_SLOTS, *pw = pk + nb.pairs * CD_OBS_SLOTS;
+    CD_HOST_FOR(N, firstprivate(c, o))
+    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, pp + b * CD_OBS_SLOTS, o);
+    CD_HOST_FOR(K, firstprivate(c, o))
+    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS, o);
+    CD_HOST_FOR(R, firstprivate(c, o))
+    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS, o);
+    cd_obs_merge(part, nb.particles + nb.pairs + nb.walls, total);
+    free(touch);
+    free(part);
+}
+
+void cd_sim_observe(const cd_sim *sim, cd_observables *o)
+{
+    double total[CD_OBS_SLOTS];
+    cd_observables_slots(sim, total);
+    unpack(&sim->s, total, o);
+}
+
+#if CD_OFFLOAD
+/* The same reductions on the offload device (the omp backend's observe
+ * operation in the offload variant); the scratch stays allocated there,
+ * grown when the pair rows grow. */
+int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    const cd_state *s = &sim->s;
+    if (!sim->backend_data) { /* not started: the host columns are current */
+        cd_observables_slots(sim, slots);
+        return 0;
+    }
+    cd_sim_obs_scratch *x = &sim->obs;
+    obs_blocks nb = count_blocks(s);
+    size_t blocks = (size_t)(nb.particles + nb.pairs + nb.walls) + 1;
+    snprintf(err, errlen, "out of device memory while summing the observables");
+    if (!x->touch) {
+        x->touch = cd_dev_alloc((s->n_particles + 1) * sizeof(cd_int));
+        x->total = cd_dev_alloc(CD_OBS_SLOTS * sizeof(cd_real));
+        if (!x->touch || !x->total) return -1;
+    }
+    if (blocks > x->cap_blocks) {
+        cd_dev_free(x->partial);
+        x->cap_blocks = blocks + blocks / 4;
+        x->partial = cd_dev_alloc(x->cap_blocks * CD_OBS_SLOTS * sizeof(cd_real));
+        if (!x->partial) return -1;
+    }
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_int W = (cd_int)s->n_walls;
+    cd_vec3 g = sim->p.gravity;
+    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_int *touch = x->touch;
+    cd_real *part = x->partial, *total = x->total;
+    cd_long pk = nb.particles * CD_OBS_SLOTS, pw = pk + nb.pairs * CD_OBS_SLOTS, n_blocks = (cd_long)blocks - 1;
+    CD_WIDE_MIN
+    CD_STEP_FOR(N, firstprivate(c) is_device_ptr(touch))
+    for (cd_long q = 0; q < N; q++) touch[q] = 0;
+    CD_STEP_FOR(K, firstprivate(c) is_device_ptr(touch))
+    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
+    CD_STEP_FOR(R, firstprivate(c) is_device_ptr(touch))
+    for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
+    cd_order o = cd_sim_step_order(sim);
+    CD_STEP_FOR(N, firstprivate(c, g, o) is_device_ptr(touch, part))
+    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS, o);
+    CD_STEP_FOR(K, firstprivate(c, law, o) is_device_ptr(part))
+    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS, o);
+    CD_STEP_FOR(R, firstprivate(c, wall_law, o) is_device_ptr(part))
+    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS, o);
+    CD_STEP_FOR(1, is_device_ptr(part, total))
+    for (int one = 0; one < 1; one++) cd_obs_merge(part, n_blocks, total);
+    return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;
+}
+#endif
+
+int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen)
+{
+    if (sim->backend && sim->backend->observe) {
+        double t[CD_OBS_SLOTS];
+        if (sim->backend->observe(sim, t, err, errlen)) return -1;
+        unpack(&sim->s, t, o);
+        return 0;
+    }
+    if (cd_sim_sync(sim, err, errlen)) return -1;
+    cd_sim_observe(sim, o);
+    return 0;
+}
+
+void cd_sim_observe_free(cd_sim *sim)
+{
+    cd_dev_free(sim->obs.touch);
+    cd_dev_free(sim->obs.partial);
+    cd_dev_free(sim->obs.total);
+    memset(&sim->obs, 0, sizeof sim->obs);
+}

@@ -1,0 +1,104 @@
+/* The loops of the OpenMP backend (src/backend/omp/step_omp.c, the time step;
+ * src/backend/omp/neighbors.c, the Verlet-list build), and the memory they run on.
+ * Two variants of every loop (docs/offload.md):
+ * - host (CAPDEM_OFFLOAD=none): `omp parallel for schedule(static)` over
+ *   host memory;
+ * - offload (CAPDEM_OFFLOAD=nvptx|host, CAPDEM_OFFLOAD_TARGET=1): `omp
+ *   target teams distribute parallel for` over device memory: the state's
+ *   columns mapped once at start, the neighbour lists and the build's
+ *   scratch allocated on the device (cd_dev_alloc), handed to the loops as
+ *   device addresses inside firstprivate structs.
+ * A function with a CD_STEP_FOR loop declares CD_WIDE_MIN first. */
+#ifndef CD_OMP_LOOPS_H
+#define CD_OMP_LOOPS_H
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/sim.h"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#define CD_PRAGMA(...) _Pragma(#__VA_ARGS__)
+#if defined(CAPDEM_OFFLOAD_TARGET) && CAPDEM_OFFLOAD_TARGET && defined(_OPENMP)
+#define CD_OFFLOAD 1
+/* One loop of the step on the offload device, or on the host when the
+ * runtime finds none: then, as in the host variant, a loop of fewer than
+ * cd_parallel_min_rows rows runs on one thread (waking threads for every
+ * small loop made the small test cases 100 times slower).  The same holds
+ * on LLVM's host offload devices (CAPDEM_OFFLOAD=host), whose teams are
+ * host threads: there test_protocols took over 300 s instead of 47 s. */
+static inline size_t cd_wide_min(void)
+{
+#if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
+    return (size_t)cd_parallel_min_rows;
+#else
+    static int devices = -1;
+    if (devices < 0) devices = omp_get_num_devices();
+    return devices > 0 ? 0 : (size_t)cd_parallel_min_rows;
+#endif
+}
+#define CD_WIDE_MIN const size_t wide_min_ = cd_wide_min();
+#if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
+/* Host devices: teams of one thread each (host threads), one team for a
+ * small loop.  No inner parallel: a serialized one (if (parallel : 0))
+ * trips an assertion of libomp 14 (kmp_runtime.cpp(1122), th_task_team). */
+#define CD_STEP_FOR(rows, ...) \
+    CD_PRAGMA(omp target teams distribute num_teams((size_t)(rows) >= wide_min_ ? omp_get_max_threads() : 1) __VA_ARGS__)
+#else
+#define CD_STEP_FOR(rows, ...) \
+    CD_PRAGMA(omp target teams distribute parallel for if (parallel : (size_t)(rows) >= wide_min_) __VA_ARGS__)
+#endif
+/* Clauses only the offload variant needs. */
+#define CD_DEV(...) __VA_ARGS__
+
+/* The device the loops run on: the default offload device, or the host
+ * when the runtime finds none (the loops then fall back to it too). */
+static inline int cd_dev_id(void)
+{
+    return omp_get_num_devices() > 0 ? omp_get_default_device() : omp_get_initial_device();
+}
+static inline void *cd_dev_alloc(size_t bytes) { return omp_target_alloc(bytes ? bytes : 1, cd_dev_id()); }
+static inline void cd_dev_free(void *p)
+{
+    if (p) omp_target_free(p, cd_dev_id());
+}
+/* bytes from device address src to host address dst (0 on success) */
+static inline int cd_dev_get(void *dst, const void *src, size_t bytes)
+{
+    return omp_target_memcpy(dst, (void *)src, bytes, 0, 0, omp_get_initial_device(), cd_dev_id());
+}
+#else
+#define CD_OFFLOAD 0
+#define CD_WIDE_MIN
+#define CD_STEP_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
+#define CD_DEV(...)
+static inline void *cd_dev_alloc(size_t bytes) { return malloc(bytes ? bytes : 1); }
+static inline void cd_dev_free(void *p) { free(p); }
+static inline int cd_dev_get(void *dst, const void *src, size_t bytes)
+{
+    memcpy(dst, src, bytes);
+    return 0;
+}
+#endif
+/* Host-only loops (set-up work on the host columns). */
+#define CD_HOST_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
+
+/* The columns the loops work on: device addresses in the offload variant
+ * once the state is mapped, the host columns otherwise (src/backend/omp/step_omp.c). */
+cd_cols cd_sim_step_cols(cd_sim *sim);
+
+/* The column of field f (cd_fields) the loops work on (src/backend/omp/step_omp.c). */
+void *cd_sim_step_field(cd_sim *sim, size_t f);
+
+/* out[0] = 0, out[k+1] = out[k] + in[k] for k < n, where the loops run
+ * (src/backend/omp/neighbors.c); chunk_sum: the build's scratch. */
+void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *chunk_sum);
+
+/* Room for n pair rows in the columns the loops work on: the host columns
+ * grow (cd_state_reserve_pairs, contents kept); in the offload variant the
+ * device copies are re-mapped at their new size, contents not kept (the
+ * build keeps what it needs first).  0, or -1 out of memory. */
+int cd_sim_reserve_step_pairs(cd_sim *sim, size_t n);
+
+#endif

@@ -1,0 +1,604 @@
+/* The time step through OpenMP: every loop is one item per primitive, pair
+ * or particle calling the shared kernel headers (kernels/step_items.h, the
+ * same functions the OpenCL kernels call), and forces reach particles by a
+ * gather in fixed order (no floating-point atomics), so results are bitwise
+ * identical for any thread count.  Four loops per step: advance (kick,
+ * drift, primitive ends, skin test), pair forces, wall forces, gather with
+ * the second kick; a neighbour-list rebuild between the first two when
+ * the skin test asks for it.  On host threads the last three and the next
+ * step's advance share one parallel region (forces_and_advance).
+ *
+ * Two variants of the same loops (src/backend/omp/omp_loops.h, docs/offload.md): on
+ * host threads over the host columns of sim->s, or on an offload device
+ * over device copies of the columns, mapped once at start (target enter
+ * data over the cd_fields table), kept on the device across steps and
+ * copied back only by sync (CAPDEM_OFFLOAD=host runs the same on LLVM's
+ * x86-64 offload devices, whose memory is separate from the program's, to
+ * test the mapping without a GPU).  The neighbour-list rebuild runs where
+ * the steps run (src/backend/omp/neighbors.c). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "backend/omp/omp_loops.h"
+#include "step_items.h"
+#include "broadphase.h"
+
+long cd_parallel_min_rows = 4096;
+
+/* The state's device columns for the per-item functions of
+ * kernels/step_items.h. */
+cd_cols cd_sim_host_cols(cd_state *s)
+{
+    cd_cols c;
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = s->name;)
+#include "fields.def"
+#undef CD_FIELD
+    return c;
+}
+
+/* ---- device residency (offload variant) -------------------------------- */
+#if CD_OFFLOAD
+typedef struct {
+    void **host;       /* per field of cd_fields: host address mapped (NULL: none) */
+    size_t *bytes;     /* per field: bytes mapped */
+    double *part;      /* per-chunk partial sums of the wall load (mapped) */
+    size_t part_n;
+    cd_cols dev;       /* device addresses of the columns */
+} cd_off;
+
+
+static void off_map(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target enter data map(to : c[0:bytes])
+    }
+}
+
+static void off_unmap(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target exit data map(delete : c[0:bytes])
+    }
+}
+
+static void off_from(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target update from(c[0:bytes])
+    }
+}
+
+static void *off_devptr(void *p)
+{
+    void *r = p;
+#pragma omp target data use_device_ptr(r)
+    {
+        p = r;
+    }
+    return p;
+}
+
+/* Rows of a group held in memory: the pair columns at their capacity. */
+static size_t alloc_rows(const cd_state *s, enum cd_field_group g)
+{
+    return cd_group_pair_rows(g) ? s->cap_pairs : cd_state_rows(s, g);
+}
+
+static void off_refresh_cols(cd_sim *sim, cd_off *o)
+{
+    cd_state d = sim->s;
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        void **slot = cd_field_ptr(&d, &cd_fields[f]);
+        if (o->host[f]) *slot = off_devptr(o->host[f]);
+    }
+    o->dev = cd_sim_host_cols(&d);
+}
+
+/* Maps field f at its current host address and size (none for the
+ * output-only columns, kernels/field_groups.h). */
+static void off_map_field(cd_sim *sim, cd_off *o, size_t f)
+{
+    void *p = cd_fields[f].group == CD_GROUP_PAIR_OUT ? NULL : *cd_field_ptr(&sim->s, &cd_fields[f]);
+    size_t bytes = alloc_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size;
+    o->host[f] = p && bytes ? p : NULL;
+    o->bytes[f] = o->host[f] ? bytes : 0;
+    off_map(o->host[f], o->bytes[f]);
+}
+
+static void off_release(cd_sim *sim)
+{
+    cd_off *o = sim->backend_data;
+    if (!o) return;
+    for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
+    off_unmap(o->part, o->part_n * sizeof(double));
+    free(o->part);
+    free(o->host);
+    free(o->bytes);
+    free(o);
+    sim->backend_data = NULL;
+}
+
+/* Is OMP_TARGET_OFFLOAD set to MANDATORY (any case)?  GCC 12's libgomp
+ * falls back to the host without a device even then, so the check is ours. */
+static int offload_mandatory(void)
+{
+    const char *v = getenv("OMP_TARGET_OFFLOAD"), *m = "MANDATORY";
+    if (!v) return 0;
+    for (; *v && *m; v++, m++)
+        if ((*v | 0x20) != (*m | 0x20)) return 0;
+    return !*v && !*m;
+}
+
+/* Copies every column of the host state to the device, once per run.  A
+ * build for offload that finds no device runs on the host, unless
+ * OMP_TARGET_OFFLOAD=MANDATORY: then the run fails rather than pass for a
+ * device run. */
+static int off_acquire(cd_sim *sim, char *err, size_t errlen)
+{
+    static int warned = 0;
+    if (omp_get_num_devices() == 0) {
+        if (offload_mandatory()) {
+            snprintf(err, errlen, "built for %s offload and OMP_TARGET_OFFLOAD=MANDATORY, but the OpenMP runtime "
+                     "finds no offload device (docs/offload.md)", CAPDEM_OFFLOAD_VARIANT);
+            return -1;
+        }
+        if (!warned)
+            fprintf(stderr, "capdem: built for %s offload but no offload device found: running on the host\n",
+                    CAPDEM_OFFLOAD_VARIANT);
+        warned = 1;
+    }
+    snprintf(err, errlen, "out of memory while mapping the state to the offload device");
+    cd_off *o = calloc(1, sizeof *o);
+    if (!o) return -1;
+    sim->backend_data = o;
+    o->host = calloc(cd_n_fields, sizeof *o->host);
+    o->bytes = calloc(cd_n_fields, sizeof *o->bytes);
+    o->part_n = sim->s.n_prims / CD_LOAD_CHUNK + 1;
+    o->part = calloc(o->part_n, sizeof(double));
+    if (!o->host || !o->bytes || !o->part) { off_release(sim); return -1; }
+    for (size_t f = 0; f < cd_n_fields; f++) off_map_field(sim, o, f);
+    off_map(o->part, o->part_n * sizeof(double));
+    off_refresh_cols(sim, o);
+    return 0;
+}
+
+/* Room for n pair rows: the host columns grow, and when they moved the
+ * device copies are re-mapped (every old mapping goes before any new one:
+ * a new block may reuse an old address).  Their contents are not carried:
+ * the neighbour-list build keeps the history it needs before calling. */
+static int off_reserve_pairs(cd_sim *sim, size_t n)
+{
+    cd_state *s = &sim->s;
+    cd_off *o = sim->backend_data;
+    if (cd_state_reserve_pairs(s, n)) return -1;
+    int moved = 0;
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group != CD_GROUP_PAIR) continue;
+        void *p = *cd_field_ptr(s, &cd_fields[f]);
+        if (p != o->host[f] || s->cap_pairs * cd_fields[f].elem_size != o->bytes[f]) moved = 1;
+    }
+    if (!moved) return 0;
+    for (size_t f = 0; f < cd_n_fields; f++)
+        if (cd_fields[f].group == CD_GROUP_PAIR) {
+            off_unmap(o->host[f], o->bytes[f]);
+            o->host[f] = NULL;
+            o->bytes[f] = 0;
+        }
+    for (size_t f = 0; f < cd_n_fields; f++)
+        if (cd_fields[f].group == CD_GROUP_PAIR) off_map_field(sim, o, f);
+    off_refresh_cols(sim, o);
+    return 0;
+}
+#endif
+
+int cd_sim_reserve_step_pairs(cd_sim *sim, size_t n)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data) return off_reserve_pairs(sim, n);
+#endif
+    return cd_state_reserve_pairs(&sim->s, n);
+}
+
+void *cd_sim_step_field(cd_sim *sim, size_t f)
+{
+#if CD_OFFLOAD
+    cd_off *o = sim->backend_data;
+    if (o) return o->host[f] ? off_devptr(o->host[f]) : NULL;
+#endif
+    return *cd_field_ptr(&sim->s, &cd_fields[f]);
+}
+
+/* Columns the step loops work on: device addresses in the offload variant,
+ * the host columns otherwise. */
+cd_cols cd_sim_step_cols(cd_sim *sim)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data) return ((cd_off *)sim->backend_data)->dev;
+#endif
+    return cd_sim_host_cols(&sim->s);
+}
+
+/* ---- the loops of a step ------------------------------------------------ */
+
+/* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
+ * world ends of its primitives and the skin test.  Returns 1 when some end
+ * moved more than half the skin; on the offload device one int comes
+ * back. */
+static int advance_particles(cd_sim *sim)
+{
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_real dt = sim->p.dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    size_t n = sim->s.n_particles;
+    int moved = 0;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c) reduction(| : moved) CD_DEV(map(tofrom : moved)))
+    for (size_t q = 0; q < n; q++) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+    return moved;
+}
+
+/* The walls move on the host (after the particles' advance, moved: its
+ * skin test).  Returns 1 when the neighbour list must be rebuilt (some
+ * primitive end or wall moved more than half the skin, or a rebuild was
+ * asked for). */
+static int advance_walls(cd_sim *sim, int moved)
+{
+    cd_state *s = &sim->s;
+    cd_real dt = sim->p.dt;
+    for (size_t w = 0; w < s->n_walls; w++) {
+        s->walls[w] = cd_wall_advanced(s->walls[w], dt);
+        moved |= cd_bp_wall_moved(s->walls[w], sim->nb.walls_ref[w]) > CD_R(0.5) * sim->nb.skin;
+    }
+    return moved || sim->nb.force_rebuild;
+}
+
+/* One work item per pair of the Verlet list: narrow phase + contact law. */
+static void pair_forces(cd_sim *sim)
+{
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_law_params law = sim->p.law;
+    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
+    cd_int blend = sim->p.parallel_blend;
+    size_t n = sim->s.n_pairs;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, law))
+    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
+}
+
+/* One work item per wall candidate of the last build (cd_item_wall_row).
+ * The walls stay host data (the protocol drives them): a few hundred bytes
+ * go out. */
+static void wall_forces(cd_sim *sim)
+{
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    const cd_wall *walls = sim->s.walls;
+    cd_int W = (cd_int)sim->s.n_walls;
+    cd_law_params law = sim->p.wall_law;
+    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
+    cd_int blend = sim->p.parallel_blend;
+    size_t n = W ? sim->nb.n_wall_rows : 0;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, d, law) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, d.wall_rows[e], walls, W, law, dt, sin_parallel, blend);
+}
+
+/* One work item per particle: gravity plus its contacts in fixed order,
+ * then (kick = 1) the second half kick with that force, in the same pass
+ * (steps 7-8). */
+static void gather_kick(cd_sim *sim, int kick)
+{
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    cd_int dim = sim->p.dimension;
+    cd_vec3 g = sim->p.gravity;
+    cd_real h = 0.5 * sim->p.dt;
+    size_t n = sim->s.n_particles;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, d, g))
+    for (size_t q = 0; q < n; q++) {
+        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
+        if (kick) cd_item_kick(c, (cd_particle_id)q, h);
+    }
+}
+
+/* Forces for the current positions (neighbour list up to date), and with
+ * kick = 1 the second half kick. */
+static void compute_forces(cd_sim *sim, int kick)
+{
+    pair_forces(sim);
+    wall_forces(sim);
+    gather_kick(sim, kick);
+}
+
+#if !CD_OFFLOAD
+/* The loops of forces_and_advance, each an orphaned `omp for` in a
+ * function of its own (the region's threads share its rows) with every
+ * call inside inlined (flatten): the items have two callers each (this
+ * region, and the separate loops of the start), and GCC then called
+ * them instead of inlining them, 1.15x the instructions of the step
+ * (callgrind). */
+__attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd_law_params law, cd_real dt,
+                                                 cd_real sin_parallel, cd_int blend)
+{
+#pragma omp for schedule(static) nowait
+    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
+}
+
+__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, size_t n, const cd_wall *walls,
+                                                 cd_int W, cd_law_params law, cd_real dt, cd_real sin_parallel,
+                                                 cd_int blend)
+{
+#pragma omp for schedule(static)
+    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], walls, W, law, dt, sin_parallel, blend);
+}
+
+__attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 g, cd_int dim,
+                                                          cd_real dt, cd_real limit2, int next)
+{
+    int moved = 0;
+#pragma omp for schedule(static) nowait /* the region's end is the barrier */
+    for (size_t q = 0; q < n; q++) {
+        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
+        cd_item_kick(c, (cd_particle_id)q, CD_R(0.5) * dt);
+        if (next) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+    }
+    return moved;
+}
+#endif
+
+/* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
+ * the next step (its advance; returns its skin test).
+ * Host threads: one parallel region, where four loops used to fork and
+ * join their threads each (docs/performance.md, "One parallel region per
+ * step"): the pair loop without a barrier before the wall loop (they
+ * write different rows and read only the particles' state), one barrier
+ * before the gather, none after it but the region's end, and the next
+ * step's advance of particle q in the same item as q's gather and kick
+ * (it reads only q's own rows).  Each item does the arithmetic it did in
+ * its own loop, in the same order: the same bits.  An offload device runs
+ * the loops one launch each, as before. */
+static int forces_and_advance(cd_sim *sim, int next)
+{
+#if CD_OFFLOAD
+    compute_forces(sim, 1);
+    return next ? advance_particles(sim) : 0;
+#else
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
+    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel, limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    cd_int blend = sim->p.parallel_blend, dim = sim->p.dimension, W = (cd_int)sim->s.n_walls;
+    cd_vec3 g = sim->p.gravity;
+    const cd_wall *walls = sim->s.walls;
+    size_t n_pairs = sim->s.n_pairs, n_walls = W ? sim->nb.n_wall_rows : 0, n = sim->s.n_particles;
+    size_t most = n_pairs > n ? n_pairs : n;
+    int moved = 0;
+#pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
+    {
+        pair_rows(c, n_pairs, law, dt, sin_parallel, blend);
+        wall_rows(c, d.wall_rows, n_walls, walls, W, wall_law, dt, sin_parallel, blend);
+        moved |= gather_kick_advance(c, d, n, g, dim, dt, limit2, next);
+    }
+    return moved;
+#endif
+}
+
+void cd_sim_refresh(cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    for (size_t q = 0; q < s->n_particles; q++) s->angvel[q] = cd_rigid_angvel(s->orientation[q], s->angmom[q], s->inertia[q]);
+    cd_cols c = cd_sim_host_cols(s);
+    size_t n = s->n_prims;
+    CD_HOST_FOR(n, firstprivate(c))
+    for (size_t i = 0; i < n; i++) cd_item_prim_ends(c, (cd_prim_id)i);
+    sim->nb.force_rebuild = 1;
+}
+
+/* bad: the user id of a particle that blew up (-1: none). */
+static int report_bad(const cd_state *s, long bad, char *err, size_t errlen)
+{
+    if (bad < 0) return 0;
+    snprintf(err, errlen, "non-finite position or velocity of particle %ld at step %lld (t = %.9g s): "
+             "the run blew up; reduce run.dt or check the material parameters", bad, s->step, s->time);
+    return -1;
+}
+
+/* A run that blew up must stop before it writes garbage. */
+int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
+{
+    const cd_state *s = &sim->s;
+    cd_cols c = cd_sim_host_cols((cd_state *)s); /* read only */
+    long bad = -1;
+    size_t n = s->n_particles;
+    CD_HOST_FOR(n, reduction(max : bad))
+    for (size_t q = 0; q < n; q++)
+        if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
+#if !CD_OFFLOAD
+    /* host threads: the host columns may be in memory order */
+    if (bad >= 0) bad = (long)cd_map(cd_sim_step_order(sim).part_uid, bad);
+#endif
+    return report_bad(s, bad, err, errlen);
+}
+
+/* The same check on the columns the steps work on (the device's). */
+static int check_step_state(cd_sim *sim, char *err, size_t errlen)
+{
+#if CD_OFFLOAD
+    cd_cols c = cd_sim_step_cols(sim);
+    long bad = -1;
+    size_t n = sim->s.n_particles;
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c) reduction(max : bad) map(tofrom : bad))
+    for (size_t q = 0; q < n; q++)
+        if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
+    cd_int uid = (cd_int)bad;
+    if (bad >= 0 && sim->nb.ordered) cd_dev_get(&uid, sim->nb.d.part_uid + bad, sizeof uid);
+    return report_bad(&sim->s, uid, err, errlen);
+#else
+    return cd_sim_check_state(sim, err, errlen);
+#endif
+}
+
+/* The backend lets go of the state: on host threads the host columns go
+ * back to user order (they are the current state); an offload device's
+ * state is dropped (the host keeps what the last sync brought). */
+static void omp_stop(cd_sim *sim)
+{
+#if CD_OFFLOAD
+    cd_reorder_forget(sim);
+    off_release(sim);
+#else
+    if (cd_reorder_to_user(sim)) fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
+    cd_reorder_forget(sim);
+#endif
+}
+
+static int omp_sync(cd_sim *sim, char *err, size_t errlen);
+
+static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
+{
+    omp_stop(sim);
+    cd_sim_refresh(sim);
+#if CD_OFFLOAD
+    if (off_acquire(sim, err, errlen)) return -1;
+#endif
+    if (compute && cd_neighbors_build(sim)) {
+        snprintf(err, errlen, "out of memory while building the first neighbour list");
+        return -1;
+    }
+    /* without compute the neighbour list is rebuilt at the first step */
+    if (compute) {
+        compute_forces(sim, 0);
+        /* The new forces, contacts and wall contacts were computed on the
+         * device: copy them back once, so that the host state is current
+         * after start (tests and tools read energies right after it), as
+         * the OpenCL backend does. */
+        return omp_sync(sim, err, errlen);
+    }
+    return 0;
+}
+
+static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
+{
+    cd_state *s = &sim->s;
+    /* host threads after a sync: the columns back in the lists' order */
+    if (cd_reorder_to_memory(sim)) {
+        snprintf(err, errlen, "out of memory putting the particles in memory order");
+        return -1;
+    }
+    int moved = n > 0 ? advance_particles(sim) : 0;
+    for (long long it = 0; it < n; it++) {
+        int rebuild = advance_walls(sim, moved);
+        if (sim->rebuild_hook && (rebuild = sim->rebuild_hook(sim, rebuild, err, errlen)) < 0) return -1;
+        int rc = rebuild ? cd_neighbors_build(sim) : 0;
+        if (rc == CD_NB_BLOWUP) {
+            snprintf(err, errlen, "particle centres spread beyond any container (or not finite) at step %lld (t = "
+                     "%.9g s): the run blew up; reduce run.dt or check the material parameters", s->step, s->time);
+            return -1;
+        }
+        if (rc) {
+            snprintf(err, errlen, "out of memory while building the neighbour list (%zu pairs)", s->n_pairs);
+            return -1;
+        }
+        moved = forces_and_advance(sim, it + 1 < n);
+        s->step++;
+        s->time += sim->p.dt;
+    }
+    return check_step_state(sim, err, errlen);
+}
+
+static int omp_sync(cd_sim *sim, char *err, size_t errlen)
+{
+#if CD_OFFLOAD
+    /* The only full copy back: every device column, rows in use. */
+    cd_off *o = sim->backend_data;
+    if (o)
+        for (size_t f = 0; f < cd_n_fields; f++) {
+#if defined(CAPDEM_PLANT_MISSING_UPDATE) && CAPDEM_PLANT_MISSING_UPDATE
+            /* tests/offload builds capdem-planted with the velocities left
+             * on the device: snapshots, observables and resumes see stale
+             * ones; the offload checks must fail on it */
+            if (*cd_field_ptr(&sim->s, &cd_fields[f]) == (void *)sim->s.velocity) continue;
+#endif
+            if (o->host[f])
+                off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
+                         cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
+        }
+#endif
+    /* the host columns in user order (src/backend/omp/reorder.c) */
+    if (cd_reorder_to_user(sim)) {
+        snprintf(err, errlen, "out of memory putting the particles in user order");
+        return -1;
+    }
+    return 0;
+}
+
+static const char *omp_device(const cd_sim *sim)
+{
+    static char buf[96];
+#if CD_OFFLOAD
+    if (omp_get_num_devices() > 0)
+        snprintf(buf, sizeof buf, "%s offload device %d of %d", CAPDEM_OFFLOAD_VARIANT, omp_get_default_device(),
+                 omp_get_num_devices());
+    else
+        snprintf(buf, sizeof buf, "host (built for %s offload, no offload device found)", CAPDEM_OFFLOAD_VARIANT);
+#else
+    snprintf(buf, sizeof buf, "host, %d OpenMP thread(s)", sim->threads);
+#endif
+    (void)sim;
+    return buf;
+}
+
+#if CD_OFFLOAD
+/* Normal load on wall w summed on the device: per-chunk partial sums in
+ * parallel, then the chunks in order (deterministic, one double back). */
+static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    cd_off *o = sim->backend_data;
+    (void)err; (void)errlen;
+    if (!o) { /* not started: the host columns are current */
+        *load = cd_sim_wall_load_host(sim, w);
+        return 0;
+    }
+    cd_cols c = o->dev;
+    double *part = o->part;
+    size_t P = sim->s.n_prims, W = sim->s.n_walls, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
+    double sum = 0;
+    CD_WIDE_MIN
+    CD_STEP_FOR(nch, firstprivate(c) is_device_ptr(prim_at))
+    for (size_t ch = 0; ch < nch; ch++)
+        part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at);
+#pragma omp target map(tofrom : sum)
+    for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
+    *load = sum;
+    return 0;
+}
+#define CD_OMP_WALL_LOAD omp_wall_load
+#define CD_OMP_OBSERVE cd_omp_observe_device /* src/backend/omp/observe.c */
+#else
+/* Host threads: the host columns are the step's, summed in user order
+ * whatever their memory order, without a sync (which would put them in
+ * user order and back). */
+static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    *load = cd_sim_wall_load_host(sim, w);
+    return 0;
+}
+
+static int omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    cd_observables_slots(sim, slots);
+    return 0;
+}
+#define CD_OMP_WALL_LOAD omp_wall_load
+#define CD_OMP_OBSERVE omp_observe
+#endif
+
+const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, CD_OMP_WALL_LOAD, CD_OMP_OBSERVE};

@@ -1,0 +1,242 @@
+/* OpenCL backend: device buffers.  Every column of kernels/fields.def gets one
+ * buffer, created once at start; only the pair columns grow (with
+ * headroom) when the Verlet list outgrows them.  Uploads happen at start,
+ * downloads at sync: between them the state lives on the device. */
+#include <stdlib.h>
+#include <string.h>
+#include "backend/opencl/backend_cl.h"
+#include "observe_items.h"
+#include "step_items.h"
+
+/* Rows above need, so that a slowly growing list does not reallocate at
+ * every rebuild (as the host list, neighbors.c). */
+static size_t with_headroom(size_t n) { return n + n / 4 + 16; }
+
+cl_mem cd_cl_buffer(cd_cl *cl, size_t bytes, const char *what)
+{
+    if (cl->status) return NULL;
+    cl_int rc;
+    cl_mem m = clCreateBuffer(cl->ctx, CL_MEM_READ_WRITE, bytes > 0 ? bytes : 16, NULL, &rc);
+    if (cd_cl_check(cl, rc, what)) return NULL;
+    return m;
+}
+
+static void release(cl_mem *m)
+{
+    if (*m) clReleaseMemObject(*m);
+    *m = NULL;
+}
+
+cl_mem cd_cl_col(const cd_cl *cl, int f)
+{
+    if (f == CD_CL_F_pair_active) return cl->hist[cl->cur].active;
+    if (f == CD_CL_F_pair_shear) return cl->hist[cl->cur].shear;
+    return cl->col[f];
+}
+
+static int is_history(int f) { return f == CD_CL_F_pair_active || f == CD_CL_F_pair_shear; }
+
+/* Rows of a column's group on the device. */
+static size_t rows_of(const cd_cl *cl, const cd_state *s, const cd_field_info *f)
+{
+    return f->group == CD_GROUP_PAIR ? cl->cap_pairs : cd_state_rows(s, f->group);
+}
+
+int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which)
+{
+    size_t want = with_headroom(n);
+    if (cl->cap_pairs < n) {
+        for (int f = 0; f < CD_CL_N_FIELDS; f++) {
+            if (cd_fields[f].group != CD_GROUP_PAIR || is_history(f)) continue;
+            release(&cl->col[f]);
+            cl->col[f] = cd_cl_buffer(cl, want * cd_fields[f].elem_size, "allocating the pair columns");
+        }
+        cl->cap_pairs = want;
+        cl->cols_dirty = 1;
+    }
+    cd_cl_pairset *h = &cl->hist[which];
+    if (h->cap < n) {
+        release(&h->active);
+        release(&h->shear);
+        release(&h->keys);
+        h->active = cd_cl_buffer(cl, want * sizeof(cd_int), "allocating the contact history");
+        h->shear = cd_cl_buffer(cl, want * sizeof(cd_vec3), "allocating the contact history");
+        h->keys = cd_cl_buffer(cl, want * sizeof(cd_ulong), "allocating the pair keys");
+        h->cap = want;
+        if (which == cl->cur) cl->cols_dirty = 1;
+    }
+    if (cl->gather_cap < 2 * n) {
+        release(&cl->gather_rows);
+        cl->gather_rows = cd_cl_buffer(cl, 2 * want * sizeof(cd_pair_id), "allocating the gather lists");
+        cl->gather_cap = 2 * want;
+    }
+    return cl->status ? -1 : 0;
+}
+
+int cd_cl_bind_cols(cd_cl *cl)
+{
+    for (int k = 0; k < CD_CLK_COUNT; k++) {
+        if (!cd_cl_kernel_takes_cols((enum cd_cl_kernel)k)) continue;
+        for (int f = 0; f < CD_CL_N_FIELDS; f++) {
+            cl_mem m = cd_cl_col(cl, f);
+            if (cd_cl_arg(cl, (enum cd_cl_kernel)k, (cl_uint)f, sizeof m, &m)) return -1;
+        }
+    }
+    cl->cols_dirty = 0;
+    return 0;
+}
+
+int cd_cl_fill_int(cd_cl *cl, cl_mem buf, cd_int value, size_t first, size_t count)
+{
+    if (cl->status) return -1;
+    if (count == 0) return 0;
+    cl_int rc = clEnqueueFillBuffer(cl->queue, buf, &value, sizeof value, first * sizeof value, count * sizeof value, 0,
+                                    NULL, NULL);
+    return cd_cl_check(cl, rc, "clearing a buffer") ? -1 : 0;
+}
+
+int cd_cl_scan(cd_cl *cl, cl_mem in, size_t n, cl_mem out)
+{
+    if (n == 0) return cd_cl_fill_int(cl, out, 0, 0, 1);
+    /* chunks of at least 64 entries, at most CD_CL_MAX_BLOCKS of them */
+    size_t blocks = (n + 63) / 64;
+    if (blocks > CD_CL_MAX_BLOCKS) blocks = CD_CL_MAX_BLOCKS;
+    cd_int chunk = (cd_int)((n + blocks - 1) / blocks), nn = (cd_int)n;
+    cd_int nb = (cd_int)((n + (size_t)chunk - 1) / (size_t)chunk);
+    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 0, sizeof in, &in);
+    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 1, sizeof nn, &nn);
+    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 2, sizeof chunk, &chunk);
+    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 3, sizeof cl->block_sum, &cl->block_sum);
+    cd_cl_run(cl, CD_CLK_SCAN_BLOCKS, (size_t)nb);
+    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 0, sizeof cl->block_sum, &cl->block_sum);
+    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 1, sizeof nb, &nb);
+    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 2, sizeof out, &out);
+    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 3, sizeof nn, &nn);
+    cd_cl_run(cl, CD_CLK_SCAN_TOP, 1);
+    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 0, sizeof in, &in);
+    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 1, sizeof nn, &nn);
+    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 2, sizeof chunk, &chunk);
+    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 3, sizeof cl->block_sum, &cl->block_sum);
+    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 4, sizeof out, &out);
+    return cd_cl_run(cl, CD_CLK_SCAN_FILL, (size_t)nb);
+}
+
+int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
+{
+    const cd_state *s = &sim->s;
+    size_t N = s->n_particles, P = s->n_prims, W = s->n_walls;
+    cl->cap_pairs = 0;
+    cl->cur = 0;
+    if (cd_cl_reserve_pairs(cl, s->n_pairs > 0 ? s->n_pairs : 1, 0)) return -1;
+    for (int f = 0; f < CD_CL_N_FIELDS; f++) {
+        if (cd_fields[f].group == CD_GROUP_PAIR) continue;
+        cl->col[f] = cd_cl_buffer(cl, rows_of(cl, s, &cd_fields[f]) * cd_fields[f].elem_size, "allocating the state");
+    }
+    cl->walls = cd_cl_buffer(cl, (W > 0 ? W : 1) * sizeof(cd_wall), "allocating the walls");
+    cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
+    cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
+    cl->load_part = cd_cl_buffer(cl, (P / CD_LOAD_CHUNK + 1) * sizeof(cd_real), "allocating the wall-load sums");
+    cl->obs_touch = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the observables' sums");
+    cl->obs_total = cd_cl_buffer(cl, CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
+    cl->obs_cap_blocks = 0; /* obs_part: at the first sum (cl_observe) */
+    cl->partial = cd_cl_buffer(cl, 7 * CD_CL_MAX_BLOCKS * sizeof(cd_real), "allocating the neighbour list");
+    cl->grid = cd_cl_buffer(cl, sizeof(cd_grid), "allocating the neighbour list");
+    /* The grid has at most 8 N + 64 <= 8 P + 64 cells (cd_grid_make), so
+     * the cell arrays never grow and the host never needs the cell count. */
+    cl->cell_cap = 8 * P + 64;
+    cl->part_cell = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the cell lists");
+    cl->cell_parts = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the cell lists");
+    cl->part_bound = cd_cl_buffer(cl, N * sizeof(cd_real), "allocating the cell lists");
+    cl->cell_count = cd_cl_buffer(cl, cl->cell_cap * sizeof(cd_int), "allocating the cell lists");
+    cl->cell_cursor = cd_cl_buffer(cl, cl->cell_cap * sizeof(cd_int), "allocating the cell lists");
+    cl->cell_start = cd_cl_buffer(cl, (cl->cell_cap + 1) * sizeof(cd_int), "allocating the cell lists");
+    cl->pair_count = cd_cl_buffer(cl, P * sizeof(cd_int), "allocating the neighbour list");
+    cl->pair_offset = cd_cl_buffer(cl, (P + 1) * sizeof(cd_int), "allocating the neighbour list");
+    /* 32 candidates per primitive cover a dense packing of hexapods with a
+     * skin of 0.1 d; the slots double whenever one overflows.
+     * CAPDEM_OPENCL_SLOTS sets the first size (test hook for the overflow
+     * path). */
+    const char *slots = getenv("CAPDEM_OPENCL_SLOTS");
+    cl->slot = slots && atoi(slots) > 0 ? atoi(slots) : 32;
+    cl->cand = cd_cl_buffer(cl, P * (size_t)cl->slot * sizeof(cd_prim_id), "allocating the neighbour list");
+    cl->block_sum = cd_cl_buffer(cl, CD_CL_MAX_BLOCKS * sizeof(cd_int), "allocating the scan");
+    cl->gather_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
+    cl->gather_cursor = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
+    cl->gather_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the gather lists");
+    size_t wall_rows = (size_t)P * s->n_walls + 1;
+    cl->wall_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the wall lists");
+    cl->wall_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the wall lists");
+    cl->wall_rows = cd_cl_buffer(cl, wall_rows * sizeof(cd_int), "allocating the wall lists");
+    if (cl->status) return -1;
+    return cd_cl_bind_cols(cl);
+}
+
+static int write(cd_cl *cl, cl_mem buf, size_t bytes, const void *src, const char *what)
+{
+    if (cl->status) return -1;
+    if (bytes == 0) return 0;
+    cl_int rc = clEnqueueWriteBuffer(cl->queue, buf, CL_TRUE, 0, bytes, src, 0, NULL, NULL);
+    return cd_cl_check(cl, rc, what) ? -1 : 0;
+}
+
+int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    for (int f = 0; f < CD_CL_N_FIELDS; f++) {
+        size_t rows = cd_state_rows(s, cd_fields[f].group); /* pairs: n_pairs rows */
+        void *host = *cd_field_ptr(s, &cd_fields[f]);
+        write(cl, cd_cl_col(cl, f), rows * cd_fields[f].elem_size, host, "uploading the state");
+    }
+    write(cl, cl->walls, s->n_walls * sizeof(cd_wall), s->walls, "uploading the walls");
+    cd_int flags[3] = {0, -1, 0};
+    write(cl, cl->flags, sizeof flags, flags, "uploading the flags");
+    cl->n_pairs = s->n_pairs;
+    /* Keys of the rows handed over (sorted, as every list capdem writes),
+     * so that the first rebuild finds their history. */
+    cd_int n = (cd_int)cl->n_pairs;
+    cl_mem keys = cl->hist[cl->cur].keys;
+    cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_FIELDS, sizeof n, &n);
+    cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_FIELDS + 1, sizeof keys, &keys);
+    cd_cl_run(cl, CD_CLK_PAIR_KEYS, cl->n_pairs);
+    return cl->status ? -1 : 0;
+}
+
+int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    if (cl->status) return -1;
+    if (cd_state_reserve_pairs(s, cl->n_pairs)) {
+        cd_cl_check(cl, CL_OUT_OF_HOST_MEMORY, "making room for the contacts on the host");
+        return -1;
+    }
+    s->n_pairs = cl->n_pairs;
+    for (int f = 0; f < CD_CL_N_FIELDS && !cl->status; f++) {
+        size_t bytes = cd_state_rows(s, cd_fields[f].group) * cd_fields[f].elem_size;
+        if (bytes == 0) continue;
+        void *host = *cd_field_ptr(s, &cd_fields[f]);
+        cl_int rc = clEnqueueReadBuffer(cl->queue, cd_cl_col(cl, f), CL_FALSE, 0, bytes, host, 0, NULL, NULL);
+        cd_cl_check(cl, rc, "downloading the state");
+    }
+    /* Not the walls: the host's copy is current after every call of step
+     * and may since have been changed by a protocol (docs/opencl.md). */
+    if (!cl->status) cd_cl_check(cl, clFinish(cl->queue), "downloading the state");
+    return cl->status ? -1 : 0;
+}
+
+void cd_cl_buffers_release(cd_cl *cl)
+{
+    for (int f = 0; f < CD_CL_N_FIELDS; f++) release(&cl->col[f]);
+    for (int h = 0; h < 2; h++) {
+        release(&cl->hist[h].active);
+        release(&cl->hist[h].shear);
+        release(&cl->hist[h].keys);
+        cl->hist[h].cap = 0;
+    }
+    cl_mem *other[] = {&cl->walls, &cl->flags, &cl->scratch_real, &cl->load_part, &cl->partial, &cl->grid, &cl->part_cell,
+                       &cl->part_bound, &cl->cell_count, &cl->cell_start, &cl->cell_cursor, &cl->cell_parts, &cl->pair_count,
+                       &cl->pair_offset, &cl->block_sum, &cl->cand, &cl->gather_count, &cl->gather_start,
+                       &cl->gather_cursor, &cl->gather_rows, &cl->wall_count, &cl->wall_start, &cl->wall_rows,
+                       &cl->obs_touch, &cl->obs_part, &cl->obs_total};
+    for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
+    cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
+}

@@ -1,0 +1,244 @@
+/* A simulation: the state, the parameters every kernel needs, the shape
+ * catalogue and the neighbour-list workspace. */
+#ifndef CD_SIM_H
+#define CD_SIM_H
+#include <stdio.h>
+#include "core/state.h"
+#include "config/config.h"
+#include "shapes/shapes.h"
+#include "contact_law.h"
+#include "cols.h"
+#include "broadphase.h"
+#include "reorder_items.h"
+#include "backend/backend.h"
+
+/* Loops over fewer rows than this run on one thread: a parallel region
+ * costs microseconds, more than a small loop, and on a loaded machine the
+ * threads' barriers cost far more.  Results do not depend on it. */
+extern long cd_parallel_min_rows;
+#define CD_PARALLEL(rows) ((long)(rows) >= cd_parallel_min_rows)
+
+/* Per-step constants handed to every kernel. */
+typedef struct {
+    cd_real dt;               /* time step [s] */
+    cd_vec3 gravity;          /* [m/s^2] */
+    cd_law_params law;        /* particle-particle contact law */
+    cd_law_params wall_law;   /* particle-wall contact law (mu = wall friction) */
+    cd_real sin_parallel;     /* sine of the parallel-contact cut-off angle [1] */
+    cd_int parallel_blend;    /* 1: the continuous parallel rule (material.parallel_blend) */
+    cd_int dimension;         /* 3, or 2: motion in the x-y plane only */
+} cd_step_params;
+
+/* The neighbour lists and the build's scratch (kernels/neighbor_items.h),
+ * in the memory the step loops run on: the offload device's in the offload
+ * variant (device addresses: never dereferenced on the host), host memory
+ * otherwise.  Handed to the loops as one firstprivate struct. */
+typedef struct {
+    /* per-particle gather lists (CSR over pair rows): for particle p the
+     * entries gather_rows[gather_start[p] .. gather_start[p+1]), 2 k + side
+     * for pair row k (side 1: p owns its primitive j), in ascending order */
+    cd_int *gather_start;     /* n_particles + 1 */
+    cd_pair_id *gather_rows;  /* 2 n_pairs */
+    /* per-particle wall candidates (CSR): for particle p the wall-contact
+     * rows wall_rows[wall_start[p] .. wall_start[p+1]) that the steps until
+     * the next build test (kernels/step_items.h, cd_item_wall_candidates),
+     * ascending */
+    cd_int *wall_start;       /* n_particles + 1 */
+    cd_int *wall_rows;        /* at most n_prims n_walls */
+    /* scratch of the build */
+    cd_grid *grid;            /* 1 */
+    cd_real *part_bound;      /* bounding radius per particle [m] */
+    cd_real *partial;         /* 7 per chunk of particles: box of centres, largest bound [m] */
+    cd_int *part_cell, *cell_count, *cell_start, *cell_parts; /* cell lists (CSR); count doubles as cursor */
+    cd_int *pair_count, *pair_offset; /* rows per primitive, their offsets (n_prims + 1) */
+    cd_prim_id *cand;         /* candidate slots, slot per primitive */
+    cd_ulong *keys, *old_keys;/* sorted keys of the new and the old rows */
+    cd_int *old_active;       /* history of the old rows */
+    cd_vec3 *old_shear;       /* [m] */
+    cd_int *count;            /* per particle: gather and wall counts, then cursors */
+    cd_int *chunk_sum;        /* prefix sums' chunk totals */
+    /* memory order (kernels/reorder_items.h, src/backend/omp/reorder.c; allocated at
+     * the first build with neighbor.reorder: cells) */
+    cd_int *part_uid, *part_at; /* particle: memory slot -> user id, user id -> memory slot */
+    cd_int *prim_uid, *prim_at; /* the same for primitives */
+    cd_int *pair_at;          /* pair rows in user order -> memory row (pair_at_cap) */
+    cd_int *pair_ustart;      /* first place of each user primitive's rows in user order (n_prims + 1) */
+    cd_int *part_src, *prim_src; /* the reorder's permutation: old slot of each new slot */
+    cd_int *new_first;        /* prim_first in the new order (n_particles + 1) */
+    cd_ulong *sort_keys;      /* cell keys, twice n_particles (radix sort in and out) */
+    cd_int *sort_vals;        /* their slots, twice n_particles */
+    cd_int *hist;             /* radix sort: digit counts per chunk, then cursors */
+    void *move;               /* scratch of one column while it moves */
+} cd_nb_lists;
+
+#define CD_NB_REORDER_ALWAYS 2
+
+/* Neighbour-list workspace. */
+typedef struct {
+    double skin;              /* Verlet skin [m] */
+    long long builds;         /* rebuilds so far */
+    int force_rebuild;        /* 1: rebuild at the next step regardless of motion */
+    cd_wall walls_ref[CD_MAX_WALLS]; /* the walls at the last build (cd_bp_wall_moved) */
+    size_t n_wall_rows;       /* entries of d.wall_rows (wall_start[n_particles]) */
+    cd_nb_lists d;            /* lists and scratch, where the loops run */
+    size_t cap_rows;          /* rows that keys and gather_rows (twice) hold */
+    size_t cap_old;           /* rows that old_keys, old_active, old_shear hold */
+    size_t cell_cap;          /* cells the cell lists hold */
+    cd_int slot;              /* candidate slot per primitive (doubles when one overflows) */
+    int reorder;              /* neighbor.reorder: 1 cells (the grid cells' order at rebuilds), 0 none;
+                                 CD_NB_REORDER_ALWAYS (tests): at every rebuild that changes the order */
+    int ordered;              /* the order maps of d are set (from the first build after start) */
+    int host_user;            /* host variant: a sync put the columns in user order; the next step
+                                 puts them back in memory order (src/backend/omp/reorder.c) */
+    long long reorders;       /* rebuilds that moved particles */
+    size_t pair_at_cap;       /* rows d.pair_at holds */
+} cd_neighbors;
+
+/* Scratch of the observables' reductions where the steps run (the offload
+ * device's memory; src/backend/omp/observe.c). */
+typedef struct {
+    cd_int *touch;     /* per particle: active contacts (marks the particles that touch) */
+    cd_real *partial;  /* CD_OBS_SLOTS per block */
+    cd_real *total;    /* CD_OBS_SLOTS */
+    size_t cap_blocks;
+} cd_sim_obs_scratch;
+
+typedef struct cd_sim {
+    cd_config cfg;
+    cd_state s;
+    cd_step_params p;
+    cd_shape shapes[CD_MAX_SPECIES];
+    int n_shapes;
+    cd_neighbors nb;
+    cd_sim_obs_scratch obs;
+    double collision_time;    /* smallest pair collision time [s] */
+    double total_mass;        /* sum of the particle masses [kg] (fixed at set-up) */
+    double solid_volume;      /* sum of the particle volumes [m^3] (fixed at set-up) */
+    int threads;              /* OpenMP threads in use */
+    const cd_backend *backend;/* runs the steps; omp unless chosen otherwise */
+    void *backend_data;       /* the backend's own state (device buffers) */
+    char device_request[16];  /* --device: cpu | gpu | auto (OpenCL) */
+    cd_state probe_base;      /* bulk probe: the relaxed base state every probe starts from (zeroed until then) */
+    int snapshot_request;     /* set by a protocol: write a snapshot of this step (then cleared by the run) */
+    /* A domain decomposition's say in the rebuild (src/mpi/mpi_backend.c,
+     * docs/mpi.md); NULL in one process.  The step calls it after its skin
+     * test with that test's answer for this process's particles (0/1) and
+     * rebuilds the neighbour list when it returns 1: the answer of every
+     * process, the particles already with their new owners; -1 with a
+     * message in err: the run stops. */
+    int (*rebuild_hook)(struct cd_sim *sim, int rebuild, char *err, size_t errlen);
+    void *rebuild_hook_data;
+} cd_sim;
+
+/* Builds a simulation from a validated config: shapes, particles placed as
+ * init.* says, walls of the domain, step parameters.  Checks the time step
+ * against the collision time.  Returns 0, or -1 with a message that names
+ * the file and key in err (exit status 2 for the caller). */
+int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen);
+void cd_sim_free(cd_sim *sim);
+
+/* Chooses the backend (before cd_sim_start).  device: cpu | gpu | auto,
+ * used by OpenCL.  Returns 0, or -1 with a message. */
+int cd_sim_use_backend(cd_sim *sim, const char *name, const char *device, char *err, size_t errlen);
+
+/* Hands the host state to the backend.  compute_forces = 1 for a new run
+ * (neighbour list and forces of the initial state), 0 after reading a
+ * checkpoint (its forces are kept, the neighbour list is rebuilt). */
+int cd_sim_start(cd_sim *sim, int compute_forces, char *err, size_t errlen);
+
+/* Refresh, neighbour list and the forces of the initial state on the
+ * chosen backend: cd_sim_start(sim, 1, ...) failing the process on error.
+ * For tests and tools. */
+int cd_sim_initial_forces(cd_sim *sim);
+
+/* Advances n steps. Returns 0, or -1 when the run blew up (message in err). */
+int cd_sim_step(cd_sim *sim, long long n, char *err, size_t errlen);
+
+/* Makes sim->s current: copies the device state back and derives the
+ * output-only pair columns (cd_sim_derive_pair_output). */
+int cd_sim_sync(cd_sim *sim, char *err, size_t errlen);
+
+/* Sum of the normal forces the particles exert on wall w [N] at the last
+ * force evaluation: the backend's reduction, or a sync and a host sum in a
+ * fixed order. */
+int cd_sim_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen);
+
+/* The host columns of s as the per-item functions of kernels/step_items.h
+ * take them (the device columns of fields.def only). */
+cd_cols cd_sim_host_cols(cd_state *s);
+
+/* Fills the output-only pair columns (fields.def, PAIR_OUT: normal,
+ * tangential force, torques) of every row from the step's columns of the
+ * host state (src/io/pair_output.c).  cd_sim_sync calls it. */
+void cd_sim_derive_pair_output(cd_sim *sim);
+
+/* The same sum over the host columns, in the same chunk order. */
+double cd_sim_wall_load_host(cd_sim *sim, int w);
+
+/* Checks the host state for non-finite values (a blown-up run). */
+int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen);
+
+/* Host-side helpers of the omp backend, shared with other backends for
+ * set-up work: world axis ends and angular velocities from the poses. */
+void cd_sim_refresh(cd_sim *sim);
+
+/* Observables (deterministic sums). */
+typedef struct {
+    double kinetic_translational, kinetic_rotational; /* [J] */
+    double kinetic_in_contact; /* kinetic energy of the particles that touch something [J] */
+    double elastic;           /* energy stored in contact springs [J] */
+    double potential;         /* gravitational potential energy -m g.x [J] */
+    double n_contacts;        /* active particle-particle contacts */
+    double n_wall_contacts;   /* active particle-wall contacts */
+    double momentum[3];       /* total linear momentum [kg m/s] */
+    double wall_force[CD_MAX_WALLS][3]; /* force of the particles on each wall [N] */
+    double max_overlap_ratio; /* largest overlap / arm diameter [1] */
+} cd_observables;
+/* From the host columns (current after a sync). */
+void cd_sim_observe(const cd_sim *sim, cd_observables *o);
+/* From the columns the steps work on, without a state copy where the
+ * backend sums on its device (the offload variant), else after a sync;
+ * the same bits either way.  0, or -1 with a message. */
+int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen);
+void cd_sim_observe_free(cd_sim *sim);
+/* The merged slots (kernels/observe_items.h, CD_OBS_SLOTS) from the host
+ * columns, and (offload variant) from the device: backends' observe. */
+void cd_observables_slots(const cd_sim *sim, double *slots);
+int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen);
+
+/* Neighbour list (neighbors.c). */
+/* reorder: 1 for neighbor.reorder: cells (src/backend/omp/reorder.c) */
+void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder);
+void cd_neighbors_free(cd_neighbors *nb);
+/* 0, -1 (out of memory) or CD_NB_BLOWUP (particle centres not finite or
+ * spread over more than 1e12 particle sizes: the run blew up, and a cell
+ * grid of them would overflow its integer coordinates). */
+#define CD_NB_BLOWUP (-2)
+int cd_neighbors_build(cd_sim *sim);
+/* The bounding radii [m] of the last build, copied to out (n_particles,
+ * user order); 0, or -1 before the first build.  For tests. */
+int cd_neighbors_part_bounds(const cd_sim *sim, double *out);
+
+/* Memory order (src/backend/omp/reorder.c, docs/architecture.md "Memory order"). */
+/* The maps the step columns are in now (the identity when not reordered),
+ * and those of the host columns (the same on host threads; the identity
+ * in the offload variant, whose host columns a sync leaves in user order). */
+cd_order cd_sim_step_order(const cd_sim *sim);
+cd_order cd_sim_host_order(const cd_sim *sim);
+/* At a rebuild, before the particles are binned: the particles, their
+ * primitives and wall rows put in the order of their grid cells (the
+ * grid of the build, d.grid), the maps updated; *moved = 1 when some
+ * particle moved (then d.prim_src holds the primitives' old slots).
+ * 0, or -1 out of memory. */
+int cd_reorder_build(cd_sim *sim, int *moved);
+/* At the end of a build: d.pair_at for the new rows.  0, or -1. */
+int cd_reorder_pair_rows(cd_sim *sim);
+/* The host columns in user order (a sync; rows copied back from a device
+ * are in memory order), and (host variant) back in memory order before
+ * the next step.  Both no-ops when not reordered.  0, or -1 out of memory. */
+int cd_reorder_to_user(cd_sim *sim);
+int cd_reorder_to_memory(cd_sim *sim);
+/* Frees the maps and forgets the order (backend start and stop). */
+void cd_reorder_forget(cd_sim *sim);
+
+#endif

@@ -1,0 +1,99 @@
+#include "core/state.h"
+#include <stdlib.h>
+#include <string.h>
+
+#define CD_GROUP_OF_PARTICLE CD_GROUP_PARTICLE
+#define CD_GROUP_OF_PRIM CD_GROUP_PRIM
+#define CD_GROUP_OF_PAIR CD_GROUP_PAIR
+#define CD_GROUP_OF_WALLC CD_GROUP_WALLC
+#define CD_GROUP_OF_PAIR_OUT CD_GROUP_PAIR_OUT
+#define CD_KIND_OF_REAL CD_KIND_REAL
+#define CD_KIND_OF_INT CD_KIND_INT
+
+const cd_field_info cd_fields[] = {
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) \
+    {CD_GROUP_OF_##group, CD_KIND_OF_##h5type, ncomp, sizeof(ctype), offsetof(cd_state, name), #name, unit, meaning},
+#include "fields.def"
+#undef CD_FIELD
+};
+const size_t cd_n_fields = sizeof(cd_fields) / sizeof(cd_fields[0]);
+
+void **cd_field_ptr(cd_state *s, const cd_field_info *f)
+{
+    return (void **)((char *)s + f->offset);
+}
+
+size_t cd_state_rows(const cd_state *s, enum cd_field_group g)
+{
+    switch (g) {
+    case CD_GROUP_PARTICLE: return s->n_particles;
+    case CD_GROUP_PRIM: return s->n_prims;
+    case CD_GROUP_PAIR:
+    case CD_GROUP_PAIR_OUT: return s->n_pairs;
+    case CD_GROUP_WALLC: return s->n_prims * s->n_walls;
+    default: return 0;
+    }
+}
+
+static size_t group_capacity(const cd_state *s, enum cd_field_group g)
+{
+    return cd_group_pair_rows(g) ? s->cap_pairs : cd_state_rows(s, g);
+}
+
+int cd_state_alloc(cd_state *s, size_t n_particles, size_t n_prims, size_t n_walls, size_t cap_pairs)
+{
+    memset(s, 0, sizeof(*s));
+    s->n_particles = n_particles;
+    s->n_prims = n_prims;
+    s->n_walls = n_walls;
+    s->cap_pairs = cap_pairs > 0 ? cap_pairs : 1;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        size_t rows = group_capacity(s, cd_fields[k].group);
+        void *p = calloc(rows > 0 ? rows : 1, cd_fields[k].elem_size);
+        if (!p) { cd_state_free(s); return -1; }
+        *cd_field_ptr(s, &cd_fields[k]) = p;
+    }
+    return 0;
+}
+
+int cd_state_reserve_pairs(cd_state *s, size_t cap)
+{
+    if (cap <= s->cap_pairs) return 0;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        if (!cd_group_pair_rows(cd_fields[k].group)) continue;
+        void **slot = cd_field_ptr(s, &cd_fields[k]);
+        void *p = realloc(*slot, cap * cd_fields[k].elem_size);
+        if (!p) return -1;
+        memset((char *)p + s->cap_pairs * cd_fields[k].elem_size, 0, (cap - s->cap_pairs) * cd_fields[k].elem_size);
+        *slot = p;
+    }
+    s->cap_pairs = cap;
+    return 0;
+}
+
+void cd_state_free(cd_state *s)
+{
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        void **slot = cd_field_ptr(s, &cd_fields[k]);
+        free(*slot);
+        *slot = NULL;
+    }
+}
+
+int cd_state_copy(cd_state *dst, const cd_state *src)
+{
+    if (!dst->position) { /* empty: allocate with src's sizes */
+        if (cd_state_alloc(dst, src->n_particles, src->n_prims, src->n_walls, src->cap_pairs)) return -1;
+    }
+    if (dst->n_particles != src->n_particles || dst->n_prims != src->n_prims || dst->n_walls != src->n_walls) return -1;
+    if (cd_state_reserve_pairs(dst, src->n_pairs)) return -1;
+    cd_state keep = *dst;
+    *dst = *src; /* counts, walls, control, time, step */
+    dst->cap_pairs = keep.cap_pairs;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        void **slot = cd_field_ptr(dst, &cd_fields[k]);
+        *slot = *cd_field_ptr(&keep, &cd_fields[k]);
+        memcpy(*slot, *cd_field_ptr((cd_state *)src, &cd_fields[k]), cd_state_rows(src, cd_fields[k].group) * cd_fields[k].elem_size);
+    }
+    return 0;
+}

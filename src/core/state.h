@@ -1,0 +1,63 @@
+/* The simulation state as structure-of-arrays columns generated from
+ * fields.def, plus the small scalar state (time, walls) that travels with it. */
+#ifndef CD_STATE_H
+#define CD_STATE_H
+#include <stddef.h>
+#include "defs.h"
+#include "geom_types.h"
+
+/* PAIR_OUT: output columns of the pair rows, derived on the host at sync
+ * (fields.def); same rows and capacity as PAIR. */
+enum cd_field_group { CD_GROUP_PARTICLE, CD_GROUP_PRIM, CD_GROUP_PAIR, CD_GROUP_WALLC, CD_GROUP_PAIR_OUT, CD_GROUP_COUNT };
+
+/* Do the columns of group g have one row per pair row (PAIR, PAIR_OUT)? */
+static inline int cd_group_pair_rows(enum cd_field_group g) { return g == CD_GROUP_PAIR || g == CD_GROUP_PAIR_OUT; }
+enum cd_field_kind { CD_KIND_REAL, CD_KIND_INT };
+
+typedef struct cd_state {
+    /* rows in use and rows allocated per group */
+    size_t n_particles, n_prims, n_pairs, n_walls;
+    size_t cap_pairs;
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) ctype *name;
+#include "fields.def"
+#undef CD_FIELD
+    cd_wall walls[CD_MAX_WALLS];   /* current wall positions and motion */
+    /* State of the protocol driving the run (phase, wall dynamics,
+     * convergence checks): doubles saved with every snapshot, so that a
+     * protocol resumes in the middle of any phase.  Meaning: src/protocols/protocol.c. */
+#define CD_CONTROL_SLOTS 32
+    double control[CD_CONTROL_SLOTS];
+    double time;                   /* simulated time [s] */
+    long long step;                /* steps taken since the start of the run */
+} cd_state;
+
+/* Description of one column, for generic allocation and I/O. */
+typedef struct {
+    enum cd_field_group group;
+    enum cd_field_kind kind;
+    int ncomp;           /* scalars per row */
+    size_t elem_size;    /* bytes per row */
+    size_t offset;       /* offset of the column pointer inside cd_state */
+    const char *name, *unit, *meaning;
+} cd_field_info;
+
+extern const cd_field_info cd_fields[];
+extern const size_t cd_n_fields;
+
+/* Pointer to the column pointer of field f inside s. */
+void **cd_field_ptr(cd_state *s, const cd_field_info *f);
+/* Rows of the group the field belongs to (n, not capacity). */
+size_t cd_state_rows(const cd_state *s, enum cd_field_group g);
+
+/* Allocates every column (zeroed); pairs get cap_pairs rows.  Returns 0 or -1. */
+int cd_state_alloc(cd_state *s, size_t n_particles, size_t n_prims, size_t n_walls, size_t cap_pairs);
+/* Grows the pair columns to at least cap rows, keeping the first n_pairs. */
+int cd_state_reserve_pairs(cd_state *s, size_t cap);
+void cd_state_free(cd_state *s);
+/* Copies every column (the rows in use) and every scalar of src into dst:
+ * dst either zeroed (its columns are then allocated with src's sizes) or
+ * allocated for the same particles, primitives and walls (its pair columns
+ * grow as needed).  Returns 0, or -1 (out of memory, or other sizes). */
+int cd_state_copy(cd_state *dst, const cd_state *src);
+
+#endif

@@ -1,0 +1,586 @@
+/* Reading a run file back (snapshots for resume, the echoed config), the
+ * layout of kernels/runfile.def as C tables, and the read primitives that
+ * the writer and every reader share (io_h5_layout.h).  Layout:
+ * docs/output.md. */
+#include "io/io_h5.h"
+#include "io/io_h5_internal.h"
+#include "io/io_h5_check.h"
+#include "contact_law.h"
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const cdh5_paths[CDH5_N_PATHS] = {
+#define CD_H5_GROUP(id, path, made, meaning) path,
+#define CD_H5_DATASET(id, path, type, unit, meaning) path,
+#include "runfile.def"
+};
+
+const char *const cdh5_names[CDH5_N_NAMES] = {
+#define CD_H5_NAME(id, name, meaning) name,
+#include "runfile.def"
+};
+
+/* Columns that a run never changes: stored once as H5MD fixed data.  Every
+ * other PARTICLE and PRIM column is stored per snapshot, so a column added
+ * to fields.def is a time series unless runfile.def names it. */
+static const char *const fixed_columns[] = {
+#define CD_H5_FIXED(column) column,
+#include "runfile.def"
+};
+
+enum cdh5_store cdh5_store_of(const cd_field_info *f)
+{
+    if (cd_group_pair_rows(f->group) || f->group == CD_GROUP_WALLC) return CDH5_ROWS;
+    for (size_t i = 0; i < sizeof fixed_columns / sizeof fixed_columns[0]; i++)
+        if (!strcmp(f->name, fixed_columns[i])) return CDH5_FIXED;
+    return CDH5_SERIES;
+}
+
+const char *cdh5_group_path(enum cd_field_group g)
+{
+    switch (g) {
+#define CD_H5_COLUMN_GROUP(field_group, id) case CD_GROUP_##field_group: return CDH5_PATH(id);
+#include "runfile.def"
+    default: return "/unknown";
+    }
+}
+
+const cd_field_info *cdh5_column(const char *name)
+{
+    for (size_t k = 0; k < cd_n_fields; k++)
+        if (!strcmp(cd_fields[k].name, name)) return &cd_fields[k];
+    return NULL;
+}
+
+const char *cdh5_column_path(const char *name, char *buf)
+{
+    const cd_field_info *f = cdh5_column(name);
+    if (f) cdh5_field_path(f, buf, CDH5_PATH_LEN);
+    else snprintf(buf, CDH5_PATH_LEN, "(no column %s in fields.def)", name);
+    return buf;
+}
+
+void cdh5_field_path(const cd_field_info *f, char *buf, size_t len)
+{
+    snprintf(buf, len, "%s/%s%s", cdh5_group_path(f->group), f->name,
+             cdh5_store_of(f) == CDH5_SERIES ? "/value" : "");
+}
+
+hid_t cdh5_mem_type(const cd_field_info *f)
+{
+    return f->kind == CD_KIND_REAL ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT32;
+}
+
+int cdh5_field_check(const cd_field_info *f, char *err, size_t errlen)
+{
+    size_t scalar = f->kind == CD_KIND_REAL ? sizeof(double) : sizeof(int32_t);
+    if (f->ncomp < 1 || f->ncomp > 64 || f->elem_size != (size_t)f->ncomp * scalar) {
+        snprintf(err, errlen, "fields.def: column %s has %zu bytes per row, expected %d x %zu: HDF5 output "
+                 "stores REAL columns as doubles and INT columns as int32", f->name, f->elem_size, f->ncomp, scalar);
+        return -1;
+    }
+    return 0;
+}
+
+size_t cdh5_max_row_bytes(void)
+{
+    size_t m = sizeof(long long);
+    for (size_t k = 0; k < cd_n_fields; k++)
+        if (cd_fields[k].elem_size > m) m = cd_fields[k].elem_size;
+    return m;
+}
+
+/* HDF5 type of one member of /walls/value: a scalar, or an array of ncomp. */
+static hid_t wall_member_type(hid_t scalar, hsize_t ncomp)
+{
+    return ncomp == 1 ? H5Tcopy(scalar) : H5Tarray_create2(scalar, 1, &ncomp);
+}
+
+hid_t cdh5_wall_mem_type(void)
+{
+    hid_t t = H5Tcreate(H5T_COMPOUND, sizeof(cd_wall)), m;
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                                  \
+    m = wall_member_type(CD_KIND_##type == CD_KIND_INT ? H5T_NATIVE_INT32 : H5T_NATIVE_DOUBLE, ncomp); \
+    H5Tinsert(t, #name, HOFFSET(cd_wall, name), m);                                                 \
+    H5Tclose(m);
+#include "runfile.def"
+    return t;
+}
+
+void cdh5_wall_units(char *buf, size_t len)
+{
+    size_t at = 0;
+    buf[0] = 0;
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit) \
+    if (at < len) at += (size_t)snprintf(buf + at, len - at, "%s" #name " " unit, at ? ", " : "");
+#include "runfile.def"
+}
+
+static herr_t innermost(unsigned n, const H5E_error2_t *e, void *data)
+{
+    if (n == 0 && e->desc) snprintf((char *)data, 256, "%s", e->desc);
+    return 0;
+}
+
+void cdh5_msg(char *err, size_t errlen, const char *fmt, ...)
+{
+    char detail[256] = "";
+    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost, detail);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, errlen, fmt, ap);
+    va_end(ap);
+    size_t l = strlen(err);
+    if (*detail && l + 1 < errlen) snprintf(err + l, errlen - l, " (HDF5: %s)", detail);
+    H5Eclear2(H5E_DEFAULT);
+}
+
+int cdh5_exists(hid_t loc, const char *path)
+{
+    char buf[CDH5_PATH_LEN];
+    size_t n = strlen(path);
+    if (n >= sizeof buf) return 0;
+    memcpy(buf, path, n + 1);
+    char *p = buf + (buf[0] == '/');
+    for (;;) {
+        char *slash = strchr(p, '/');
+        if (slash) *slash = 0;
+        if (*p && H5Lexists(loc, buf, H5P_DEFAULT) <= 0) {
+            H5Eclear2(H5E_DEFAULT);
+            return 0;
+        }
+        if (!slash) return 1;
+        *slash = '/';
+        p = slash + 1;
+    }
+}
+
+int cdh5_dims(hid_t dset, hsize_t dims[3])
+{
+    hid_t sp = H5Dget_space(dset);
+    if (sp < 0) return -1;
+    int r = H5Sget_simple_extent_ndims(sp);
+    dims[0] = dims[1] = dims[2] = 1;
+    if (r < 0 || r > 3 || H5Sget_simple_extent_dims(sp, dims, NULL) < 0) r = -1;
+    H5Sclose(sp);
+    return r;
+}
+
+herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype, void *buf)
+{
+    hsize_t dims[3];
+    int rank = cdh5_dims(dset, dims);
+    if (rank < 1) return -1;
+    hsize_t start[3] = {start0, 0, 0}, cnt[3] = {count0, dims[1], dims[2]};
+    if (start0 + count0 > dims[0]) return -1;
+    if (cnt[0] * cnt[1] * cnt[2] == 0) return 0;
+    hid_t fs = H5Dget_space(dset), ms = H5Screate_simple(rank, cnt, NULL);
+    herr_t e = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL);
+    if (e >= 0) e = H5Dread(dset, memtype, ms, fs, H5P_DEFAULT, buf);
+    H5Sclose(fs);
+    H5Sclose(ms);
+    return e;
+}
+
+long long cdh5_field_rows(hid_t d, const cd_field_info *f, const char *dpath, const char *file, char *err,
+                          size_t errlen)
+{
+    hsize_t dims[3];
+    enum cdh5_store st = cdh5_store_of(f);
+    int vec = f->ncomp > 1, want = (st == CDH5_SERIES ? 2 : 1) + vec;
+    int rank = cdh5_dims(d, dims);
+    if (rank != want || (vec && dims[rank - 1] != (hsize_t)f->ncomp)) {
+        cdh5_msg(err, errlen, "%s: %s has rank %d (last dimension %llu), column %s needs rank %d%s", file, dpath,
+                 rank, rank > 0 ? (unsigned long long)dims[rank - 1] : 0ULL, f->name, want,
+                 vec ? " with that many components" : "");
+        return -1;
+    }
+    hid_t t = H5Dget_type(d);
+    H5T_class_t cl = H5Tget_class(t);
+    size_t size = H5Tget_size(t);
+    H5Tclose(t);
+    int ok = f->kind == CD_KIND_REAL ? (cl == H5T_FLOAT && size == 8) : (cl == H5T_INTEGER && size == 4);
+    if (!ok) {
+        cdh5_msg(err, errlen, "%s: %s holds %zu-byte %s, column %s needs %s", file, dpath, size,
+                 cl == H5T_FLOAT ? "floats" : cl == H5T_INTEGER ? "integers" : "values", f->name,
+                 f->kind == CD_KIND_REAL ? "doubles" : "int32");
+        return -1;
+    }
+    return (long long)(st == CDH5_SERIES ? dims[1] : dims[0]);
+}
+
+static long long rows_of_path(hid_t file, const char *path, const char *fname, char *err, size_t errlen)
+{
+    hsize_t dims[3];
+    hid_t d = H5Dopen2(file, path, H5P_DEFAULT);
+    int r = d < 0 ? -1 : cdh5_dims(d, dims);
+    if (r != 1) cdh5_msg(err, errlen, "%s: cannot read the length of %s", fname, path);
+    if (d >= 0) H5Dclose(d);
+    return r == 1 ? (long long)dims[0] : -1;
+}
+
+long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen)
+{
+    if (!cdh5_exists(file, CDH5_SNAP_STEP)) return 0;
+    const char *const clocks[4] = {CDH5_SNAP_STEP, CDH5_SNAP_TIME, CDH5_C_OFFSET, CDH5_W_OFFSET};
+    long long n = -1;
+    for (int i = 0; i < 4; i++) {
+        long long r = rows_of_path(file, clocks[i], path, err, errlen);
+        if (r < 0) return -1;
+        if (i >= 2) r = r > 0 ? r - 1 : 0; /* offsets hold n + 1 entries */
+        if (n < 0 || r < n) n = r;
+    }
+    if (H5Aexists(file, CDH5_COMMIT_ATTR) > 0) {
+        long long c = -1;
+        hid_t a = H5Aopen(file, CDH5_COMMIT_ATTR, H5P_DEFAULT);
+        char what[64];
+        snprintf(what, sizeof what, "/%s", CDH5_COMMIT_ATTR);
+        if (a >= 0 && cd_h5_check_number_attr(a, path, what, err, errlen)) {
+            H5Aclose(a);
+            return -1;
+        }
+        if (a < 0 || H5Aread(a, H5T_NATIVE_LLONG, &c) < 0) {
+            cdh5_msg(err, errlen, "%s: cannot read attribute /%s", path, CDH5_COMMIT_ATTR);
+            if (a >= 0) H5Aclose(a);
+            return -1;
+        }
+        H5Aclose(a);
+        if (c >= 0 && c < n) n = c;
+    }
+    H5Eclear2(H5E_DEFAULT);
+    return n;
+}
+
+void cdh5_quiet_begin(cdh5_quiet *q)
+{
+    H5Eget_auto2(H5E_DEFAULT, &q->func, &q->data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+void cdh5_quiet_end(const cdh5_quiet *q)
+{
+    H5Eset_auto2(H5E_DEFAULT, q->func, q->data);
+}
+
+/* ---- reading ---------------------------------------------------------------- */
+
+hid_t cdh5_open_ro(const char *path, char *err, size_t errlen)
+{
+    hid_t fapl = cdh5_fapl(); /* replays a killed writer's journal in memory */
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    if (f < 0) cdh5_msg(err, errlen, "%s: cannot open the run file", path);
+    H5Pclose(fapl);
+    return f;
+}
+
+int cd_h5_snapshot_count(const char *path, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    hid_t f = cdh5_open_ro(path, err, errlen);
+    long long n = f < 0 ? -1 : cdh5_committed(f, path, err, errlen);
+    if (f >= 0) H5Fclose(f);
+    cdh5_quiet_end(&q);
+    return n > 2147483647LL ? 2147483647 : (int)n;
+}
+
+typedef struct {
+    const char *path;
+    char *err;
+    size_t errlen;
+    hid_t file;
+    hid_t *ds;         /* one per cd_fields[] entry */
+    hid_t walls, step, time, c_offset, w_offset, w_index, control;
+    long long c0, c1, w0, w1;
+    long long *windex;
+    void *tmp;
+    int legacy_force;  /* the file predates /contacts/pair_force (rebuilt from F_n n + F_t) */
+} reader;
+
+/* Is field f the pair force, which files written before it existed lack? */
+static int is_pair_force(const cd_field_info *f) { return !strcmp(f->name, "pair_force"); }
+
+static int rfail(reader *r, const char *fmt, ...)
+{
+    char msg[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    cdh5_msg(r->err, r->errlen, "%s: %s", r->path, msg);
+    return -1;
+}
+
+static hid_t ropen(reader *r, const char *dpath)
+{
+    hid_t d = H5Dopen2(r->file, dpath, H5P_DEFAULT);
+    if (d < 0) rfail(r, "cannot open dataset %s (is this a capdem run file with snapshots?)", dpath);
+    return d;
+}
+
+static int read_ll(reader *r, hid_t d, const char *what, long long row, long long *v)
+{
+    if (cdh5_read_rows(d, (hsize_t)row, 1, H5T_NATIVE_LLONG, v) < 0)
+        return rfail(r, "cannot read row %lld of %s", row, what);
+    return 0;
+}
+
+/* Opens everything snapshot k needs and checks it against the state, before
+ * the state is touched. */
+static int check_snapshot(reader *r, long long k, const cd_state *s)
+{
+    static const char *const names[CD_GROUP_COUNT] = {"particles", "primitives", "contacts", "wall contacts"};
+    hsize_t dims[3];
+    r->walls = ropen(r, CDH5_WALLS_VALUE);
+    r->step = ropen(r, CDH5_SNAP_STEP);
+    r->time = ropen(r, CDH5_SNAP_TIME);
+    r->c_offset = ropen(r, CDH5_C_OFFSET);
+    r->w_offset = ropen(r, CDH5_W_OFFSET);
+    r->w_index = ropen(r, CDH5_W_INDEX);
+    r->control = ropen(r, CDH5_CONTROL_VALUE);
+    if (r->control < 0) return -1;
+    if (r->walls < 0 || r->step < 0 || r->time < 0 || r->c_offset < 0 || r->w_offset < 0 || r->w_index < 0) return -1;
+    /* shapes first: every read below goes into a buffer sized by the layout */
+    const hsize_t one_snap[1] = {(hsize_t)k + 1}, two_snap[1] = {(hsize_t)k + 2};
+    const hsize_t ctl_lo[2] = {(hsize_t)k + 1, 1}, ctl_hi[2] = {0, CD_CONTROL_SLOTS}, walls_lo[2] = {(hsize_t)k + 1, 0};
+    if (cd_h5_check_dset(r->step, r->path, CDH5_SNAP_STEP, H5T_INTEGER, 1, one_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->time, r->path, CDH5_SNAP_TIME, H5T_FLOAT, 1, one_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->c_offset, r->path, CDH5_C_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->w_offset, r->path, CDH5_W_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->w_index, r->path, CDH5_W_INDEX, H5T_INTEGER, 1, NULL, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->control, r->path, CDH5_CONTROL_VALUE, H5T_FLOAT, 2, ctl_lo, ctl_hi, NULL, r->err,
+                         r->errlen) ||
+        cd_h5_check_dset(r->walls, r->path, CDH5_WALLS_VALUE, H5T_COMPOUND, 2, walls_lo, NULL, dims, r->err,
+                         r->errlen))
+        return -1;
+    if (dims[1] != s->n_walls)
+        return rfail(r, "the file holds %llu walls, the state %zu: was the state set up from the same config?",
+                     (unsigned long long)dims[1], s->n_walls);
+    if (s->n_walls > CD_MAX_WALLS) return rfail(r, "the state has %zu walls, at most %d", s->n_walls, CD_MAX_WALLS);
+    if (read_ll(r, r->c_offset, CDH5_C_OFFSET, k, &r->c0) || read_ll(r, r->c_offset, CDH5_C_OFFSET, k + 1, &r->c1) ||
+        read_ll(r, r->w_offset, CDH5_W_OFFSET, k, &r->w0) || read_ll(r, r->w_offset, CDH5_W_OFFSET, k + 1, &r->w1))
+        return -1;
+    if (r->c0 < 0 || r->c1 < r->c0 || r->w0 < 0 || r->w1 < r->w0)
+        return rfail(r, "offsets of snapshot %lld are inconsistent (contacts %lld..%lld, wall contacts %lld..%lld)", k,
+                     r->c0, r->c1, r->w0, r->w1);
+    for (size_t i = 0; i < cd_n_fields; i++) {
+        const cd_field_info *f = &cd_fields[i];
+        char p[CDH5_PATH_LEN];
+        if (cdh5_field_check(f, r->err, r->errlen)) return -1;
+        cdh5_field_path(f, p, sizeof p);
+        if (is_pair_force(f) && !cdh5_exists(r->file, p)) {
+            r->legacy_force = 1;
+            continue;
+        }
+        r->ds[i] = ropen(r, p);
+        if (r->ds[i] < 0) return -1;
+        long long n = cdh5_field_rows(r->ds[i], f, p, r->path, r->err, r->errlen);
+        if (n < 0) return -1;
+        enum cdh5_store st = cdh5_store_of(f);
+        if (st == CDH5_ROWS) {
+            long long end = cd_group_pair_rows(f->group) ? r->c1 : r->w1;
+            if (n < end) return rfail(r, "%s has %lld rows, snapshot %lld needs %lld", p, n, k, end);
+            continue;
+        }
+        size_t want = cd_state_rows(s, f->group);
+        if ((size_t)n != want)
+            return rfail(r, "the file holds %lld %s (%s), the state %zu: was the state set up from the same config?", n,
+                         names[f->group], p, want);
+        if (st == CDH5_SERIES && (cdh5_dims(r->ds[i], dims) < 1 || dims[0] <= (hsize_t)k))
+            return rfail(r, "%s lacks snapshot %lld", p, k);
+    }
+    /* wall-contact rows: where they go */
+    long long wm = r->w1 - r->w0, nwc = (long long)(s->n_prims * s->n_walls);
+    size_t wbytes, big;
+    if (cd_h5_mul(&wbytes, (size_t)(wm > 0 ? wm : 1), sizeof *r->windex, 1) ||
+        cd_h5_mul(&big, (size_t)(wm > 0 ? wm : 1), cdh5_max_row_bytes(), 1))
+        return rfail(r, "%s: %lld wall-contact rows overflow a size; the file is refused", CDH5_W_OFFSET, wm);
+    r->windex = malloc(wbytes);
+    if (!r->windex) return rfail(r, "out of memory");
+    if (wm && cdh5_read_rows(r->w_index, (hsize_t)r->w0, (hsize_t)wm, H5T_NATIVE_LLONG, r->windex) < 0)
+        return rfail(r, "cannot read %s rows %lld..%lld", CDH5_W_INDEX, r->w0, r->w1);
+    for (long long j = 0; j < wm; j++)
+        if (r->windex[j] < 0 || r->windex[j] >= nwc)
+            return rfail(r, "%s row %lld is %lld, outside 0..%lld", CDH5_W_INDEX, r->w0 + j, r->windex[j], nwc - 1);
+    long long m = r->c1 - r->c0;
+    r->tmp = malloc(big);
+    if (!r->tmp) return rfail(r, "out of memory");
+    if ((size_t)m > s->cap_pairs && cd_state_reserve_pairs((cd_state *)s, (size_t)m))
+        return rfail(r, "out of memory for %lld contacts", m);
+    return 0;
+}
+
+static int read_snapshot(reader *r, long long k, cd_state *s)
+{
+    long long m = r->c1 - r->c0, wm = r->w1 - r->w0;
+    for (size_t i = 0; i < cd_n_fields; i++) {
+        const cd_field_info *f = &cd_fields[i];
+        char *col = *cd_field_ptr(s, f);
+        hid_t mt = cdh5_mem_type(f);
+        herr_t e = 0;
+        if (r->ds[i] < 0 && is_pair_force(f) && r->legacy_force) continue; /* rebuilt below */
+        switch (cdh5_store_of(f)) {
+        case CDH5_FIXED:
+            if (cd_state_rows(s, f->group)) e = H5Dread(r->ds[i], mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, col);
+            break;
+        case CDH5_SERIES: e = cdh5_read_rows(r->ds[i], (hsize_t)k, 1, mt, col); break;
+        case CDH5_ROWS:
+            if (cd_group_pair_rows(f->group)) {
+                e = cdh5_read_rows(r->ds[i], (hsize_t)r->c0, (hsize_t)m, mt, col);
+            } else {
+                memset(col, 0, cd_state_rows(s, f->group) * f->elem_size);
+                e = cdh5_read_rows(r->ds[i], (hsize_t)r->w0, (hsize_t)wm, mt, r->tmp);
+                for (long long j = 0; e >= 0 && j < wm; j++)
+                    memcpy(col + (size_t)r->windex[j] * f->elem_size, (char *)r->tmp + (size_t)j * f->elem_size,
+                           f->elem_size);
+            }
+            break;
+        }
+        if (e < 0) return rfail(r, "cannot read column %s of snapshot %lld", f->name, k);
+    }
+    s->n_pairs = (size_t)m;
+    /* The force on j of a file that stored only its parts: F_n n + F_t,
+     * the law's expression (kernels/contact_law.h), so the same bits. */
+    if (r->legacy_force)
+        for (long long j = 0; j < m; j++) s->pair_force[j] = cd_contact_force_on_j(s->pair_fn[j], s->pair_normal[j], s->pair_ft[j]);
+    cd_wall walls[CD_MAX_WALLS];
+    memset(walls, 0, sizeof walls);
+    hid_t wt = cdh5_wall_mem_type();
+    herr_t e = cdh5_read_rows(r->walls, (hsize_t)k, 1, wt, walls);
+    H5Tclose(wt);
+    if (e < 0) return rfail(r, "cannot read %s of snapshot %lld", CDH5_WALLS_VALUE, k);
+    memcpy(s->walls, walls, s->n_walls * sizeof walls[0]);
+    memset(s->control, 0, sizeof s->control); /* a file may hold fewer slots (checked: never more) */
+    if (cdh5_read_rows(r->control, (hsize_t)k, 1, H5T_NATIVE_DOUBLE, s->control) < 0)
+        return rfail(r, "cannot read %s of snapshot %lld", CDH5_CONTROL_VALUE, k);
+    long long step;
+    if (read_ll(r, r->step, CDH5_SNAP_STEP, k, &step)) return -1;
+    if (cdh5_read_rows(r->time, (hsize_t)k, 1, H5T_NATIVE_DOUBLE, &s->time) < 0)
+        return rfail(r, "cannot read row %lld of %s", k, CDH5_SNAP_TIME);
+    s->step = step;
+    return 0;
+}
+
+int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    reader r = {path, err, errlen, H5I_INVALID_HID, NULL, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID,
+                H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, 0, 0, 0, 0, NULL, NULL, 0};
+    int rc = -1;
+    r.ds = malloc(cd_n_fields * sizeof *r.ds);
+    if (!r.ds) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        goto done;
+    }
+    for (size_t i = 0; i < cd_n_fields; i++) r.ds[i] = H5I_INVALID_HID;
+    r.file = cdh5_open_ro(path, err, errlen);
+    if (r.file < 0) goto done;
+    long long n = cdh5_committed(r.file, path, err, errlen);
+    if (n < 0) goto done;
+    long long kk = k < 0 ? n - 1 : k;
+    if (n == 0) {
+        rfail(&r, "the file holds no complete snapshot");
+        goto done;
+    }
+    if (kk >= n) {
+        rfail(&r, "snapshot %d requested, the file holds %lld (0..%lld)", k, n, n - 1);
+        goto done;
+    }
+    if (check_snapshot(&r, kk, s) == 0) rc = read_snapshot(&r, kk, s);
+done:
+    if (r.ds)
+        for (size_t i = 0; i < cd_n_fields; i++)
+            if (r.ds[i] >= 0) H5Dclose(r.ds[i]);
+    hid_t ids[] = {r.walls, r.step, r.time, r.c_offset, r.w_offset, r.w_index, r.control};
+    for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++)
+        if (ids[i] >= 0) H5Dclose(ids[i]);
+    if (r.file >= 0) H5Fclose(r.file);
+    free(r.ds);
+    free(r.windex);
+    free(r.tmp);
+    cdh5_quiet_end(&q);
+    return rc;
+}
+
+static char *read_text(const char *path, const char *dpath, char *err, size_t errlen);
+
+char *cd_h5_read_config_text(const char *path, char *err, size_t errlen)
+{
+    return read_text(path, CDH5_PATH(CONFIG), err, errlen);
+}
+
+char *cd_h5_read_latest_config_text(const char *path, char *where, size_t wlen, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    hid_t f = cdh5_open_ro(path, err, errlen);
+    int k = 0;
+    char p[CDH5_PATH_LEN];
+    while (f >= 0 && k < 1000000) {
+        snprintf(p, sizeof p, "%s/%d", CDH5_PATH(RESUMES), k);
+        if (!cdh5_exists(f, p)) break;
+        k++;
+    }
+    if (f >= 0) H5Fclose(f);
+    cdh5_quiet_end(&q);
+    if (f < 0) return NULL;
+    if (k > 0) snprintf(where, wlen, "%s/%d", CDH5_PATH(RESUMES), k - 1);
+    else snprintf(where, wlen, "%s", CDH5_PATH(CONFIG));
+    return read_text(path, where, err, errlen);
+}
+
+static char *read_text(const char *path, const char *dpath, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    hid_t f = cdh5_open_ro(path, err, errlen);
+    char *out = f < 0 ? NULL : cdh5_read_string(f, path, dpath, (size_t)1 << 26, err, errlen);
+    if (f >= 0) H5Fclose(f);
+    cdh5_quiet_end(&q);
+    return out;
+}
+
+char *cdh5_read_string(hid_t f, const char *path, const char *dpath, size_t max_bytes, char *err, size_t errlen)
+{
+    char *out = NULL;
+    hid_t d = -1, t = -1, mt = -1;
+    d = H5Dopen2(f, dpath, H5P_DEFAULT);
+    if (d < 0) {
+        cdh5_msg(err, errlen, "%s: cannot open dataset %s", path, dpath);
+        goto done;
+    }
+    if (cd_h5_check_string(d, 0, path, dpath, max_bytes, err, errlen)) goto done;
+    t = H5Dget_type(d);
+    mt = H5Tcopy(t);
+    if (H5Tis_variable_str(t) > 0) {
+        char *p = NULL;
+        if (H5Dread(d, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p) < 0 || !p) {
+            cdh5_msg(err, errlen, "%s: cannot read %s", path, dpath);
+            goto done;
+        }
+        size_t len = strlen(p);
+        out = malloc(len + 1);
+        if (out) memcpy(out, p, len + 1);
+        H5free_memory(p);
+    } else {
+        size_t size = H5Tget_size(t);
+        out = malloc(size + 1);
+        if (out && H5Dread(d, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) < 0) {
+            cdh5_msg(err, errlen, "%s: cannot read %s", path, dpath);
+            free(out);
+            out = NULL;
+            goto done;
+        }
+        if (out) out[size] = 0;
+    }
+    if (!out) snprintf(err, errlen, "%s: out of memory", path);
+done:
+    if (mt >= 0) H5Tclose(mt);
+    if (t >= 0) H5Tclose(t);
+    if (d >= 0) H5Dclose(d);
+    return out;
+}

@@ -1,0 +1,350 @@
+/* The MPI run as a backend (docs/mpi.md): cd_backend_mpi wraps the omp
+ * backend.  Every rank sets the run up from the same config (the global
+ * state, the same bits everywhere); start cuts each rank's local state
+ * from it; step runs the serial step on the local state, with the
+ * rebuild decided by all ranks together (the serial program's decision)
+ * and the particles migrating to their new owners right before each
+ * rebuild, then refreshes the ghosts; sync and observe gather the owned
+ * rows on every rank, where output (rank 0), observables and protocols
+ * use the serial functions, in the serial order; wall loads are summed
+ * from the nonzero rows in the serial order. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "mpi/mpi_halo.h"
+#include "broadphase.h"
+#include "observe_items.h"
+
+static int began_here; /* MPI_Init was called by cd_mpi_begin */
+/* The decomposition of this process's run (cd_mpi_wrap): it outlives the
+ * backend's stop, which a protocol calls to restart from a state it put
+ * back (the bulk probe), and reports at cd_mpi_end. */
+static cd_mpi_ctx *the_ctx;
+static void report(const cd_mpi_ctx *x);
+
+static int world(int *rank)
+{
+    int on = 0, size = 1;
+    *rank = 0;
+    MPI_Initialized(&on);
+    if (on) {
+        MPI_Comm_rank(MPI_COMM_WORLD, rank);
+        MPI_Comm_size(MPI_COMM_WORLD, &size);
+    }
+    return size;
+}
+
+/* Started by an MPI launcher (mpirun, mpiexec, srun)?  Without one the
+ * run is the serial program and MPI is not started at all: nothing of the
+ * MPI library's start (a singleton's daemon, its files) can get in the way
+ * of a plain `capdem run`. */
+static int launched(void)
+{
+    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "MPI_LOCALNRANKS"};
+    for (size_t k = 0; k < sizeof vars / sizeof vars[0]; k++)
+        if (getenv(vars[k])) return 1;
+    return 0;
+}
+
+int cd_mpi_begin(void)
+{
+    int on = 0, rank;
+    MPI_Initialized(&on);
+    if (!on && !launched()) return 0;
+    if (!on) {
+        if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return -1;
+        began_here = 1;
+    }
+    if (world(&rank) > 1 && rank > 0) { /* rank 0 speaks for all (mpi_decomp.h) */
+        fflush(stderr);
+        if (!freopen("/dev/null", "w", stderr)) return -1;
+    }
+    return 0;
+}
+
+int cd_mpi_agree(int status)
+{
+    int rank, all = status;
+    if (world(&rank) > 1) MPI_Allreduce(&status, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    return all;
+}
+
+int cd_mpi_end(int status)
+{
+    if (the_ctx) {
+        if (the_ctx->ran) report(the_ctx);
+        free(the_ctx);
+        the_ctx = NULL;
+    }
+    status = cd_mpi_agree(status);
+    if (began_here) MPI_Finalize();
+    began_here = 0;
+    return status;
+}
+
+int cd_mpi_is_writer(void)
+{
+    int rank;
+    world(&rank);
+    return rank == 0;
+}
+
+int cd_mpi_decomposed(void)
+{
+    int rank;
+    return world(&rank) > 1;
+}
+
+/* The scalars of the local state (step, time, walls, protocol slots) on
+ * the global one: every rank's are the same bits. */
+static void scalars_back(cd_sim *sim, const cd_state *loc)
+{
+    sim->s.step = loc->step;
+    sim->s.time = loc->time;
+    memcpy(sim->s.walls, loc->walls, sizeof sim->s.walls);
+    memcpy(sim->s.control, loc->control, sizeof sim->s.control);
+}
+
+/* After the ranks learned the lowest rank that failed (first; the rank
+ * count: none): its message in err on every rank, and -1. */
+static int failure_of(cd_mpi_ctx *x, int first, char *err, size_t errlen)
+{
+    if (first == x->size) return 0;
+    MPI_Bcast(err, (int)errlen, MPI_CHAR, first, x->comm);
+    return -1;
+}
+
+/* Whether any rank failed (rc != 0), as failure_of says. */
+static int agree_failure(cd_mpi_ctx *x, int rc, char *err, size_t errlen)
+{
+    int who = rc ? x->rank : x->size, first;
+    MPI_Allreduce(&who, &first, 1, MPI_INT, MPI_MIN, x->comm);
+    return failure_of(x, first, err, errlen);
+}
+
+/* The step's rebuild decision for all ranks (the serial program's: some
+ * primitive of some particle or a wall moved more than half the skin), and
+ * with it the migration: particles go to their owners by their centre now,
+ * and the rebuild that follows finds every pair of an owned particle,
+ * because the ghosts reach the interaction range. */
+static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
+{
+    cd_mpi_ctx *x = loc->rebuild_hook_data;
+    /* A rank without particles (a sub-domain the pile left) builds no list,
+     * so its skin test knows no reference walls: it has no say. */
+    int any = 0, vote = loc->s.n_particles ? rebuild : 0;
+    double t0 = MPI_Wtime();
+    MPI_Allreduce(&vote, &any, 1, MPI_INT, MPI_LOR, x->comm);
+    double t1 = MPI_Wtime();
+    x->t_decide += t1 - t0;
+    if (!any) return 0;
+    if (cd_mpi_migrate(x)) {
+        snprintf(err, errlen, "out of memory while moving particles to their new MPI ranks");
+        MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
+    }
+    x->t_migrate += MPI_Wtime() - t1;
+    if (!loc->s.n_particles) { /* still none: no list to build (the build needs a particle) */
+        loc->nb.force_rebuild = 0;
+        return 0;
+    }
+    return 1;
+}
+
+/* Interaction range [m]: twice the largest bounding radius (about the
+ * centre, as the neighbour build takes it: rotation changes it by
+ * roundings only, covered by the factor) plus the skin. */
+static double interaction_range(const cd_sim *sim)
+{
+    const cd_state *s = &sim->s;
+    double bmax = 0;
+    for (size_t q = 0; q < s->n_particles; q++) {
+        double b = cd_bp_particle_bound(s->prim_a_body, s->prim_b_body, s->prim_radius, s->prim_first[q],
+                                        s->prim_count[q], cd_v3_zero());
+        if (b > bmax) bmax = b;
+    }
+    return (2 * bmax + sim->nb.skin) * (1 + 1e-6);
+}
+
+/* Rank 0's summary of the decomposition: migrations, and the owned
+ * particles and ghosts per rank at the end (the halo's share of the
+ * work).  Collective: every rank ends the run at the same point. */
+static void report(const cd_mpi_ctx *x)
+{
+    long mine[2] = {x->last_owned, x->last_ghosts}, lo[2], hi[2], sum[2];
+    MPI_Reduce(mine, lo, 2, MPI_LONG, MPI_MIN, 0, x->comm);
+    MPI_Reduce(mine, hi, 2, MPI_LONG, MPI_MAX, 0, x->comm);
+    MPI_Reduce(mine, sum, 2, MPI_LONG, MPI_SUM, 0, x->comm);
+    double t[4] = {x->t_step, x->t_decide, x->t_migrate, x->t_ghosts}, tmax[4]; /* [s] */
+    MPI_Reduce(t, tmax, 4, MPI_DOUBLE, MPI_MAX, 0, x->comm);
+    if (x->rank == 0)
+        fprintf(stderr, "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
+                "ghosts (%.3g ghosts per owned particle); slowest rank's seconds: step %.3g, rebuild decision %.3g, "
+                "migration %.3g, ghost refresh %.3g\n", x->size, x->migrations, lo[0], hi[0], lo[1], hi[1],
+                sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0, tmax[0], tmax[1], tmax[2], tmax[3]);
+}
+
+/* Ends the local state; the context stays for a restart (cd_mpi_end
+ * frees it). */
+static void mpi_stop(cd_sim *sim)
+{
+    cd_mpi_ctx *x = sim->backend_data;
+    if (!x) return;
+    if (x->started) {
+        x->last_owned = (long)x->n_owned;
+        x->last_ghosts = (long)(x->loc.s.n_particles - x->n_owned);
+    }
+    cd_sim_free(&x->loc);
+    cd_mpi_halo_free(x);
+    x->started = 0;
+}
+
+static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
+{
+    cd_mpi_ctx *x = sim->backend_data;
+    cd_sim_free(&x->loc);
+    cd_mpi_halo_free(x);
+    x->started = 0;
+    const cd_state *s = &sim->s;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t q = 0; q < s->n_particles; q++) {
+        double p[3] = {s->position[q].x, s->position[q].y, s->position[q].z};
+        for (int a = 0; a < 3; a++)
+            if (isfinite(p[a])) {
+                lo[a] = p[a] < lo[a] ? p[a] : lo[a];
+                hi[a] = p[a] > hi[a] ? p[a] : hi[a];
+            }
+    }
+    for (int a = 0; a < 3; a++)
+        if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0;
+    /* The grid is chosen at the first start and kept for a restart (the
+     * bulk probe's, from a compacted packing that it might not split as
+     * well): the bits do not depend on it. */
+    if (!x->ran && cd_decomp_choose(&x->grid, &sim->cfg, x->size, lo, hi, interaction_range(sim), 0, err, errlen))
+        return -1; /* every rank: the same data, the same refusal */
+
+    sim->nb.reorder = 0; /* the replicated state stays in global id order too */
+    cd_sim *loc = &x->loc;
+    memset(loc, 0, sizeof *loc);
+    loc->cfg = sim->cfg; /* shallow: cd_sim_free leaves the config alone */
+    loc->p = sim->p;
+    memcpy(loc->shapes, sim->shapes, sizeof loc->shapes);
+    loc->n_shapes = sim->n_shapes;
+    loc->collision_time = sim->collision_time;
+    loc->total_mass = sim->total_mass;
+    loc->solid_volume = sim->solid_volume;
+    loc->threads = sim->threads;
+    loc->backend = x->inner;
+    memcpy(loc->device_request, sim->device_request, sizeof loc->device_request);
+    /* reorder off: the MPI layer keeps local order = global id order (docs/mpi.md) */
+    cd_neighbors_init(&loc->nb, sim->nb.skin, 0);
+    loc->rebuild_hook = rebuild_hook;
+    loc->rebuild_hook_data = x;
+    size_t R = (size_t)x->size;
+    x->send_count = calloc(R, sizeof(int));
+    x->send_displ = calloc(R, sizeof(int));
+    x->recv_count = calloc(R, sizeof(int));
+    x->recv_displ = calloc(R, sizeof(int));
+    int rc = x->send_count && x->send_displ && x->recv_count && x->recv_displ ? 0 : -1;
+    if (!rc) rc = cd_mpi_distribute(x, &sim->s);
+    if (rc) snprintf(err, errlen, "out of memory while distributing the particles over %d MPI ranks", x->size);
+    /* (a rank without particles has no list to build and no forces) */
+    if (!rc) rc = x->inner->start(loc, compute && loc->s.n_particles > 0, err, errlen);
+    if (agree_failure(x, rc, err, errlen)) return -1;
+    x->started = x->ran = 1;
+    /* the ghosts' forces from their owners (a start computes them from
+     * the pairs this rank sees) */
+    cd_mpi_refresh_ghosts(x, 0);
+    return 0;
+}
+
+static int mpi_step(cd_sim *sim, long long n, char *err, size_t errlen)
+{
+    cd_mpi_ctx *x = sim->backend_data;
+    /* the walls and protocol slots as the protocol left them (the same on
+     * every rank: it decides from the same loads and observables) */
+    memcpy(x->loc.s.walls, sim->s.walls, sizeof x->loc.s.walls);
+    memcpy(x->loc.s.control, sim->s.control, sizeof x->loc.s.control);
+    for (long long it = 0; it < n; it++) {
+        double t0 = MPI_Wtime(), hook = x->t_decide + x->t_migrate;
+        int rc = x->inner->step(&x->loc, 1, err, errlen);
+        scalars_back(sim, &x->loc.s);
+        double t1 = MPI_Wtime();
+        x->t_step += t1 - t0 - (x->t_decide + x->t_migrate - hook);
+        /* one exchange per step: the ghosts, and whether every rank's step
+         * went well (a failed rank's ghosts are not used: all stop) */
+        int first = cd_mpi_refresh_ghosts(x, rc != 0);
+        x->t_ghosts += MPI_Wtime() - t1;
+        if (failure_of(x, first, err, errlen)) return -1;
+    }
+    return 0;
+}
+
+static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
+{
+    cd_mpi_ctx *x = sim->backend_data;
+    int rc = x->inner->sync(&x->loc, err, errlen);
+    if (!rc) rc = cd_mpi_gather(x, &sim->s);
+    if (rc) snprintf(err, errlen, "out of memory while gathering the state on MPI rank 0");
+    return agree_failure(x, rc, err, errlen);
+}
+
+/* The observables of the serial program: the state gathered in global
+ * order on every rank and summed there as in one process
+ * (kernels/observe_items.h): the run's decisions on them are every
+ * rank's. */
+static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    if (mpi_sync(sim, err, errlen)) return -1;
+    cd_observables_slots(sim, slots);
+    return 0;
+}
+
+/* The load a protocol asks for at every control call: the nonzero wall
+ * rows only, summed in the serial order (cd_mpi_wall_load). */
+static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    (void)err; (void)errlen;
+    *load = cd_mpi_wall_load(sim->backend_data, w, sim->s.n_prims);
+    return 0;
+}
+
+static const char *mpi_device(const cd_sim *sim)
+{
+    static char buf[192];
+    const cd_mpi_ctx *x = sim->backend_data;
+    snprintf(buf, sizeof buf, "%d MPI ranks (sub-domains %d x %d x %d), each: %s", x->size, x->grid.dims[0],
+             x->grid.dims[1], x->grid.dims[2], x->inner->device(&x->loc));
+    return buf;
+}
+
+static const cd_backend cd_backend_mpi = {"mpi", mpi_start, mpi_step, mpi_sync, mpi_stop, mpi_device, mpi_wall_load,
+                                          mpi_observe};
+
+int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
+{
+    if (!cd_mpi_decomposed()) return 0;
+    if (strcmp(backend, "omp")) {
+        snprintf(err, errlen, "--backend %s: several MPI ranks run the omp backend only so far (docs/mpi.md)", backend);
+        return -1;
+    }
+#if defined(CAPDEM_OFFLOAD_TARGET)
+    snprintf(err, errlen, "this build offloads (%s): several MPI ranks run on host threads only so far (docs/mpi.md)",
+             CAPDEM_OFFLOAD_VARIANT);
+    return -1;
+#endif
+    cd_mpi_ctx *x = calloc(1, sizeof *x);
+    if (!x) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    x->comm = MPI_COMM_WORLD;
+    MPI_Comm_rank(x->comm, &x->rank);
+    MPI_Comm_size(x->comm, &x->size);
+    x->inner = sim->backend ? sim->backend : &cd_backend_omp;
+    sim->backend = &cd_backend_mpi;
+    sim->backend_data = x;
+    free(the_ctx);
+    the_ctx = x;
+    return 0;
+}

@@ -1,0 +1,80 @@
+/* MPI domain decomposition (docs/mpi.md): `mpirun -np R capdem run ...`
+ * splits space into a Cartesian grid of R sub-domains; each rank steps the
+ * particles whose centre lies in its sub-domain (owned) with copies of the
+ * particles near it (ghosts), through the serial backend's own step, and
+ * the run's trajectories are bitwise those of the serial program.
+ *
+ * The run (src/core/run.c) sees one operation table, cd_backend_mpi, wrapping
+ * the omp backend: start distributes the global state, step steps the
+ * local one and refreshes the ghosts, sync and observe gather the owned
+ * rows to rank 0 in global order, so that output, observables and wall
+ * loads are computed there by the serial functions.
+ *
+ * Without CAPDEM_MPI the hooks below are inline no-ops: one process, which
+ * writes. */
+#ifndef CD_MPI_DECOMP_H
+#define CD_MPI_DECOMP_H
+#include <stddef.h>
+#include "config/config.h"
+
+struct cd_sim;
+
+#if defined(CAPDEM_MPI) && CAPDEM_MPI
+/* Starts MPI (once per process; a no-op when already started).  On ranks
+ * other than 0, stderr goes to /dev/null: every rank takes the same
+ * decisions from the same data, and rank 0 reports them. */
+int cd_mpi_begin(void);
+/* Ends MPI; returns status (the agreed exit status of the run). */
+int cd_mpi_end(int status);
+/* The largest of every rank's status (0: all went well): the point where
+ * the ranks agree to go on or to stop together, without a hang. */
+int cd_mpi_agree(int status);
+/* Rank 0 (of a run with more than one rank), or a serial run: the process
+ * that writes the output. */
+int cd_mpi_is_writer(void);
+/* More than one rank: the run is decomposed. */
+int cd_mpi_decomposed(void);
+/* With more than one rank: checks that the config can run decomposed
+ * (solver, protocol, backend) and puts cd_backend_mpi in front of the
+ * chosen backend.  0, or -1 with a message naming the key (exit 2). */
+int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err, size_t errlen);
+#else
+static inline int cd_mpi_begin(void) { return 0; }
+static inline int cd_mpi_end(int status) { return status; }
+static inline int cd_mpi_agree(int status) { return status; }
+static inline int cd_mpi_is_writer(void) { return 1; }
+static inline int cd_mpi_decomposed(void) { return 0; }
+static inline int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err, size_t errlen)
+{
+    (void)sim; (void)backend; (void)err; (void)errlen;
+    return 0;
+}
+#endif
+
+/* ---- the Cartesian grid of sub-domains (src/mpi/mpi_decomp.c) -------------
+ * Plain C, no MPI: unit-testable in any build. */
+typedef struct {
+    int dims[3];       /* sub-domains along x, y, z (their product: the ranks) */
+    double lo[3];      /* [m] lower corner of the split box (box of the centres at start) */
+    double width[3];   /* [m] width of an inner sub-domain; the outer ones reach to infinity */
+    double range;      /* [m] interaction range: largest bounding diameter + skin */
+    double margin;     /* [m] motion allowed between migrations (ghosts reach range + margin) */
+    double halo;       /* [m] range + margin */
+} cd_decomp_grid;
+
+/* Chooses the grid of `ranks` sub-domains over the box of centres lo..hi
+ * [m]: cfg's mpi.grid when given (every entry >= 1), else the grid with
+ * the smallest cut area that leaves the gravity axis whole where it can
+ * (a settling pile fills the bottom of its box).  A sub-domain narrower
+ * than the interaction range is refused (more ranks than the domain can
+ * be split into).  0, or -1 with a message naming the key (exit 2). */
+int cd_decomp_choose(cd_decomp_grid *g, const cd_config *cfg, int ranks, const double lo[3], const double hi[3],
+                     double range, double margin, char *err, size_t errlen);
+/* The rank whose sub-domain holds the point x [m] (outer sub-domains reach
+ * to infinity; a non-finite coordinate counts as the lowest). */
+int cd_decomp_owner(const cd_decomp_grid *g, const double x[3]);
+/* The ranks other than skip whose sub-domain comes within the halo of x,
+ * ascending, into out (room for every rank); returns how many. */
+int cd_decomp_ghost_ranks(const cd_decomp_grid *g, const double x[3], int skip, int *out);
+
+#endif

@@ -1,0 +1,631 @@
+/* The exchanges of the MPI decomposition (docs/mpi.md, "Design"): the
+ * local state cut from the global one, migration at neighbour-list
+ * rebuilds, the ghost refresh of every step, the gather to rank 0.
+ *
+ * A rank's local state is an ordinary cd_state whose particles are its
+ * owned ones and its ghosts, in ascending global id, each with all its
+ * primitives and wall-contact rows.  Local order is global order, so the
+ * serial step run on it orients every pair row, sorts every row list and
+ * sums every particle's contacts exactly as the serial program does: an
+ * owned particle gets the same bits.
+ *
+ * Records travel as bytes: a particle with its primitives and wall rows
+ * (every column of fields.def, so a new column travels without a change
+ * here), and a pair row with its two global primitive ids. */
+#include <stdlib.h>
+#include <string.h>
+#include "mpi/mpi_halo.h"
+#include "step_items.h"
+
+typedef struct {
+    long long gid, gprim_first, n_prims, pad;
+} rec_head;
+
+typedef struct {
+    long long gi, gj; /* global primitives */
+    long long rank_in_row; /* gather: the row's place among the rows of primitive gi (0 in a migration) */
+} pair_head;
+
+/* A record found in a received buffer. */
+typedef struct {
+    long long a, b;  /* particle: gid, -; pair: global primitives i, j */
+    const char *at;  /* the record */
+} rec_ref;
+
+static size_t group_bytes(enum cd_field_group g)
+{
+    size_t b = 0;
+    for (size_t k = 0; k < cd_n_fields; k++)
+        if (cd_fields[k].group == g) b += cd_fields[k].elem_size;
+    return b;
+}
+
+static size_t particle_bytes(long long n_prims, size_t n_walls)
+{
+    return sizeof(rec_head) + group_bytes(CD_GROUP_PARTICLE) +
+           (size_t)n_prims * (group_bytes(CD_GROUP_PRIM) + n_walls * group_bytes(CD_GROUP_WALLC));
+}
+
+static size_t pair_bytes(void) { return sizeof(pair_head) + group_bytes(CD_GROUP_PAIR); }
+
+/* Rows [row, row + n) of every column of group g to b (pack = 1) or from
+ * b; returns the end of those bytes in b. */
+static char *rows_io(cd_state *s, enum cd_field_group g, size_t row, size_t n, char *b, int pack)
+{
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        if (f->group != g) continue;
+        char *col = (char *)*cd_field_ptr(s, f) + row * f->elem_size;
+        if (pack) memcpy(b, col, n * f->elem_size);
+        else memcpy(col, b, n * f->elem_size);
+        b += n * f->elem_size;
+    }
+    return b;
+}
+
+/* Particle q of s with global id gid and first global primitive gp. */
+static char *pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b)
+{
+    rec_head h = {gid, gp, s->prim_count[q], 0};
+    memcpy(b, &h, sizeof h);
+    b += sizeof h;
+    size_t p0 = (size_t)s->prim_first[q], n = (size_t)s->prim_count[q];
+    b = rows_io(s, CD_GROUP_PARTICLE, q, 1, b, 1);
+    b = rows_io(s, CD_GROUP_PRIM, p0, n, b, 1);
+    return rows_io(s, CD_GROUP_WALLC, p0 * s->n_walls, n * s->n_walls, b, 1);
+}
+
+/* A particle record into row l of s, its primitives from row pl. */
+static void unpack_particle(cd_state *s, size_t l, size_t pl, const char *rec)
+{
+    rec_head h;
+    memcpy(&h, rec, sizeof h);
+    char *b = (char *)rec + sizeof h;
+    size_t n = (size_t)h.n_prims;
+    b = rows_io(s, CD_GROUP_PARTICLE, l, 1, b, 0);
+    b = rows_io(s, CD_GROUP_PRIM, pl, n, b, 0);
+    rows_io(s, CD_GROUP_WALLC, pl * s->n_walls, n * s->n_walls, b, 0);
+    s->prim_first[l] = (cd_int)pl; /* the index columns in this state's numbering */
+    for (size_t k = 0; k < n; k++) s->prim_particle[pl + k] = (cd_int)l;
+}
+
+static char *pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b)
+{
+    pair_head h = {gi, gj, rank_in_row};
+    memcpy(b, &h, sizeof h);
+    return rows_io(s, CD_GROUP_PAIR, k, 1, b + sizeof h, 1);
+}
+
+static int cmp_ref(const void *pa, const void *pb)
+{
+    const rec_ref *a = pa, *b = pb;
+    if (a->a != b->a) return a->a < b->a ? -1 : 1;
+    if (a->b != b->b) return a->b < b->b ? -1 : 1;
+    return 0;
+}
+
+/* The records of n bytes at buf: particles (pairs = 0) or pair rows, sorted
+ * by global id or key; *count of them.  NULL only when out of memory. */
+static rec_ref *parse(const char *buf, size_t n, int pairs, size_t n_walls, size_t *count)
+{
+    size_t cap = 16, m = 0;
+    rec_ref *r = malloc(cap * sizeof *r);
+    for (size_t at = 0; r && at < n; m++) {
+        if (m == cap) {
+            rec_ref *g = realloc(r, (cap *= 2) * sizeof *r);
+            if (!g) { free(r); return NULL; }
+            r = g;
+        }
+        long long h[3];
+        memcpy(h, buf + at, sizeof h);
+        r[m] = (rec_ref){h[0], pairs ? h[1] : 0, buf + at};
+        at += pairs ? pair_bytes() : particle_bytes(h[2], n_walls);
+    }
+    if (r) qsort(r, m, sizeof *r, cmp_ref);
+    *count = m;
+    return r;
+}
+
+/* Index of global primitive g among the ascending gprim[0..n), or -1. */
+static long long local_prim(const long long *gprim, size_t n, long long g)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (gprim[mid] < g) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < n && gprim[lo] == g ? (long long)lo : -1;
+}
+
+/* The pair records (sorted by key, a key given twice taken once) whose two
+ * primitives the local state s holds (gprim: their global ids) into its
+ * pair rows, in key order: the order the serial build keeps them in, which
+ * is also local key order (the history the next build carries over). */
+static int place_pairs(cd_state *s, const rec_ref *r, size_t n, const long long *gprim)
+{
+    if (cd_state_reserve_pairs(s, n + 16)) return -1;
+    size_t m = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (k > 0 && r[k].a == r[k - 1].a && r[k].b == r[k - 1].b) continue;
+        long long i = local_prim(gprim, s->n_prims, r[k].a), j = local_prim(gprim, s->n_prims, r[k].b);
+        if (i < 0 || j < 0) continue;
+        rows_io(s, CD_GROUP_PAIR, m, 1, (char *)r[k].at + sizeof(pair_head), 0);
+        s->pair_prim_i[m] = (cd_int)i;
+        s->pair_prim_j[m] = (cd_int)j;
+        m++;
+    }
+    s->n_pairs = m;
+    return 0;
+}
+
+static void copy_scalars(cd_state *dst, const cd_state *src)
+{
+    dst->n_walls = src->n_walls;
+    memcpy(dst->walls, src->walls, sizeof dst->walls);
+    memcpy(dst->control, src->control, sizeof dst->control);
+    dst->time = src->time;
+    dst->step = src->step;
+}
+
+static double *pos3(const cd_state *s, size_t q, double x[3])
+{
+    x[0] = s->position[q].x;
+    x[1] = s->position[q].y;
+    x[2] = s->position[q].z;
+    return x;
+}
+
+/* The ghost refresh until the next migration: owned particles to the
+ * ranks whose halo they are in, ghosts from their owners, both in
+ * ascending global id (the same lists, seen from either side). */
+static int plan_refresh(cd_mpi_ctx *x)
+{
+    cd_state *s = &x->loc.s;
+    int R = x->size, *ranks = malloc((size_t)R * sizeof *ranks);
+    if (!ranks) return -1;
+    double p[3];
+    memset(x->send_count, 0, (size_t)R * sizeof(int));
+    memset(x->recv_count, 0, (size_t)R * sizeof(int));
+    for (int pass = 0; pass < 2; pass++) { /* count, then fill */
+        if (pass == 1) {
+            int ns = 0, nr = 0;
+            for (int r = 0; r < R; r++) {
+                x->send_displ[r] = ns;
+                x->recv_displ[r] = nr;
+                ns += x->send_count[r];
+                nr += x->recv_count[r];
+                x->send_count[r] = x->recv_count[r] = 0;
+            }
+            free(x->send_list); free(x->recv_list); free(x->send_buf); free(x->recv_buf);
+            x->send_list = malloc(((size_t)ns + 1) * sizeof(int));
+            x->recv_list = malloc(((size_t)nr + 1) * sizeof(int));
+            /* (one status per rank ahead of each rank's ghosts: cd_mpi_refresh_ghosts) */
+            x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
+            x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
+            if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) { free(ranks); return -1; }
+        }
+        for (size_t q = 0; q < s->n_particles; q++) {
+            if (x->owned[q]) {
+                int n = cd_decomp_ghost_ranks(&x->grid, pos3(s, q, p), x->rank, ranks);
+                for (int k = 0; k < n; k++) {
+                    if (pass) x->send_list[x->send_displ[ranks[k]] + x->send_count[ranks[k]]] = (int)q;
+                    x->send_count[ranks[k]]++;
+                }
+            } else {
+                int o = cd_decomp_owner(&x->grid, pos3(s, q, p));
+                if (pass) x->recv_list[x->recv_displ[o] + x->recv_count[o]] = (int)q;
+                x->recv_count[o]++;
+            }
+        }
+    }
+    free(ranks);
+    return 0;
+}
+
+/* The local state from received records (particles: pbuf, pair rows:
+ * cbuf), the scalars of scal; the neighbour list to be rebuilt. */
+static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal)
+{
+    size_t W = scal->n_walls, N = 0, K = 0, P = 0;
+    rec_ref *pr = parse(pbuf, plen, 0, W, &N), *cr = parse(cbuf, clen, 1, W, &K);
+    cd_state s;
+    int rc = pr && cr ? 0 : -1;
+    for (size_t q = 0; !rc && q < N; q++) {
+        rec_head h;
+        memcpy(&h, pr[q].at, sizeof h);
+        P += (size_t)h.n_prims;
+    }
+    if (!rc) rc = cd_state_alloc(&s, N, P, W, K + 16);
+    long long *gid = rc ? NULL : malloc((N + 1) * sizeof *gid), *gprim = rc ? NULL : malloc((P + 1) * sizeof *gprim);
+    unsigned char *owned = rc ? NULL : malloc(N + 1);
+    if (!rc && (!gid || !gprim || !owned)) { cd_state_free(&s); rc = -1; }
+    if (rc) { free(pr); free(cr); free(gid); free(gprim); free(owned); return -1; }
+    copy_scalars(&s, scal);
+    size_t pl = 0;
+    x->n_owned = 0;
+    for (size_t q = 0; q < N; q++) {
+        rec_head h;
+        memcpy(&h, pr[q].at, sizeof h);
+        unpack_particle(&s, q, pl, pr[q].at);
+        gid[q] = h.gid;
+        for (long long k = 0; k < h.n_prims; k++) gprim[pl + (size_t)k] = h.gprim_first + k;
+        pl += (size_t)h.n_prims;
+        double p[3];
+        owned[q] = cd_decomp_owner(&x->grid, pos3(&s, q, p)) == x->rank;
+        x->n_owned += owned[q];
+    }
+    rc = place_pairs(&s, cr, K, gprim);
+    free(pr);
+    free(cr);
+    if (rc) { cd_state_free(&s); free(gid); free(gprim); free(owned); return -1; }
+    cd_state_free(&x->loc.s);
+    x->loc.s = s;
+    free(x->gid); free(x->gprim); free(x->owned);
+    x->gid = gid;
+    x->gprim = gprim;
+    x->owned = owned;
+    double skin = x->loc.nb.skin; /* [m] */
+    cd_neighbors_free(&x->loc.nb); /* sized for the old rows */
+    cd_neighbors_init(&x->loc.nb, skin, 0); /* local order = global id order (docs/mpi.md) */
+    return plan_refresh(x);
+}
+
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
+{
+    size_t W = global->n_walls, pb = 0, cb = 0;
+    int *ranks = malloc((size_t)x->size * sizeof *ranks);
+    double p[3];
+    for (size_t q = 0; q < global->n_particles; q++) pb += particle_bytes(global->prim_count[q], W);
+    for (size_t k = 0; k < global->n_pairs; k++) cb += global->pair_active[k] ? pair_bytes() : 0;
+    char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *at = pbuf;
+    int rc = ranks && pbuf && cbuf ? 0 : -1;
+    for (size_t q = 0; !rc && q < global->n_particles; q++) {
+        int o = cd_decomp_owner(&x->grid, pos3(global, q, p)), here = o == x->rank;
+        int n = cd_decomp_ghost_ranks(&x->grid, p, o, ranks);
+        for (int k = 0; k < n && !here; k++) here = ranks[k] == x->rank;
+        if (here) at = pack_particle(global, q, (long long)q, global->prim_first[q], at);
+    }
+    size_t plen = rc ? 0 : (size_t)(at - pbuf);
+    at = cbuf;
+    for (size_t k = 0; !rc && k < global->n_pairs; k++)
+        if (global->pair_active[k]) at = pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
+    if (!rc) rc = assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
+    free(ranks); free(pbuf); free(cbuf);
+    return rc;
+}
+
+/* Alltoallv of bytes: send (sc[r] bytes to rank r, in rank order) into a
+ * new buffer *recv of *rlen bytes. */
+static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen)
+{
+    int R = x->size, *rc = calloc((size_t)R * 3 + 1, sizeof(int)), *sd = malloc(((size_t)R + 1) * sizeof(int));
+    if (!rc || !sd) { free(rc); free(sd); return -1; }
+    int *rd = rc + R;
+    MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, x->comm);
+    size_t ns = 0, nr = 0;
+    for (int r = 0; r < R; r++) {
+        sd[r] = (int)ns;
+        rd[r] = (int)nr;
+        ns += (size_t)sc[r];
+        nr += (size_t)rc[r];
+    }
+    *recv = malloc(nr + 1);
+    *rlen = nr;
+    if (*recv) MPI_Alltoallv(send, sc, sd, MPI_BYTE, *recv, rc, rd, MPI_BYTE, x->comm);
+    free(rc);
+    free(sd);
+    return *recv ? 0 : -1;
+}
+
+/* Growable list of ranks per owned particle: the ranks a particle goes to
+ * at a migration (its new owner first). */
+typedef struct {
+    int *first, *count, *ranks;
+    size_t n, cap;
+} dest_lists;
+
+static int dests_of_owned(cd_mpi_ctx *x, dest_lists *d)
+{
+    cd_state *s = &x->loc.s;
+    size_t N = s->n_particles;
+    d->first = calloc(N + 1, sizeof(int));
+    d->count = calloc(N + 1, sizeof(int));
+    d->cap = 2 * N + (size_t)x->size + 16;
+    d->ranks = malloc(d->cap * sizeof(int));
+    d->n = 0;
+    if (!d->first || !d->count || !d->ranks) return -1;
+    double p[3];
+    for (size_t q = 0; q < N; q++) {
+        if (!x->owned[q]) continue;
+        if (d->n + (size_t)x->size + 1 > d->cap) {
+            int *g = realloc(d->ranks, (d->cap *= 2) * sizeof(int));
+            if (!g) return -1;
+            d->ranks = g;
+        }
+        int o = cd_decomp_owner(&x->grid, pos3(s, q, p));
+        d->first[q] = (int)d->n;
+        d->ranks[d->n] = o;
+        d->count[q] = 1 + cd_decomp_ghost_ranks(&x->grid, p, o, d->ranks + d->n + 1);
+        d->n += (size_t)d->count[q];
+    }
+    return 0;
+}
+
+/* Does particle q (owned) go to rank r? */
+static int goes_to(const dest_lists *d, size_t q, int r)
+{
+    for (int k = 0; k < d->count[q]; k++)
+        if (d->ranks[d->first[q] + k] == r) return 1;
+    return 0;
+}
+
+/* Pair row k goes to every rank that an owned particle of it goes to,
+ * each rank once: body runs with r set to each of them. */
+#define FOR_PAIR_DESTS(x, d, k, r, body)                                                                     \
+    do {                                                                                                     \
+        cd_state *s_ = &(x)->loc.s;                                                                          \
+        size_t pi_ = (size_t)s_->prim_particle[s_->pair_prim_i[k]], pj_ = (size_t)s_->prim_particle[s_->pair_prim_j[k]]; \
+        if ((x)->owned[pi_])                                                                                 \
+            for (int e_ = 0; e_ < (d)->count[pi_]; e_++) { int r = (d)->ranks[(d)->first[pi_] + e_]; body; } \
+        if ((x)->owned[pj_])                                                                                 \
+            for (int e_ = 0; e_ < (d)->count[pj_]; e_++) {                                                   \
+                int r = (d)->ranks[(d)->first[pj_] + e_];                                                    \
+                if (!(x)->owned[pi_] || !goes_to(d, pi_, r)) { body; }                                       \
+            }                                                                                                \
+    } while (0)
+
+int cd_mpi_migrate(cd_mpi_ctx *x)
+{
+    cd_state *s = &x->loc.s;
+    int R = x->size;
+    size_t W = s->n_walls;
+    dest_lists d = {0};
+    int *pc = calloc((size_t)R, sizeof(int)), *cc = calloc((size_t)R, sizeof(int));
+    size_t *po = calloc((size_t)R + 1, sizeof(size_t)), *co = calloc((size_t)R + 1, sizeof(size_t));
+    char *pbuf = NULL, *cbuf = NULL, *prec = NULL, *crec = NULL;
+    size_t plen = 0, clen = 0;
+    int rc = pc && cc && po && co ? dests_of_owned(x, &d) : -1;
+    for (size_t q = 0; !rc && q < s->n_particles; q++)
+        for (int k = 0; x->owned[q] && k < d.count[q]; k++)
+            pc[d.ranks[d.first[q] + k]] += (int)particle_bytes(s->prim_count[q], W);
+    for (size_t k = 0; !rc && k < s->n_pairs; k++)
+        if (s->pair_active[k]) FOR_PAIR_DESTS(x, &d, k, r, cc[r] += (int)pair_bytes());
+    for (int r = 0; !rc && r < R; r++) {
+        po[r + 1] = po[r] + (size_t)pc[r];
+        co[r + 1] = co[r] + (size_t)cc[r];
+    }
+    if (!rc) {
+        pbuf = malloc(po[R] + 1);
+        cbuf = malloc(co[R] + 1);
+        rc = pbuf && cbuf ? 0 : -1;
+    }
+    for (size_t q = 0; !rc && q < s->n_particles; q++)
+        for (int k = 0; x->owned[q] && k < d.count[q]; k++) {
+            int r = d.ranks[d.first[q] + k];
+            char *end = pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], pbuf + po[r]);
+            po[r] = (size_t)(end - pbuf);
+        }
+    for (size_t k = 0; !rc && k < s->n_pairs; k++)
+        if (s->pair_active[k])
+            FOR_PAIR_DESTS(x, &d, k, r, {
+                char *end = pack_pair(s, k, x->gprim[s->pair_prim_i[k]], x->gprim[s->pair_prim_j[k]], 0, cbuf + co[r]);
+                co[r] = (size_t)(end - cbuf);
+            });
+    if (!rc) rc = exchange_bytes(x, pbuf, pc, &prec, &plen);
+    if (!rc) rc = exchange_bytes(x, cbuf, cc, &crec, &clen);
+    cd_state scal = *s; /* the scalars only: assemble replaces s */
+    if (!rc) rc = assemble(x, prec, plen, crec, clen, &scal);
+    if (!rc) x->migrations++;
+    free(d.first); free(d.count); free(d.ranks);
+    free(pc); free(cc); free(po); free(co); free(pbuf); free(cbuf); free(prec); free(crec);
+    return rc;
+}
+
+/* The ghost columns of particle q to or from b. */
+static void ghost_io(cd_state *s, size_t q, double *b, int pack)
+{
+    double *cols[] = {&s->position[q].x, &s->orientation[q].w, &s->velocity[q].x, &s->angmom[q].x,
+                      &s->angvel[q].x, &s->force[q].x, &s->torque[q].x};
+    int len[] = {3, 4, 3, 3, 3, 3, 3};
+    for (int c = 0; c < 7; c++) {
+        if (pack) memcpy(b, cols[c], (size_t)len[c] * sizeof(double));
+        else memcpy(cols[c], b, (size_t)len[c] * sizeof(double));
+        b += len[c];
+    }
+}
+
+int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
+{
+    cd_state *s = &x->loc.s;
+    int R = x->size, G = CD_MPI_GHOST_DOUBLES;
+    int *sc = calloc((size_t)R * 4, sizeof(int));
+    if (!sc) MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
+    int *sd = sc + R, *rcv = sc + 2 * R, *rd = sc + 3 * R;
+    /* to every rank: this rank's status, then the ghosts it owns there */
+    for (int r = 0; r < R; r++) {
+        sc[r] = 1 + x->send_count[r] * G;
+        sd[r] = r + x->send_displ[r] * G;
+        rcv[r] = 1 + x->recv_count[r] * G;
+        rd[r] = r + x->recv_displ[r] * G;
+        x->send_buf[sd[r]] = failed;
+        for (int k = 0; k < x->send_count[r]; k++)
+            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + k], x->send_buf + (size_t)(sd[r] + 1 + k * G), 1);
+    }
+    MPI_Alltoallv(x->send_buf, sc, sd, MPI_DOUBLE, x->recv_buf, rcv, rd, MPI_DOUBLE, x->comm);
+    int first = R;
+    for (int r = 0; r < R; r++) {
+        if (x->recv_buf[rd[r]] != 0 && r < first) first = r;
+        for (int k = 0; k < x->recv_count[r]; k++)
+            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + k], x->recv_buf + (size_t)(rd[r] + 1 + k * G), 0);
+    }
+    free(sc);
+    return first;
+}
+
+/* Allgatherv of n bytes from every rank: all of them, in rank order, in
+ * *all (*alen bytes) on every rank.  0, or -1 (out of memory: aborts the
+ * run, the other ranks being in the exchange). */
+static int allgather_bytes(cd_mpi_ctx *x, const void *buf, int n, char **all, size_t *alen)
+{
+    int R = x->size, *cnt = malloc((size_t)R * sizeof(int)), *dsp = malloc((size_t)R * sizeof(int));
+    if (!cnt || !dsp) MPI_Abort(x->comm, 1);
+    MPI_Allgather(&n, 1, MPI_INT, cnt, 1, MPI_INT, x->comm);
+    size_t t = 0;
+    for (int r = 0; r < R; r++) {
+        dsp[r] = (int)t;
+        t += (size_t)cnt[r];
+    }
+    *all = malloc(t + 1);
+    *alen = t;
+    if (!*all) MPI_Abort(x->comm, 1);
+    MPI_Allgatherv(buf, n, MPI_BYTE, *all, cnt, dsp, MPI_BYTE, x->comm);
+    free(cnt);
+    free(dsp);
+    return 0;
+}
+
+/* The serial program's list rebuilt from the rows each primitive
+ * has (counts: global primitive, rows; as many as n_counts) and the active
+ * rows at their place among them: the same row numbers as the serial list
+ * (the same build, at the same step), inactive rows marked so.  The
+ * observables sum the pair rows in blocks of row numbers
+ * (kernels/observe_items.h), so they get the serial bits. */
+static int place_serial_rows(cd_state *g, const long long *counts, size_t n_counts, const rec_ref *r, size_t n)
+{
+    size_t P = g->n_prims;
+    long long *first = calloc(P + 1, sizeof *first);
+    if (!first) return -1;
+    for (size_t e = 0; e < n_counts; e++) first[counts[2 * e] + 1] = counts[2 * e + 1];
+    for (size_t i = 0; i < P; i++) first[i + 1] += first[i];
+    size_t rows = (size_t)first[P];
+    int rc = cd_state_reserve_pairs(g, rows + 16);
+    for (size_t k = 0; !rc && k < rows; k++) {
+        g->pair_active[k] = 0;
+        g->pair_prim_i[k] = g->pair_prim_j[k] = 0;
+    }
+    for (size_t k = 0; !rc && k < n; k++) {
+        pair_head h;
+        memcpy(&h, r[k].at, sizeof h);
+        long long row = first[h.gi] + h.rank_in_row;
+        if (row >= first[h.gi + 1]) { rc = -1; break; } /* cannot happen: the row is among its primitive's */
+        rows_io(g, CD_GROUP_PAIR, (size_t)row, 1, (char *)r[k].at + sizeof h, 0);
+        g->pair_prim_i[row] = (cd_int)h.gi;
+        g->pair_prim_j[row] = (cd_int)h.gj;
+    }
+    if (!rc) g->n_pairs = rows;
+    free(first);
+    return rc;
+}
+
+int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
+{
+    cd_state *s = &x->loc.s;
+    size_t pb = 0, cb = 0, nc = 0, P = s->n_prims;
+    /* the rows of each primitive: contiguous, the list being in key order */
+    long long *row0 = malloc((P + 1) * sizeof *row0), *rows = calloc(P + 1, sizeof *rows);
+    long long *counts = malloc((2 * P + 1) * sizeof *counts);
+    if (!row0 || !rows || !counts) MPI_Abort(x->comm, 1); /* the other ranks are about to wait in the exchange */
+    for (size_t k = s->n_pairs; k-- > 0;) {
+        row0[s->pair_prim_i[k]] = (long long)k;
+        rows[s->pair_prim_i[k]]++;
+    }
+    for (size_t q = 0; q < s->n_particles; q++) {
+        if (!x->owned[q]) continue;
+        pb += particle_bytes(s->prim_count[q], s->n_walls);
+        for (cd_int i = s->prim_first[q]; i < s->prim_first[q] + s->prim_count[q]; i++)
+            if (rows[i]) {
+                counts[2 * nc] = x->gprim[i];
+                counts[2 * nc + 1] = rows[i];
+                nc++;
+            }
+    }
+    for (size_t k = 0; k < s->n_pairs; k++) /* each row once: by the owner of its particle i */
+        if (s->pair_active[k] && x->owned[s->prim_particle[s->pair_prim_i[k]]]) cb += pair_bytes();
+    char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *pall = NULL, *call = NULL, *nall = NULL;
+    if (!pbuf || !cbuf) MPI_Abort(x->comm, 1);
+    char *at = pbuf;
+    for (size_t q = 0; q < s->n_particles; q++)
+        if (x->owned[q]) at = pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], at);
+    at = cbuf;
+    for (size_t k = 0; k < s->n_pairs; k++) {
+        cd_int i = s->pair_prim_i[k];
+        if (s->pair_active[k] && x->owned[s->prim_particle[i]])
+            at = pack_pair(s, k, x->gprim[i], x->gprim[s->pair_prim_j[k]], (long long)k - row0[i], at);
+    }
+    size_t plen, clen, nlen;
+    int rc = allgather_bytes(x, pbuf, (int)pb, &pall, &plen);
+    rc |= allgather_bytes(x, cbuf, (int)cb, &call, &clen);
+    rc |= allgather_bytes(x, counts, (int)(2 * nc * sizeof *counts), &nall, &nlen);
+    /* (the scalars not: the global ones lead between steps, where a protocol sets walls and slots) */
+    if (!rc) {
+        size_t N, K;
+        rec_ref *pr = parse(pall, plen, 0, s->n_walls, &N), *cr = parse(call, clen, 1, s->n_walls, &K);
+        rc = pr && cr ? 0 : -1;
+        for (size_t q = 0; !rc && q < N; q++) {
+            rec_head h;
+            memcpy(&h, pr[q].at, sizeof h);
+            unpack_particle(global, (size_t)h.gid, (size_t)h.gprim_first, pr[q].at);
+        }
+        if (!rc) rc = place_serial_rows(global, (const long long *)nall, nlen / (2 * sizeof(long long)), cr, K);
+        free(pr);
+        free(cr);
+    }
+    free(row0); free(rows); free(counts);
+    free(pbuf); free(cbuf); free(pall); free(call); free(nall);
+    return rc;
+}
+
+/* A wall row's normal force with its global primitive. */
+typedef struct {
+    long long prim;
+    double fn; /* [N] */
+} prim_load;
+
+static int cmp_prim_load(const void *pa, const void *pb)
+{
+    const prim_load *a = pa, *b = pb;
+    return a->prim < b->prim ? -1 : a->prim > b->prim;
+}
+
+double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
+{
+    cd_state *s = &x->loc.s;
+    size_t W = s->n_walls, n = 0;
+    prim_load *mine = malloc((s->n_prims + 1) * sizeof *mine);
+    if (!mine) MPI_Abort(x->comm, 1);
+    for (size_t q = 0; q < s->n_particles; q++)
+        for (cd_int i = s->prim_first[q]; x->owned[q] && i < s->prim_first[q] + s->prim_count[q]; i++)
+            if (s->wallc_fn[(size_t)i * W + (size_t)w] != 0)
+                mine[n++] = (prim_load){x->gprim[i], s->wallc_fn[(size_t)i * W + (size_t)w]};
+    char *all;
+    size_t len;
+    allgather_bytes(x, mine, (int)(n * sizeof *mine), &all, &len);
+    size_t m = len / sizeof(prim_load);
+    prim_load *e = (prim_load *)all;
+    qsort(e, m, sizeof *e, cmp_prim_load);
+    /* kernels/step_items.h, CD_LOAD_CHUNK: per chunk of primitives the sum
+     * in primitive order, the chunks' sums in order.  The rows left out
+     * hold exact zeros: adding one changes no sum that starts at +0. */
+    double load = 0;
+    size_t k = 0;
+    for (size_t ch = 0; ch * CD_LOAD_CHUNK < n_prims_global; ch++) {
+        double acc = 0;
+        for (; k < m && (size_t)e[k].prim < (ch + 1) * CD_LOAD_CHUNK; k++) acc += e[k].fn;
+        load += acc;
+    }
+    free(mine);
+    free(all);
+    return load;
+}
+
+void cd_mpi_halo_free(cd_mpi_ctx *x)
+{
+    free(x->gid); free(x->gprim); free(x->owned);
+    free(x->send_count); free(x->send_displ); free(x->recv_count); free(x->recv_displ);
+    free(x->send_list); free(x->recv_list); free(x->send_buf); free(x->recv_buf);
+    x->gid = x->gprim = NULL;
+    x->owned = NULL;
+    x->send_count = x->send_displ = x->recv_count = x->recv_displ = x->send_list = x->recv_list = NULL;
+    x->send_buf = x->recv_buf = NULL;
+}

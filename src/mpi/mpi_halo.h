@@ -1,0 +1,67 @@
+/* Inside the MPI decomposition (docs/mpi.md): the context of one rank, and
+ * the exchanges of src/mpi/mpi_halo.c that src/mpi/mpi_backend.c drives. */
+#ifndef CD_MPI_HALO_H
+#define CD_MPI_HALO_H
+#include <mpi.h>
+#include "core/sim.h"
+#include "mpi/mpi_decomp.h"
+
+typedef struct {
+    MPI_Comm comm;
+    int rank, size;
+    cd_decomp_grid grid;
+    const cd_backend *inner;  /* the backend that steps the local state (omp) */
+    cd_sim loc;               /* owned particles and ghosts, in ascending global id */
+    /* per local particle and primitive, the global ids (ascending) */
+    long long *gid, *gprim;
+    unsigned char *owned;     /* per local particle: 1 owned here, 0 a ghost */
+    size_t n_owned;
+    /* the ghost refresh of every step, fixed between migrations: the owned
+     * particles each rank gets (send_list, per rank in ascending order) and
+     * the ghosts each rank sends (recv_list) */
+    int *send_count, *send_displ, *recv_count, *recv_displ; /* per rank, in particles */
+    int *send_list, *recv_list;
+    double *send_buf, *recv_buf;
+    long long migrations;     /* times the particles went to new owners */
+    int started;              /* the local state runs (start succeeded on every rank) */
+    int ran;                  /* it ran at least once (the closing report) */
+    long last_owned, last_ghosts; /* particles of this rank when it last stopped */
+    /* wall-clock seconds of this rank (MPI_Wtime): in the serial step (the
+     * decision and migration taken out), deciding the rebuild (waits for
+     * the slowest rank included), migrating, refreshing ghosts */
+    double t_step, t_decide, t_migrate, t_ghosts;
+} cd_mpi_ctx;
+
+/* Doubles per particle of the ghost refresh: position 3, orientation 4,
+ * velocity 3, angmom 3, angvel 3, force 3, torque 3. */
+#define CD_MPI_GHOST_DOUBLES 22
+
+/* The local state of this rank cut from a global state (every rank holds
+ * the same one at start): owned particles, ghosts, the active pair rows
+ * among them; the ghost refresh planned.  0, or -1 (out of memory). */
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global);
+/* Every owned particle to its owner by its centre now, with ghosts to the
+ * ranks within the interaction range, their primitive and wall-contact
+ * rows and the active pair rows (history); the local state replaced.
+ * Collective.  0, or -1 (out of memory). */
+int cd_mpi_migrate(cd_mpi_ctx *x);
+/* The ghosts' pose, velocities, force and torque from their owners, after
+ * a step (the serial step leaves them computed from partial forces), and
+ * with them every rank's status (failed: 0 or 1), so that the ranks agree
+ * to go on or stop in the same message.  Collective.  Returns the lowest
+ * rank that failed, or the rank count when none did. */
+int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
+/* The owned rows of every rank into global, on every rank: particles,
+ * primitives and wall-contact rows at their global row, the pair rows at
+ * the serial list's row numbers (inactive ones marked); the scalars (step,
+ * time, walls, control).  Every rank then holds the serial program's
+ * state, so that protocols, observables and output read it as they do in
+ * one process.  Collective.  0, or -1 (out of memory). */
+int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global);
+/* Normal load on wall w [N] with the serial program's bits (the sum of
+ * kernels/step_items.h, CD_LOAD_CHUNK, over n_prims_global primitives),
+ * from the nonzero rows alone: every rank's, on every rank.  Collective. */
+double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
+void cd_mpi_halo_free(cd_mpi_ctx *x);
+
+#endif

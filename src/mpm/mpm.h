@@ -1,0 +1,137 @@
+/* The material point method solver (solver: mpm; docs/mpm.md): the state
+ * as structure-of-arrays columns, its set-up from a config, and the
+ * explicit step.  2D plane strain: every extensive quantity is per metre of
+ * thickness (mass kg/m, volume m^3/m, force N/m). */
+#ifndef CD_MPM_H
+#define CD_MPM_H
+#include <stddef.h>
+#include "config/config.h"
+#include "mpm_material.h"
+
+#define CD_MPM_MAX_WALLS 4
+
+/* A rigid plane wall driven at a given velocity. */
+typedef struct {
+    double px, py;   /* a point of the plane [m] */
+    double nx, ny;   /* unit normal into the material [1] */
+    double vx, vy;   /* velocity [m/s] */
+    double fx, fy;   /* force of the material on the wall in the last step [N/m] */
+} cd_mpm_wall;
+
+typedef struct {
+    /* material points (n of them) */
+    size_t n;
+    double *x, *y;             /* position [m] */
+    double *vx, *vy;           /* velocity [m/s] */
+    double *mass;              /* [kg/m] */
+    double *vol;               /* volume [m^3/m] */
+    double *half;              /* half the initial side of the point's square [m] */
+    double *sxx, *syy, *sxy, *szz; /* Cauchy stress [Pa] */
+    double *eps_p;             /* equivalent plastic strain [1] */
+    double *f_xx, *f_xy, *f_yx, *f_yy; /* deformation gradient [1] */
+    int *particle;             /* particle (body) id: 0 .. n_bodies-1, the points of a body contiguous */
+    /* per-step scratch of the points */
+    int *bx, *by;              /* first node of the stencil in x and y (common mesh) */
+    double *wx, *wy, *dwx, *dwy; /* 4 weights [1] and gradients [1/m] per point and direction */
+    double *ex, *ey;           /* external (wall) force on the point [N/m] */
+    size_t *order;             /* point indices sorted by (body, cell), stable */
+
+    /* the common background mesh: nodes (i, j) at (ox + i h, oy + j h), i < nx, j < ny */
+    int nx, ny;
+    double h, ox, oy;          /* cell size and origin [m] */
+
+    /* bodies (docs/mpm.md, "Contact"): each has its own nodes on a window
+     * of the common mesh, nodes (i0 + a, j0 + b), a < wnx, b < wny, stored
+     * from win_off[k] on; found at the first step from the particle column */
+    int n_bodies;              /* 0 until the first step */
+    size_t *pfirst;            /* points of body k: pfirst[k] .. pfirst[k+1]-1 */
+    int *win_i0, *win_j0, *win_nx, *win_ny;
+    size_t *win_off;           /* n_bodies + 1 */
+    size_t n_bnodes, cap_bnodes; /* body-nodes in use, allocated */
+    int *bnode_body;           /* body of each body-node */
+    size_t *cell_start;        /* first entry in order of each body-cell (indexed like the body-nodes); + 1 */
+    double *gm;                /* node mass [kg/m] */
+    double *gpx, *gpy;         /* node momentum [kg/s] per metre */
+    double *gfx, *gfy;         /* node force [N/m], then acceleration [m/s^2] */
+    double *gvx, *gvy;         /* node velocity [m/s] */
+    double *gnx, *gny;         /* sum m_p grad N(x_p - x_i) [kg/m^2]: minus the node's mass gradient, the body's outward normal */
+
+    /* contact: common nodes holding two or more bodies (src/mpm/mpm_contact.c) */
+    size_t *cn_start;          /* per common node (nx * ny + 1): its body-nodes in cn_entry */
+    size_t *cn_entry;          /* body-nodes sorted by common node, bodies ascending (cap_bnodes) */
+    size_t *cn_list;           /* common nodes with >= 2 bodies (nx * ny) */
+    unsigned *cn_active;       /* per listed node: bit q set when its q-th body pair is in contact (gap <= contact_gap) */
+    size_t n_cn;               /* listed nodes */
+    long long *pair_keys;      /* scratch: k * n_bodies + l of the pairs in contact */
+    size_t cap_pairs;
+    double contact_gap;        /* two bodies' contact acts from this gap between them on [m] */
+    long n_contacts;           /* body pairs in contact (at a node within contact_gap) in the last step */
+    double penetration;        /* deepest overlap of two bodies in the last step, from the contact nodes [m]; 0 if none */
+
+    int n_walls;
+    cd_mpm_wall walls[CD_MPM_MAX_WALLS];
+    double wall_k;             /* wall penalty stiffness per point [N/m per metre] */
+    double box_h0;             /* distance of walls 0 and 1 at start [m] */
+
+    cd_mpm_material mat;
+    double dt, time;           /* [s] */
+    long long step;
+} cd_mpm;
+
+/* Allocates n points and an nx x ny node mesh of cell size h [m] whose
+ * node (0, 0) sits at (ox, oy) [m]; every column zeroed, deformation
+ * gradients set to I.  0, or -1 with a message. */
+int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, double oy, char *err, size_t errlen);
+void cd_mpm_free(cd_mpm *m);
+
+/* The set-up a config describes (mpm.setup diametral: one disk between two
+ * walls, docs/mpm.md), and the time step checked against the explicit
+ * scheme's stability limit.  0, or -1 with a message naming the file and
+ * key (bad input). */
+int cd_mpm_setup(cd_mpm *m, const cd_config *c, char *err, size_t errlen);
+
+/* Largest stable time step estimate [s]: the mesh's wave crossing time
+ * h / (c_p + v_max) and the wall penalty's 2 sqrt(m_p / k) (docs/mpm.md). */
+double cd_mpm_dt_limit(const cd_mpm *m);
+
+/* Bodies from the particle column (ids 0 .. n_bodies-1, each body's
+ * points contiguous, none empty): 0, or -1 with a message.  cd_mpm_step
+ * calls it at the first step. */
+int cd_mpm_bodies(cd_mpm *m, char *err, size_t errlen);
+
+/* One explicit step (MUSL, docs/mpm.md).  0, or -1 with a message when a
+ * point leaves the mesh or a value is not finite (the run blew up). */
+int cd_mpm_step(cd_mpm *m, char *err, size_t errlen);
+
+/* Sums over the points, in index order [J/m]. */
+double cd_mpm_kinetic_energy(const cd_mpm *m);
+/* Elastic strain energy sum V (sigma : C^-1 : sigma) / 2 (plane strain,
+ * sigma_zz included) [J/m]: the elastic energy of an elastic material. */
+double cd_mpm_strain_energy(const cd_mpm *m);
+
+/* The packing's measures (set-up packing, docs/mpm.md): packing fraction
+ * phi, the points' area over the box's [1]; the applied stress, the bottom
+ * wall's force over the box width [Pa] (compression positive); the strain
+ * ln(h_i / h) of the box height h [1] (compression positive); the
+ * coordination number 2 N_c / N of the body pairs in contact [1]. */
+void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double *strain, double *z);
+
+/* Contact (src/mpm/mpm_contact.c, docs/mpm.md "Contact"): lists the common
+ * nodes two or more bodies share; corrects the bodies' node velocities
+ * there (phase 0: after the forces, detects the contacts, sets the
+ * accelerations to match and counts the body pairs; phase 1: the MUSL
+ * remap).  -1 with a message when more bodies than CD_MPM_NODE_BODIES
+ * meet at a node. */
+#define CD_MPM_NODE_BODIES 8
+void cd_mpm_contact_nodes(cd_mpm *m);
+int cd_mpm_contact_correct(cd_mpm *m, int phase, char *err, size_t errlen);
+/* The common-mesh coordinates (i, j) of body-node t. */
+static inline void cd_mpm_bnode_ij(const cd_mpm *m, size_t t, int *i, int *j)
+{
+    int k = m->bnode_body[t];
+    size_t local = t - m->win_off[k];
+    *i = m->win_i0[k] + (int)(local % (size_t)m->win_nx[k]);
+    *j = m->win_j0[k] + (int)(local / (size_t)m->win_nx[k]);
+}
+
+#endif
