@@ -28,8 +28,8 @@ const char *cd_bench_case_names(void) { return "spheres, crosses2d, hexapods_a3,
 int cd_bench_case_yaml(const cd_bench_case *c, long n, unsigned seed, const char *friction_limit, char *yaml,
                        size_t len)
 {
-    double tip = c->aspect * c->diameter;                       /* tip-to-tip length L [m] */
-    double size = tip * (1 + c->polydispersity) * 1.1;          /* lattice spacing [m] (clearance 1.1) */
+    double tip = c->aspect * c->diameter;              /* tip-to-tip length L [m] */
+    double size = tip * (1 + c->polydispersity) * 1.1; /* lattice spacing [m] (clearance 1.1) */
     double width, thickness, height;
     if (c->dimension == 2) {
         /* one layer of sites; columns about 4x as tall as wide */
@@ -53,7 +53,7 @@ int cd_bench_case_yaml(const cd_bench_case *c, long n, unsigned seed, const char
                      "particles: [{shape: %s, aspect: %g, diameter: %g, count: %ld, polydispersity: %g}]\n"
                      "domain: {type: box, width: %.9g, thickness: %.9g, height: %.9g}\n"
                      "init: {placement: lattice, clearance: 1.1, speed: 0.25}\n",
-                     c->dt, seed, c->dimension, friction_limit, c->shape, c->aspect, c->diameter, n,
-                     c->polydispersity, width, thickness, height * 1.01);
+                     c->dt, seed, c->dimension, friction_limit, c->shape, c->aspect, c->diameter, n, c->polydispersity,
+                     width, thickness, height * 1.01);
     return k < 0 || (size_t)k >= len ? -1 : k;
 }

@@ -7,14 +7,14 @@
 #include <stddef.h>
 
 typedef struct {
-    const char *name;        /* spheres | crosses2d | hexapods_a3 | hexapods_a9 */
-    const char *shape;       /* config particles[].shape */
-    double aspect;           /* alpha (1 for spheres) */
-    double diameter;         /* arm diameter d_p [m] */
-    double polydispersity;   /* p: sizes uniform in [1-p, 1+p] */
-    int dimension;           /* 3, or 2 (motion in the x-y plane) */
-    double dt;               /* time step [s], below t_col/20 of the lightest pair */
-    long settle_steps;       /* default settling steps under 50 g */
+    const char *name;      /* spheres | crosses2d | hexapods_a3 | hexapods_a9 */
+    const char *shape;     /* config particles[].shape */
+    double aspect;         /* alpha (1 for spheres) */
+    double diameter;       /* arm diameter d_p [m] */
+    double polydispersity; /* p: sizes uniform in [1-p, 1+p] */
+    int dimension;         /* 3, or 2 (motion in the x-y plane) */
+    double dt;             /* time step [s], below t_col/20 of the lightest pair */
+    long settle_steps;     /* default settling steps under 50 g */
 } cd_bench_case;
 
 /* The case called name, or NULL. */

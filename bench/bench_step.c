@@ -72,7 +72,8 @@ static size_t state_bytes(const cd_sim *sim)
     size_t b = 0;
     for (size_t f = 0; f < cd_n_fields; f++) {
         if (cd_fields[f].group == CD_GROUP_PAIR_OUT) continue; /* host-only output columns */
-        size_t rows = cd_fields[f].group == CD_GROUP_PAIR ? sim->s.cap_pairs : cd_state_rows(&sim->s, cd_fields[f].group);
+        size_t rows =
+            cd_fields[f].group == CD_GROUP_PAIR ? sim->s.cap_pairs : cd_state_rows(&sim->s, cd_fields[f].group);
         b += rows * cd_fields[f].elem_size;
     }
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
@@ -109,14 +110,23 @@ int main(int argc, char **argv)
     char perr[512];
     long long v;
     /* every number strictly (cd_parse_cli_int/real: whole argument, in range), exit 2 otherwise */
-#define INT_OPT(name, lo, hi, dst)                                                                              \
-    else if (!strcmp(argv[i], name)) {                                                                        \
-        if (cd_parse_cli_int(argv[i], argv[i + 1], lo, hi, &v, perr, sizeof perr)) return fail(perr, 2);      \
-        dst = v;                                                                                              \
+#define INT_OPT(name, lo, hi, dst)                                                                                     \
+    if (!strcmp(argv[i], name)) {                                                                                      \
+        if (cd_parse_cli_int(argv[i], argv[i + 1], lo, hi, &v, perr, sizeof perr)) return fail(perr, 2);               \
+        dst = v;                                                                                                       \
+        continue;                                                                                                      \
     }
-    for (int i = 1; i < argc; i += 2) {
-        if (i + 1 >= argc) { fprintf(stderr, "capdem-bench: %s needs a value\n", argv[i]); return 2; }
-        if (!strcmp(argv[i], "--case")) case_name = argv[i + 1];
+#define STRING_OPT(name, dst)                                                                                          \
+    if (!strcmp(argv[i], name)) {                                                                                      \
+        dst = argv[i + 1];                                                                                             \
+        continue;                                                                                                      \
+    }
+    for (int i = 1; i < argc; i += 2) { /* each option ends its turn with continue */
+        if (i + 1 >= argc) {
+            fprintf(stderr, "capdem-bench: %s needs a value\n", argv[i]);
+            return 2;
+        }
+        STRING_OPT("--case", case_name)
         INT_OPT("--n", 1, 2147483647LL, n)
         INT_OPT("--threads", 1, 4096, threads)
         INT_OPT("--settle-steps", 0, LLONG_MAX, settle)
@@ -125,36 +135,43 @@ int main(int argc, char **argv)
         INT_OPT("--repeat", 0, LLONG_MAX, repeat)
         INT_OPT("--seed", 0, 4294967295LL, seed)
         INT_OPT("--shuffle", 0, 4294967295LL, shuffle)
-        else if (!strcmp(argv[i], "--gravity")) {
+        STRING_OPT("--backend", backends)
+        STRING_OPT("--device", device)
+        STRING_OPT("--friction-limit", friction_limit)
+        STRING_OPT("--save-settled", save_path)
+        STRING_OPT("--load-settled", load_path)
+        if (!strcmp(argv[i], "--gravity")) {
             if (cd_parse_cli_real(argv[i], argv[i + 1], 0, HUGE_VAL, &gravity, perr, sizeof perr)) return fail(perr, 2);
+            continue;
         }
-        else if (!strcmp(argv[i], "--backend")) backends = argv[i + 1];
-        else if (!strcmp(argv[i], "--device")) device = argv[i + 1];
-        else if (!strcmp(argv[i], "--friction-limit")) friction_limit = argv[i + 1];
-        else if (!strcmp(argv[i], "--save-settled")) save_path = argv[i + 1];
-        else if (!strcmp(argv[i], "--load-settled")) load_path = argv[i + 1];
-        else if (!strcmp(argv[i], "--reorder")) {
+        if (!strcmp(argv[i], "--reorder")) {
             reorder = argv[i + 1];
             if (strcmp(reorder, "cells") && strcmp(reorder, "none")) {
                 fprintf(stderr, "capdem-bench: --reorder %s: expected cells or none\n", reorder);
                 return 2;
             }
+            continue;
         }
-        else if (!strcmp(argv[i], "--tile")) {
+        if (!strcmp(argv[i], "--tile")) {
             char kx[32], *comma = strchr(argv[i + 1], ',');
             long long tx, tz;
             snprintf(kx, sizeof kx, "%.*s", comma ? (int)(comma - argv[i + 1]) : 0, argv[i + 1]);
             if (!comma || cd_parse_cli_int("--tile KX", kx, 1, 1024, &tx, perr, sizeof perr) ||
                 cd_parse_cli_int("--tile KZ", comma + 1, 1, 1024, &tz, perr, sizeof perr)) {
-                fprintf(stderr, "capdem-bench: --tile %s: expected KX,KZ (copies along x and z, each an integer in "
-                        "[1, 1024])%s%s\n", argv[i + 1], comma ? ": " : "", comma ? perr : "");
+                fprintf(stderr,
+                        "capdem-bench: --tile %s: expected KX,KZ (copies along x and z, each an integer in "
+                        "[1, 1024])%s%s\n",
+                        argv[i + 1], comma ? ": " : "", comma ? perr : "");
                 return 2;
             }
             tile_x = (int)tx;
             tile_z = (int)tz;
+            continue;
         }
-        else { fprintf(stderr, "capdem-bench: unknown option %s\n", argv[i]); return 2; }
+        fprintf(stderr, "capdem-bench: unknown option %s\n", argv[i]);
+        return 2;
     }
+#undef STRING_OPT
 #undef INT_OPT
     /* the backend list is checked before anything is set up */
     char list[256], *save = NULL, *names[8];
@@ -167,7 +184,8 @@ int main(int argc, char **argv)
         char *colon = strchr(b, ':');
         round_threads[n_backends] = threads;
         if (colon) {
-            if (cd_parse_cli_int("--backend NAME:THREADS", colon + 1, 1, 4096, &v, perr, sizeof perr)) return fail(perr, 2);
+            if (cd_parse_cli_int("--backend NAME:THREADS", colon + 1, 1, 4096, &v, perr, sizeof perr))
+                return fail(perr, 2);
             round_threads[n_backends] = (int)v;
             *colon = 0;
         }
@@ -188,7 +206,8 @@ int main(int argc, char **argv)
         if (!text) return fail(err, 2);
         int rc = cd_config_parse(text, load_path, &cfg, err, sizeof err);
         free(text);
-        if (rc || cd_sim_setup(&sim, &cfg, err, sizeof err) || cd_h5_read_snapshot(load_path, -1, &sim.s, err, sizeof err))
+        if (rc || cd_sim_setup(&sim, &cfg, err, sizeof err) ||
+            cd_h5_read_snapshot(load_path, -1, &sim.s, err, sizeof err))
             return fail(err, 2);
         if (tile_x * tile_z > 1) {
             static cd_sim big;
@@ -197,15 +216,18 @@ int main(int argc, char **argv)
             double w = sim.cfg.box_width, t = sim.cfg.box_thickness;
             if (cd_bench_tile_config(cfg.source_text, tile_x, tile_z, tiled, sizeof tiled))
                 return fail("--tile: the loaded file is not a capdem-bench case", 2);
-            if (cd_config_parse(tiled, load_path, &big_cfg, err, sizeof err) || cd_sim_setup(&big, &big_cfg, err, sizeof err))
+            if (cd_config_parse(tiled, load_path, &big_cfg, err, sizeof err) ||
+                cd_sim_setup(&big, &big_cfg, err, sizeof err))
                 return fail(err, 2);
-            if (cd_bench_tile_state(&big.s, &sim.s, tile_x, tile_z, w, t)) return fail("--tile: counts do not match", 2);
+            if (cd_bench_tile_state(&big.s, &sim.s, tile_x, tile_z, w, t))
+                return fail("--tile: counts do not match", 2);
             cd_sim_free(&sim);
             cd_config_free(&cfg);
             sim = big; /* the tiled simulation replaces the loaded one */
             cfg = big_cfg;
         }
-        if (shuffle >= 0 && cd_bench_shuffle_state(&sim.s, (unsigned)shuffle)) return fail("--shuffle: out of memory", 3);
+        if (shuffle >= 0 && cd_bench_shuffle_state(&sim.s, (unsigned)shuffle))
+            return fail("--shuffle: out of memory", 3);
         n = (long)sim.s.n_particles;
         const char *tag = strstr(cfg.source_text, "# case: ");
         if (tag && sscanf(tag + 8, "%63s", yaml) == 1) case_name = yaml;
@@ -224,7 +246,8 @@ int main(int argc, char **argv)
     }
     const char *case_label = case_name;
     if (reorder) sim.nb.reorder = !strcmp(reorder, "cells");
-    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) || cd_sim_start(&sim, load_path && tile_x * tile_z == 1 && shuffle < 0 ? 0 : 1, err, sizeof err))
+    if (cd_sim_use_backend(&sim, names[0], device, err, sizeof err) ||
+        cd_sim_start(&sim, load_path && tile_x * tile_z == 1 && shuffle < 0 ? 0 : 1, err, sizeof err))
         return fail(err, 2);
     double t0 = now();
     if (!load_path && cd_sim_step(&sim, settle, err, sizeof err)) return fail(err, 3);
@@ -247,7 +270,10 @@ int main(int argc, char **argv)
             /* hand the settled state over through the host, as a resumed run
              * does, and warm up (first list build, lazy kernel compilation) */
             sim.backend->stop(&sim);
-            if (cd_state_copy(&sim.s, &settled)) { fprintf(stderr, "capdem-bench: out of memory\n"); return 3; }
+            if (cd_state_copy(&sim.s, &settled)) {
+                fprintf(stderr, "capdem-bench: out of memory\n");
+                return 3;
+            }
             if (cd_sim_use_backend(&sim, names[k], device, err, sizeof err) || cd_sim_start(&sim, 0, err, sizeof err) ||
                 cd_sim_step(&sim, 20, err, sizeof err)) {
                 fprintf(stderr, "capdem-bench: %s\n", err);
@@ -263,14 +289,23 @@ int main(int argc, char **argv)
         if (cd_sim_step(&sim, 1, err, sizeof err)) return fail(err, 3);
         for (long r = 0; r < repeat; r++) {
             cd_observables o; /* summed where the steps run: no sync, which would leave the columns in user order */
-            if (cd_sim_observe_step(&sim, &o, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
+            if (cd_sim_observe_step(&sim, &o, err, sizeof err)) {
+                fprintf(stderr, "capdem-bench: %s\n", err);
+                return 3;
+            }
             double contacts = o.n_contacts + o.n_wall_contacts;
             long long builds0 = sim.nb.builds; /* rebuilds of the timed segment alone */
             double t = now(), c = clock_s(CLOCK_PROCESS_CPUTIME_ID);
-            if (cd_sim_step(&sim, steps, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
+            if (cd_sim_step(&sim, steps, err, sizeof err)) {
+                fprintf(stderr, "capdem-bench: %s\n", err);
+                return 3;
+            }
             double wall = now() - t, cpu = clock_s(CLOCK_PROCESS_CPUTIME_ID) - c;
             /* (a sync, untimed, for the pair count of the report) */
-            if (cd_sim_sync(&sim, err, sizeof err)) { fprintf(stderr, "capdem-bench: %s\n", err); return 3; }
+            if (cd_sim_sync(&sim, err, sizeof err)) {
+                fprintf(stderr, "capdem-bench: %s\n", err);
+                return 3;
+            }
             cd_observables after; /* the counts the traffic model uses */
             cd_sim_observe(&sim, &after);
             cd_traffic tr[CD_TRAFFIC_KERNELS];
@@ -284,15 +319,18 @@ int main(int argc, char **argv)
                                tr[kk].kernel, tr[kk].read / (double)n, tr[kk].write / (double)n);
             }
             printf("{\"case\": \"%s\", \"N\": %ld, \"backend\": \"%s\", \"device\": \"%s\", \"threads\": %d, "
-                   "\"steps\": %ld, \"wall_s\": %.6g, \"cpu_s\": %.6g, \"particle_steps_per_s\": %.4g, \"contact_updates_per_s\": %.4g, "
+                   "\"steps\": %ld, \"wall_s\": %.6g, \"cpu_s\": %.6g, \"particle_steps_per_s\": %.4g, "
+                   "\"contact_updates_per_s\": %.4g, "
                    "\"contacts_per_particle\": %.3f, \"pairs_in_list\": %zu, \"bytes_per_particle\": %.0f, "
                    "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"neighbor_builds_timed\": %lld, \"dt\": %g, "
                    "\"reorder\": \"%s\", \"reorders\": %lld, "
                    "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}, "
-                   "\"rows\": {\"prims\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, \"walls\": %zu, \"wall_contacts\": %.0f}}\n",
+                   "\"rows\": {\"prims\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, \"walls\": %zu, "
+                   "\"wall_contacts\": %.0f}}\n",
                    case_label, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
-                   round_threads[k], steps, wall, cpu, (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n,
-                   sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
+                   round_threads[k], steps, wall, cpu, (double)n * steps / wall, contacts * steps / wall,
+                   2 * o.n_contacts / (double)n, sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle,
+                   sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
                    sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
                    moved / (double)n, kernels, sim.s.n_prims, sim.s.n_pairs, after.n_contacts, sim.s.n_walls,
                    after.n_wall_contacts);

@@ -118,7 +118,8 @@ CD_INLINE cd_long cd_bp_find_key(const CD_GLOBAL cd_ulong *keys, cd_long n, cd_u
     cd_long lo = 0, hi = n;
     while (lo < hi) {
         cd_long mid = lo + (hi - lo) / 2;
-        if (keys[mid] < key) lo = mid + 1; else hi = mid;
+        if (keys[mid] < key) lo = mid + 1;
+        else hi = mid;
     }
     return (lo < n && keys[lo] == key) ? lo : -1;
 }

@@ -15,24 +15,24 @@ enum { CD_LAW_LINEAR = 0, CD_LAW_HERTZ_MINDLIN = 1 };
 /* Passed by value to the OpenCL kernels: the reals first, then the ints
  * padded to a multiple of 8 bytes, so C and OpenCL C lay it out alike. */
 typedef struct {
-    cd_real kn;          /* particle normal stiffness [N/m]; a contact has kn/2 (two springs in series) */
-    cd_real kt;          /* particle tangential stiffness [N/m]; a contact has kt/2 */
-    cd_real eta_n;       /* normal damping ratio [1] */
-    cd_real eta_t;       /* tangential damping ratio [1] */
-    cd_real mu;          /* Coulomb friction coefficient [1] */
-    cd_real e_eff;       /* Hertz-Mindlin: contact modulus E* = E / (2 (1 - nu^2)) [Pa] */
-    cd_real g_eff;       /* Hertz-Mindlin: contact shear modulus G* = E / (4 (2 - nu) (1 + nu)) [Pa] */
-    cd_int limit_total;  /* 0: limit mu F_n,elastic (seed 000); 1: mu F_n (seed 001, LAMMPS) */
-    cd_int clip_normal;  /* 1: F_n = max(0, ...) as SPEC 3; 0: allow the damping to pull (textbook oscillator) */
-    cd_int law;          /* CD_LAW_* */
-    cd_int pad_;         /* keeps the size a multiple of 8 bytes on every backend */
+    cd_real kn;         /* particle normal stiffness [N/m]; a contact has kn/2 (two springs in series) */
+    cd_real kt;         /* particle tangential stiffness [N/m]; a contact has kt/2 */
+    cd_real eta_n;      /* normal damping ratio [1] */
+    cd_real eta_t;      /* tangential damping ratio [1] */
+    cd_real mu;         /* Coulomb friction coefficient [1] */
+    cd_real e_eff;      /* Hertz-Mindlin: contact modulus E* = E / (2 (1 - nu^2)) [Pa] */
+    cd_real g_eff;      /* Hertz-Mindlin: contact shear modulus G* = E / (4 (2 - nu) (1 + nu)) [Pa] */
+    cd_int limit_total; /* 0: limit mu F_n,elastic (seed 000); 1: mu F_n (seed 001, LAMMPS) */
+    cd_int clip_normal; /* 1: F_n = max(0, ...) as SPEC 3; 0: allow the damping to pull (textbook oscillator) */
+    cd_int law;         /* CD_LAW_* */
+    cd_int pad_;        /* keeps the size a multiple of 8 bytes on every backend */
 } cd_law_params;
 
 typedef struct {
-    cd_vec3 force_j;     /* force on body j [N]; body i gets -force_j */
-    cd_real fn;          /* normal force magnitude F_n >= 0 [N] */
-    cd_vec3 ft;          /* tangential force on body j [N] */
-    cd_int sliding;      /* 1 when the Coulomb cap was reached */
+    cd_vec3 force_j; /* force on body j [N]; body i gets -force_j */
+    cd_real fn;      /* normal force magnitude F_n >= 0 [N] */
+    cd_vec3 ft;      /* tangential force on body j [N] */
+    cd_int sliding;  /* 1 when the Coulomb cap was reached */
 } cd_contact_force;
 
 CD_DEVICE_BEGIN
@@ -91,10 +91,10 @@ CD_INLINE cd_real cd_law_hertz_collision_time(cd_real e_eff, cd_real r_eff, cd_r
 /* Stiffness and damping of one contact, from the law: what the update below
  * needs, so that both laws share the history and the Coulomb cap. */
 typedef struct {
-    cd_real kn_c;     /* normal force per overlap, F_n,elastic = kn_c delta_n [N/m] */
-    cd_real kt_c;     /* tangential spring: F_t,elastic = -kt_c delta_t [N/m] */
-    cd_real gamma_n;  /* normal dashpot [N s/m] */
-    cd_real gamma_t;  /* tangential dashpot [N s/m] */
+    cd_real kn_c;    /* normal force per overlap, F_n,elastic = kn_c delta_n [N/m] */
+    cd_real kt_c;    /* tangential spring: F_t,elastic = -kt_c delta_t [N/m] */
+    cd_real gamma_n; /* normal dashpot [N s/m] */
+    cd_real gamma_t; /* tangential dashpot [N s/m] */
 } cd_contact_coeffs;
 
 /* sqrt(5/6): the factor of the Hertz-Mindlin dashpots (Tsuji et al. 1992;
@@ -112,9 +112,9 @@ CD_INLINE cd_contact_coeffs cd_contact_coefficients(cd_law_params p, cd_real m_e
          * a = sqrt(R_eff delta_n); tangent stiffnesses S_n = 2 E* a and
          * Mindlin's S_t = 8 G* a (no micro-slip: the spring is linear in
          * delta_t at fixed a, as LAMMPS's tangential mindlin). */
-        cd_real a = sqrt(r_eff * overlap);               /* [m] */
-        cd_real s_n = CD_R(2) * p.e_eff * a;              /* [N/m] */
-        cd_real s_t = CD_R(8) * p.g_eff * a;              /* [N/m] */
+        cd_real a = sqrt(r_eff * overlap);   /* [m] */
+        cd_real s_n = CD_R(2) * p.e_eff * a; /* [N/m] */
+        cd_real s_t = CD_R(8) * p.g_eff * a; /* [N/m] */
         k.kn_c = CD_R(2) / CD_R(3) * s_n;
         k.kt_c = s_t;
         k.gamma_n = CD_R(2) * CD_SQRT_5_6 * p.eta_n * sqrt(s_n * m_eff);

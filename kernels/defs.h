@@ -14,7 +14,7 @@ typedef int cd_int;
 typedef uint cd_uint;
 typedef long cd_long;
 typedef ulong cd_ulong;
-#define CD_GLOBAL __global
+#define CD_GLOBAL      __global
 #define CD_CONST_TABLE __constant
 #define CD_DEVICE_BEGIN
 #define CD_DEVICE_END
@@ -31,7 +31,7 @@ typedef uint64_t cd_ulong;
 #if defined(_OPENMP)
 /* Functions between these markers are compiled for the offload target too. */
 #define CD_DEVICE_BEGIN _Pragma("omp declare target")
-#define CD_DEVICE_END _Pragma("omp end declare target")
+#define CD_DEVICE_END   _Pragma("omp end declare target")
 #else
 #define CD_DEVICE_BEGIN
 #define CD_DEVICE_END
@@ -39,8 +39,8 @@ typedef uint64_t cd_ulong;
 #endif
 
 #define CD_INLINE static inline
-#define CD_R(x) ((cd_real)(x))
-#define CD_PI CD_R(3.14159265358979323846)
+#define CD_R(x)   ((cd_real)(x))
+#define CD_PI     CD_R(3.14159265358979323846)
 
 /* Named index types: what an integer indexes is part of its type name. */
 typedef cd_int cd_particle_id; /* index into particle columns */
@@ -73,7 +73,11 @@ static inline cd_int cd_atomic_inc(cd_int *p)
 #endif
 
 /* Own vector structs: OpenCL's double3 is 32 bytes and differs from C. */
-typedef struct { cd_real x, y, z; } cd_vec3;
-typedef struct { cd_real w, x, y, z; } cd_quat; /* unit quaternion, w scalar */
+typedef struct {
+    cd_real x, y, z;
+} cd_vec3;
+typedef struct {
+    cd_real w, x, y, z;
+} cd_quat; /* unit quaternion, w scalar */
 
 #endif

@@ -11,9 +11,9 @@
 #define CD_FIELD_GROUPS_H
 
 #define CD_ON_DEVICE_PARTICLE(...) __VA_ARGS__
-#define CD_ON_DEVICE_PRIM(...) __VA_ARGS__
-#define CD_ON_DEVICE_PAIR(...) __VA_ARGS__
-#define CD_ON_DEVICE_WALLC(...) __VA_ARGS__
+#define CD_ON_DEVICE_PRIM(...)     __VA_ARGS__
+#define CD_ON_DEVICE_PAIR(...)     __VA_ARGS__
+#define CD_ON_DEVICE_WALLC(...)    __VA_ARGS__
 #define CD_ON_DEVICE_PAIR_OUT(...)
 
 #endif

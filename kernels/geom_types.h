@@ -7,8 +7,9 @@
 /* Geometry of one contact between two spherocylinders, or between a
  * spherocylinder and a wall. */
 typedef struct {
-    cd_vec3 point;    /* contact point c [m] */
-    cd_vec3 normal;   /* unit normal n, from body i towards body j (wall: from wall into the particle is -n; see walls.h) */
+    cd_vec3 point; /* contact point c [m] */
+    cd_vec3
+        normal; /* unit normal n, from body i towards body j (wall: from wall into the particle is -n; see walls.h) */
     cd_real overlap;  /* delta_n = r_i + r_j - D [m]; > 0 means contact */
     cd_real distance; /* D, distance between the closest axis points [m] */
     cd_int parallel;  /* 1 when the parallel-contact rule placed the point */
@@ -23,14 +24,14 @@ enum {
 
 /* A wall.  Plain struct so that it can live in an OpenCL buffer. */
 typedef struct {
-    cd_int type;            /* CD_WALL_* */
-    cd_int pad_;            /* keeps the doubles 8-byte aligned on every backend */
-    cd_vec3 point;          /* plane: a point on it; cylinder: a point on the axis; sphere: centre [m] */
-    cd_vec3 normal;         /* plane: unit normal pointing into the domain; cylinder: unit axis */
-    cd_vec3 velocity;       /* translational velocity of the wall [m/s] */
-    cd_real radius;         /* cylinder / sphere radius [m] (particles are inside) */
-    cd_real radial_velocity;/* sphere: dR/dt [m/s] */
-    cd_real friction;       /* Coulomb coefficient mu_w [1] */
+    cd_int type;             /* CD_WALL_* */
+    cd_int pad_;             /* keeps the doubles 8-byte aligned on every backend */
+    cd_vec3 point;           /* plane: a point on it; cylinder: a point on the axis; sphere: centre [m] */
+    cd_vec3 normal;          /* plane: unit normal pointing into the domain; cylinder: unit axis */
+    cd_vec3 velocity;        /* translational velocity of the wall [m/s] */
+    cd_real radius;          /* cylinder / sphere radius [m] (particles are inside) */
+    cd_real radial_velocity; /* sphere: dR/dt [m/s] */
+    cd_real friction;        /* Coulomb coefficient mu_w [1] */
 } cd_wall;
 
 /* Walls a simulation may have (the state's table, the observables' slots). */

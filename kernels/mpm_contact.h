@@ -20,10 +20,10 @@ CD_DEVICE_BEGIN
  * (dx, dy) = x_i - x_p [m] from the point, along the unit vector (nx, ny),
  * in the point's parallelogram of half-side half_side [m] and deformation
  * gradient f_*; returns 0 when the line misses it. */
-CD_INLINE cd_int cd_mpm_point_chord(cd_real half_side, cd_real f_xx, cd_real f_xy, cd_real f_yx, cd_real f_yy, cd_real dx,
-                                    cd_real dy, cd_real nx, cd_real ny, cd_real *s_lo, cd_real *s_hi)
+CD_INLINE cd_int cd_mpm_point_chord(cd_real half_side, cd_real f_xx, cd_real f_xy, cd_real f_yx, cd_real f_yy,
+                                    cd_real dx, cd_real dy, cd_real nx, cd_real ny, cd_real *s_lo, cd_real *s_hi)
 {
-    cd_real det = f_xx * f_yy - f_xy * f_yx;                    /* det F > 0 [1] */
+    cd_real det = f_xx * f_yy - f_xy * f_yx;                                         /* det F > 0 [1] */
     cd_real a0 = (f_yy * dx - f_xy * dy) / det, a1 = (-f_yx * dx + f_xx * dy) / det; /* F^-1 (x_i - x_p) [m] */
     cd_real d0 = (f_yy * nx - f_xy * ny) / det, d1 = (-f_yx * nx + f_xx * ny) / det; /* F^-1 n [1] */
     cd_real lo = -CD_R(1e300), hi = CD_R(1e300);

@@ -13,14 +13,16 @@
 #include "defs.h"
 
 typedef struct {
-    cd_real lambda;   /* Lame's first parameter E nu / ((1 + nu)(1 - 2 nu)) [Pa] */
-    cd_real shear;    /* G = E / (2 (1 + nu)) [Pa] */
-    cd_real yield;    /* initial yield stress sigma_y [Pa]; < 0: elastic only */
-    cd_real hardening;/* plastic modulus H = d sigma_y / d eps_p [Pa] (docs/mpm.md: uniaxial tangent E H / (E + H)) */
+    cd_real lambda;    /* Lame's first parameter E nu / ((1 + nu)(1 - 2 nu)) [Pa] */
+    cd_real shear;     /* G = E / (2 (1 + nu)) [Pa] */
+    cd_real yield;     /* initial yield stress sigma_y [Pa]; < 0: elastic only */
+    cd_real hardening; /* plastic modulus H = d sigma_y / d eps_p [Pa] (docs/mpm.md: uniaxial tangent E H / (E + H)) */
 } cd_mpm_material;
 
 /* Cauchy stress of a plane-strain point [Pa]. */
-typedef struct { cd_real xx, yy, xy, zz; } cd_mpm_stress;
+typedef struct {
+    cd_real xx, yy, xy, zz;
+} cd_mpm_stress;
 
 CD_DEVICE_BEGIN
 
@@ -41,8 +43,9 @@ CD_INLINE cd_mpm_material cd_mpm_material_make(cd_real young, cd_real poisson, c
 CD_INLINE cd_real cd_mpm_elastic_energy_density(cd_mpm_material m, cd_mpm_stress s)
 {
     cd_real ss = s.xx * s.xx + s.yy * s.yy + s.zz * s.zz + CD_R(2) * s.xy * s.xy; /* [Pa^2] */
-    cd_real tr = s.xx + s.yy + s.zz;                                                /* [Pa] */
-    return ss / (CD_R(4) * m.shear) - m.lambda * tr * tr / (CD_R(4) * m.shear * (CD_R(3) * m.lambda + CD_R(2) * m.shear));
+    cd_real tr = s.xx + s.yy + s.zz;                                              /* [Pa] */
+    return ss / (CD_R(4) * m.shear) -
+           m.lambda * tr * tr / (CD_R(4) * m.shear * (CD_R(3) * m.lambda + CD_R(2) * m.shear));
 }
 
 /* P-wave modulus lambda + 2 G [Pa]: the explicit step's wave speed is sqrt(it / rho). */
@@ -63,8 +66,8 @@ CD_INLINE cd_real cd_mpm_von_mises(cd_mpm_stress s)
  * the plastic multiplier closed-form: d_gamma = f / (3 G + H), where f is
  * the trial's excess of q over the current yield stress.  Returns 1 when
  * the step was plastic. */
-CD_INLINE cd_int cd_mpm_stress_update(cd_mpm_material m, cd_mpm_stress *s, cd_real *eps_p, cd_real de_xx,
-                                      cd_real de_yy, cd_real de_xy)
+CD_INLINE cd_int cd_mpm_stress_update(cd_mpm_material m, cd_mpm_stress *s, cd_real *eps_p, cd_real de_xx, cd_real de_yy,
+                                      cd_real de_xy)
 {
     cd_real tr = de_xx + de_yy; /* volumetric increment (de_zz = 0) [1] */
     cd_mpm_stress t;
@@ -82,7 +85,7 @@ CD_INLINE cd_int cd_mpm_stress_update(cd_mpm_material m, cd_mpm_stress *s, cd_re
         *s = t;
         return 0;
     }
-    cd_real d_gamma = f / (CD_R(3) * m.shear + m.hardening); /* plastic strain increment [1] */
+    cd_real d_gamma = f / (CD_R(3) * m.shear + m.hardening);   /* plastic strain increment [1] */
     cd_real scale = CD_R(1) - CD_R(3) * m.shear * d_gamma / q; /* deviator shrink factor [1] */
     cd_real p = (t.xx + t.yy + t.zz) / CD_R(3);
     s->xx = p + scale * (t.xx - p);

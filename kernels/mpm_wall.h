@@ -18,8 +18,8 @@ CD_DEVICE_BEGIN
 CD_INLINE cd_real cd_mpm_point_reach(cd_real half_side, cd_real f_xx, cd_real f_xy, cd_real f_yx, cd_real f_yy,
                                      cd_real nx, cd_real ny)
 {
-    cd_real ex = f_xx * nx + f_yx * ny;           /* (F^T n)_x [1] */
-    cd_real ey = f_xy * nx + f_yy * ny;           /* (F^T n)_y [1] */
+    cd_real ex = f_xx * nx + f_yx * ny; /* (F^T n)_x [1] */
+    cd_real ey = f_xy * nx + f_yy * ny; /* (F^T n)_y [1] */
     return half_side * (fabs(ex) + fabs(ey));
 }
 
@@ -29,7 +29,7 @@ CD_INLINE cd_real cd_mpm_point_reach(cd_real half_side, cd_real f_xx, cd_real f_
 CD_INLINE cd_real cd_mpm_wall_overlap(cd_real x, cd_real y, cd_real half_side, cd_real f_xx, cd_real f_xy, cd_real f_yx,
                                       cd_real f_yy, cd_real wx, cd_real wy, cd_real nx, cd_real ny)
 {
-    cd_real gap = nx * (x - wx) + ny * (y - wy);  /* centre's distance from the plane [m] */
+    cd_real gap = nx * (x - wx) + ny * (y - wy); /* centre's distance from the plane [m] */
     return cd_mpm_point_reach(half_side, f_xx, f_xy, f_yx, f_yy, nx, ny) - gap;
 }
 

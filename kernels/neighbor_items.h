@@ -35,8 +35,8 @@ CD_DEVICE_BEGIN
 /* Pass 1: bounding radius [m] of each particle of chunk g, [g chunk,
  * (g+1) chunk), into part_bound, and the chunk's box of centres and largest
  * bound as 7 reals (lo xyz, hi xyz, rmax) at partial + 7 g. */
-CD_INLINE void cd_nb_item_bounds(cd_cols c, cd_int g, cd_int chunk, cd_int n_particles,
-                                 CD_GLOBAL cd_real *part_bound, CD_GLOBAL cd_real *partial)
+CD_INLINE void cd_nb_item_bounds(cd_cols c, cd_int g, cd_int chunk, cd_int n_particles, CD_GLOBAL cd_real *part_bound,
+                                 CD_GLOBAL cd_real *partial)
 {
     cd_real lo[3], hi[3], rmax = 0;
     for (int k = 0; k < 3; k++) {
@@ -45,8 +45,8 @@ CD_INLINE void cd_nb_item_bounds(cd_cols c, cd_int g, cd_int chunk, cd_int n_par
     }
     cd_int end = (g + 1) * chunk < n_particles ? (g + 1) * chunk : n_particles;
     for (cd_int p = g * chunk; p < end; p++) {
-        cd_real b = cd_bp_particle_bound(c.prim_a, c.prim_b, c.prim_radius, c.prim_first[p], c.prim_count[p],
-                                         c.position[p]);
+        cd_real b =
+            cd_bp_particle_bound(c.prim_a, c.prim_b, c.prim_radius, c.prim_first[p], c.prim_count[p], c.position[p]);
         part_bound[p] = b;
         cd_bp_bounds_add(lo, hi, &rmax, c.position[p], b);
     }
@@ -131,8 +131,7 @@ CD_INLINE void cd_nb_item_cell_fill(cd_particle_id q, const CD_GLOBAL cd_int *pa
 CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL cd_grid *grid,
                                   const CD_GLOBAL cd_int *cell_start, const CD_GLOBAL cd_int *cell_parts,
                                   const CD_GLOBAL cd_real *part_bound, cd_real skin, CD_GLOBAL cd_prim_id *out,
-                                  cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count,
-                                  cd_order o)
+                                  cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count, cd_order o)
 {
     cd_grid g = grid[0];
     cd_int first = c.prim_first[p], last = first + c.prim_count[p];
@@ -218,9 +217,8 @@ CD_INLINE void cd_nb_item_place(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_int 
  * old rows were made (null: the same; src/backend/omp/reorder.c), so that the key is
  * looked up as the old rows wrote it. */
 CD_INLINE void cd_nb_item_carry(cd_cols c, cd_long k, const CD_GLOBAL cd_ulong *keys,
-                                const CD_GLOBAL cd_ulong *old_keys, cd_long n_old,
-                                const CD_GLOBAL cd_int *old_active, const CD_GLOBAL cd_vec3 *old_shear,
-                                const CD_GLOBAL cd_int *prim_src)
+                                const CD_GLOBAL cd_ulong *old_keys, cd_long n_old, const CD_GLOBAL cd_int *old_active,
+                                const CD_GLOBAL cd_vec3 *old_shear, const CD_GLOBAL cd_int *prim_src)
 {
     cd_ulong key = keys[k];
     if (prim_src) key = cd_bp_pair_key(prim_src[key >> 32], (cd_prim_id)(key & 0xffffffffUL));

@@ -17,14 +17,14 @@
 
 #define CD_OBS_BLOCK 4096
 /* Slots of a partial sum: summed ... */
-#define CD_OBS_KT 0   /* translational kinetic energy [J] */
-#define CD_OBS_KR 1   /* rotational kinetic energy [J] */
-#define CD_OBS_EL 2   /* elastic energy of the contact springs [J] */
-#define CD_OBS_PE 3   /* gravitational potential energy [J] */
-#define CD_OBS_NC 4   /* active pair contacts */
-#define CD_OBS_NW 5   /* active wall contacts */
-#define CD_OBS_PX 6   /* momentum x, y, z [kg m/s] */
-#define CD_OBS_KC 9   /* kinetic energy of the particles that touch something [J] */
+#define CD_OBS_KT   0  /* translational kinetic energy [J] */
+#define CD_OBS_KR   1  /* rotational kinetic energy [J] */
+#define CD_OBS_EL   2  /* elastic energy of the contact springs [J] */
+#define CD_OBS_PE   3  /* gravitational potential energy [J] */
+#define CD_OBS_NC   4  /* active pair contacts */
+#define CD_OBS_NW   5  /* active wall contacts */
+#define CD_OBS_PX   6  /* momentum x, y, z [kg m/s] */
+#define CD_OBS_KC   9  /* kinetic energy of the particles that touch something [J] */
 #define CD_OBS_WALL 10 /* force on wall w, 3 per wall [N] */
 /* ... and merged by maximum */
 #define CD_OBS_MAXOV (CD_OBS_WALL + 3 * CD_MAX_WALLS) /* largest overlap / arm diameter [1] */
@@ -58,15 +58,16 @@ CD_INLINE cd_long cd_obs_block_end(cd_long b, cd_long n)
 
 /* Block b of the particles: kinetic and potential energy in gravity
  * [m/s^2], momentum. */
-CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 gravity,
-                                      const CD_GLOBAL cd_int *touch, CD_GLOBAL cd_real *acc, cd_order o)
+CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 gravity, const CD_GLOBAL cd_int *touch,
+                                      CD_GLOBAL cd_real *acc, cd_order o)
 {
     cd_obs_clear(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long q = cd_map(o.part_at, u);
         cd_vec3 v = c.velocity[q];
         cd_real m = c.mass[q];
-        cd_real kt = CD_R(0.5) * m * cd_v3_norm2(v), kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], c.inertia[q]);
+        cd_real kt = CD_R(0.5) * m * cd_v3_norm2(v),
+                kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], c.inertia[q]);
         acc[CD_OBS_KT] += kt;
         acc[CD_OBS_KR] += kr;
         if (touch[q]) acc[CD_OBS_KC] += kt + kr;
@@ -86,7 +87,8 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
         cd_long k = cd_map(o.pair_at, u);
         if (!c.pair_active[k]) continue;
         cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
-        acc[CD_OBS_EL] += cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
+        acc[CD_OBS_EL] +=
+            cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
         acc[CD_OBS_NC] += 1;
         cd_real ratio = c.pair_overlap[k] / (2 * (ri < rj ? ri : rj));
         if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
@@ -102,8 +104,7 @@ CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_wall
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
         if (!c.wallc_active[r]) continue;
-        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.prim_radius[i], c.wallc_overlap[r],
-                                                     c.wallc_shear[r]);
+        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.prim_radius[i], c.wallc_overlap[r], c.wallc_shear[r]);
         acc[CD_OBS_NW] += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
         acc[CD_OBS_WALL + 3 * w + 0] -= c.wallc_force[r].x;

@@ -5,16 +5,22 @@
 
 CD_DEVICE_BEGIN
 
-CD_INLINE cd_quat cd_q(cd_real w, cd_real x, cd_real y, cd_real z) { cd_quat q; q.w = w; q.x = x; q.y = y; q.z = z; return q; }
+CD_INLINE cd_quat cd_q(cd_real w, cd_real x, cd_real y, cd_real z)
+{
+    cd_quat q;
+    q.w = w;
+    q.x = x;
+    q.y = y;
+    q.z = z;
+    return q;
+}
 CD_INLINE cd_quat cd_q_identity(void) { return cd_q(1, 0, 0, 0); }
 
 /* Hamilton product a*b: rotation b first, then a. */
 CD_INLINE cd_quat cd_q_mul(cd_quat a, cd_quat b)
 {
-    return cd_q(a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
-                a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
-                a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
-                a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w);
+    return cd_q(a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+                a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w);
 }
 
 CD_INLINE cd_quat cd_q_normalize(cd_quat q)
@@ -52,19 +58,32 @@ CD_INLINE void cd_sincos(cd_real x, cd_real *sin_x, cd_real *cos_x)
     cd_real z = r * r;
     cd_real ps = CD_R(-7.647163731819816e-13) + z * (CD_R(2.8114572543455206e-15) + z * CD_R(-8.22063524662433e-18));
     ps = CD_R(-1.9841269841269841e-04) +
-         z * (CD_R(2.7557319223985893e-06) + z * (CD_R(-2.505210838544172e-08) + z * (CD_R(1.6059043836821613e-10) + z * ps)));
+         z * (CD_R(2.7557319223985893e-06) +
+              z * (CD_R(-2.505210838544172e-08) + z * (CD_R(1.6059043836821613e-10) + z * ps)));
     cd_real sr = r + r * z * (CD_R(-0.16666666666666666) + z * (CD_R(8.3333333333333332e-03) + z * ps));
     cd_real pc = CD_R(-1.1470745597729725e-11) + z * (CD_R(4.779477332387385e-14) + z * CD_R(-1.5619206968586225e-16));
     pc = CD_R(-1.3888888888888889e-03) +
-         z * (CD_R(2.4801587301587302e-05) + z * (CD_R(-2.755731922398589e-07) + z * (CD_R(2.08767569878681e-09) + z * pc)));
+         z * (CD_R(2.4801587301587302e-05) +
+              z * (CD_R(-2.755731922398589e-07) + z * (CD_R(2.08767569878681e-09) + z * pc)));
     cd_real cr = CD_R(1) + z * (CD_R(-0.5) + z * (CD_R(4.1666666666666664e-02) + z * pc));
     /* quadrant: k mod 4 (exact for |k| < 2^53; a non-finite x gives NaN) */
     cd_real m = k - CD_R(4) * floor(CD_R(0.25) * k);
-    if (m == CD_R(0)) { *sin_x = sr; *cos_x = cr; }
-    else if (m == CD_R(1)) { *sin_x = cr; *cos_x = -sr; }
-    else if (m == CD_R(2)) { *sin_x = -sr; *cos_x = -cr; }
-    else if (m == CD_R(3)) { *sin_x = -cr; *cos_x = sr; }
-    else { *sin_x = x - x; *cos_x = x - x; } /* x not finite: NaN */
+    if (m == CD_R(0)) {
+        *sin_x = sr;
+        *cos_x = cr;
+    } else if (m == CD_R(1)) {
+        *sin_x = cr;
+        *cos_x = -sr;
+    } else if (m == CD_R(2)) {
+        *sin_x = -sr;
+        *cos_x = -cr;
+    } else if (m == CD_R(3)) {
+        *sin_x = -cr;
+        *cos_x = sr;
+    } else {
+        *sin_x = x - x;
+        *cos_x = x - x;
+    } /* x not finite: NaN */
 }
 
 /* Rotation by angle [rad] about a unit axis. */
@@ -83,10 +102,7 @@ CD_INLINE cd_vec3 cd_q_rotate(cd_quat q, cd_vec3 v)
 }
 
 /* v rotated from world to body frame: q^-1 v q. */
-CD_INLINE cd_vec3 cd_q_rotate_inv(cd_quat q, cd_vec3 v)
-{
-    return cd_q_rotate(cd_q(q.w, -q.x, -q.y, -q.z), v);
-}
+CD_INLINE cd_vec3 cd_q_rotate_inv(cd_quat q, cd_vec3 v) { return cd_q_rotate(cd_q(q.w, -q.x, -q.y, -q.z), v); }
 
 CD_DEVICE_END
 #endif

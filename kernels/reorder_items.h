@@ -44,8 +44,8 @@ CD_INLINE cd_long cd_map(const CD_GLOBAL cd_int *map, cd_long x) { return map ? 
  * particle's neighbours at a few fixed strides in memory (the next cell,
  * row and layer), which the CPU's prefetchers follow; Morton's jumps made
  * the step 0.67x as fast on a 1e5 bed (docs/performance.md). */
-CD_INLINE void cd_reorder_item_key(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_grid *grid,
-                                   CD_GLOBAL cd_ulong *keys, CD_GLOBAL cd_int *vals)
+CD_INLINE void cd_reorder_item_key(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_grid *grid, CD_GLOBAL cd_ulong *keys,
+                                   CD_GLOBAL cd_int *vals)
 {
     cd_grid g = grid[0];
     keys[q] = (cd_ulong)cd_grid_cell_of(&g, c.position[q]);
@@ -59,8 +59,8 @@ CD_INLINE void cd_reorder_item_key(cd_cols c, cd_particle_id q, const CD_GLOBAL 
  * independent of the chunking: ties keep their memory order, so the
  * permutation is the same on every run and backend. */
 #define CD_RADIX_BINS 256
-CD_INLINE void cd_reorder_item_hist(const CD_GLOBAL cd_ulong *keys, cd_int n, cd_int chunk, cd_int n_chunks,
-                                    cd_int g, int shift, CD_GLOBAL cd_int *hist)
+CD_INLINE void cd_reorder_item_hist(const CD_GLOBAL cd_ulong *keys, cd_int n, cd_int chunk, cd_int n_chunks, cd_int g,
+                                    int shift, CD_GLOBAL cd_int *hist)
 {
     for (cd_int d = 0; d < CD_RADIX_BINS; d++) hist[d * n_chunks + g] = 0;
     cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n;

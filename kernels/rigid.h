@@ -56,9 +56,19 @@ CD_INLINE void cd_rigid_cayley_axis(cd_quat *q, cd_vec3 *Lb, int k, cd_real a)
     cd_vec3 v = *Lb;
     cd_quat r = *q;
     cd_real tau, li, lj; /* (i, j, k) cyclic */
-    if (k == 0) { tau = a * v.x; li = v.y; lj = v.z; }
-    else if (k == 1) { tau = a * v.y; li = v.z; lj = v.x; }
-    else { tau = a * v.z; li = v.x; lj = v.y; }
+    if (k == 0) {
+        tau = a * v.x;
+        li = v.y;
+        lj = v.z;
+    } else if (k == 1) {
+        tau = a * v.y;
+        li = v.z;
+        lj = v.x;
+    } else {
+        tau = a * v.z;
+        li = v.x;
+        lj = v.y;
+    }
     if (tau == CD_R(0)) return; /* the identity (2D: the x and y sub-rotations) */
     cd_real t2 = tau * tau, den = CD_R(1) / (CD_R(1) + t2);
     cd_real c = (CD_R(1) - t2) * den, s = CD_R(2) * tau * den;

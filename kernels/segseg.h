@@ -120,8 +120,7 @@ CD_INLINE cd_real cd_segseg_normalize(cd_vec3 v, cd_vec3 *u)
         cd_vec3 vs;
         cd_real l;
         mx = mx > az ? mx : az;
-        if (mx == CD_R(0))
-            return CD_R(0);
+        if (mx == CD_R(0)) return CD_R(0);
         vs = cd_v3(v.x / mx, v.y / mx, v.z / mx);
         l = sqrt(cd_v3_dot(vs, vs));
         *u = cd_v3(vs.x / l, vs.y / l, vs.z / l);
@@ -139,23 +138,15 @@ CD_INLINE cd_vec3 cd_segseg_any_perpendicular(cd_vec3 u)
     cd_real ax = fabs(u.x), ay = fabs(u.y), az = fabs(u.z);
     cd_vec3 f, n;
     cd_real big;
-    if (ax >= ay && ax >= az)
-        big = u.x;
-    else if (ay >= az)
-        big = u.y;
-    else
-        big = u.z;
-    if (big == CD_R(0))
-        return cd_v3(0, 0, 1);
-    if (big < CD_R(0))
-        u = cd_v3_neg(u);
+    if (ax >= ay && ax >= az) big = u.x;
+    else if (ay >= az) big = u.y;
+    else big = u.z;
+    if (big == CD_R(0)) return cd_v3(0, 0, 1);
+    if (big < CD_R(0)) u = cd_v3_neg(u);
     /* u x e_k for the smallest |u_k| */
-    if (ax <= ay && ax <= az)
-        f = cd_v3(0, u.z, -u.y);
-    else if (ay <= az)
-        f = cd_v3(-u.z, 0, u.x);
-    else
-        f = cd_v3(u.y, -u.x, 0);
+    if (ax <= ay && ax <= az) f = cd_v3(0, u.z, -u.y);
+    else if (ay <= az) f = cd_v3(-u.z, 0, u.x);
+    else f = cd_v3(u.y, -u.x, 0);
     n = cd_v3(0, 0, 1);
     cd_segseg_normalize(f, &n);
     return n;
@@ -191,10 +182,8 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
     } else {
         n = cd_segseg_any_perpendicular(a >= e ? d1 : d2);
         sd = cd_v3_dot(n, wm);
-        if (sd == CD_R(0))
-            sd = wm.x != CD_R(0) ? wm.x : (wm.y != CD_R(0) ? wm.y : wm.z);
-        if (sd == CD_R(0))
-            sd = a - e;
+        if (sd == CD_R(0)) sd = wm.x != CD_R(0) ? wm.x : (wm.y != CD_R(0) ? wm.y : wm.z);
+        if (sd == CD_R(0)) sd = a - e;
     }
     return sd < CD_R(0) ? cd_v3_neg(n) : n;
 }
@@ -214,10 +203,8 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
 CD_INLINE cd_real cd_parallel_weight(cd_real cross2, cd_real norm2, cd_real sin_parallel, cd_int blend)
 {
     cd_real sp2 = sin_parallel * sin_parallel;
-    if (!(sin_parallel > CD_R(0)) || !(cross2 < (blend ? CD_R(4) : CD_R(1)) * sp2 * norm2))
-        return CD_R(0);
-    if (cross2 < sp2 * norm2)
-        return CD_R(1);
+    if (!(sin_parallel > CD_R(0)) || !(cross2 < (blend ? CD_R(4) : CD_R(1)) * sp2 * norm2)) return CD_R(0);
+    if (cross2 < sp2 * norm2) return CD_R(1);
     return CD_R(2) - sqrt(cross2 / norm2) / sin_parallel;
 }
 
@@ -270,8 +257,8 @@ CD_INLINE void cd_segseg_contact_closest(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_
     g->parallel = 0;
 }
 
-CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
-                                    cd_real s, cd_real t, cd_real sin_parallel, cd_int blend, cd_contact_geom *g)
+CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj, cd_real s,
+                                    cd_real t, cd_real sin_parallel, cd_int blend, cd_contact_geom *g)
 {
     cd_vec3 d1 = cd_v3_sub(p1, p0);
     cd_vec3 d2 = cd_v3_sub(q1, q0);
@@ -280,8 +267,8 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
         cd_real aa = cd_v3_dot(d1, d1);
         cd_real ee = cd_v3_dot(d2, d2);
         cd_vec3 m = cd_v3_cross(d1, d2);
-        cd_real wpar = aa > CD_R(0) && ee > CD_R(0) ? cd_parallel_weight(cd_v3_dot(m, m), aa * ee, sin_parallel, blend)
-                                                    : CD_R(0);
+        cd_real wpar =
+            aa > CD_R(0) && ee > CD_R(0) ? cd_parallel_weight(cd_v3_dot(m, m), aa * ee, sin_parallel, blend) : CD_R(0);
         if (wpar > CD_R(0)) {
             /* section of axis i covered by j, and of axis j covered by i */
             cd_real u0 = cd_v3_dot(cd_v3_sub(q0, p0), d1) / aa;
@@ -355,8 +342,8 @@ CD_INLINE void cd_segseg_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0,
  * same sum, is within a few 1e-16 of it), so skipping it changes no result;
  * it spares the square root, the divisions and the parallel rule of the
  * separated rows, most rows of a Verlet list with a skin. */
-CD_INLINE int cd_segseg_clearly_apart(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
-                                      cd_real s, cd_real t)
+CD_INLINE int cd_segseg_clearly_apart(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj, cd_real s,
+                                      cd_real t)
 {
     cd_vec3 a = cd_v3_axpy(p0, s, cd_v3_sub(p1, p0));
     cd_vec3 b = cd_v3_axpy(q0, t, cd_v3_sub(q1, q0));
@@ -372,15 +359,14 @@ CD_INLINE int cd_segseg_clearly_apart(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec
  * needs two axes of non-zero length (its weight is 0 for a point).
  * Returns 1 when the two are clearly apart (g is then not filled), 0
  * after filling g. */
-CD_INLINE int cd_segseg_point_segment_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1,
-                                              cd_real rj, cd_contact_geom *g)
+CD_INLINE int cd_segseg_point_segment_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj,
+                                              cd_contact_geom *g)
 {
     cd_vec3 d1 = cd_v3_sub(p1, p0), d2 = cd_v3_sub(q1, q0), w = cd_v3_sub(q0, p0);
     cd_real a = cd_v3_dot(d1, d1), e = cd_v3_dot(d2, d2), s = CD_R(0), t = CD_R(0);
     if (a <= CD_R(0)) /* i is the point: p0 projected onto j */
         t = cd_clamp01(-cd_v3_dot(w, d2) / e);
-    else /* j is the point: q0 projected onto i */
-        s = cd_clamp01(cd_v3_dot(w, d1) / a);
+    else /* j is the point: q0 projected onto i */ s = cd_clamp01(cd_v3_dot(w, d1) / a);
     if (cd_segseg_clearly_apart(p0, p1, ri, q0, q1, rj, s, t)) return 1;
     cd_segseg_contact_closest(p0, p1, ri, q0, q1, rj, s, t, g);
     return 0;

@@ -174,7 +174,8 @@ CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall 
     cd_wall wall = walls[row % n_walls]; /* private copy: the wall functions take private pointers */
     cd_contact_geom g;
     int apart = cd_wall_clearly_apart(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
-    if (!apart) cd_wall_contact_rule(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, parallel_blend, &g);
+    if (!apart)
+        cd_wall_contact_rule(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, parallel_blend, &g);
     if (apart || !(g.overlap > 0)) {
         /* written only when it changes, to spare the bandwidth */
         if (c.wallc_active[row]) cd_wall_row_clear(c, row);

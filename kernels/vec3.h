@@ -5,13 +5,23 @@
 
 CD_DEVICE_BEGIN
 
-CD_INLINE cd_vec3 cd_v3(cd_real x, cd_real y, cd_real z) { cd_vec3 r; r.x = x; r.y = y; r.z = z; return r; }
+CD_INLINE cd_vec3 cd_v3(cd_real x, cd_real y, cd_real z)
+{
+    cd_vec3 r;
+    r.x = x;
+    r.y = y;
+    r.z = z;
+    return r;
+}
 CD_INLINE cd_vec3 cd_v3_zero(void) { return cd_v3(0, 0, 0); }
 CD_INLINE cd_vec3 cd_v3_add(cd_vec3 a, cd_vec3 b) { return cd_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
 CD_INLINE cd_vec3 cd_v3_sub(cd_vec3 a, cd_vec3 b) { return cd_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
 CD_INLINE cd_vec3 cd_v3_scale(cd_vec3 a, cd_real s) { return cd_v3(a.x * s, a.y * s, a.z * s); }
 /* a + s b */
-CD_INLINE cd_vec3 cd_v3_axpy(cd_vec3 a, cd_real s, cd_vec3 b) { return cd_v3(a.x + s * b.x, a.y + s * b.y, a.z + s * b.z); }
+CD_INLINE cd_vec3 cd_v3_axpy(cd_vec3 a, cd_real s, cd_vec3 b)
+{
+    return cd_v3(a.x + s * b.x, a.y + s * b.y, a.z + s * b.z);
+}
 CD_INLINE cd_vec3 cd_v3_neg(cd_vec3 a) { return cd_v3(-a.x, -a.y, -a.z); }
 CD_INLINE cd_real cd_v3_dot(cd_vec3 a, cd_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 CD_INLINE cd_vec3 cd_v3_cross(cd_vec3 a, cd_vec3 b)

@@ -109,8 +109,7 @@ CD_INLINE void cd_wall_plane_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_
 CD_INLINE cd_vec3 cd_wall_radial(const cd_wall *w, cd_vec3 x)
 {
     cd_vec3 rel = cd_v3_sub(x, w->point);
-    if (w->type == CD_WALL_CYLINDER)
-        rel = cd_v3_axpy(rel, -cd_v3_dot(rel, w->normal), w->normal);
+    if (w->type == CD_WALL_CYLINDER) rel = cd_v3_axpy(rel, -cd_v3_dot(rel, w->normal), w->normal);
     return rel;
 }
 
@@ -181,7 +180,7 @@ CD_INLINE int cd_wall_clearly_apart(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_r
     if (w->type == CD_WALL_CYLINDER || w->type == CD_WALL_SPHERE) {
         cd_vec3 ra = cd_wall_radial(w, a), rb = cd_wall_radial(w, b);
         cd_real ra2 = cd_v3_dot(ra, ra), rb2 = cd_v3_dot(rb, rb); /* [m^2] */
-        cd_real q = w->radius - r - CD_R(1e-5) * w->radius;        /* [m] */
+        cd_real q = w->radius - r - CD_R(1e-5) * w->radius;       /* [m] */
         return q > CD_R(0) && (ra2 >= rb2 ? ra2 : rb2) < q * q;
     }
     return 1; /* unknown type: cd_wall_contact reports CD_WALL_FAR */
@@ -226,8 +225,7 @@ CD_INLINE cd_vec3 cd_wall_velocity_at(const cd_wall *w, cd_vec3 point)
     cd_vec3 v = w->velocity;
     if (w->type == CD_WALL_SPHERE) {
         cd_vec3 e = cd_v3_zero();
-        if (cd_segseg_normalize(cd_v3_sub(point, w->point), &e) > CD_R(0))
-            v = cd_v3_axpy(v, w->radial_velocity, e);
+        if (cd_segseg_normalize(cd_v3_sub(point, w->point), &e) > CD_R(0)) v = cd_v3_axpy(v, w->radial_velocity, e);
     }
     return v;
 }

@@ -36,7 +36,7 @@ int cd_cmd_analyze(int argc, char **argv);
 typedef struct {
     char name[48];
     double value;
-    char unit[24];          /* SI unit, "1" for dimensionless */
+    char unit[24]; /* SI unit, "1" for dimensionless */
 } cd_an_scalar;
 
 typedef struct {
@@ -66,8 +66,8 @@ typedef struct {
 typedef struct {
     int n_groups;
     cd_an_group *groups;
-    long long step;         /* of the analysed snapshot */
-    double time;            /* [s] */
+    long long step; /* of the analysed snapshot */
+    double time;    /* [s] */
     int snapshot, n_snapshots;
 } cd_an_report;
 
@@ -102,39 +102,39 @@ typedef struct {
     double bounding_radius; /* [m] */
     int n_arms;
     double arms[CD_MAX_ARMS][7]; /* body frame a (3), b (3), radius [m] */
-    double area2d;          /* slice z = 0 of the body frame [m^2] (2D packing fraction), 0 until computed */
+    double area2d;               /* slice z = 0 of the body frame [m^2] (2D packing fraction), 0 until computed */
 } cd_an_shape;
 
 typedef struct {
     char path[CD_PATH_MAX];
     int snapshot, n_snapshots;
     long long step;
-    double time;            /* [s] */
-    cd_config cfg;          /* the run's config as echoed in the file */
-    int cfg_ok;             /* 0: the echoed config did not parse; cfg holds defaults */
+    double time;   /* [s] */
+    cd_config cfg; /* the run's config as echoed in the file */
+    int cfg_ok;    /* 0: the echoed config did not parse; cfg holds defaults */
     int n_shapes;
     cd_an_shape *shapes;
-    size_t n;               /* particles */
-    cd_vec3 *pos;           /* centres [m] */
-    double *scale;          /* length scale factors [1] */
-    int32_t *shape;         /* shape index */
+    size_t n;       /* particles */
+    cd_vec3 *pos;   /* centres [m] */
+    double *scale;  /* length scale factors [1] */
+    int32_t *shape; /* shape index */
     size_t n_prims;
     cd_vec3 *prim_a, *prim_b; /* world axis ends [m] */
-    double *prim_radius;    /* [m] */
+    double *prim_radius;      /* [m] */
     int32_t *prim_particle;
-    size_t nc;              /* particle-particle contacts of the snapshot */
-    int32_t *ci, *cj;       /* particles; the normal points from ci to cj */
-    double *fn;             /* normal force magnitude [N] */
-    cd_vec3 *normal;        /* unit normal [1] */
-    cd_vec3 *ft;            /* tangential force on cj [N] */
-    cd_vec3 *point;         /* contact point [m] */
-    size_t nw;              /* primitive-wall contacts */
+    size_t nc;        /* particle-particle contacts of the snapshot */
+    int32_t *ci, *cj; /* particles; the normal points from ci to cj */
+    double *fn;       /* normal force magnitude [N] */
+    cd_vec3 *normal;  /* unit normal [1] */
+    cd_vec3 *ft;      /* tangential force on cj [N] */
+    cd_vec3 *point;   /* contact point [m] */
+    size_t nw;        /* primitive-wall contacts */
     int32_t *w_prim, *w_wall;
-    cd_vec3 *w_force;       /* force of the wall on the primitive [N] */
-    cd_vec3 *w_point;       /* contact point [m] (recomputed, see cd_an_wall_points) */
+    cd_vec3 *w_force; /* force of the wall on the primitive [N] */
+    cd_vec3 *w_point; /* contact point [m] (recomputed, see cd_an_wall_points) */
     int n_walls;
-    cd_wall *walls;         /* walls at the snapshot */
-    int n_control;          /* protocol state of the snapshot (/walls/control, docs/protocols.md), 0 if absent */
+    cd_wall *walls; /* walls at the snapshot */
+    int n_control;  /* protocol state of the snapshot (/walls/control, docs/protocols.md), 0 if absent */
     double control[64];
 } cd_an_snapshot;
 
@@ -156,18 +156,18 @@ typedef enum { CD_AN_FREE, CD_AN_BOX2D, CD_AN_PSEUDO2D, CD_AN_BOX3D, CD_AN_CYLIN
 
 typedef struct {
     cd_an_kind kind;
-    int dim;                 /* 2 for BOX2D (x-y plane), else 3 */
-    double L;                /* reference length: tip-to-tip length of the largest shape [m] */
-    double lo[3], hi[3];     /* box extents, hi[1] the effective top; cylinder: lo[1] floor, hi[1] top [m] */
-    cd_vec3 centre;          /* cylinder: point on the axis (axis along y); ball: centre [m] */
-    double radius;           /* cylinder or ball radius [m] */
-    double top_wall;         /* lowest plane wall facing down (lid or piston), HUGE_VAL if none [m] */
-    double top_particles;    /* highest point of any particle [m] */
+    int dim;                        /* 2 for BOX2D (x-y plane), else 3 */
+    double L;                       /* reference length: tip-to-tip length of the largest shape [m] */
+    double lo[3], hi[3];            /* box extents, hi[1] the effective top; cylinder: lo[1] floor, hi[1] top [m] */
+    cd_vec3 centre;                 /* cylinder: point on the axis (axis along y); ball: centre [m] */
+    double radius;                  /* cylinder or ball radius [m] */
+    double top_wall;                /* lowest plane wall facing down (lid or piston), HUGE_VAL if none [m] */
+    double top_particles;           /* highest point of any particle [m] */
     double margin_side, margin_end; /* core region: distance kept from side walls and from floor/top [m] */
-    double volume;           /* container (2D: area [m^2]) [m^3] */
-    double core_volume;      /* core region (2D: area [m^2]) [m^3] */
-    double plane_z;          /* BOX2D: z of the particles' plane [m] */
-    char note[256];          /* why there is no container or no core, "" otherwise */
+    double volume;                  /* container (2D: area [m^2]) [m^3] */
+    double core_volume;             /* core region (2D: area [m^2]) [m^3] */
+    double plane_z;                 /* BOX2D: z of the particles' plane [m] */
+    char note[256];                 /* why there is no container or no core, "" otherwise */
 } cd_an_geometry;
 
 /* Margins in units of L; negative: the defaults of SPEC 7 (10 L from every
@@ -182,14 +182,14 @@ const char *cd_an_kind_name(cd_an_kind k);
 /* ---- cell lists -------------------------------------------------------- */
 
 typedef struct {
-    int dim;                 /* 2: cells in x-y only */
-    double lo[3];            /* [m] */
-    double cs;               /* cell size [m] */
+    int dim;      /* 2: cells in x-y only */
+    double lo[3]; /* [m] */
+    double cs;    /* cell size [m] */
     int n[3];
     size_t ncell;
-    size_t *start;           /* ncell + 1 */
-    size_t *item;            /* point indices sorted by cell */
-    cd_vec3 *x;              /* the points in that order: a row of cells along x is one contiguous range */
+    size_t *start; /* ncell + 1 */
+    size_t *item;  /* point indices sorted by cell */
+    cd_vec3 *x;    /* the points in that order: a row of cells along x is one contiguous range */
 } cd_an_cells;
 
 /* Cells of size at least cs over the points (grown when the box would need
@@ -205,11 +205,11 @@ void cd_an_cells_free(cd_an_cells *c);
 /* ---- bonds (pairs of touching particles) -------------------------------- */
 
 typedef struct {
-    size_t n;                /* bonds */
-    int32_t *i, *j;          /* the two particles, i < j */
-    int32_t *k;              /* valence: number of contacts of the bond */
-    cd_vec3 *force;          /* vector sum of the contact forces on j [N] */
-    size_t *first;           /* contacts of bond b: order[first[b] .. first[b] + k[b]) */
+    size_t n;       /* bonds */
+    int32_t *i, *j; /* the two particles, i < j */
+    int32_t *k;     /* valence: number of contacts of the bond */
+    cd_vec3 *force; /* vector sum of the contact forces on j [N] */
+    size_t *first;  /* contacts of bond b: order[first[b] .. first[b] + k[b]) */
     size_t *order;
 } cd_an_bonds;
 
@@ -236,16 +236,16 @@ enum {
 };
 
 typedef struct {
-    int snapshot;            /* index, < 0 from the end (-1: last) */
-    unsigned measures;       /* CD_AN_* bits */
-    int strict;              /* 1: a measure that cannot be computed fails the run (exit 2) */
-    double margin_side, margin_end; /* core margins [L], < 0: SPEC defaults */
-    double rdf_max, rdf_bin; /* G(r) range and bin [L], <= 0: defaults */
-    long mc_points;          /* Monte Carlo points for the core packing fraction */
-    int write;               /* 1: write /analysis into the run file */
-    int json;                /* 1: JSON on stdout instead of the text summary */
-    int quiet;               /* 1: no text summary, no warnings on stderr */
-    int timings;             /* 1: wall-clock time of each phase on stderr */
+    int snapshot;                      /* index, < 0 from the end (-1: last) */
+    unsigned measures;                 /* CD_AN_* bits */
+    int strict;                        /* 1: a measure that cannot be computed fails the run (exit 2) */
+    double margin_side, margin_end;    /* core margins [L], < 0: SPEC defaults */
+    double rdf_max, rdf_bin;           /* G(r) range and bin [L], <= 0: defaults */
+    long mc_points;                    /* Monte Carlo points for the core packing fraction */
+    int write;                         /* 1: write /analysis into the run file */
+    int json;                          /* 1: JSON on stdout instead of the text summary */
+    int quiet;                         /* 1: no text summary, no warnings on stderr */
+    int timings;                       /* 1: wall-clock time of each phase on stderr */
     const char *phi_series, *z_series; /* observables for the jamming fit (NULL: known names) */
 } cd_an_options;
 
@@ -260,7 +260,7 @@ typedef struct {
     const cd_an_geometry *g;
     const cd_an_bonds *b;
     const cd_an_options *opt;
-    double mean_fn;          /* mean normal contact force <F_n> [N] */
+    double mean_fn; /* mean normal contact force <F_n> [N] */
 } cd_an_input;
 
 int cd_an_forces(const cd_an_input *in, cd_an_report *r, char *err, size_t errlen);
@@ -297,8 +297,8 @@ int cd_an_print_json(const cd_an_report *rep, const char *path, void *stream);
 
 /* Exponential tail P(f) ~ exp(-k f) above fmin. */
 typedef struct {
-    double k, lo, hi;        /* estimate and 95% interval [1] */
-    size_t n;                /* samples (MLE) or bins (WLS) used */
+    double k, lo, hi; /* estimate and 95% interval [1] */
+    size_t n;         /* samples (MLE) or bins (WLS) used */
 } cd_an_exp_fit;
 
 /* Maximum likelihood on the samples f > fmin: f - fmin is exponential with
@@ -308,16 +308,16 @@ int cd_an_fit_exp_tail_mle(const double *f, size_t n, double fmin, cd_an_exp_fit
 /* Weighted least squares of log P on the non-empty bins with centre > fmin
  * (weights = counts, the inverse variance of log of a Poisson count);
  * interval from Student's t with bins - 2 degrees of freedom. */
-int cd_an_fit_exp_tail_wls(const double *centre, const double *counts, int nb, double width, double total,
-                           double fmin, cd_an_exp_fit *out);
+int cd_an_fit_exp_tail_wls(const double *centre, const double *counts, int nb, double width, double total, double fmin,
+                           cd_an_exp_fit *out);
 
 /* Nonlinear least-squares result (up to 4 parameters). */
 typedef struct {
     int np;
     double p[4], se[4], lo[4], hi[4]; /* estimate, standard error, 95% interval */
-    double chi2;             /* weighted sum of squared residuals */
+    double chi2;                      /* weighted sum of squared residuals */
     int dof;
-    size_t n;                /* points used */
+    size_t n; /* points used */
 } cd_an_nlfit;
 
 /* Puts fit parameter k as names[k], with its 95% interval as
@@ -326,14 +326,14 @@ void cd_an_put_fit(cd_an_group *g, const char *const *names, const cd_an_nlfit *
 
 /* Mueth's P = a (1 - b exp(-f^2)) exp(-beta f) on a density histogram
  * (bin centres, counts, total samples, bin width); p = {a, b, beta}. */
-int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double width, double total,
-                    double beta_guess, cd_an_nlfit *out);
+int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double width, double total, double beta_guess,
+                    cd_an_nlfit *out);
 
 /* Cascade model (seed 001, eq. 12-13) with the force normalised to mean 1. */
 double cd_an_cascade_beta(double gamma);
 double cd_an_cascade_pdf(double f, double gamma);
 typedef struct {
-    double gamma, lo, hi;    /* maximum likelihood and 95% profile-likelihood interval [1] */
+    double gamma, lo, hi; /* maximum likelihood and 95% profile-likelihood interval [1] */
     double beta, beta_lo, beta_hi;
     size_t n;
 } cd_an_cascade_fit;

@@ -34,10 +34,10 @@ static const struct {
     int needs_contacts;
     measure_fn fn;
 } measures[] = {
-    {"forces", CD_AN_FORCES, 1, cd_an_forces},     {"bonds", CD_AN_BONDS, 1, cd_an_bond_forces},
-    {"stress", CD_AN_STRESS, 1, cd_an_stress},     {"rdf", CD_AN_RDF, 0, cd_an_rdf},
-    {"branch", CD_AN_BRANCH, 1, cd_an_branch},     {"network", CD_AN_NETWORK, 1, cd_an_network},
-    {"packing", CD_AN_PACKING, 0, cd_an_packing},  {"modulus", CD_AN_MODULUS, 1, cd_an_modulus},
+    {"forces", CD_AN_FORCES, 1, cd_an_forces},       {"bonds", CD_AN_BONDS, 1, cd_an_bond_forces},
+    {"stress", CD_AN_STRESS, 1, cd_an_stress},       {"rdf", CD_AN_RDF, 0, cd_an_rdf},
+    {"branch", CD_AN_BRANCH, 1, cd_an_branch},       {"network", CD_AN_NETWORK, 1, cd_an_network},
+    {"packing", CD_AN_PACKING, 0, cd_an_packing},    {"modulus", CD_AN_MODULUS, 1, cd_an_modulus},
     {"compaction", CD_AN_COMPACTION, 0, compaction}, {"jamming", CD_AN_JAMMING, 0, jamming},
 };
 #define N_MEASURES (sizeof measures / sizeof measures[0])
@@ -204,8 +204,8 @@ int cd_analyze_file(const char *path, const cd_an_options *opt, cd_an_report *re
 /* Human-readable summary: every scalar and text, group by group. */
 static void print_summary(const cd_an_report *rep, const char *path)
 {
-    printf("%s: snapshot %d (of 0..%d), step %lld, time %.6g s\n", path, rep->snapshot, rep->n_snapshots - 1,
-           rep->step, rep->time);
+    printf("%s: snapshot %d (of 0..%d), step %lld, time %.6g s\n", path, rep->snapshot, rep->n_snapshots - 1, rep->step,
+           rep->time);
     for (int k = 0; k < rep->n_groups; k++) {
         const cd_an_group *g = &rep->groups[k];
         printf("[%s]\n", g->name);
@@ -256,7 +256,8 @@ int cd_cmd_analyze(int argc, char **argv)
             char err[256];
             /* the strict parser of every command line (src/config/config_cli.c):
              * no 1e3, 2x or blanks; negative counts from the end */
-            if (strcmp(t, "last") && cd_parse_cli_int("--snapshot", t, -2147483647LL, 2147483647LL, &k, err, sizeof err)) {
+            if (strcmp(t, "last") &&
+                cd_parse_cli_int("--snapshot", t, -2147483647LL, 2147483647LL, &k, err, sizeof err)) {
                 fprintf(stderr, "capdem analyze: %s (or last)\n", err);
                 return 2;
             }

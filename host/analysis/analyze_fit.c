@@ -55,8 +55,8 @@ int cd_an_fit_exp_tail_mle(const double *f, size_t n, double fmin, cd_an_exp_fit
     return 0;
 }
 
-int cd_an_fit_exp_tail_wls(const double *centre, const double *counts, int nb, double width, double total,
-                           double fmin, cd_an_exp_fit *out)
+int cd_an_fit_exp_tail_wls(const double *centre, const double *counts, int nb, double width, double total, double fmin,
+                           cd_an_exp_fit *out)
 {
     memset(out, 0, sizeof(*out));
     double *x = malloc((size_t)(nb > 0 ? nb : 1) * 3 * sizeof(double));
@@ -67,7 +67,7 @@ int cd_an_fit_exp_tail_wls(const double *centre, const double *counts, int nb, d
         if (centre[b] > fmin && counts[b] > 0) {
             x[m] = centre[b];
             y[m] = log(counts[b] / (total * width)); /* log of the density */
-            w[m] = counts[b];                         /* 1 / var(log count) for Poisson counts */
+            w[m] = counts[b];                        /* 1 / var(log count) for Poisson counts */
             m++;
         }
     out->n = m;
@@ -172,8 +172,8 @@ static int nl_fit(nl_model model, const double *x, const double *y, const double
 
 static double mueth(double f, const double *p) { return p[0] * (1 - p[1] * exp(-f * f)) * exp(-p[2] * f); }
 
-int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double width, double total,
-                    double beta_guess, cd_an_nlfit *out)
+int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double width, double total, double beta_guess,
+                    cd_an_nlfit *out)
 {
     memset(out, 0, sizeof(*out));
     int last = -1;
@@ -214,7 +214,7 @@ int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double w
         double before[3] = {out->p[0], out->p[1], out->p[2]};
         for (size_t k = 0; k < n; k++) {
             double mu = mueth(centre[k], out->p) * norm; /* expected count of bin k */
-            w[k] = norm * norm / (mu > 0 ? mu : 1); /* 1 / variance of the density [1] */
+            w[k] = norm * norm / (mu > 0 ? mu : 1);      /* 1 / variance of the density [1] */
         }
         rc = nl_fit(mueth, centre, y, w, n, 3, before, 1, out);
         double change = 0;
@@ -243,7 +243,7 @@ double cd_an_cascade_pdf(double f, double gamma)
 }
 
 typedef struct {
-    const double *x, *wt;    /* sample values (or bin means) and their multiplicities */
+    const double *x, *wt; /* sample values (or bin means) and their multiplicities */
     size_t n;
 } cascade_data;
 

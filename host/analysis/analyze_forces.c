@@ -18,13 +18,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PF_BINS 50
+#define PF_BINS  50
 #define PF_WIDTH 0.2
 
 /* Density histogram of x (n samples) as a curve (x, P, count) and the
  * raw counts in counts[PF_BINS]. */
-static int density_curve(cd_an_group *g, const char *name, const char *xname, const double *x, size_t n,
-                         double *counts)
+static int density_curve(cd_an_group *g, const char *name, const char *xname, const double *x, size_t n, double *counts)
 {
     size_t under, over;
     cd_an_histogram(x, n, 0, PF_WIDTH, PF_BINS, counts, &under, &over);

@@ -14,12 +14,18 @@
 const char *cd_an_kind_name(cd_an_kind k)
 {
     switch (k) {
-    case CD_AN_BOX2D: return "box-2d";
-    case CD_AN_PSEUDO2D: return "box-pseudo-2d";
-    case CD_AN_BOX3D: return "box-3d";
-    case CD_AN_CYLINDER: return "cylinder";
-    case CD_AN_BALL: return "ball";
-    default: return "free";
+    case CD_AN_BOX2D:
+        return "box-2d";
+    case CD_AN_PSEUDO2D:
+        return "box-pseudo-2d";
+    case CD_AN_BOX3D:
+        return "box-3d";
+    case CD_AN_CYLINDER:
+        return "cylinder";
+    case CD_AN_BALL:
+        return "ball";
+    default:
+        return "free";
     }
 }
 
@@ -72,8 +78,8 @@ static void box_extents(const cd_an_snapshot *s, cd_an_geometry *g)
         const double n[3] = {wl->normal.x, wl->normal.y, wl->normal.z};
         const double p[3] = {wl->point.x, wl->point.y, wl->point.z};
         for (int k = 0; k < 3; k++) {
-            if (n[k] > 0.999 && p[k] > g->lo[k]) g->lo[k] = p[k];   /* faces +k: a lower bound */
-            if (n[k] < -0.999 && p[k] < g->hi[k]) g->hi[k] = p[k];  /* faces -k: an upper bound */
+            if (n[k] > 0.999 && p[k] > g->lo[k]) g->lo[k] = p[k];  /* faces +k: a lower bound */
+            if (n[k] < -0.999 && p[k] < g->hi[k]) g->hi[k] = p[k]; /* faces -k: an upper bound */
         }
     }
 }
@@ -92,7 +98,8 @@ int cd_an_geometry_setup(const cd_an_snapshot *s, double margin_side_L, double m
     box_extents(s, g);
     /* A 2D box has no front and back walls (docs/motion.md): its slab is
      * [0, domain.thickness]. */
-    if (s->cfg_ok && s->cfg.dimension == 2 && s->cfg.domain_kind == CD_DOMAIN_BOX && isinf(g->lo[2]) && isinf(g->hi[2])) {
+    if (s->cfg_ok && s->cfg.dimension == 2 && s->cfg.domain_kind == CD_DOMAIN_BOX && isinf(g->lo[2]) &&
+        isinf(g->hi[2])) {
         g->lo[2] = 0;
         g->hi[2] = s->cfg.box_thickness;
     }
@@ -171,8 +178,10 @@ int cd_an_geometry_setup(const cd_an_snapshot *s, double margin_side_L, double m
     if (g->kind == CD_AN_FREE && !g->note[0])
         snprintf(g->note, sizeof g->note, "domain.type %s has no container", s->cfg_ok ? s->cfg.domain : "(unknown)");
     else if (g->kind == CD_AN_BALL && !(g->core_volume > 0))
-        snprintf(g->note, sizeof g->note, "no core region: the ball is within %.3g L of its wall everywhere; set "
-                 "--margins", ms / L);
+        snprintf(g->note, sizeof g->note,
+                 "no core region: the ball is within %.3g L of its wall everywhere; set "
+                 "--margins",
+                 ms / L);
     else if (g->kind != CD_AN_FREE && !(g->core_volume > 0))
         snprintf(g->note, sizeof g->note,
                  "no core region: the container is within %.3g L (sides) / %.3g L (floor and top) of its walls "

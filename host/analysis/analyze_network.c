@@ -35,8 +35,8 @@ int cd_an_bonds_build(const cd_an_snapshot *s, cd_an_bonds *b, char *err, size_t
     for (size_t c = 0; c < C; c++) {
         int32_t i = s->ci[c], j = s->cj[c];
         if (i < 0 || j < 0 || (size_t)i >= N || (size_t)j >= N || i == j) {
-            snprintf(err, errlen, "%s: contact row %zu of snapshot %d joins particles %d and %d (N = %zu)", s->path,
-                     c, s->snapshot, (int)i, (int)j, N);
+            snprintf(err, errlen, "%s: contact row %zu of snapshot %d joins particles %d and %d (N = %zu)", s->path, c,
+                     s->snapshot, (int)i, (int)j, N);
             return 2;
         }
     }

@@ -82,7 +82,8 @@ static cd_vec3 core_point(const cd_an_geometry *g, cd_rng *r)
                       g->centre.z + cd_rng_range(r, -rc, rc));
         } else if (g->kind == CD_AN_BALL) {
             double rc = g->radius - ms;
-            p = cd_v3_add(g->centre, cd_v3(cd_rng_range(r, -rc, rc), cd_rng_range(r, -rc, rc), cd_rng_range(r, -rc, rc)));
+            p = cd_v3_add(g->centre,
+                          cd_v3(cd_rng_range(r, -rc, rc), cd_rng_range(r, -rc, rc), cd_rng_range(r, -rc, rc)));
         } else {
             int thin = g->kind != CD_AN_BOX3D; /* 2D and pseudo-2D cores span the thickness */
             p = cd_v3(cd_rng_range(r, g->lo[0] + ms, g->hi[0] - ms), cd_rng_range(r, g->lo[1] + me, g->hi[1] - me),
@@ -287,7 +288,9 @@ int cd_an_modulus(const cd_an_input *in, cd_an_report *r, char *err, size_t errl
     }
     if (b->n == 0 || g->kind == CD_AN_FREE || !(g->volume > 0)) {
         snprintf(err, errlen, "%s: no K_t: %s", s->path,
-                 b->n == 0 ? "the snapshot has no contacts" : g->note[0] ? g->note : "no container volume");
+                 b->n == 0    ? "the snapshot has no contacts"
+                 : g->note[0] ? g->note
+                              : "no container volume");
         return 2;
     }
     double sl2 = 0, sl2_core = 0; /* sums of l^2 over contacts [m^2] */
@@ -302,8 +305,8 @@ int cd_an_modulus(const cd_an_input *in, cd_an_report *r, char *err, size_t errl
                     ncore++;
                 }
     }
-    double kc = 0.5 * s->cfg.kn;           /* contact stiffness [N/m] */
-    double d2 = g->dim == 2 ? 4 : 9;       /* dimension squared */
+    double kc = 0.5 * s->cfg.kn;     /* contact stiffness [N/m] */
+    double d2 = g->dim == 2 ? 4 : 9; /* dimension squared */
     const char *unit = g->dim == 2 ? "N/m" : "Pa";
     double nc = (double)s->nc / g->volume; /* [1/m^3], 2D [1/m^2] */
     cd_an_group *grp = cd_an_group_get(r, "modulus");

@@ -55,8 +55,7 @@ static int rd_dims(rd *r, const char *dpath, hsize_t dims[3])
 /* Reads count0 rows from row start0 of dataset dpath (rank 1..3; rows are
  * the first dimension; every other dimension is read whole) as memtype.
  * The dataset must have inner elements per row (1 for rank 1). */
-static int rd_rows(rd *r, const char *dpath, hsize_t start0, hsize_t count0, hsize_t inner, hid_t memtype,
-                   void *buf)
+static int rd_rows(rd *r, const char *dpath, hsize_t start0, hsize_t count0, hsize_t inner, hid_t memtype, void *buf)
 {
     hsize_t dims[3];
     hid_t d = rd_open(r, dpath);
@@ -161,9 +160,9 @@ int cd_an_snapshot_alloc(cd_an_snapshot *s, size_t n, size_t P, size_t nc, size_
 
 void cd_an_snapshot_free(cd_an_snapshot *s)
 {
-    void *p[] = {s->pos, s->scale, s->shape, s->prim_a, s->prim_b, s->prim_radius, s->prim_particle, s->ci, s->cj,
-                 s->fn, s->normal, s->ft, s->point, s->w_prim, s->w_wall, s->w_force, s->w_point, s->walls,
-                 s->shapes};
+    void *p[] = {s->pos,    s->scale,   s->shape,   s->prim_a, s->prim_b, s->prim_radius, s->prim_particle,
+                 s->ci,     s->cj,      s->fn,      s->normal, s->ft,     s->point,       s->w_prim,
+                 s->w_wall, s->w_force, s->w_point, s->walls,  s->shapes};
     for (size_t k = 0; k < sizeof p / sizeof p[0]; k++) free(p[k]);
     cd_config_free(&s->cfg);
     memset(s, 0, sizeof(*s));
@@ -224,7 +223,12 @@ static int rd_all(rd *r, int k, int S, cd_an_snapshot *s)
     hid_t D = H5T_NATIVE_DOUBLE, I = H5T_NATIVE_INT32;
     hsize_t c0 = (hsize_t)coff[0], w0 = (hsize_t)woff[0], K = (hsize_t)kk;
     /* column (fields.def) or dataset (NULL column: path), rows start..start+count-1 */
-    const struct { const char *column, *path; hsize_t start, count, inner; hid_t type; void *buf; } reads[] = {
+    const struct {
+        const char *column, *path;
+        hsize_t start, count, inner;
+        hid_t type;
+        void *buf;
+    } reads[] = {
         {"position", NULL, K, 1, N * 3, D, s->pos},
         {"scale", NULL, 0, N, 1, D, s->scale},
         {"shape", NULL, 0, N, 1, I, s->shape},

@@ -133,8 +133,14 @@ void cd_an_histogram(const double *x, size_t n, double lo, double w, int nb, dou
     for (int b = 0; b < nb; b++) counts[b] = 0;
     for (size_t i = 0; i < n; i++) {
         double t = (x[i] - lo) / w;
-        if (!(t >= 0)) { u++; continue; } /* NaN counts as outside too */
-        if (t >= nb) { o++; continue; }
+        if (!(t >= 0)) {
+            u++;
+            continue;
+        } /* NaN counts as outside too */
+        if (t >= nb) {
+            o++;
+            continue;
+        }
         counts[(int)t] += 1;
     }
     if (under) *under = u;

@@ -24,8 +24,8 @@ typedef struct {
     size_t rows;
     int ncomp;
     long long *step;
-    double *time;            /* [s] */
-    double *value;           /* rows x ncomp */
+    double *time;  /* [s] */
+    double *value; /* rows x ncomp */
 } series;
 
 typedef struct {
@@ -135,8 +135,9 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
             (cd_h5_check_dset(dt, path, pt, H5T_FLOAT, 1, exact, exact, NULL, err, errlen) ||
              cd_h5_check_dset(ds, path, ps, H5T_INTEGER, 1, exact, exact, NULL, err, errlen)))
             rc = 2;
-        if (!rc && s->rows && (H5Dread(dt, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->time) < 0 ||
-                               H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->step) < 0)) {
+        if (!rc && s->rows &&
+            (H5Dread(dt, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->time) < 0 ||
+             H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->step) < 0)) {
             snprintf(err, errlen, "%s: cannot read the clock of %s/%s", path, obs, s->name);
             rc = 2;
         }
@@ -189,12 +190,13 @@ int cd_an_compaction(const char *path, const cd_an_snapshot *snap, const cd_an_g
     char names[MAXCOL][40], units[MAXCOL][16];
     int nc = 0;
     for (int k = 0; k < MAXCOL; k++) col[k] = calloc(R, sizeof(double));
-#define ADD(nm, un) (snprintf(names[nc], sizeof names[0], "%s", nm), snprintf(units[nc], sizeof units[0], "%s", un), col[nc++])
+#define ADD(nm, un)                                                                                                    \
+    (snprintf(names[nc], sizeof names[0], "%s", nm), snprintf(units[nc], sizeof units[0], "%s", un), col[nc++])
     double *t = ADD("time", "s");
     for (size_t i = 0; i < R; i++) t[i] = master->time[i];
     /* the protocol's own series (docs/protocols.md) when the run has them */
-    const char *plain[][2] = {{"contacts", "1"},         {"elastic_energy", "J"}, {"packing_fraction", "1"},
-                              {"coordination", "1"},     {"phase", "1"},          {"wall_load", "N"},
+    const char *plain[][2] = {{"contacts", "1"},     {"elastic_energy", "J"}, {"packing_fraction", "1"},
+                              {"coordination", "1"}, {"phase", "1"},          {"wall_load", "N"},
                               {"pressure", "Pa"}};
     for (size_t k = 0; k < sizeof plain / sizeof plain[0]; k++) {
         const series *s = series_find(&set, plain[k][0]);
@@ -360,7 +362,8 @@ int cd_an_jamming(const char *path, const cd_an_options *opt, cd_an_report *r, c
     }
     cd_an_group *g = cd_an_group_get(r, "jamming");
     if (used < ph->rows)
-        cd_an_put_text(g, "rows_used", "phases compress, hold, compact with a loaded wall (%zu of %zu rows)", used, ph->rows);
+        cd_an_put_text(g, "rows_used", "phases compress, hold, compact with a loaded wall (%zu of %zu rows)", used,
+                       ph->rows);
     cd_an_put_text(g, "phi_series", "%s", ph->name);
     cd_an_put_text(g, "z_series", "%s", z->name);
     static const char *const names[3] = {"phi_c", "z_c", "amplitude"};

@@ -88,7 +88,8 @@ int cd_an_stress(const cd_an_input *in, cd_an_report *r, char *err, size_t errle
         for (size_t p = 0; p < s->n; p++) {
             const double *sg = sigma + 9 * p;
             for (int a = 0; a < 3; a++)
-                for (int b = 0; b < 3; b++) gsl_matrix_set(A, (size_t)a, (size_t)b, 0.5 * (sg[3 * a + b] + sg[3 * b + a]));
+                for (int b = 0; b < 3; b++)
+                    gsl_matrix_set(A, (size_t)a, (size_t)b, 0.5 * (sg[3 * a + b] + sg[3 * b + a]));
             if (!w || !A || !ev || gsl_eigen_symm(A, ev, w)) {
                 nfail++;
                 continue;

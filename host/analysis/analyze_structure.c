@@ -72,12 +72,15 @@ int cd_an_rdf(const cd_an_input *in, cd_an_report *r, char *err, size_t errlen)
     if (nref == 0) {
         free(ref);
         if (g->kind == CD_AN_BALL)
-            snprintf(err, errlen, "%s: no G(r): no particle centre lies in the core region (%.3g L from the ball); "
-                     "set --margins", s->path, g->margin_side / L);
+            snprintf(err, errlen,
+                     "%s: no G(r): no particle centre lies in the core region (%.3g L from the ball); "
+                     "set --margins",
+                     s->path, g->margin_side / L);
         else
-            snprintf(err, errlen, "%s: no G(r): no particle centre lies in the core region (%.3g L from the side "
-                     "walls, %.3g L from floor and top); set --margins", s->path, g->margin_side / L,
-                     g->margin_end / L);
+            snprintf(err, errlen,
+                     "%s: no G(r): no particle centre lies in the core region (%.3g L from the side "
+                     "walls, %.3g L from floor and top); set --margins",
+                     s->path, g->margin_side / L, g->margin_end / L);
         return 2;
     }
     /* Pseudo-2D: the centres fill a slab; its thickness from the spread of
@@ -101,7 +104,7 @@ int cd_an_rdf(const cd_an_input *in, cd_an_report *r, char *err, size_t errlen)
     double *hist = calloc((size_t)nb, sizeof(double));
     int R = (int)ceil(rmax / cells.cs);
     double r2max = rmax * rmax, inv_dr = 1 / dr;
-    const cd_vec3 *X = cells.x;     /* positions in cell order */
+    const cd_vec3 *X = cells.x;      /* positions in cell order */
     const size_t *item = cells.item; /* local copies: the histogram stores cannot alias them */
 #pragma omp parallel
     {
@@ -205,8 +208,8 @@ int cd_an_branch(const cd_an_input *in, cd_an_report *r, char *err, size_t errle
         double l = cd_v3_norm(cd_v3_sub(s->pos[j], s->pos[i]));
         /* per-pair length scale: mean tip-to-tip length of the two
          * particles with their polydisperse scale */
-        double Lij = 0.5 * (s->shapes[s->shape[i]].tip_length * s->scale[i] +
-                            s->shapes[s->shape[j]].tip_length * s->scale[j]);
+        double Lij =
+            0.5 * (s->shapes[s->shape[i]].tip_length * s->scale[i] + s->shapes[s->shape[j]].tip_length * s->scale[j]);
         x[q] = l / L;
         sl += l;
         sl2 += l * l;

@@ -89,8 +89,10 @@ int cd_an_write_h5(const char *path, const cd_an_report *rep, char *err, size_t 
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, fapl), top = -1, snap = -1;
     H5Pclose(fapl);
     if (f < 0) {
-        snprintf(err, errlen, "%s: cannot open the run file for writing the analysis (is a run still writing it, or "
-                 "is it read-only? --no-write skips this)", path);
+        snprintf(err, errlen,
+                 "%s: cannot open the run file for writing the analysis (is a run still writing it, or "
+                 "is it read-only? --no-write skips this)",
+                 path);
         goto done;
     }
     top = open_or_create(f, CDH5_PATH(ANALYSIS));

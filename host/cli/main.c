@@ -51,13 +51,18 @@ static int parse_double(const char *opt, const char *s, double *out)
 
 static int cmd_shape(int argc, char **argv)
 {
-    if (argc < 1) { usage(stderr); return 2; }
+    if (argc < 1) {
+        usage(stderr);
+        return 2;
+    }
     const char *kind = argv[0];
     double aspect = 1, diameter = 0.005, density = 1000; /* [1], [m], [kg/m^3] */
     int json = 0;
     for (int i = 1; i < argc; i++) {
-        double *target = !strcmp(argv[i], "--aspect") ? &aspect : !strcmp(argv[i], "--diameter") ? &diameter
-                       : !strcmp(argv[i], "--density") ? &density : NULL;
+        double *target = !strcmp(argv[i], "--aspect")     ? &aspect
+                         : !strcmp(argv[i], "--diameter") ? &diameter
+                         : !strcmp(argv[i], "--density")  ? &density
+                                                          : NULL;
         if (target && i + 1 < argc) {
             if (parse_double(argv[i], argv[i + 1], target)) return 2;
             i++;
@@ -79,7 +84,8 @@ static int cmd_shape(int argc, char **argv)
     } else {
         printf("%s  aspect %g  diameter %g m  L %g m\n", s.kind, s.aspect, s.diameter, s.tip_length);
         printf("volume %.10g m^3  area %.10g m^2  sphericity %.6f\n", s.volume, s.area, s.sphericity);
-        printf("mass %.10g kg  principal moments %.10g %.10g %.10g kg m^2\n", s.mass, s.principal[0], s.principal[1], s.principal[2]);
+        printf("mass %.10g kg  principal moments %.10g %.10g %.10g kg m^2\n", s.mass, s.principal[0], s.principal[1],
+               s.principal[2]);
     }
     return 0;
 }
@@ -94,21 +100,24 @@ static int cmd_run(int argc, char **argv)
         const char *a = argv[i];
         int has_value = i + 1 < argc;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            printf("usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--overwrite] [--steps N] [--threads N]\n"
-                   "                  [--allow-change KEY]... [--quiet] [--backend omp|opencl] [--device cpu|gpu|auto]\n\n"
-                   "  --output RUN.h5   run file (default run.output, else <run.name>.h5); an existing file is refused\n"
-                   "  --overwrite       replace an existing output, once the new run's first snapshot is written (the old\n"
-                   "                    file stays until then); never an input, never a file another process has open\n"
-                   "  --resume RUN.h5   continue RUN.h5 from its last complete snapshot, appending to it (--output, if\n"
-                   "                    given, must name the same file); the config must match the one stored in RUN.h5\n"
-                   "                    except for keys marked 'May change on --resume' below\n"
-                   "  --allow-change KEY  with --resume: accept a changed KEY (e.g. material.friction); repeatable\n"
-                   "  --steps N         run.steps: the step to reach, counted from step 0 of the run, also on a resume\n"
-                   "                    (a resume at step S continues to N; N < S is refused)\n"
-                   "  --threads N       OpenMP threads (1 to 4096)\n"
-                   "Exit status: 0 done, 2 bad input (nothing written), 3 the run blew up (the snapshots written so far\n"
-                   "stay readable), 1 other failures.\n\n"
-                   "Config keys (YAML; SI units):\n");
+            printf(
+                "usage: capdem run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--overwrite] [--steps N] "
+                "[--threads N]\n"
+                "                  [--allow-change KEY]... [--quiet] [--backend omp|opencl] [--device cpu|gpu|auto]\n\n"
+                "  --output RUN.h5   run file (default run.output, else <run.name>.h5); an existing file is refused\n"
+                "  --overwrite       replace an existing output, once the new run's first snapshot is written (the "
+                "old\n"
+                "                    file stays until then); never an input, never a file another process has open\n"
+                "  --resume RUN.h5   continue RUN.h5 from its last complete snapshot, appending to it (--output, if\n"
+                "                    given, must name the same file); the config must match the one stored in RUN.h5\n"
+                "                    except for keys marked 'May change on --resume' below\n"
+                "  --allow-change KEY  with --resume: accept a changed KEY (e.g. material.friction); repeatable\n"
+                "  --steps N         run.steps: the step to reach, counted from step 0 of the run, also on a resume\n"
+                "                    (a resume at step S continues to N; N < S is refused)\n"
+                "  --threads N       OpenMP threads (1 to 4096)\n"
+                "Exit status: 0 done, 2 bad input (nothing written), 3 the run blew up (the snapshots written so far\n"
+                "stay readable), 1 other failures.\n\n"
+                "Config keys (YAML; SI units):\n");
             cd_config_print_keys(stdout, 0);
             return 0;
         } else if (!strcmp(a, "--help-markdown")) { /* the key table of docs/config.md */
@@ -125,7 +134,8 @@ static int cmd_run(int argc, char **argv)
         } else if (!strcmp(a, "--overwrite")) opt.overwrite = 1;
         else if (!strcmp(a, "--allow-change") && has_value) {
             if (opt.n_allow_change == (int)(sizeof allow / sizeof allow[0])) {
-                fprintf(stderr, "capdem run: --allow-change given more than %d times\n", (int)(sizeof allow / sizeof allow[0]));
+                fprintf(stderr, "capdem run: --allow-change given more than %d times\n",
+                        (int)(sizeof allow / sizeof allow[0]));
                 return 2;
             }
             allow[opt.n_allow_change++] = argv[++i];
@@ -207,24 +217,32 @@ static int cmd_recover(int argc, char **argv)
         fprintf(stderr, "capdem recover: %s\n", err);
         return 1;
     }
-    printf("%s: %s\n", argv[0], rc ? "the commit a killed run had begun is now complete in the file"
-                                    : "nothing to recover (the file holds its last commit)");
+    printf("%s: %s\n", argv[0],
+           rc ? "the commit a killed run had begun is now complete in the file"
+              : "nothing to recover (the file holds its last commit)");
     return 0;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) { usage(stderr); return 2; }
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
     const char *cmd = argv[1];
     if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) return print_version();
-    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) { usage(stdout); return 0; }
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        usage(stdout);
+        return 0;
+    }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "shape")) return cmd_shape(argc - 2, argv + 2);
     if (!strcmp(cmd, "recover")) return cmd_recover(argc - 2, argv + 2);
     if (!strcmp(cmd, "analyze") || !strcmp(cmd, "export") || !strcmp(cmd, "render"))
         for (int i = 2; i < argc; i++)
             if (argv[i][0] != '-' && cd_mpm_is_run_file(argv[i])) {
-                fprintf(stderr, "capdem %s: %s: a run file of solver mpm; `capdem %s` does not read those yet (docs/mpm.md)\n",
+                fprintf(stderr,
+                        "capdem %s: %s: a run file of solver mpm; `capdem %s` does not read those yet (docs/mpm.md)\n",
                         cmd, argv[i], cmd);
                 return 2;
             }

@@ -78,23 +78,28 @@ int cd_cmd_render(int argc, char **argv)
     if (!python || !python[0]) python = CD_RENDER_PYTHON;
     char script[4096];
     if (cd_render_find_script(script, sizeof script)) {
-        fprintf(stderr, "capdem render: cannot find host/render.py: looked in the source folder this binary was built from"
+        fprintf(stderr,
+                "capdem render: cannot find host/render.py: looked in the source folder this binary was built from"
 #ifdef CAPDEM_SOURCE_DIR
-                        " (" CAPDEM_SOURCE_DIR ")"
+                " (" CAPDEM_SOURCE_DIR ")"
 #endif
-                        " and in $CAPDEM_SOURCE_DIR; set CAPDEM_SOURCE_DIR to the capdem source folder\n");
+                " and in $CAPDEM_SOURCE_DIR; set CAPDEM_SOURCE_DIR to the capdem source folder\n");
         return 2;
     }
     if (access(python, X_OK) != 0) {
-        fprintf(stderr, "capdem render: %s is missing (%s); install Debian's python3, python3-matplotlib, "
-                        "python3-h5py and python3-numpy\n", python, strerror(errno));
+        fprintf(stderr,
+                "capdem render: %s is missing (%s); install Debian's python3, python3-matplotlib, "
+                "python3-h5py and python3-numpy\n",
+                python, strerror(errno));
         return 2;
     }
     /* Checked here as well as in render.py so that the message names the
      * Debian packages even when render.py cannot start at all. */
     if (cd_render_python_has(python, "import matplotlib, numpy, h5py") != 0) {
-        fprintf(stderr, "capdem render: %s cannot import matplotlib, numpy and h5py; install them with\n"
-                        "  apt-get install python3-matplotlib python3-numpy python3-h5py\n", python);
+        fprintf(stderr,
+                "capdem render: %s cannot import matplotlib, numpy and h5py; install them with\n"
+                "  apt-get install python3-matplotlib python3-numpy python3-h5py\n",
+                python);
         return 2;
     }
     /* Python isolated (-I): neither the current folder (for -c) or the
@@ -102,7 +107,10 @@ int cd_cmd_render(int argc, char **argv)
      * enter its import path, so an h5py.py lying in the folder a run file
      * came in cannot run as capdem. */
     char **args = calloc((size_t)argc + 4, sizeof *args);
-    if (!args) { fprintf(stderr, "capdem render: out of memory\n"); return 1; }
+    if (!args) {
+        fprintf(stderr, "capdem render: out of memory\n");
+        return 1;
+    }
     args[0] = (char *)python;
     args[1] = "-I";
     args[2] = script;
@@ -129,6 +137,7 @@ int cd_cmd_render(int argc, char **argv)
         }
     }
     if (WIFEXITED(st)) return WEXITSTATUS(st);
-    fprintf(stderr, "capdem render: %s %s was killed by signal %d\n", python, script, WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+    fprintf(stderr, "capdem render: %s %s was killed by signal %d\n", python, script,
+            WIFSIGNALED(st) ? WTERMSIG(st) : 0);
     return 1;
 }

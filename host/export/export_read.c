@@ -31,7 +31,8 @@ static int cd_export_describe(hid_t f, const char *path, cd_export_field *fl)
     fl->precision = (int)H5Tget_size(t);
     if (cls == H5T_FLOAT && (fl->precision == 4 || fl->precision == 8)) {
         strcpy(fl->number_type, "Float");
-    } else if (cls == H5T_INTEGER && (fl->precision == 1 || fl->precision == 2 || fl->precision == 4 || fl->precision == 8)) {
+    } else if (cls == H5T_INTEGER &&
+               (fl->precision == 1 || fl->precision == 2 || fl->precision == 4 || fl->precision == 8)) {
         strcpy(fl->number_type, H5Tget_sign(t) == H5T_SGN_NONE ? "UInt" : "Int");
         if (fl->precision == 1) strcpy(fl->number_type, H5Tget_sign(t) == H5T_SGN_NONE ? "UChar" : "Char");
     } else {
@@ -46,11 +47,15 @@ static int cd_export_describe(hid_t f, const char *path, cd_export_field *fl)
 static int cd_export_read_all(cd_export_ctx *x, const char *path, hid_t memtype, hsize_t n, void *buf)
 {
     hid_t d = H5Dopen2(x->f, path, H5P_DEFAULT);
-    if (d < 0) return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: missing dataset %s (is this a capdem run file?)", x->path, path);
+    if (d < 0)
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: missing dataset %s (is this a capdem run file?)", x->path,
+                              path);
     hsize_t dims[3];
     int rc = cdh5_dims(d, dims) == 1 && dims[0] >= n ? cdh5_read_rows(d, 0, n, memtype, buf) : -1;
     H5Dclose(d);
-    if (rc < 0) return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: cannot read %llu values of %s", x->path, (unsigned long long)n, path);
+    if (rc < 0)
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: cannot read %llu values of %s", x->path,
+                              (unsigned long long)n, path);
     return 0;
 }
 
@@ -99,13 +104,16 @@ static void cd_export_classify(cd_export_ctx *x, const char *path, const char *l
     cd_export_field *list;
     int *n;
     if ((where == CD_EXPORT_PART_TIME || where == CD_EXPORT_ANALYSIS) && per_snapshot) {
-        list = x->pt; n = &x->npt;
+        list = x->pt;
+        n = &x->npt;
         cd_export_set_ncomp(&fl, 2);
     } else if ((where == CD_EXPORT_PART_FIXED || where == CD_EXPORT_ANALYSIS) && fixed) {
-        list = x->pf; n = &x->npf;
+        list = x->pf;
+        n = &x->npf;
         cd_export_set_ncomp(&fl, 1);
     } else if ((where == CD_EXPORT_CONTACT || where == CD_EXPORT_ANALYSIS) && contact) {
-        list = x->cf; n = &x->ncf;
+        list = x->cf;
+        n = &x->ncf;
         cd_export_set_ncomp(&fl, 1);
     } else {
         return;
@@ -160,8 +168,7 @@ static void cd_export_walk(cd_export_ctx *x, const char *base, const char *rel, 
              * geometry, not an attribute. */
             if (strcmp(label, "position") && depth == 1 && !strcmp(name, CDH5_NAME(VALUE)))
                 cd_export_classify(x, path, label, CD_EXPORT_PART_TIME);
-            else if (depth == 0)
-                cd_export_classify(x, path, label, CD_EXPORT_PART_FIXED);
+            else if (depth == 0) cd_export_classify(x, path, label, CD_EXPORT_PART_FIXED);
         } else if (depth == 0 && strcmp(path, CDH5_PATH(C_OFFSET)) && strcmp(name, CDH5_NAME(STEP)) &&
                    strcmp(name, CDH5_NAME(TIME)) && strcmp(name, "pair_active")) {
             /* /contacts without the clock, the offsets and the all-ones
@@ -199,8 +206,9 @@ int cd_export_read_run(cd_export_ctx *x)
         cd_export_describe(x->f, cdh5_column_path("prim_a", pa_path), pa) || pa->rank != 3 || pa->dims[2] != 3 ||
         cd_export_describe(x->f, cdh5_column_path("prim_b", pb_path), pb) || pb->rank != 3 || pb->dims[2] != 3 ||
         pa->dims[1] != pb->dims[1])
-        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: not a capdem run file (needs %s (S, N, 3) and %s, %s (S, P, 3))",
-                              x->path, ppos, pa_path, pb_path);
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT,
+                              "%s: not a capdem run file (needs %s (S, N, 3) and %s, %s (S, P, 3))", x->path, ppos,
+                              pa_path, pb_path);
     snprintf(pos->name, sizeof pos->name, "position");
     pos->ncomp = 3;
     x->N = pos->dims[1];
@@ -210,7 +218,8 @@ int cd_export_read_run(cd_export_ctx *x)
     hsize_t rows = pos->dims[0] < pa->dims[0] ? pos->dims[0] : pa->dims[0];
     if (pb->dims[0] < rows) rows = pb->dims[0];
     if ((hsize_t)x->S > rows) x->S = (int)rows;
-    if (x->S == 0) return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: the run file holds no complete snapshot", x->path);
+    if (x->S == 0)
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: the run file holds no complete snapshot", x->path);
     x->off = malloc(sizeof(long long) * (size_t)(x->S + 1));
     x->step = malloc(sizeof(long long) * (size_t)x->S);
     x->time = malloc(sizeof(double) * (size_t)x->S);
@@ -221,11 +230,12 @@ int cd_export_read_run(cd_export_ctx *x)
         return -1;
     for (int k = 0; k < x->S; k++)
         if (x->off[k + 1] < x->off[k] || x->off[k] < 0)
-            return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s decreases at snapshot %d", x->path, CDH5_PATH(C_OFFSET), k);
+            return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s decreases at snapshot %d", x->path,
+                                  CDH5_PATH(C_OFFSET), k);
     cd_export_field pi, pj;
-    if (x->off[x->S] > 0 &&
-        (cd_export_describe(x->f, CDH5_PATH(C_PARTICLE_I), &pi) || cd_export_describe(x->f, CDH5_PATH(C_PARTICLE_J), &pj) ||
-         pi.rank != 1 || pj.rank != 1 || pi.dims[0] < (hsize_t)x->off[x->S] || pj.dims[0] < (hsize_t)x->off[x->S]))
+    if (x->off[x->S] > 0 && (cd_export_describe(x->f, CDH5_PATH(C_PARTICLE_I), &pi) ||
+                             cd_export_describe(x->f, CDH5_PATH(C_PARTICLE_J), &pj) || pi.rank != 1 || pj.rank != 1 ||
+                             pi.dims[0] < (hsize_t)x->off[x->S] || pj.dims[0] < (hsize_t)x->off[x->S]))
         return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s and %s must hold the %lld contact rows", x->path,
                               CDH5_PATH(C_PARTICLE_I), CDH5_PATH(C_PARTICLE_J), x->off[x->S]);
     return 0;

@@ -27,7 +27,10 @@ static void cd_export_copy_unit(cd_export_ctx *x, const char *src, hid_t dst)
         char *buf = one ? calloc(n + 1, 1) : NULL;
         if (buf && H5Tget_class(t) == H5T_STRING && !H5Tis_variable_str(t) && H5Aread(a, t, buf) >= 0) {
             hid_t s = H5Screate(H5S_SCALAR), b = H5Acreate2(dst, "unit", t, s, H5P_DEFAULT, H5P_DEFAULT);
-            if (b >= 0) { H5Awrite(b, t, buf); H5Aclose(b); }
+            if (b >= 0) {
+                H5Awrite(b, t, buf);
+                H5Aclose(b);
+            }
             H5Sclose(s);
         }
         free(buf);
@@ -44,7 +47,10 @@ static void cd_export_set_unit_one(hid_t d)
     H5Tset_size(t, 2);
     H5Tset_strpad(t, H5T_STR_NULLTERM);
     hid_t s = H5Screate(H5S_SCALAR), a = H5Acreate2(d, "unit", t, s, H5P_DEFAULT, H5P_DEFAULT);
-    if (a >= 0) { H5Awrite(a, t, "1"); H5Aclose(a); }
+    if (a >= 0) {
+        H5Awrite(a, t, "1");
+        H5Aclose(a);
+    }
     H5Sclose(s);
     H5Tclose(t);
 }
@@ -82,11 +88,14 @@ typedef struct {
     hsize_t vstart[3], vcount[3];
 } cd_export_block;
 
-static int cd_export_vds(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims,
-                         int nblock, const cd_export_block *blocks)
+static int cd_export_vds(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims, int nblock,
+                         const cd_export_block *blocks)
 {
     hid_t d = cd_export_reuse(parent, name, H5D_VIRTUAL, rank, dims);
-    if (d > 0) { H5Dclose(d); return 0; }
+    if (d > 0) {
+        H5Dclose(d);
+        return 0;
+    }
     hid_t src = H5Dopen2(x->f, blocks[0].src->src, H5P_DEFAULT);
     if (src < 0) return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: cannot open %s", x->path, blocks[0].src->src);
     hid_t ftype = H5Dget_type(src);
@@ -109,8 +118,8 @@ static int cd_export_vds(cd_export_ctx *x, hid_t parent, const char *name, int r
     H5Tclose(ftype);
     if (!ok || d < 0) {
         char why[256];
-        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create the virtual dataset %s over %s (HDF5: %s)",
-                              x->path, name, blocks[0].src->src, cd_export_h5_reason(why));
+        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create the virtual dataset %s over %s (HDF5: %s)", x->path,
+                              name, blocks[0].src->src, cd_export_h5_reason(why));
     }
     cd_export_copy_unit(x, blocks[0].src->src, d);
     H5Dclose(d);
@@ -132,7 +141,8 @@ static int cd_export_ints(cd_export_ctx *x, hid_t parent, const char *name, int 
     if (d < 0 || (n > 0 && H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0)) {
         char why[256];
         if (d >= 0) H5Dclose(d);
-        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write /visualization/.../%s (HDF5: %s)", x->path, name, cd_export_h5_reason(why));
+        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write /visualization/.../%s (HDF5: %s)", x->path, name,
+                              cd_export_h5_reason(why));
     }
     cd_export_set_unit_one(d);
     H5Dclose(d);
@@ -155,7 +165,10 @@ static void cd_export_write_attr(hid_t loc, const char *name, hid_t ftype, hid_t
     hsize_t dim = (hsize_t)n;
     hid_t sp = n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &dim, NULL);
     hid_t a = H5Acreate2(loc, name, ftype, sp, H5P_DEFAULT, H5P_DEFAULT);
-    if (a >= 0) { H5Awrite(a, mtype, v); H5Aclose(a); }
+    if (a >= 0) {
+        H5Awrite(a, mtype, v);
+        H5Aclose(a);
+    }
     H5Sclose(sp);
 }
 
@@ -169,20 +182,25 @@ static int cd_export_open_viz(cd_export_ctx *x)
         int same = g >= 0 && !cd_export_read_attr_ll(g, "layout", &have[0], 1) &&
                    !cd_export_read_attr_ll(g, "n_particles", &have[1], 1) &&
                    !cd_export_read_attr_ll(g, "n_prims", &have[2], 1) && !memcmp(want, have, sizeof want);
-        if (same) { x->viz = g; return 0; }
+        if (same) {
+            x->viz = g;
+            return 0;
+        }
         if (g >= 0) H5Gclose(g);
         H5Ldelete(x->vf, "visualization", H5P_DEFAULT);
     }
     x->viz = H5Gcreate2(x->vf, "visualization", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (x->viz < 0) {
         char why[256];
-        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization (HDF5: %s)", x->path, cd_export_h5_reason(why));
+        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization (HDF5: %s)", x->path,
+                              cd_export_h5_reason(why));
     }
     cd_export_write_attr(x->viz, "layout", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[0]);
     cd_export_write_attr(x->viz, "n_particles", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[1]);
     cd_export_write_attr(x->viz, "n_prims", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[2]);
-    const char *about = "helper datasets of `capdem export` (docs/visualization.md): connectivity, and virtual datasets "
-                        "selecting one snapshot of the run's datasets; safe to delete";
+    const char *about =
+        "helper datasets of `capdem export` (docs/visualization.md): connectivity, and virtual datasets "
+        "selecting one snapshot of the run's datasets; safe to delete";
     hid_t t = H5Tcopy(H5T_C_S1);
     H5Tset_size(t, strlen(about) + 1);
     cd_export_write_attr(x->viz, "about", t, t, 1, about);
@@ -195,8 +213,10 @@ static int cd_export_fixed_helpers(cd_export_ctx *x)
 {
     /* ids are ints: counts past INT_MAX (a crafted extent) are refused */
     if (x->N > INT_MAX || x->P > INT_MAX / 2)
-        return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %llu particles, %llu primitives: more than ids can name; "
-                              "the file is refused", x->path, (unsigned long long)x->N, (unsigned long long)x->P);
+        return cd_export_fail(x, CD_EXPORT_BAD_INPUT,
+                              "%s: %llu particles, %llu primitives: more than ids can name; "
+                              "the file is refused",
+                              x->path, (unsigned long long)x->N, (unsigned long long)x->P);
     hsize_t n = x->N > 2 * x->P ? x->N : 2 * x->P;
     size_t vb;
     if (cd_h5_mul(&vb, (size_t)(n > 0 ? n : 1), sizeof(int), 1))
@@ -232,18 +252,27 @@ static int cd_export_contact_cells(cd_export_ctx *x, hid_t g, long long c0, long
         return 0;
     }
     size_t ijb, colb;
-    if (cd_h5_mul(&ijb, (size_t)C, 2, sizeof(int)) || cd_h5_mul(&colb, (size_t)C, sizeof(int), 1) || C > (hsize_t)SIZE_MAX)
+    if (cd_h5_mul(&ijb, (size_t)C, 2, sizeof(int)) || cd_h5_mul(&colb, (size_t)C, sizeof(int), 1) ||
+        C > (hsize_t)SIZE_MAX)
         return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: %s: %llu contact rows overflow a size; the file is refused",
                               x->path, CDH5_PATH(C_OFFSET), (unsigned long long)C);
     int *ij = malloc(ijb), *col = malloc(colb);
-    if (!ij || !col) { free(ij); free(col); return cd_export_fail(x, CD_EXPORT_FAIL, "out of memory"); }
+    if (!ij || !col) {
+        free(ij);
+        free(col);
+        return cd_export_fail(x, CD_EXPORT_FAIL, "out of memory");
+    }
     const char *names[2] = {CDH5_PATH(C_PARTICLE_I), CDH5_PATH(C_PARTICLE_J)};
     int rc = 0;
     for (int e = 0; e < 2 && !rc; e++) {
         hid_t d = H5Dopen2(x->f, names[e], H5P_DEFAULT);
-        if (d < 0) { rc = cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: missing %s", x->path, names[e]); break; }
+        if (d < 0) {
+            rc = cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: missing %s", x->path, names[e]);
+            break;
+        }
         if (cdh5_read_rows(d, (hsize_t)c0, C, H5T_NATIVE_INT, col) < 0)
-            rc = cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: cannot read rows %lld..%lld of %s", x->path, c0, c1 - 1, names[e]);
+            rc = cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: cannot read rows %lld..%lld of %s", x->path, c0, c1 - 1,
+                                names[e]);
         H5Dclose(d);
         for (hsize_t r = 0; r < C && !rc; r++) ij[2 * r + (hsize_t)e] = col[r];
     }
@@ -283,7 +312,8 @@ static int cd_export_snapshot_helpers(cd_export_ctx *x, int k)
     H5Gclose(snaps);
     if (g < 0) {
         char why[256];
-        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization/snapshots/%s (HDF5: %s)", x->path, name, cd_export_h5_reason(why));
+        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization/snapshots/%s (HDF5: %s)", x->path,
+                              name, cd_export_h5_reason(why));
     }
     cd_export_write_attr(g, "contact_rows", H5T_STD_I64LE, H5T_NATIVE_LLONG, 2, rows);
     cd_export_write_attr(g, "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &x->step[k]);
@@ -337,11 +367,12 @@ int cd_export_helpers(cd_export_ctx *x)
     hid_t snaps = H5Gopen2(x->viz, "snapshots", H5P_DEFAULT);
     H5G_info_t gi;
     if (snaps >= 0 && H5Gget_info(snaps, &gi) >= 0 && gi.nlinks > 0) {
-        char (*stale)[64] = calloc(gi.nlinks, sizeof *stale);
+        char(*stale)[64] = calloc(gi.nlinks, sizeof *stale);
         hsize_t nstale = 0;
         for (hsize_t i = 0; stale && i < gi.nlinks; i++) {
             char name[64], *end;
-            if (H5Lget_name_by_idx(snaps, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT) < 0) continue;
+            if (H5Lget_name_by_idx(snaps, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT) < 0)
+                continue;
             long k = strtol(name, &end, 10);
             if (end == name || *end || k < 0 || k >= x->S) snprintf(stale[nstale++], 64, "%s", name);
         }

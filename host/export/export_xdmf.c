@@ -94,19 +94,30 @@ static void cd_export_xml_text(FILE *o, const char *s)
 {
     for (; *s; s++) {
         switch (*s) {
-        case '&': fputs("&amp;", o); break;
-        case '<': fputs("&lt;", o); break;
-        case '>': fputs("&gt;", o); break;
-        case '"': fputs("&quot;", o); break;
-        case '\'': fputs("&apos;", o); break;
-        default: fputc(*s, o);
+        case '&':
+            fputs("&amp;", o);
+            break;
+        case '<':
+            fputs("&lt;", o);
+            break;
+        case '>':
+            fputs("&gt;", o);
+            break;
+        case '"':
+            fputs("&quot;", o);
+            break;
+        case '\'':
+            fputs("&apos;", o);
+            break;
+        default:
+            fputc(*s, o);
         }
     }
 }
 
 /* <DataItem> naming file:path, of the given shape (rank 1 or 2). */
-static void cd_export_xml_item(FILE *o, const char *indent, const char *file, const char *path,
-                               hsize_t rows, int ncomp, const char *number_type, int precision)
+static void cd_export_xml_item(FILE *o, const char *indent, const char *file, const char *path, hsize_t rows, int ncomp,
+                               const char *number_type, int precision)
 {
     fprintf(o, "%s<DataItem Dimensions=\"%llu", indent, (unsigned long long)rows);
     if (ncomp > 1) fprintf(o, " %d", ncomp);
@@ -166,7 +177,8 @@ static void cd_export_xml_arms(FILE *o, const cd_export_ctx *x, int k)
     cd_export_xml_geometry(o, x, k, "arm_points", 2 * x->P);
     /* Point copies first: the Tube filter takes its radius from point data. */
     cd_export_xml_attr(o, "radius", "Node", x->viz_ref, "/visualization/arm_point_radius", 2 * x->P, &x->prim_radius);
-    cd_export_xml_attr(o, "particle", "Node", x->viz_ref, "/visualization/arm_point_particle", 2 * x->P, &x->prim_particle);
+    cd_export_xml_attr(o, "particle", "Node", x->viz_ref, "/visualization/arm_point_particle", 2 * x->P,
+                       &x->prim_particle);
     cd_export_xml_attr(o, "radius", "Cell", x->h5_ref, x->prim_radius.src, x->P, &x->prim_radius);
     cd_export_xml_attr(o, "particle", "Cell", x->h5_ref, x->prim_particle.src, x->P, &x->prim_particle);
     fprintf(o, "    </Grid>\n");
@@ -236,14 +248,16 @@ static int cd_export_write_xml(cd_export_ctx *x, const char *out)
     fprintf(o, "<!-- Written by `capdem export` from ");
     /* "--" is not allowed inside an XML comment. */
     for (const char *s = x->h5_ref; *s; s++) fputc(s[0] == '-' && s[1] == '-' ? '_' : s[0], o);
-    fprintf(o, ": %d snapshots, %llu particles, %llu arms, %lld contact rows.\n"
-               "     Three temporal collections: arms (lines; radius as point and cell data, for the Tube filter),\n"
-               "     particles (centres) and contacts (lines between the centres of touching particles).\n"
-               "     Every data item points into the run file or into its /visualization helpers: no copy of the data.\n"
-               "     ParaView: any of its XDMF readers; docs/visualization.md. -->\n",
+    fprintf(o,
+            ": %d snapshots, %llu particles, %llu arms, %lld contact rows.\n"
+            "     Three temporal collections: arms (lines; radius as point and cell data, for the Tube filter),\n"
+            "     particles (centres) and contacts (lines between the centres of touching particles).\n"
+            "     Every data item points into the run file or into its /visualization helpers: no copy of the data.\n"
+            "     ParaView: any of its XDMF readers; docs/visualization.md. -->\n",
             x->S, (unsigned long long)x->N, (unsigned long long)x->P, x->off[x->S]);
     fprintf(o, "<Xdmf Version=\"2.0\">\n  <Domain>\n");
-    void (*grids[3])(FILE *, const cd_export_ctx *, int) = {cd_export_xml_arms, cd_export_xml_particles, cd_export_xml_contacts};
+    void (*grids[3])(FILE *, const cd_export_ctx *, int) = {cd_export_xml_arms, cd_export_xml_particles,
+                                                            cd_export_xml_contacts};
     const char *names[3] = {"arms", "particles", "contacts"};
     for (int g = 0; g < 3; g++) {
         fprintf(o, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", names[g]);
@@ -323,13 +337,16 @@ static int cd_export_open_sidecar(cd_export_ctx *x, const char *side, const char
         x->vf = H5Fcreate(side, H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT);
         if (x->vf >= 0) return 0;
         if (lstat(side, &before) != 0) /* not a link that appeared meanwhile: no room, no permission */
-            return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write into it (%s) nor create %s for the helper "
-                                  "datasets", x->path, why, side);
+            return cd_export_fail(x, CD_EXPORT_FAIL,
+                                  "%s: cannot write into it (%s) nor create %s for the helper "
+                                  "datasets",
+                                  x->path, why, side);
     }
     const char *refused = NULL;
     if (S_ISLNK(before.st_mode)) refused = "is a symbolic link";
     else if (!S_ISREG(before.st_mode)) refused = "is not a regular file";
-    else if ((x->vf = H5Fopen(side, H5F_ACC_RDWR, H5P_DEFAULT)) < 0) refused = "is not an HDF5 file export can write into";
+    else if ((x->vf = H5Fopen(side, H5F_ACC_RDWR, H5P_DEFAULT)) < 0)
+        refused = "is not an HDF5 file export can write into";
     if (!refused) {
         /* the file opened must be the one looked at (no link swapped in) */
         void *handle = NULL;
@@ -345,9 +362,10 @@ static int cd_export_open_sidecar(cd_export_ctx *x, const char *side, const char
     if (!refused) return 0;
     if (x->vf >= 0) H5Fclose(x->vf);
     x->vf = -1;
-    return cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s is read-only here (%s), and its sidecar %s %s: refused, the "
-                          "sidecar is left as it is (remove it, or export a writable copy of %s)", x->path, why, side,
-                          refused, x->path);
+    return cd_export_fail(x, CD_EXPORT_BAD_INPUT,
+                          "%s is read-only here (%s), and its sidecar %s %s: refused, the "
+                          "sidecar is left as it is (remove it, or export a writable copy of %s)",
+                          x->path, why, side, refused, x->path);
 }
 
 /* Opens the run file for writing the helpers, or falls back to a sidecar
@@ -370,7 +388,8 @@ static int cd_export_open(cd_export_ctx *x, const char *out)
     H5Pclose(fapl);
     if (x->f < 0) {
         cd_export_h5_reason(why);
-        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot open (HDF5: %s; is a run still writing it?)", x->path, why);
+        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot open (HDF5: %s; is a run still writing it?)", x->path,
+                              why);
     }
     char side[CD_EXPORT_PATH];
     cd_export_swap_suffix(side, sizeof side, x->path, ".viz.h5");
@@ -409,7 +428,10 @@ int cd_cmd_export(int argc, char **argv)
     else cd_export_swap_suffix(out, sizeof out, run, ".xmf");
 
     cd_export_ctx *x = calloc(1, sizeof *x);
-    if (!x) { fprintf(stderr, "capdem export: out of memory\n"); return CD_EXPORT_FAIL; }
+    if (!x) {
+        fprintf(stderr, "capdem export: out of memory\n");
+        return CD_EXPORT_FAIL;
+    }
     x->path = run;
     x->f = x->vf = x->viz = -1;
 
@@ -428,11 +450,15 @@ int cd_cmd_export(int argc, char **argv)
         cd_export_fail(x, locked ? CD_EXPORT_FAIL : CD_EXPORT_BAD_INPUT, "%s%s", err,
                        locked ? " (is a run still writing it? export it when the run has ended)" : "");
     } else if (!cd_export_open(x, out) && !cd_export_read_run(x) && !cd_export_discover(x) && !cd_export_helpers(x)) {
-        if (x->viz >= 0) { H5Gclose(x->viz); x->viz = -1; }
+        if (x->viz >= 0) {
+            H5Gclose(x->viz);
+            x->viz = -1;
+        }
         if (cdh5_commit(x->vf, run, err, sizeof err) < 0) {
             char why[256];
             cdh5_drop_on_close(x->vf); /* the run file keeps its last commit */
-            cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot flush the helper datasets (HDF5: %s)", run, cd_export_h5_reason(why));
+            cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot flush the helper datasets (HDF5: %s)", run,
+                           cd_export_h5_reason(why));
         } else {
             cd_export_write_xml(x, out);
         }
@@ -448,8 +474,10 @@ int cd_cmd_export(int argc, char **argv)
         fprintf(stderr, "capdem export: %s\n", x->err);
     } else {
         if (x->bad_contacts)
-            fprintf(stderr, "capdem export: warning: %lld contact rows name particle -1 (primitive out of range); "
-                            "drawn as zero-length lines\n", x->bad_contacts);
+            fprintf(stderr,
+                    "capdem export: warning: %lld contact rows name particle -1 (primitive out of range); "
+                    "drawn as zero-length lines\n",
+                    x->bad_contacts);
         printf("capdem export: wrote %s (%d snapshots, %llu particles, %llu arms, %lld contact rows; "
                "helper datasets in %s:/visualization)\n",
                out, x->S, (unsigned long long)x->N, (unsigned long long)x->P, x->off[x->S], x->viz_ref);

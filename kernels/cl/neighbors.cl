@@ -153,8 +153,8 @@ __kernel void cd_cl_wall_cand_count(
 
 __kernel void cd_cl_wall_cand_fill(
 #include "col_params.h"
-    cd_int n_particles, __global const cd_wall *walls, cd_int n_walls, cd_real skin,
-    __global const cd_int *wall_start, __global cd_int *wall_rows)
+    cd_int n_particles, __global const cd_wall *walls, cd_int n_walls, cd_real skin, __global const cd_int *wall_start,
+    __global cd_int *wall_rows)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);

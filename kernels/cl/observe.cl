@@ -30,8 +30,8 @@ __kernel void cd_cl_obs_particles(
 {
 #include "col_bind.h"
     cd_long b = (cd_long)get_global_id(0);
-    if (b * CD_OBS_BLOCK < n) cd_obs_block_particles(c, b, n, gravity, touch, part + (first + b) * CD_OBS_SLOTS,
-                                                      cd_order_identity());
+    if (b * CD_OBS_BLOCK < n)
+        cd_obs_block_particles(c, b, n, gravity, touch, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
 }
 
 __kernel void cd_cl_obs_pairs(
@@ -49,8 +49,8 @@ __kernel void cd_cl_obs_walls(
 {
 #include "col_bind.h"
     cd_long b = (cd_long)get_global_id(0);
-    if (b * CD_OBS_BLOCK < n) cd_obs_block_walls(c, b, n, n_walls, wall_law, part + (first + b) * CD_OBS_SLOTS,
-                                                  cd_order_identity());
+    if (b * CD_OBS_BLOCK < n)
+        cd_obs_block_walls(c, b, n, n_walls, wall_law, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
 }
 
 __kernel void cd_cl_obs_merge(__global const cd_real *part, cd_long n_blocks, __global cd_real *total)

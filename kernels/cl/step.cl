@@ -46,8 +46,8 @@ __kernel void cd_cl_wall_forces(
 __kernel void cd_cl_gather_kick(
 #include "col_params.h"
     cd_int n_particles, __global const cd_int *gather_start, __global const cd_pair_id *gather_rows,
-    __global const cd_int *wall_start, __global const cd_int *wall_rows, cd_vec3 gravity, cd_int dimension,
-    cd_int kick, cd_real dt)
+    __global const cd_int *wall_start, __global const cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_int kick,
+    cd_real dt)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);

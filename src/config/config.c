@@ -20,13 +20,10 @@ static void apply_default(const cd_key *k, void *base);
 static int read_list(reader *r, const cd_key *k, const char *path, yaml_node_t *v)
 {
     char item_sect[PATHLEN], item_path[PATHLEN + 16];
-    if (is_null(v) && k->min_items == 0)
-        return 0;
-    if (v->type != YAML_SEQUENCE_NODE)
-        return cd_cfg_bad(r, k, v, path, NULL);
+    if (is_null(v) && k->min_items == 0) return 0;
+    if (v->type != YAML_SEQUENCE_NODE) return cd_cfg_bad(r, k, v, path, NULL);
     long n = v->data.sequence.items.top - v->data.sequence.items.start;
-    if (n < k->min_items || n > k->max_items)
-        return cd_cfg_bad(r, k, v, path, NULL);
+    if (n < k->min_items || n > k->max_items) return cd_cfg_bad(r, k, v, path, NULL);
     snprintf(item_sect, sizeof item_sect, "%s[]", k->path);
     char *items = (char *)r->base[k->target] + k->offset;
     for (long i = 0; i < n; i++) {
@@ -34,18 +31,17 @@ static int read_list(reader *r, const cd_key *k, const char *path, yaml_node_t *
         void *dst = items + (size_t)i * k->item_size;
         memset(dst, 0, k->item_size);
         for (size_t q = 0; q < cd_config_nkeys; q++)
-            if (cd_config_keys[q].target == k->item_target)
-                apply_default(&cd_config_keys[q], dst);
+            if (cd_config_keys[q].target == k->item_target) apply_default(&cd_config_keys[q], dst);
         r->base[k->item_target] = dst;
         snprintf(item_path, sizeof item_path, "%.200s[%ld]", path, i);
         if (item->type != YAML_MAPPING_NODE) {
             char val[VALLEN], list[512];
             cd_cfg_render(r->doc, item, val, sizeof val, 0);
             cd_key_known_list(item_sect, NULL, -1, list, sizeof list);
-            return cd_cfg_fail(r, line_of(item), "%s = %s: expected a mapping with keys %s (%s)", item_path, val, list, k->label);
+            return cd_cfg_fail(r, line_of(item), "%s = %s: expected a mapping with keys %s (%s)", item_path, val, list,
+                               k->label);
         }
-        if (read_map(r, item_sect, item_path, item, line_of(item)) != 0)
-            return -1;
+        if (read_map(r, item_sect, item_path, item, line_of(item)) != 0) return -1;
     }
     *(int *)((char *)r->base[CD_TGT_CONFIG] + k->count_offset) = (int)n;
     return 0;
@@ -53,8 +49,7 @@ static int read_list(reader *r, const cd_key *k, const char *path, yaml_node_t *
 
 static yaml_node_t *lookup(yaml_document_t *d, yaml_node_t *map, const char *name, yaml_node_t **key)
 {
-    if (!map || map->type != YAML_MAPPING_NODE)
-        return NULL;
+    if (!map || map->type != YAML_MAPPING_NODE) return NULL;
     for (yaml_node_pair_t *p = map->data.mapping.pairs.start; p < map->data.mapping.pairs.top; p++) {
         yaml_node_t *kn = yaml_document_get_node(d, p->key);
         if (kn->type == YAML_SCALAR_NODE && strcmp(sval(kn), name) == 0) {
@@ -79,21 +74,20 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
     for (size_t i = 0; i < cd_config_nkeys; i++)
         if (cd_key_in_section(&cd_config_keys[i], sect) && (cd_config_keys[i].flags & CD_KF_SELECTOR))
             sel = &cd_config_keys[i];
-    if (map && is_null(map))
-        map = NULL;
+    if (map && is_null(map)) map = NULL;
     if (map && map->type != YAML_MAPPING_NODE) {
         char list[512];
         cd_cfg_render(r->doc, map, val, sizeof val, 0);
         cd_key_known_list(sect, NULL, -1, list, sizeof list);
-        return cd_cfg_fail(r, line_of(map), "%s = %s: expected a mapping with keys %s", *epath ? epath : "(top level)", val, list);
+        return cd_cfg_fail(r, line_of(map), "%s = %s: expected a mapping with keys %s", *epath ? epath : "(top level)",
+                           val, list);
     }
     /* the selector first: it decides which other keys apply */
     if (sel) {
         yaml_node_t *v = lookup(r->doc, map, cd_key_leaf(sel), NULL);
         cd_cfg_join(path, epath, cd_key_leaf(sel));
         if (v) {
-            if (cd_cfg_convert(r, sel, v, r->base[sel->target], path, &choice) != 0)
-                return -1;
+            if (cd_cfg_convert(r, sel, v, r->base[sel->target], path, &choice) != 0) return -1;
         } else if (sel->def) {
             choice = cd_key_choice_index(sel->choices, sel->def);
         } else if (sel->required) {
@@ -108,7 +102,8 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
             yaml_node_t *v = yaml_document_get_node(r->doc, p->value);
             if (kn->type != YAML_SCALAR_NODE) {
                 cd_cfg_render(r->doc, kn, val, sizeof val, 0);
-                return cd_cfg_fail(r, line_of(kn), "%s key %s: expected a key name (a word)", *epath ? epath : "top-level", val);
+                return cd_cfg_fail(r, line_of(kn), "%s key %s: expected a key name (a word)",
+                                   *epath ? epath : "top-level", val);
             }
             const char *key = sval(kn);
             cd_cfg_join(path, epath, key);
@@ -116,8 +111,9 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
                 yaml_node_t *kq = yaml_document_get_node(r->doc, q->key);
                 if (kq->type == YAML_SCALAR_NODE && strcmp(sval(kq), key) == 0) {
                     cd_cfg_render(r->doc, v, val, sizeof val, 0);
-                    return cd_cfg_fail(r, line_of(kn), "%s = %s: given twice (first at line %d); expected each key once",
-                                path, val, line_of(kq));
+                    return cd_cfg_fail(r, line_of(kn),
+                                       "%s = %s: given twice (first at line %d); expected each key once", path, val,
+                                       line_of(kq));
                 }
             }
             cd_cfg_join(full, sect, key);
@@ -125,21 +121,17 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
             int exists = 0;
             for (size_t i = 0; i < cd_config_nkeys; i++) {
                 const cd_key *c = &cd_config_keys[i];
-                if (strcmp(c->path, full) != 0)
-                    continue;
+                if (strcmp(c->path, full) != 0) continue;
                 exists = 1;
-                if (!k && (choice < 0 || (cd_key_applies(c) >> choice & 1u)))
-                    k = c;
+                if (!k && (choice < 0 || (cd_key_applies(c) >> choice & 1u))) k = c;
             }
             if (!exists) {
                 size_t fl = strlen(full);
                 int is_sub = fl && full[fl - 1] != ']';
                 for (size_t i = 0; is_sub && i < cd_config_nkeys; i++)
-                    if (strncmp(cd_config_keys[i].path, full, fl) == 0 && cd_config_keys[i].path[fl] == '.')
-                        is_sub = 2;
+                    if (strncmp(cd_config_keys[i].path, full, fl) == 0 && cd_config_keys[i].path[fl] == '.') is_sub = 2;
                 if (is_sub == 2) {
-                    if (read_map(r, full, path, v, line_of(kn)) != 0)
-                        return -1;
+                    if (read_map(r, full, path, v, line_of(kn)) != 0) return -1;
                     continue;
                 }
                 return cd_cfg_unknown_key(r, sect, epath, key, v, sel, choice);
@@ -150,22 +142,19 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
                 cd_cfg_join(sp, epath, cd_key_leaf(sel));
                 cd_cfg_render(r->doc, v, val, sizeof val, 0);
                 cd_key_known_list(sect, sel, choice, list, sizeof list);
-                return cd_cfg_fail(r, line_of(kn), "%s = %s: does not apply to %s = %s; expected one of the keys for %s: %s",
-                            path, val, sp, cname, cname, list);
+                return cd_cfg_fail(r, line_of(kn),
+                                   "%s = %s: does not apply to %s = %s; expected one of the keys for %s: %s", path, val,
+                                   sp, cname, cname, list);
             }
             size_t idx = (size_t)(k - cd_config_keys);
             seen[idx] = v;
-            if (k->target == CD_TGT_CONFIG || k->target == CD_TGT_SCRATCH)
-                r->seen[idx] = v;
-            if (k == sel)
-                continue;
+            if (k->target == CD_TGT_CONFIG || k->target == CD_TGT_SCRATCH) r->seen[idx] = v;
+            if (k == sel) continue;
             if (k->type == CD_KT_LIST) {
-                if (read_list(r, k, path, v) != 0)
-                    return -1;
+                if (read_list(r, k, path, v) != 0) return -1;
             } else {
                 int dummy;
-                if (cd_cfg_convert(r, k, v, r->base[k->target], path, &dummy) != 0)
-                    return -1;
+                if (cd_cfg_convert(r, k, v, r->base[k->target], path, &dummy) != 0) return -1;
             }
         }
     }
@@ -174,16 +163,13 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
         cd_cfg_join(full, sect, name);
         cd_cfg_join(path, epath, name);
         int is_key = 0;
-        for (size_t k = 0; k < cd_config_nkeys; k++)
-            is_key |= strcmp(cd_config_keys[k].path, full) == 0;
-        if (!is_key && !lookup(r->doc, map, name, NULL) && read_map(r, full, path, NULL, line) != 0)
-            return -1;
+        for (size_t k = 0; k < cd_config_nkeys; k++) is_key |= strcmp(cd_config_keys[k].path, full) == 0;
+        if (!is_key && !lookup(r->doc, map, name, NULL) && read_map(r, full, path, NULL, line) != 0) return -1;
     }
     /* required keys, keys that exclude each other */
     for (size_t i = 0; i < cd_config_nkeys; i++) {
         const cd_key *k = &cd_config_keys[i];
-        if (!cd_key_in_section(k, sect))
-            continue;
+        if (!cd_key_in_section(k, sect)) continue;
         unsigned req = k->required & cd_key_applies(k);
         int needed = sel ? (choice >= 0 && (req >> choice & 1u)) : req != 0;
         if (needed && !seen[i]) {
@@ -198,7 +184,7 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
             cd_key_expect_text(k, exp, sizeof exp);
             cd_cfg_join(path, epath, cd_key_leaf(k));
             return cd_cfg_fail(r, line > 0 ? line : 1, "%s: missing; expected %s (%s%s%s)%s", path, exp, k->label,
-                        unit ? ", " : "", unit ? k->unit : "", cond);
+                               unit ? ", " : "", unit ? k->unit : "", cond);
         }
         if (k->conflicts && seen[i]) {
             cd_cfg_join(full, sect, k->conflicts);
@@ -211,8 +197,10 @@ static int read_map(reader *r, const char *sect, const char *epath, yaml_node_t 
                     cd_cfg_join(path, epath, cd_key_leaf(lk));
                     cd_cfg_join(other, epath, cd_key_leaf(ek));
                     cd_cfg_render(r->doc, later, val, sizeof val, 0);
-                    return cd_cfg_fail(r, line_of(later), "%s = %s: cannot be given together with %s (line %d); expected only one of %s and %s",
-                                path, val, other, line_of(later == seen[i] ? seen[q] : seen[i]), other, path);
+                    return cd_cfg_fail(
+                        r, line_of(later),
+                        "%s = %s: cannot be given together with %s (line %d); expected only one of %s and %s", path,
+                        val, other, line_of(later == seen[i] ? seen[q] : seen[i]), other, path);
                 }
         }
     }
@@ -228,8 +216,7 @@ static void apply_default(const cd_key *k, void *base)
     reader r = {.file = "(built-in default)"};
     char err[256];
     int choice;
-    if (!k->def || (k->flags & CD_KF_DERIVED) || k->type == CD_KT_LIST)
-        return;
+    if (!k->def || (k->flags & CD_KF_DERIVED) || k->type == CD_KT_LIST) return;
     r.err = err;
     r.errlen = sizeof err;
     yaml_parser_initialize(&p);
@@ -250,8 +237,7 @@ static void apply_default(const cd_key *k, void *base)
 static size_t key_index(const char *path)
 {
     for (size_t i = 0; i < cd_config_nkeys; i++)
-        if (strcmp(cd_config_keys[i].path, path) == 0)
-            return i;
+        if (strcmp(cd_config_keys[i].path, path) == 0) return i;
     abort();
 }
 
@@ -262,10 +248,8 @@ static void derive(cd_config *c, yaml_node_t *const *seen, const cd_config_scrat
         double le = log(s->restitution);
         c->eta_n = -le / sqrt(CD_PI * CD_PI + le * le);
     }
-    if (!seen || !seen[key_index("material.kt")])
-        c->kt = 0.5 * c->kn;
-    if (!seen || !seen[key_index("material.damping_tangential")])
-        c->eta_t = c->eta_n;
+    if (!seen || !seen[key_index("material.kt")]) c->kt = 0.5 * c->kn;
+    if (!seen || !seen[key_index("material.damping_tangential")]) c->eta_t = c->eta_n;
     for (int i = 0; i < c->n_extra_walls; i++) {
         c->extra_walls[i].type = CD_WALL_PLANE;
         c->extra_walls[i].friction = c->wall_friction;
@@ -295,8 +279,7 @@ void cd_config_defaults(cd_config *c)
     }
     memset(c, 0, sizeof *c);
     for (size_t i = 0; i < cd_config_nkeys; i++)
-        if (cd_config_keys[i].target == CD_TGT_CONFIG)
-            apply_default(&cd_config_keys[i], c);
+        if (cd_config_keys[i].target == CD_TGT_CONFIG) apply_default(&cd_config_keys[i], c);
     derive(c, NULL, NULL);
     set_selectors(c);
 }
@@ -306,13 +289,13 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
 {
     /* Each solver reads sections of its own: a section of the other is a
      * mistake (a value that would be silently ignored), named as such. */
-    static const char *const dem_only[] = {"physics", "material", "domain", "init", "neighbor", "protocol", "mpi",
-                                           "run.steps_per_collision", "run.max_overlap"};
+    static const char *const dem_only[] = {"physics",        "material", "domain", "init",
+                                           "neighbor",       "protocol", "mpi",    "run.steps_per_collision",
+                                           "run.max_overlap"};
     int mpm = c->solver == 1;
     for (size_t i = 0; i < sizeof dem_only / sizeof dem_only[0] + 1; i++) {
         const char *name = i < sizeof dem_only / sizeof dem_only[0] ? dem_only[i] : "mpm";
-        if (mpm == !strcmp(name, "mpm"))
-            continue;
+        if (mpm == !strcmp(name, "mpm")) continue;
         const char *dot = strchr(name, '.');
         yaml_node_t *key = NULL, *v;
         if (dot) {
@@ -326,8 +309,9 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
             char val[VALLEN];
             cd_cfg_render(r->doc, v, val, sizeof val, 0);
             return cd_cfg_fail(r, line_of(key), "%s = %s: does not apply to solver = %s; expected %s", name, val,
-                               mpm ? "mpm" : "dem", mpm ? "the keys of section mpm (docs/mpm.md) and run.*"
-                                                        : "solver: mpm for the mpm section (docs/mpm.md)");
+                               mpm ? "mpm" : "dem",
+                               mpm ? "the keys of section mpm (docs/mpm.md) and run.*"
+                                   : "solver: mpm for the mpm section (docs/mpm.md)");
         }
     }
     yaml_node_t *plist = lookup(r->doc, root, "particles", NULL);
@@ -339,36 +323,47 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
         if (strcmp(sp->shape, "sphere") == 0 && sp->aspect != 1.0) {
             char val[VALLEN];
             cd_cfg_render(r->doc, a, val, sizeof val, 0);
-            return cd_cfg_fail(r, line_of(a), "particles[%d].aspect = %s: expected 1 for shape sphere (aspect ratio)", i, val);
+            return cd_cfg_fail(r, line_of(a), "particles[%d].aspect = %s: expected 1 for shape sphere (aspect ratio)",
+                               i, val);
         }
         if (sp->count == 0 && !(c->fill_ratio > 0 && c->n_species == 1))
-            return cd_cfg_fail(r, line_of(item), "particles[%d].count: missing; expected an integer >= 1 (particle count)%s", i,
+            return cd_cfg_fail(r, line_of(item),
+                               "particles[%d].count: missing; expected an integer >= 1 (particle count)%s", i,
                                c->n_species == 1 ? ", or protocol.fill_ratio with protocol.type deposit_compress"
                                                  : "; protocol.fill_ratio picks the count of a single species only");
         if (sp->count > 0 && c->fill_ratio > 0) {
             yaml_node_t *n = lookup(r->doc, item, "count", NULL);
-            return cd_cfg_fail(r, line_of(n), "particles[%d].count = %ld: cannot be given together with protocol.fill_ratio = %g; "
-                               "expected only one of them (the fill ratio picks the count)", i, sp->count, c->fill_ratio);
+            return cd_cfg_fail(r, line_of(n),
+                               "particles[%d].count = %ld: cannot be given together with protocol.fill_ratio = %g; "
+                               "expected only one of them (the fill ratio picks the count)",
+                               i, sp->count, c->fill_ratio);
         }
         total += sp->count;
     }
     yaml_node_t *proto = lookup(r->doc, root, "protocol", NULL);
     if (c->fill_ratio > 0 && !(c->fill_fraction > 0))
-        return cd_cfg_fail(r, line_of(proto), "protocol.fill_fraction: missing; expected a number in (0, 1) (expected packing fraction), "
-                           "needed for protocol.fill_ratio = %g", c->fill_ratio);
+        return cd_cfg_fail(r, line_of(proto),
+                           "protocol.fill_fraction: missing; expected a number in (0, 1) (expected packing fraction), "
+                           "needed for protocol.fill_ratio = %g",
+                           c->fill_ratio);
     int ball = c->protocol_kind == CD_PROTOCOL_RADIAL || c->protocol_kind == CD_PROTOCOL_BULK;
     if (ball && c->law == CD_LAW_HERTZ_MINDLIN && c->pressure == 0)
-        return cd_cfg_fail(r, line_of(proto), "protocol.pressure: missing; expected a number > 0 (pressure, Pa), needed for "
-                           "material.law = hertz_mindlin (protocol.pressure_ratio scales material.kn, which that law does not use)");
+        return cd_cfg_fail(
+            r, line_of(proto),
+            "protocol.pressure: missing; expected a number > 0 (pressure, Pa), needed for "
+            "material.law = hertz_mindlin (protocol.pressure_ratio scales material.kn, which that law does not use)");
     yaml_node_t *dom = lookup(r->doc, root, "domain", NULL);
     int tall = c->domain_kind == CD_DOMAIN_BOX || c->domain_kind == CD_DOMAIN_CYLINDER;
     double height = c->domain_kind == CD_DOMAIN_BOX ? c->box_height : c->cyl_height;
     if (tall && height == 0 && strcmp(c->placement, "lattice"))
-        return cd_cfg_fail(r, line_of(dom), "domain.height: missing; expected a number > 0 (%s height, m): "
-                           "only init.placement lattice can pick the height (init.placement = %s)", c->domain, c->placement);
+        return cd_cfg_fail(r, line_of(dom),
+                           "domain.height: missing; expected a number > 0 (%s height, m): "
+                           "only init.placement lattice can pick the height (init.placement = %s)",
+                           c->domain, c->placement);
     if (total > 2147483647LL)
-        return cd_cfg_fail(r, line_of(plist), "particles = (%lld particles in all): expected at most 2147483647 in all (particle count)",
-                    total);
+        return cd_cfg_fail(r, line_of(plist),
+                           "particles = (%lld particles in all): expected at most 2147483647 in all (particle count)",
+                           total);
     return 0;
 }
 
@@ -383,11 +378,12 @@ static int parse_document(reader *r, cd_config *c, const char *text)
         if (p.error == YAML_READER_ERROR)
             cd_cfg_fail(r, 0, "not readable as UTF-8 text at byte %zu: %s", p.problem_offset, p.problem);
         else if (p.context)
-            cd_cfg_fail(r, (int)p.problem_mark.line + 1, "YAML syntax error: %s (%s that starts at line %d); expected valid YAML 1.1",
-                 p.problem ? p.problem : "?", p.context, (int)p.context_mark.line + 1);
+            cd_cfg_fail(r, (int)p.problem_mark.line + 1,
+                        "YAML syntax error: %s (%s that starts at line %d); expected valid YAML 1.1",
+                        p.problem ? p.problem : "?", p.context, (int)p.context_mark.line + 1);
         else
             cd_cfg_fail(r, (int)p.problem_mark.line + 1, "YAML syntax error: %s; expected valid YAML 1.1",
-                 p.problem ? p.problem : "out of memory");
+                        p.problem ? p.problem : "out of memory");
         yaml_parser_delete(&p);
         return -1;
     }
@@ -395,21 +391,17 @@ static int parse_document(reader *r, cd_config *c, const char *text)
     yaml_node_t *root = yaml_document_get_root_node(&d);
     if (root && yaml_parser_load(&p, &d2)) {
         yaml_node_t *more = yaml_document_get_root_node(&d2);
-        if (more)
-            cd_cfg_fail(r, line_of(more), "a second YAML document starts here; expected one document");
+        if (more) cd_cfg_fail(r, line_of(more), "a second YAML document starts here; expected one document");
         yaml_document_delete(&d2);
-        if (more)
-            goto done;
+        if (more) goto done;
     } else if (root) {
         cd_cfg_fail(r, (int)p.problem_mark.line + 1, "YAML syntax error: %s; expected valid YAML 1.1",
-             p.problem ? p.problem : "out of memory");
+                    p.problem ? p.problem : "out of memory");
         goto done;
     }
-    if (read_map(r, "", "", root, 1) != 0)
-        goto done;
+    if (read_map(r, "", "", root, 1) != 0) goto done;
     set_selectors(c);
-    if (check_whole(r, c, root) != 0)
-        goto done;
+    if (check_whole(r, c, root) != 0) goto done;
     derive(c, r->seen, &r->scratch);
     set_selectors(c);
     rc = 0;
@@ -428,11 +420,9 @@ int cd_config_parse(const char *text, const char *name_for_errors, cd_config *c,
     r.errlen = errlen;
     cd_config_defaults(c);
     snprintf(c->source_path, sizeof c->source_path, "%s", r.file);
-    if (!text)
-        return cd_cfg_fail(&r, 0, "no text to read");
+    if (!text) return cd_cfg_fail(&r, 0, "no text to read");
     c->source_text = malloc(strlen(text) + 1);
-    if (!c->source_text)
-        return cd_cfg_fail(&r, 0, "out of memory");
+    if (!c->source_text) return cd_cfg_fail(&r, 0, "out of memory");
     strcpy(c->source_text, text);
     r.base[CD_TGT_CONFIG] = c;
     r.base[CD_TGT_SCRATCH] = &r.scratch;
@@ -486,8 +476,7 @@ int cd_config_load(const char *path, cd_config *c, char *err, size_t errlen)
 
 void cd_config_free(cd_config *c)
 {
-    if (!c)
-        return;
+    if (!c) return;
     free(c->source_text);
     c->source_text = NULL;
 }

@@ -6,24 +6,24 @@
 #include <stddef.h>
 #include "geom_types.h"
 
-#define CD_MAX_SPECIES 8
+#define CD_MAX_SPECIES   8
 #define CD_MAX_CFG_WALLS 8
-#define CD_MAX_ARMS 16
-#define CD_PATH_MAX 1024
+#define CD_MAX_ARMS      16
+#define CD_PATH_MAX      1024
 
 /* One kind of particle in the run. */
 /* neighbor.reorder: the memory order of the particles (src/backend/omp/reorder.c). */
 enum { CD_REORDER_CELLS = 0, CD_REORDER_NONE = 1 };
 
 typedef struct {
-    char shape[32];          /* sphere | rod | cross | hexapod | segments */
-    double aspect;           /* alpha = L / d_p [1] (named shapes) */
-    double diameter;         /* arm diameter d_p [m] (named shapes) */
-    int n_segments;          /* shape: segments */
+    char shape[32];                                      /* sphere | rod | cross | hexapod | segments */
+    double aspect;                                       /* alpha = L / d_p [1] (named shapes) */
+    double diameter;                                     /* arm diameter d_p [m] (named shapes) */
+    int n_segments;                                      /* shape: segments */
     double seg_a[CD_MAX_ARMS][3], seg_b[CD_MAX_ARMS][3]; /* body-frame axis ends [m] */
     double seg_radius[CD_MAX_ARMS];                      /* [m] */
-    long count;              /* number of particles of this species */
-    double polydispersity;   /* p: scale factor uniform in [1-p, 1+p] [1] */
+    long count;                                          /* number of particles of this species */
+    double polydispersity;                               /* p: scale factor uniform in [1-p, 1+p] [1] */
 } cd_species_config;
 
 /* The choices of domain.type and protocol.type, as the code selects on
@@ -40,31 +40,31 @@ typedef struct {
 
     /* run */
     char name[128];
-    unsigned long long seed;       /* random seed */
-    double dt;                     /* time step [s] */
-    long long steps;               /* steps to take */
-    char output[CD_PATH_MAX];      /* HDF5 output path ("" = <name>.h5 next to cwd) */
-    long long snapshot_every;      /* steps between snapshots */
-    long long thermo_every;        /* steps between time-series rows */
-    double steps_per_collision;    /* > 0: dt = t_col / steps_per_collision (run.dt not given) */
-    int force_dt;                  /* 1: run even when dt > t_col/5 */
-    double max_overlap;            /* stop when an overlap exceeds this fraction of the arm diameter [1] */
+    unsigned long long seed;    /* random seed */
+    double dt;                  /* time step [s] */
+    long long steps;            /* steps to take */
+    char output[CD_PATH_MAX];   /* HDF5 output path ("" = <name>.h5 next to cwd) */
+    long long snapshot_every;   /* steps between snapshots */
+    long long thermo_every;     /* steps between time-series rows */
+    double steps_per_collision; /* > 0: dt = t_col / steps_per_collision (run.dt not given) */
+    int force_dt;               /* 1: run even when dt > t_col/5 */
+    double max_overlap;         /* stop when an overlap exceeds this fraction of the arm diameter [1] */
 
     /* physics */
-    int dimension;                 /* 3, or 2 (x-y plane motion only) */
-    double gravity[3];             /* [m/s^2] */
-    double density;                /* rho [kg/m^3] */
-    double kn, kt;                 /* particle stiffness [N/m] */
-    double eta_n, eta_t;           /* damping ratios [1] */
-    double friction;               /* mu between particles [1] */
-    double wall_friction;          /* mu_w [1] */
-    int friction_limit_total;      /* 0: mu F_n,elastic ((kn/2) delta_n, seed 000); 1: mu F_n (seed 001, LAMMPS) */
-    int law;                       /* material.law: CD_LAW_LINEAR | CD_LAW_HERTZ_MINDLIN (kernels/contact_law.h) */
-    double young_modulus;          /* hertz_mindlin: E [Pa] */
-    double poisson_ratio;          /* hertz_mindlin: nu [1] */
-    double impact_speed;           /* hertz_mindlin: speed of the collision time t_col [m/s] */
-    double parallel_angle_deg;     /* parallel-contact cut-off [deg] */
-    int parallel_blend;            /* 1: contact point blended up to twice the cut-off (docs/contacts.md) */
+    int dimension;             /* 3, or 2 (x-y plane motion only) */
+    double gravity[3];         /* [m/s^2] */
+    double density;            /* rho [kg/m^3] */
+    double kn, kt;             /* particle stiffness [N/m] */
+    double eta_n, eta_t;       /* damping ratios [1] */
+    double friction;           /* mu between particles [1] */
+    double wall_friction;      /* mu_w [1] */
+    int friction_limit_total;  /* 0: mu F_n,elastic ((kn/2) delta_n, seed 000); 1: mu F_n (seed 001, LAMMPS) */
+    int law;                   /* material.law: CD_LAW_LINEAR | CD_LAW_HERTZ_MINDLIN (kernels/contact_law.h) */
+    double young_modulus;      /* hertz_mindlin: E [Pa] */
+    double poisson_ratio;      /* hertz_mindlin: nu [1] */
+    double impact_speed;       /* hertz_mindlin: speed of the collision time t_col [m/s] */
+    double parallel_angle_deg; /* parallel-contact cut-off [deg] */
+    int parallel_blend;        /* 1: contact point blended up to twice the cut-off (docs/contacts.md) */
 
     /* particles */
     int n_species;
@@ -72,39 +72,39 @@ typedef struct {
 
     /* domain: box | cylinder | ball | none, plus extra walls */
     char domain[16];
-    enum cd_domain_kind domain_kind; /* domain as a selector, set at load */
-    double box_width, box_thickness, box_height;  /* x, z, y extents [m] */
-    double cyl_diameter, cyl_height;              /* [m] */
-    double ball_radius;                            /* [m] */
+    enum cd_domain_kind domain_kind;             /* domain as a selector, set at load */
+    double box_width, box_thickness, box_height; /* x, z, y extents [m] */
+    double cyl_diameter, cyl_height;             /* [m] */
+    double ball_radius;                          /* [m] */
     int n_extra_walls;
     cd_wall extra_walls[CD_MAX_CFG_WALLS];
 
     /* initial placement */
-    char placement[16];            /* lattice | random */
-    char exclusion[16];            /* random placement: bounding_sphere | shape */
-    int random_placement;          /* placement is random (set at load) */
-    int exclude_by_shape;          /* exclusion is shape (set at load) */
-    double clearance;              /* lattice spacing / particle size [1] */
-    double lattice_gap;            /* > 0: lattice spacing = particle size + this [m] (init.clearance not given) */
-    double init_speed;             /* velocity components uniform in (-v, v) [m/s] */
+    char placement[16];   /* lattice | random */
+    char exclusion[16];   /* random placement: bounding_sphere | shape */
+    int random_placement; /* placement is random (set at load) */
+    int exclude_by_shape; /* exclusion is shape (set at load) */
+    double clearance;     /* lattice spacing / particle size [1] */
+    double lattice_gap;   /* > 0: lattice spacing = particle size + this [m] (init.clearance not given) */
+    double init_speed;    /* velocity components uniform in (-v, v) [m/s] */
 
     /* neighbour list */
-    double skin;                   /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
-    int reorder;                   /* neighbor.reorder: CD_REORDER_CELLS | CD_REORDER_NONE (src/backend/omp/reorder.c) */
+    double skin; /* Verlet skin [m] (0 = 0.1 x smallest arm diameter) */
+    int reorder; /* neighbor.reorder: CD_REORDER_CELLS | CD_REORDER_NONE (src/backend/omp/reorder.c) */
 
     /* MPI domain decomposition (docs/mpi.md; read by the MPI build only) */
-    int mpi_decomposition;         /* 0: cartesian */
-    double mpi_grid[3];            /* sub-domains along x, y, z; [0, 0, 0]: chosen from the ranks and the domain */
+    int mpi_decomposition; /* 0: cartesian */
+    double mpi_grid[3];    /* sub-domains along x, y, z; [0, 0, 0]: chosen from the ranks and the domain */
 
     /* protocol (SPEC section 6; src/protocols/protocol.c) */
-    char protocol[24];             /* none | deposit_compress | radial_compaction | bulk_modulus */
+    char protocol[24];                   /* none | deposit_compress | radial_compaction | bulk_modulus */
     enum cd_protocol_kind protocol_kind; /* protocol as a selector, set at load */
-    double settle_time;            /* deposit: settling time [s] (0 = 3 sqrt(2 h / g)) */
-    double piston_speed;           /* deposit: piston speed while compressing [m/s] */
-    double piston_force;           /* deposit: target force on the piston [N] */
-    double fill_ratio;             /* deposit: packing height / width that picks the count (0 = counts given) */
-    double fill_fraction;          /* deposit: expected packing fraction for fill_ratio [1] (0 = not given) */
-    int piston_hold_position;      /* deposit: 1: the piston stops where the load was reached; 0: it carries the load (mass piston_mass) */
+    double settle_time;                  /* deposit: settling time [s] (0 = 3 sqrt(2 h / g)) */
+    double piston_speed;                 /* deposit: piston speed while compressing [m/s] */
+    double piston_force;                 /* deposit: target force on the piston [N] */
+    double fill_ratio;                   /* deposit: packing height / width that picks the count (0 = counts given) */
+    double fill_fraction;                /* deposit: expected packing fraction for fill_ratio [1] (0 = not given) */
+    int piston_hold_position; /* deposit: 1: the piston stops where the load was reached; 0: it carries the load (mass piston_mass) */
     int piston_from_top;           /* deposit: 1: the piston starts at the top; 0: just above the settled packing */
     double piston_mass;            /* deposit: piston mass while holding [kg] (0 = total particle mass) */
     double pressure;               /* ball: applied pressure [Pa] (0 = pressure_ratio kn / L) */
@@ -117,10 +117,10 @@ typedef struct {
     long long probe_steps;         /* bulk: relaxation steps after each strain */
 
     /* solver: which program runs the file (docs/mpm.md) */
-    int solver;                    /* 0 dem (rigid particles), 1 mpm (material point method) */
+    int solver; /* 0 dem (rigid particles), 1 mpm (material point method) */
     /* mpm (docs/mpm.md) */
-    int mpm_setup;                 /* 0 diametral: one disk between two plane walls; 1 packing: a DEM packing in a box */
-    double mpm_diameter;           /* disk diameter D [m] (diametral) */
+    int mpm_setup;       /* 0 diametral: one disk between two plane walls; 1 packing: a DEM packing in a box */
+    double mpm_diameter; /* disk diameter D [m] (diametral) */
     char mpm_packing[CD_PATH_MAX]; /* the DEM run file of the packing (packing) */
     int mpm_cells;                 /* background cells across D [1] */
     int mpm_points_per_side;       /* material points per cell and direction at start [1] */

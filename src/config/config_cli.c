@@ -12,10 +12,8 @@
 static void expect_int(const char *opt, const char *s, long long lo, long long hi, const char *why, char *err,
                        size_t errlen)
 {
-    if (hi == LLONG_MAX)
-        snprintf(err, errlen, "%s %s: %sexpected an integer >= %lld", opt, s, why, lo);
-    else
-        snprintf(err, errlen, "%s %s: %sexpected an integer in [%lld, %lld]", opt, s, why, lo, hi);
+    if (hi == LLONG_MAX) snprintf(err, errlen, "%s %s: %sexpected an integer >= %lld", opt, s, why, lo);
+    else snprintf(err, errlen, "%s %s: %sexpected an integer in [%lld, %lld]", opt, s, why, lo, hi);
 }
 
 int cd_parse_cli_int(const char *opt, const char *s, long long lo, long long hi, long long *out, char *err,
@@ -49,10 +47,8 @@ int cd_parse_cli_real(const char *opt, const char *s, double lo, double hi, doub
         v > hi) {
         if (hi >= HUGE_VAL && lo <= -HUGE_VAL)
             snprintf(err, errlen, "%s %s: expected a finite number", opt, s ? s : "(missing)");
-        else if (hi >= HUGE_VAL)
-            snprintf(err, errlen, "%s %s: expected a number >= %g", opt, s ? s : "(missing)", lo);
-        else
-            snprintf(err, errlen, "%s %s: expected a number in [%g, %g]", opt, s ? s : "(missing)", lo, hi);
+        else if (hi >= HUGE_VAL) snprintf(err, errlen, "%s %s: expected a number >= %g", opt, s ? s : "(missing)", lo);
+        else snprintf(err, errlen, "%s %s: expected a number in [%g, %g]", opt, s ? s : "(missing)", lo, hi);
         return -1;
     }
     *out = v;

@@ -10,10 +10,14 @@
 static const char *base_of(const cd_key *k, const cd_config *c, int i)
 {
     switch (k->target) {
-    case CD_TGT_CONFIG: return (const char *)c;
-    case CD_TGT_SPECIES: return (const char *)&c->species[i];
-    case CD_TGT_WALL: return (const char *)&c->extra_walls[i];
-    default: return NULL;
+    case CD_TGT_CONFIG:
+        return (const char *)c;
+    case CD_TGT_SPECIES:
+        return (const char *)&c->species[i];
+    case CD_TGT_WALL:
+        return (const char *)&c->extra_walls[i];
+    default:
+        return NULL;
     }
 }
 
@@ -25,19 +29,27 @@ static void value_text(const cd_key *k, const char *base, char *buf, size_t n)
     const char *p = base + k->offset;
     char a[40], b[40], c[40];
     switch (k->type) {
-    case CD_KT_STRING: snprintf(buf, n, "\"%s\"", p); break;
+    case CD_KT_STRING:
+        snprintf(buf, n, "\"%s\"", p);
+        break;
     case CD_KT_ENUM:
         if (k->size) snprintf(buf, n, "%s", p);
         else cd_key_choice_name(k->choices, *(const int *)p, buf, n);
         break;
-    case CD_KT_BOOL: snprintf(buf, n, "%s", *(const int *)p ? "true" : "false"); break;
+    case CD_KT_BOOL:
+        snprintf(buf, n, "%s", *(const int *)p ? "true" : "false");
+        break;
     case CD_KT_INT:
         if (k->size == sizeof(int)) snprintf(buf, n, "%d", *(const int *)p);
         else if (k->size == sizeof(long)) snprintf(buf, n, "%ld", *(const long *)p);
         else snprintf(buf, n, "%lld", *(const long long *)p);
         break;
-    case CD_KT_UINT: snprintf(buf, n, "%llu", *(const unsigned long long *)p); break;
-    case CD_KT_REAL: real_text(*(const double *)p, buf, n); break;
+    case CD_KT_UINT:
+        snprintf(buf, n, "%llu", *(const unsigned long long *)p);
+        break;
+    case CD_KT_REAL:
+        real_text(*(const double *)p, buf, n);
+        break;
     case CD_KT_VEC3: {
         const double *v = (const double *)p;
         real_text(v[0], a, sizeof a);
@@ -62,7 +74,9 @@ static void value_text(const cd_key *k, const char *base, char *buf, size_t n)
         if (j < n) snprintf(buf + j, n - j, "]");
         break;
     }
-    default: buf[0] = 0; break;
+    default:
+        buf[0] = 0;
+        break;
     }
 }
 
@@ -71,15 +85,20 @@ static int differs(const cd_key *k, const char *pa, const char *pb)
 {
     const char *a = pa + k->offset, *b = pb + k->offset;
     switch (k->type) {
-    case CD_KT_STRING: return strcmp(a, b) != 0;
-    case CD_KT_ENUM: return k->size ? strcmp(a, b) != 0 : *(const int *)a != *(const int *)b;
-    case CD_KT_BOOL: return *(const int *)a != *(const int *)b;
+    case CD_KT_STRING:
+        return strcmp(a, b) != 0;
+    case CD_KT_ENUM:
+        return k->size ? strcmp(a, b) != 0 : *(const int *)a != *(const int *)b;
+    case CD_KT_BOOL:
+        return *(const int *)a != *(const int *)b;
     case CD_KT_INT:
         if (k->size == sizeof(int)) return *(const int *)a != *(const int *)b;
         if (k->size == sizeof(long)) return *(const long *)a != *(const long *)b;
         return *(const long long *)a != *(const long long *)b;
-    case CD_KT_UINT: return *(const unsigned long long *)a != *(const unsigned long long *)b;
-    case CD_KT_REAL: return *(const double *)a != *(const double *)b;
+    case CD_KT_UINT:
+        return *(const unsigned long long *)a != *(const unsigned long long *)b;
+    case CD_KT_REAL:
+        return *(const double *)a != *(const double *)b;
     case CD_KT_VEC3:
         for (int c = 0; c < 3; c++)
             if (((const double *)a)[c] != ((const double *)b)[c]) return 1;
@@ -94,7 +113,8 @@ static int differs(const cd_key *k, const char *pa, const char *pb)
             if (sa->seg_radius[q] != sb->seg_radius[q]) return 1;
         return 0;
     }
-    default: return 0;
+    default:
+        return 0;
     }
 }
 
@@ -192,7 +212,8 @@ int cd_config_resume_diff(const cd_config *stored, const cd_config *given, const
             }
             value_text(k, pa, va, sizeof va);
             value_text(k, pb, vb, sizeof vb);
-            if (k->flags & CD_KF_DERIVED) note = " (derived from another key when not given: allow it too if that change is meant)";
+            if (k->flags & CD_KF_DERIVED)
+                note = " (derived from another key when not given: allow it too if that change is meant)";
             else if (!strcmp(k->path, "material.damping_normal")) note = " (or set by material.restitution)";
             else note = "";
             int ok = (k->flags & CD_KF_RESUMABLE) || allowed(name, allow, n_allow);

@@ -11,16 +11,16 @@
 #include "config/config_schema.h"
 
 #define MAX_KEYS 96 /* >= cd_config_nkeys (checked in cd_config_defaults) */
-#define PATHLEN 256
-#define VALLEN 96
+#define PATHLEN  256
+#define VALLEN   96
 
 typedef struct {
     const char *file;
     char *err;
     size_t errlen;
     yaml_document_t *doc;
-    void *base[CD_TGT_COUNT];         /* where rows of each target are stored now */
-    yaml_node_t *seen[MAX_KEYS];      /* value given for each cd_config / scratch row */
+    void *base[CD_TGT_COUNT];    /* where rows of each target are stored now */
+    yaml_node_t *seen[MAX_KEYS]; /* value given for each cd_config / scratch row */
     cd_config_scratch scratch;
 } reader;
 
@@ -38,11 +38,9 @@ static inline int is_plain(const yaml_node_t *v)
 static inline int is_null(const yaml_node_t *v)
 {
     static const char *const nulls[] = {"", "~", "null", "Null", "NULL"};
-    if (!is_plain(v))
-        return 0;
+    if (!is_plain(v)) return 0;
     for (size_t i = 0; i < sizeof nulls / sizeof nulls[0]; i++)
-        if (strcmp(sval(v), nulls[i]) == 0)
-            return 1;
+        if (strcmp(sval(v), nulls[i]) == 0) return 1;
     return 0;
 }
 
@@ -63,7 +61,7 @@ int cd_cfg_bad(reader *r, const cd_key *k, yaml_node_t *v, const char *path, con
 /* An unknown key name in section sect: a near miss, the same key elsewhere,
  * or the keys that are known here. */
 int cd_cfg_unknown_key(reader *r, const char *sect, const char *epath, const char *name, yaml_node_t *v,
-                const cd_key *sel, int choice);
+                       const cd_key *sel, int choice);
 
 /* ---- values: config_value.c --------------------------------------------- */
 

@@ -32,10 +32,8 @@ void cd_cfg_render(yaml_document_t *d, yaml_node_t *v, char *buf, size_t n, int 
         const char *q = v->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE   ? "'"
                         : v->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE ? "\""
                                                                                   : "";
-        if (!*q && !*sval(v))
-            PUT("(empty)");
-        else
-            PUT("%s%s%s", q, sval(v), q);
+        if (!*q && !*sval(v)) PUT("(empty)");
+        else PUT("%s%s%s", q, sval(v), q);
     } else if (depth > 2) {
         PUT(v->type == YAML_SEQUENCE_NODE ? "[...]" : "{...}");
     } else if (v->type == YAML_SEQUENCE_NODE) {
@@ -57,14 +55,10 @@ void cd_cfg_render(yaml_document_t *d, yaml_node_t *v, char *buf, size_t n, int 
         PUT("}");
     }
 #undef PUT
-    if (j >= n && n > 4)
-        strcpy(buf + n - 4, "...");
+    if (j >= n && n > 4) strcpy(buf + n - 4, "...");
 }
 
-void cd_cfg_join(char *buf, const char *a, const char *b)
-{
-    snprintf(buf, PATHLEN, "%s%s%s", a, *a ? "." : "", b);
-}
+void cd_cfg_join(char *buf, const char *a, const char *b) { snprintf(buf, PATHLEN, "%s%s%s", a, *a ? "." : "", b); }
 
 /* "path = value: expected ... (label, unit)" plus an optional note. */
 int cd_cfg_bad(reader *r, const cd_key *k, yaml_node_t *v, const char *path, const char *note)
@@ -74,11 +68,11 @@ int cd_cfg_bad(reader *r, const cd_key *k, yaml_node_t *v, const char *path, con
     cd_key_expect_text(k, exp, sizeof exp);
     int unit = strcmp(k->unit, "-") != 0 && strcmp(k->unit, "1") != 0;
     return cd_cfg_fail(r, line_of(v), "%s = %s: expected %s (%s%s%s)%s%s", path, val, exp, k->label, unit ? ", " : "",
-                unit ? k->unit : "", note ? "; " : "", note ? note : "");
+                       unit ? k->unit : "", note ? "; " : "", note ? note : "");
 }
 
 int cd_cfg_unknown_key(reader *r, const char *sect, const char *epath, const char *name, yaml_node_t *v,
-                const cd_key *sel, int choice)
+                       const cd_key *sel, int choice)
 {
     char path[PATHLEN], val[VALLEN], cand[64], best[64] = "", list[512];
     int bestd = 3;
@@ -98,8 +92,9 @@ int cd_cfg_unknown_key(reader *r, const char *sect, const char *epath, const cha
     }
     for (size_t k = 0; k < cd_config_nkeys; k++)
         if (strcmp(cd_key_leaf(&cd_config_keys[k]), name) == 0)
-            return cd_cfg_fail(r, line_of(v), "%s = %s: unknown key here; did you mean %s?", path, val, cd_config_keys[k].path);
+            return cd_cfg_fail(r, line_of(v), "%s = %s: unknown key here; did you mean %s?", path, val,
+                               cd_config_keys[k].path);
     cd_key_known_list(sect, sel, choice, list, sizeof list);
     return cd_cfg_fail(r, line_of(v), "%s = %s: unknown key; expected one of the keys %s%s: %s", path, val,
-                *epath ? "of " : "at the top level", epath, list);
+                       *epath ? "of " : "at the top level", epath, list);
 }

@@ -9,35 +9,35 @@
 #include "config/config.h"
 
 typedef enum {
-    CD_KT_STRING,   /* text, stored in char[size] */
-    CD_KT_ENUM,     /* one of choices; stored as text in char[size], or as the choice index in an int when size == 0 */
-    CD_KT_BOOL,     /* true/false (YAML 1.1 forms), stored as int 0/1 */
-    CD_KT_INT,      /* signed integer, stored in an integer of size bytes */
-    CD_KT_UINT,     /* unsigned long long */
-    CD_KT_REAL,     /* double */
-    CD_KT_VEC3,     /* list of 3 reals, stored as double[3] */
-    CD_KT_LIST,     /* list of mappings whose keys are the rows under "<path>[]" */
-    CD_KT_SEGMENTS  /* list of [ax, ay, az, bx, by, bz, radius] into a cd_species_config */
+    CD_KT_STRING,  /* text, stored in char[size] */
+    CD_KT_ENUM,    /* one of choices; stored as text in char[size], or as the choice index in an int when size == 0 */
+    CD_KT_BOOL,    /* true/false (YAML 1.1 forms), stored as int 0/1 */
+    CD_KT_INT,     /* signed integer, stored in an integer of size bytes */
+    CD_KT_UINT,    /* unsigned long long */
+    CD_KT_REAL,    /* double */
+    CD_KT_VEC3,    /* list of 3 reals, stored as double[3] */
+    CD_KT_LIST,    /* list of mappings whose keys are the rows under "<path>[]" */
+    CD_KT_SEGMENTS /* list of [ax, ay, az, bx, by, bz, radius] into a cd_species_config */
 } cd_key_type;
 
 /* Which struct a row's offset is into. */
 typedef enum {
-    CD_TGT_CONFIG,   /* cd_config */
-    CD_TGT_SPECIES,  /* cd_species_config (one particles[] item) */
-    CD_TGT_WALL,     /* cd_wall (one domain.walls[] item) */
-    CD_TGT_SCRATCH,  /* cd_config_scratch: read, then turned into cd_config fields */
+    CD_TGT_CONFIG,  /* cd_config */
+    CD_TGT_SPECIES, /* cd_species_config (one particles[] item) */
+    CD_TGT_WALL,    /* cd_wall (one domain.walls[] item) */
+    CD_TGT_SCRATCH, /* cd_config_scratch: read, then turned into cd_config fields */
     CD_TGT_COUNT
 } cd_key_target;
 
 /* Values that are read but stored in cd_config only after conversion. */
 typedef struct {
-    double restitution;  /* material.restitution -> eta_n */
+    double restitution; /* material.restitution -> eta_n */
 } cd_config_scratch;
 
 enum {
-    CD_KF_DERIVED  = 1u << 0, /* def describes a rule applied after reading, not a literal */
+    CD_KF_DERIVED = 1u << 0,  /* def describes a rule applied after reading, not a literal */
     CD_KF_SELECTOR = 1u << 1, /* this enum's value decides which sibling keys apply */
-    CD_KF_UNIT     = 1u << 2, /* vec3 that must be nonzero; stored normalised */
+    CD_KF_UNIT = 1u << 2,     /* vec3 that must be nonzero; stored normalised */
     CD_KF_NONEMPTY = 1u << 3, /* string that must not be empty */
     CD_KF_RESUMABLE = 1u << 4 /* may differ from the run file's config on --resume (run length, output cadence,
                                * stopping criteria): neither the physics nor the set-up */
@@ -46,16 +46,16 @@ enum {
 #define CD_ALL_CHOICES (~0u)
 
 typedef struct {
-    const char *path;      /* dotted key; "[]" marks the items of a list key */
+    const char *path; /* dotted key; "[]" marks the items of a list key */
     cd_key_type type;
-    const char *unit;      /* SI unit; "1" dimensionless, "-" none */
-    const char *def;       /* default as YAML text (or the rule, with CD_KF_DERIVED); NULL: none */
-    char lo_kind;          /* '[' inclusive, '(' exclusive, 0 no lower bound */
+    const char *unit; /* SI unit; "1" dimensionless, "-" none */
+    const char *def;  /* default as YAML text (or the rule, with CD_KF_DERIVED); NULL: none */
+    char lo_kind;     /* '[' inclusive, '(' exclusive, 0 no lower bound */
     double lo, hi;
-    char hi_kind;          /* ']' inclusive, ')' exclusive, 0 no upper bound */
-    const char *choices;   /* enum: "a|b|c" */
-    const char *label;     /* short name used in error messages */
-    const char *meaning;   /* one line for --help and docs/config.md */
+    char hi_kind;        /* ']' inclusive, ')' exclusive, 0 no upper bound */
+    const char *choices; /* enum: "a|b|c" */
+    const char *label;   /* short name used in error messages */
+    const char *meaning; /* one line for --help and docs/config.md */
     cd_key_target target;
     size_t offset;         /* offsetof the field in the target struct */
     size_t size;           /* storage bytes (string, enum-as-text, int) */

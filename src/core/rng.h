@@ -4,7 +4,9 @@
 #define CD_RNG_H
 #include <stdint.h>
 
-typedef struct { uint64_t s[4]; } cd_rng;
+typedef struct {
+    uint64_t s[4];
+} cd_rng;
 
 static inline uint64_t cd_splitmix64(uint64_t *x)
 {

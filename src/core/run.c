@@ -24,11 +24,17 @@ static int observable_table(const cd_sim *sim, cd_observable_info *info)
 {
     int W = (int)sim->s.n_walls;
     cd_observable_info t[OBS_COUNT] = {
-        {"kinetic_energy_translational", "J", 1}, {"kinetic_energy_rotational", "J", 1},
+        {"kinetic_energy_translational", "J", 1},
+        {"kinetic_energy_rotational", "J", 1},
         {"kinetic_energy_in_contact", "J", 1},
-        {"elastic_energy", "J", 1}, {"potential_energy", "J", 1},
-        {"contacts", "1", 1}, {"wall_contacts", "1", 1}, {"momentum", "kg m/s", 3},
-        {"wall_force", "N", 3 * W}, {"wall_position", "m", 3 * W}, {"wall_radius", "m", W},
+        {"elastic_energy", "J", 1},
+        {"potential_energy", "J", 1},
+        {"contacts", "1", 1},
+        {"wall_contacts", "1", 1},
+        {"momentum", "kg m/s", 3},
+        {"wall_force", "N", 3 * W},
+        {"wall_position", "m", 3 * W},
+        {"wall_radius", "m", W},
     };
     int n = 0;
     for (int k = 0; k < OBS_COUNT; k++)
@@ -84,8 +90,8 @@ static void progress(progress_t *pg, const cd_sim *sim, long long total, int fin
     long long done = sim->s.step - pg->step0;
     double rate = done > 0 ? (double)done / (t - pg->start) : 0; /* steps/s */
     double eta = rate > 0 ? (double)(total - sim->s.step) / rate : 0;
-    fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  %.3g particle-steps/s  ETA %.0f s%s",
-            pg->tty ? "\r" : "", sim->s.step, total, sim->s.time, rate * (double)sim->s.n_particles, eta,
+    fprintf(stderr, "%sstep %lld/%lld  t = %.6g s  %.3g particle-steps/s  ETA %.0f s%s", pg->tty ? "\r" : "",
+            sim->s.step, total, sim->s.time, rate * (double)sim->s.n_particles, eta,
             pg->tty ? (final ? "\n" : "   ") : "\n");
     fflush(stderr);
 }
@@ -128,7 +134,8 @@ static int check_wall_placement(const cd_sim *sim, char *err, size_t errlen)
         if (w >= first_extra) snprintf(wall, sizeof wall, "domain.walls[%zu]", w - first_extra);
         else snprintf(wall, sizeof wall, "wall %zu of domain.type %s", w, c->domain);
         const cd_vec3 x = s->position[worst_q];
-        snprintf(err, errlen, "%s: %s (point [%g, %g, %g] m, normal [%g, %g, %g]) cuts through the start positions: "
+        snprintf(err, errlen,
+                 "%s: %s (point [%g, %g, %g] m, normal [%g, %g, %g]) cuts through the start positions: "
                  "%zu particle%s reach%s across it, the deepest particle %zu (particles[%d], centre [%g, %g, %g] m) by "
                  "%g m (%.3g arm diameters) beyond the contact distance; every arm must start on the side the normal "
                  "points to, at least its radius %g m away: move the wall, turn its normal, or shrink the domain",
@@ -160,7 +167,8 @@ static int blowup_cause(cd_sim *sim, char *cause, size_t len)
         if (v > vmax) vmax = v, qmax = q;
     }
     if (!(vmax * sim->p.dt > 0.5 * dmin)) return 0;
-    snprintf(cause, len, "runaway velocity at step %lld (t = %.9g s): particle %zu moves at %.3g m/s, %.3g arm "
+    snprintf(cause, len,
+             "runaway velocity at step %lld (t = %.9g s): particle %zu moves at %.3g m/s, %.3g arm "
              "diameters per step (dt = %g s): the run blew up; reduce run.dt or check the material parameters",
              s->step, s->time, qmax, vmax, vmax * sim->p.dt / dmin, sim->p.dt);
     return 1;
@@ -173,12 +181,12 @@ static void write_failed(const cd_run_options *opt, const cd_config *cfg, long l
     if (last_snap < 0)
         fprintf(stderr, "capdem: the run stops before its first snapshot%s\n",
                 opt->overwrite ? "; an existing file of that name is left as it was" : "");
-    else if (access(cfg->output, F_OK) != 0)
-        fprintf(stderr, "capdem: the run stops\n");
+    else if (access(cfg->output, F_OK) != 0) fprintf(stderr, "capdem: the run stops\n");
     else
-        fprintf(stderr, "capdem: the run stops; %s keeps its complete snapshots, the last at step %lld: once the cause "
-                "is removed (room made), `capdem run %s --resume %s` continues from there\n", cfg->output, last_snap,
-                opt->config_path, cfg->output);
+        fprintf(stderr,
+                "capdem: the run stops; %s keeps its complete snapshots, the last at step %lld: once the cause "
+                "is removed (room made), `capdem run %s --resume %s` continues from there\n",
+                cfg->output, last_snap, opt->config_path, cfg->output);
 }
 
 /* Under MPI (docs/mpi.md) rank 0 alone holds the output (out is NULL on
@@ -233,11 +241,13 @@ static int check_resume_config(const cd_run_options *opt, const cd_config *given
         fprintf(stderr, "capdem: --resume %s: %s changes keys that may change on a resume or were allowed:\n%s",
                 opt->resume_path, opt->config_path, accepted);
     if (n == 0) return 0;
-    fprintf(stderr, "capdem: --resume %s: %s changes %d key%s of the run's own config (%s in the run file) that "
-            "set%s the physics or the set-up; a resume continues the same simulation, so this is refused:\n%s"
-            "capdem: pass --allow-change KEY for each change that is meant (it applies from the resumed step on; masses, "
-            "shapes and counts stay the file's), or start a new run\n",
-            opt->resume_path, opt->config_path, n, n == 1 ? "" : "s", dpath, n == 1 ? "s" : "", refused);
+    fprintf(
+        stderr,
+        "capdem: --resume %s: %s changes %d key%s of the run's own config (%s in the run file) that "
+        "set%s the physics or the set-up; a resume continues the same simulation, so this is refused:\n%s"
+        "capdem: pass --allow-change KEY for each change that is meant (it applies from the resumed step on; masses, "
+        "shapes and counts stay the file's), or start a new run\n",
+        opt->resume_path, opt->config_path, n, n == 1 ? "" : "s", dpath, n == 1 ? "s" : "", refused);
     return 2;
 }
 
@@ -260,9 +270,10 @@ static int check_files(const cd_run_options *opt, const cd_config *cfg, const cd
     }
     if (opt->resume_path) {
         if (opt->output_path && !same_file(opt->output_path, opt->resume_path)) {
-            fprintf(stderr, "capdem: --output %s with --resume %s: a resume appends to the file it resumes; copy %s "
-                    "to %s first and resume that copy\n", opt->output_path, opt->resume_path, opt->resume_path,
-                    opt->output_path);
+            fprintf(stderr,
+                    "capdem: --output %s with --resume %s: a resume appends to the file it resumes; copy %s "
+                    "to %s first and resume that copy\n",
+                    opt->output_path, opt->resume_path, opt->resume_path, opt->output_path);
             return 2;
         }
         if (cd_output_check_target(opt->resume_path, CD_OUTPUT_RESUME, inputs, 1, err, sizeof err)) {
@@ -356,13 +367,16 @@ static int run(const cd_run_options *opt)
          * more: one behind the resumed step is refused. */
         if (cfg.steps < sim.s.step) {
             if (opt->steps >= 0)
-                fprintf(stderr, "capdem: --steps %lld: the run file %s is at step %lld already; on a resume --steps "
+                fprintf(stderr,
+                        "capdem: --steps %lld: the run file %s is at step %lld already; on a resume --steps "
                         "is the step to reach, counted from the start of the run: expected an integer >= %lld\n",
                         cfg.steps, opt->resume_path, sim.s.step, sim.s.step);
             else
-                fprintf(stderr, "capdem: %s: run.steps = %lld, but the run file %s is at step %lld already; on a "
+                fprintf(stderr,
+                        "capdem: %s: run.steps = %lld, but the run file %s is at step %lld already; on a "
                         "resume it is the step to reach, counted from the start of the run: give --steps N with "
-                        "N >= %lld\n", opt->config_path, cfg.steps, opt->resume_path, sim.s.step, sim.s.step);
+                        "N >= %lld\n",
+                        opt->config_path, cfg.steps, opt->resume_path, sim.s.step, sim.s.step);
             status = 2;
             goto done;
         }
@@ -399,17 +413,20 @@ static int run(const cd_run_options *opt)
             out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg,
                                         sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
     }
-    if (cd_mpi_agree(cd_mpi_is_writer() && !out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
+    if (cd_mpi_agree(cd_mpi_is_writer() &&
+                     !out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
         status = 1;
         goto done;
     }
-    fprintf(stderr, "capdem: %zu particles, %zu primitives, %zu walls, dt = %g s (t_col/%.1f), backend %s on %s, output %s\n",
+    fprintf(stderr,
+            "capdem: %zu particles, %zu primitives, %zu walls, dt = %g s (t_col/%.1f), backend %s on %s, output %s\n",
             sim.s.n_particles, sim.s.n_prims, sim.s.n_walls, sim.p.dt, sim.collision_time / sim.p.dt, sim.backend->name,
             sim.backend->device(&sim), cfg.output);
     if (cfg.fill_ratio > 0)
         fprintf(stderr, "capdem: protocol.fill_ratio %g at protocol.fill_fraction %g: %ld particles\n", cfg.fill_ratio,
                 cfg.fill_fraction, sim.cfg.species[0].count);
-    if ((cfg.domain_kind == CD_DOMAIN_BOX && cfg.box_height == 0) || (cfg.domain_kind == CD_DOMAIN_CYLINDER && cfg.cyl_height == 0))
+    if ((cfg.domain_kind == CD_DOMAIN_BOX && cfg.box_height == 0) ||
+        (cfg.domain_kind == CD_DOMAIN_CYLINDER && cfg.cyl_height == 0))
         fprintf(stderr, "capdem: domain.height %g m (the lowest that holds the init lattice)\n",
                 cfg.domain_kind == CD_DOMAIN_BOX ? sim.cfg.box_height : sim.cfg.cyl_height);
 
@@ -485,7 +502,8 @@ static int run(const cd_run_options *opt)
                 break;
             }
             if (o.max_overlap_ratio > cfg.max_overlap) {
-                fprintf(stderr, "\ncapdem: run stopped at step %lld (t = %.9g s): an overlap reached %.3g of the arm diameter "
+                fprintf(stderr,
+                        "\ncapdem: run stopped at step %lld (t = %.9g s): an overlap reached %.3g of the arm diameter "
                         "(limit run.max_overlap = %.2g); the time step %g s, the stiffness or the load is unsuitable. "
                         "%s keeps the snapshots written so far\n",
                         sim.s.step, sim.s.time, o.max_overlap_ratio, cfg.max_overlap, sim.p.dt, cfg.output);
@@ -510,9 +528,10 @@ static int run(const cd_run_options *opt)
     }
     if (!opt->quiet && status == 0) progress(&pg, &sim, cfg.steps, 1);
     if (status == 0 && cfg.protocol_kind != CD_PROTOCOL_NONE && !protocol_done)
-        fprintf(stderr, "capdem: warning: run.steps = %lld reached in protocol phase '%s'; continue with "
-                "`capdem run %s --resume %s --steps N`\n", cfg.steps, cd_protocol_phase_name((int)sim.s.control[0]),
-                opt->config_path, cfg.output);
+        fprintf(stderr,
+                "capdem: warning: run.steps = %lld reached in protocol phase '%s'; continue with "
+                "`capdem run %s --resume %s --steps N`\n",
+                cfg.steps, cd_protocol_phase_name((int)sim.s.control[0]), opt->config_path, cfg.output);
 done:
     if (out && cd_output_close(out)) status = status ? status : 1;
     cd_sim_free(&sim);

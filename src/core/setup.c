@@ -21,7 +21,8 @@ static cd_quat random_orientation(cd_rng *r, int dimension)
     if (dimension == 2) return cd_q_from_axis_angle(cd_v3(0, 0, 1), cd_rng_range(r, 0, 2 * CD_PI));
     double u1 = cd_rng_uniform(r), u2 = cd_rng_uniform(r), u3 = cd_rng_uniform(r);
     double a = sqrt(1 - u1), b = sqrt(u1);
-    return cd_q_normalize(cd_q(a * sin(2 * CD_PI * u2), a * cos(2 * CD_PI * u2), b * sin(2 * CD_PI * u3), b * cos(2 * CD_PI * u3)));
+    return cd_q_normalize(
+        cd_q(a * sin(2 * CD_PI * u2), a * cos(2 * CD_PI * u2), b * sin(2 * CD_PI * u3), b * cos(2 * CD_PI * u3)));
 }
 
 static int add_wall(cd_sim *sim, cd_wall w, char *err, size_t errlen)
@@ -115,17 +116,33 @@ static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out
 {
     double lo[3], hi[3];
     if (c->domain_kind == CD_DOMAIN_BOX) {
-        lo[0] = 0; hi[0] = c->box_width; lo[1] = 0; hi[1] = c->box_height; lo[2] = 0; hi[2] = c->box_thickness;
+        lo[0] = 0;
+        hi[0] = c->box_width;
+        lo[1] = 0;
+        hi[1] = c->box_height;
+        lo[2] = 0;
+        hi[2] = c->box_thickness;
     } else if (c->domain_kind == CD_DOMAIN_CYLINDER) {
         double rc = 0.5 * c->cyl_diameter;
-        lo[0] = -rc; hi[0] = rc; lo[1] = 0; hi[1] = c->cyl_height; lo[2] = -rc; hi[2] = rc;
+        lo[0] = -rc;
+        hi[0] = rc;
+        lo[1] = 0;
+        hi[1] = c->cyl_height;
+        lo[2] = -rc;
+        hi[2] = rc;
     } else if (c->domain_kind == CD_DOMAIN_BALL) {
-        for (int k = 0; k < 3; k++) { lo[k] = -c->ball_radius; hi[k] = c->ball_radius; }
+        for (int k = 0; k < 3; k++) {
+            lo[k] = -c->ball_radius;
+            hi[k] = c->ball_radius;
+        }
     } else {
         /* Free space: a cube of sites about the origin. */
         double side = a * ceil(cbrt((double)max) + 1);
         if (c->dimension == 2) side = a * ceil(sqrt((double)max) + 1);
-        for (int k = 0; k < 3; k++) { lo[k] = -0.5 * side; hi[k] = 0.5 * side; }
+        for (int k = 0; k < 3; k++) {
+            lo[k] = -0.5 * side;
+            hi[k] = 0.5 * side;
+        }
     }
     long n[3];
     double off[3];
@@ -134,8 +151,12 @@ static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out
         if (n[k] < 1) n[k] = 1;
         off[k] = lo[k] + 0.5 * (hi[k] - lo[k] - (double)(n[k] - 1) * a); /* centred rows */
     }
-    if (c->dimension == 2) { n[2] = 1; off[2] = 0.5 * (lo[2] + hi[2]); }
-    if (c->domain_kind == CD_DOMAIN_BOX && c->dimension == 3 && n[2] == 1) off[2] = 0.5 * c->box_thickness; /* pseudo-2D */
+    if (c->dimension == 2) {
+        n[2] = 1;
+        off[2] = 0.5 * (lo[2] + hi[2]);
+    }
+    if (c->domain_kind == CD_DOMAIN_BOX && c->dimension == 3 && n[2] == 1)
+        off[2] = 0.5 * c->box_thickness; /* pseudo-2D */
     size_t count = 0;
     for (long iy = 0; iy < n[1] && count < max; iy++)
         for (long iz = 0; iz < n[2] && count < max; iz++)
@@ -153,14 +174,28 @@ static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out
 static void sampling_box(const cd_config *c, double R, size_t max, double lo[3], double hi[3])
 {
     if (c->domain_kind == CD_DOMAIN_BOX) {
-        lo[0] = 0; hi[0] = c->box_width; lo[1] = 0; hi[1] = c->box_height; lo[2] = 0; hi[2] = c->box_thickness;
+        lo[0] = 0;
+        hi[0] = c->box_width;
+        lo[1] = 0;
+        hi[1] = c->box_height;
+        lo[2] = 0;
+        hi[2] = c->box_thickness;
     } else if (c->domain_kind == CD_DOMAIN_CYLINDER) {
-        lo[0] = lo[2] = -0.5 * c->cyl_diameter; hi[0] = hi[2] = 0.5 * c->cyl_diameter; lo[1] = 0; hi[1] = c->cyl_height;
+        lo[0] = lo[2] = -0.5 * c->cyl_diameter;
+        hi[0] = hi[2] = 0.5 * c->cyl_diameter;
+        lo[1] = 0;
+        hi[1] = c->cyl_height;
     } else if (c->domain_kind == CD_DOMAIN_BALL) {
-        for (int k = 0; k < 3; k++) { lo[k] = -c->ball_radius; hi[k] = c->ball_radius; }
+        for (int k = 0; k < 3; k++) {
+            lo[k] = -c->ball_radius;
+            hi[k] = c->ball_radius;
+        }
     } else {
         double side = 2 * R * cbrt(4.0 * (double)max) + 2 * R;
-        for (int k = 0; k < 3; k++) { lo[k] = -0.5 * side; hi[k] = 0.5 * side; }
+        for (int k = 0; k < 3; k++) {
+            lo[k] = -0.5 * side;
+            hi[k] = 0.5 * side;
+        }
     }
 }
 
@@ -218,8 +253,10 @@ static int shapes_overlap(const cd_state *s, size_t i, size_t j)
 static int arms_inside_domain(const cd_config *c, const cd_state *s, size_t q)
 {
     for (cd_int u = s->prim_first[q]; u < s->prim_first[q] + s->prim_count[q]; u++)
-        if (!inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_a_body[u]), s->prim_radius[u]) ||
-            !inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_b_body[u]), s->prim_radius[u]))
+        if (!inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_a_body[u]),
+                           s->prim_radius[u]) ||
+            !inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_b_body[u]),
+                           s->prim_radius[u]))
             return 0;
     return 1;
 }
@@ -253,8 +290,10 @@ static size_t random_shape_placement(const cd_sim *sim, cd_state *s, cd_rng *r, 
 
 static void describe_domain(const cd_config *c, char *buf, size_t n)
 {
-    if (c->domain_kind == CD_DOMAIN_BOX) snprintf(buf, n, "domain.width/height/thickness = %g/%g/%g m", c->box_width, c->box_height, c->box_thickness);
-    else if (c->domain_kind == CD_DOMAIN_CYLINDER) snprintf(buf, n, "domain.diameter/height = %g/%g m", c->cyl_diameter, c->cyl_height);
+    if (c->domain_kind == CD_DOMAIN_BOX)
+        snprintf(buf, n, "domain.width/height/thickness = %g/%g/%g m", c->box_width, c->box_height, c->box_thickness);
+    else if (c->domain_kind == CD_DOMAIN_CYLINDER)
+        snprintf(buf, n, "domain.diameter/height = %g/%g m", c->cyl_diameter, c->cyl_height);
     else if (c->domain_kind == CD_DOMAIN_BALL) snprintf(buf, n, "domain.radius = %g m", c->ball_radius);
     else snprintf(buf, n, "domain.type = none");
 }
@@ -283,7 +322,7 @@ static void resolve_fill_count(cd_sim *sim)
     if (!(c->fill_ratio > 0) || c->n_species != 1 || c->species[0].count > 0) return;
     double width = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter; /* [m] */
     double section = c->domain_kind == CD_DOMAIN_BOX ? c->box_width * c->box_thickness
-                                               : 0.25 * CD_PI * c->cyl_diameter * c->cyl_diameter; /* [m^2] */
+                                                     : 0.25 * CD_PI * c->cyl_diameter * c->cyl_diameter; /* [m^2] */
     double p = c->species[0].polydispersity;
     double v = sim->shapes[0].volume * (1 + p * p); /* mean particle volume [m^3] */
     c->species[0].count = (long)ceil(c->fill_ratio * width * section * c->fill_fraction / v);
@@ -304,10 +343,12 @@ static double lattice_spacing(const cd_config *c, double R)
 static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
 {
     cd_config *c = &sim->cfg;
-    double *h = c->domain_kind == CD_DOMAIN_BOX ? &c->box_height : c->domain_kind == CD_DOMAIN_CYLINDER ? &c->cyl_height : NULL;
+    double *h = c->domain_kind == CD_DOMAIN_BOX        ? &c->box_height
+                : c->domain_kind == CD_DOMAIN_CYLINDER ? &c->cyl_height
+                                                       : NULL;
     if (!h || *h > 0) return 0;
-    double R = largest_bounding_radius(sim), a = lattice_spacing(c, R); /* [m] */
-    double wx = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter;    /* [m] */
+    double R = largest_bounding_radius(sim), a = lattice_spacing(c, R);               /* [m] */
+    double wx = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter;     /* [m] */
     double wz = c->domain_kind == CD_DOMAIN_BOX ? c->box_thickness : c->cyl_diameter; /* [m] */
     size_t N = sim->s.n_particles, row_max = (size_t)(floor(wx / a) + 1) * (size_t)(floor(wz / a) + 1);
     cd_vec3 *sites = malloc(row_max * sizeof(cd_vec3));
@@ -318,7 +359,8 @@ static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
     if (per_row == 0) {
         char dom[256];
         describe_domain(c, dom, sizeof dom);
-        snprintf(err, errlen, "%s: domain: no particle of size %g m fits across the domain (%s)", c->source_path, 2 * R, dom);
+        snprintf(err, errlen, "%s: domain: no particle of size %g m fits across the domain (%s)", c->source_path, 2 * R,
+                 dom);
         return -1;
     }
     *h = (double)((N + per_row - 1) / per_row) * a * (1 + 1e-9);
@@ -330,7 +372,7 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
     const cd_config *c = &sim->cfg;
     cd_state *s = &sim->s;
     double R = largest_bounding_radius(sim); /* [m] */
-    double a = lattice_spacing(c, R);         /* [m] */
+    double a = lattice_spacing(c, R);        /* [m] */
     size_t N = s->n_particles, got;
     int random = c->random_placement, by_shape = random && c->exclude_by_shape;
     if (by_shape) {
@@ -348,13 +390,15 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
         if (by_shape) snprintf(how, sizeof how, "random places without overlapping arms");
         else if (random) snprintf(how, sizeof how, "random places for bounding spheres of %g m", 2 * R);
         else snprintf(how, sizeof how, "lattice sites (size %g m, spacing %g m)", 2 * R, a);
-        snprintf(err, errlen, "%s: particles: %zu particles do not fit: %s holds only %zu %s; "
-                 "enlarge the domain or lower the counts", c->source_path, N, dom, got, how);
+        snprintf(err, errlen,
+                 "%s: particles: %zu particles do not fit: %s holds only %zu %s; "
+                 "enlarge the domain or lower the counts",
+                 c->source_path, N, dom, got, how);
         return -1;
     }
     for (size_t q = 0; q < N; q++) {
         if (!by_shape) s->orientation[q] = random_orientation(rng, c->dimension); /* drawn with the place otherwise */
-        double v = c->init_speed; /* [m/s] */
+        double v = c->init_speed;                                                 /* [m/s] */
         /* z, y, x one by one, as in random_point (argument order is unspecified) */
         double vz = c->dimension == 2 ? 0 : cd_rng_range(rng, -v, v), vy = cd_rng_range(rng, -v, v);
         double vx = cd_rng_range(rng, -v, v);
@@ -373,8 +417,10 @@ static int check_time_step(cd_sim *sim, char *err, size_t errlen)
     /* The two lightest particles give the shortest collision. */
     double m1 = INFINITY, m2 = INFINITY;
     for (size_t q = 0; q < s->n_particles; q++) {
-        if (s->mass[q] < m1) { m2 = m1; m1 = s->mass[q]; }
-        else if (s->mass[q] < m2) m2 = s->mass[q];
+        if (s->mass[q] < m1) {
+            m2 = m1;
+            m1 = s->mass[q];
+        } else if (s->mass[q] < m2) m2 = s->mass[q];
     }
     double m_eff = s->n_particles > 1 ? cd_law_effective_mass(m1, m2) : m1;
     if (c->law == CD_LAW_HERTZ_MINDLIN) {
@@ -391,13 +437,17 @@ static int check_time_step(cd_sim *sim, char *err, size_t errlen)
     }
     if (c->steps_per_collision > 0) c->dt = sim->collision_time / c->steps_per_collision;
     if (c->dt > sim->collision_time / 5 && !c->force_dt) {
-        snprintf(err, errlen, "%s: run.dt = %g s: expected at most t_col/5 = %g s (collision time %g s of the lightest pair); "
-                 "lower dt or set run.force_dt: true", c->source_path, c->dt, sim->collision_time / 5, sim->collision_time);
+        snprintf(err, errlen,
+                 "%s: run.dt = %g s: expected at most t_col/5 = %g s (collision time %g s of the lightest pair); "
+                 "lower dt or set run.force_dt: true",
+                 c->source_path, c->dt, sim->collision_time / 5, sim->collision_time);
         return -1;
     }
     if (c->dt > sim->collision_time / 20)
-        fprintf(stderr, "capdem: warning: run.dt = %g s is above t_col/20 = %g s; contacts are resolved in fewer than 20 steps\n",
-                c->dt, sim->collision_time / 20);
+        fprintf(
+            stderr,
+            "capdem: warning: run.dt = %g s is above t_col/20 = %g s; contacts are resolved in fewer than 20 steps\n",
+            c->dt, sim->collision_time / 20);
     return 0;
 }
 
@@ -452,7 +502,8 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
             s->mass[q] = sh->mass * f * f * f;
             sim->total_mass += s->mass[q];
             sim->solid_volume += sh->volume * f * f * f;
-            s->inertia[q] = cd_v3(sh->principal[0] * pow(f, 5), sh->principal[1] * pow(f, 5), sh->principal[2] * pow(f, 5));
+            s->inertia[q] =
+                cd_v3(sh->principal[0] * pow(f, 5), sh->principal[1] * pow(f, 5), sh->principal[2] * pow(f, 5));
             s->prim_first[q] = (cd_int)prim;
             s->prim_count[q] = sh->n_prims;
             for (int a = 0; a < sh->n_prims; a++, prim++) {

@@ -20,13 +20,13 @@ extern long cd_parallel_min_rows;
 
 /* Per-step constants handed to every kernel. */
 typedef struct {
-    cd_real dt;               /* time step [s] */
-    cd_vec3 gravity;          /* [m/s^2] */
-    cd_law_params law;        /* particle-particle contact law */
-    cd_law_params wall_law;   /* particle-wall contact law (mu = wall friction) */
-    cd_real sin_parallel;     /* sine of the parallel-contact cut-off angle [1] */
-    cd_int parallel_blend;    /* 1: the continuous parallel rule (material.parallel_blend) */
-    cd_int dimension;         /* 3, or 2: motion in the x-y plane only */
+    cd_real dt;             /* time step [s] */
+    cd_vec3 gravity;        /* [m/s^2] */
+    cd_law_params law;      /* particle-particle contact law */
+    cd_law_params wall_law; /* particle-wall contact law (mu = wall friction) */
+    cd_real sin_parallel;   /* sine of the parallel-contact cut-off angle [1] */
+    cd_int parallel_blend;  /* 1: the continuous parallel rule (material.parallel_blend) */
+    cd_int dimension;       /* 3, or 2: motion in the x-y plane only */
 } cd_step_params;
 
 /* The neighbour lists and the build's scratch (kernels/neighbor_items.h),
@@ -37,69 +37,69 @@ typedef struct {
     /* per-particle gather lists (CSR over pair rows): for particle p the
      * entries gather_rows[gather_start[p] .. gather_start[p+1]), 2 k + side
      * for pair row k (side 1: p owns its primitive j), in ascending order */
-    cd_int *gather_start;     /* n_particles + 1 */
-    cd_pair_id *gather_rows;  /* 2 n_pairs */
+    cd_int *gather_start;    /* n_particles + 1 */
+    cd_pair_id *gather_rows; /* 2 n_pairs */
     /* per-particle wall candidates (CSR): for particle p the wall-contact
      * rows wall_rows[wall_start[p] .. wall_start[p+1]) that the steps until
      * the next build test (kernels/step_items.h, cd_item_wall_candidates),
      * ascending */
-    cd_int *wall_start;       /* n_particles + 1 */
-    cd_int *wall_rows;        /* at most n_prims n_walls */
+    cd_int *wall_start; /* n_particles + 1 */
+    cd_int *wall_rows;  /* at most n_prims n_walls */
     /* scratch of the build */
-    cd_grid *grid;            /* 1 */
-    cd_real *part_bound;      /* bounding radius per particle [m] */
-    cd_real *partial;         /* 7 per chunk of particles: box of centres, largest bound [m] */
+    cd_grid *grid;       /* 1 */
+    cd_real *part_bound; /* bounding radius per particle [m] */
+    cd_real *partial;    /* 7 per chunk of particles: box of centres, largest bound [m] */
     cd_int *part_cell, *cell_count, *cell_start, *cell_parts; /* cell lists (CSR); count doubles as cursor */
-    cd_int *pair_count, *pair_offset; /* rows per primitive, their offsets (n_prims + 1) */
-    cd_prim_id *cand;         /* candidate slots, slot per primitive */
-    cd_ulong *keys, *old_keys;/* sorted keys of the new and the old rows */
-    cd_int *old_active;       /* history of the old rows */
-    cd_vec3 *old_shear;       /* [m] */
-    cd_int *count;            /* per particle: gather and wall counts, then cursors */
-    cd_int *chunk_sum;        /* prefix sums' chunk totals */
+    cd_int *pair_count, *pair_offset;                         /* rows per primitive, their offsets (n_prims + 1) */
+    cd_prim_id *cand;                                         /* candidate slots, slot per primitive */
+    cd_ulong *keys, *old_keys;                                /* sorted keys of the new and the old rows */
+    cd_int *old_active;                                       /* history of the old rows */
+    cd_vec3 *old_shear;                                       /* [m] */
+    cd_int *count;                                            /* per particle: gather and wall counts, then cursors */
+    cd_int *chunk_sum;                                        /* prefix sums' chunk totals */
     /* memory order (kernels/reorder_items.h, src/backend/omp/reorder.c; allocated at
      * the first build with neighbor.reorder: cells) */
-    cd_int *part_uid, *part_at; /* particle: memory slot -> user id, user id -> memory slot */
-    cd_int *prim_uid, *prim_at; /* the same for primitives */
-    cd_int *pair_at;          /* pair rows in user order -> memory row (pair_at_cap) */
-    cd_int *pair_ustart;      /* first place of each user primitive's rows in user order (n_prims + 1) */
+    cd_int *part_uid, *part_at;  /* particle: memory slot -> user id, user id -> memory slot */
+    cd_int *prim_uid, *prim_at;  /* the same for primitives */
+    cd_int *pair_at;             /* pair rows in user order -> memory row (pair_at_cap) */
+    cd_int *pair_ustart;         /* first place of each user primitive's rows in user order (n_prims + 1) */
     cd_int *part_src, *prim_src; /* the reorder's permutation: old slot of each new slot */
-    cd_int *new_first;        /* prim_first in the new order (n_particles + 1) */
-    cd_ulong *sort_keys;      /* cell keys, twice n_particles (radix sort in and out) */
-    cd_int *sort_vals;        /* their slots, twice n_particles */
-    cd_int *hist;             /* radix sort: digit counts per chunk, then cursors */
-    void *move;               /* scratch of one column while it moves */
+    cd_int *new_first;           /* prim_first in the new order (n_particles + 1) */
+    cd_ulong *sort_keys;         /* cell keys, twice n_particles (radix sort in and out) */
+    cd_int *sort_vals;           /* their slots, twice n_particles */
+    cd_int *hist;                /* radix sort: digit counts per chunk, then cursors */
+    void *move;                  /* scratch of one column while it moves */
 } cd_nb_lists;
 
 #define CD_NB_REORDER_ALWAYS 2
 
 /* Neighbour-list workspace. */
 typedef struct {
-    double skin;              /* Verlet skin [m] */
-    long long builds;         /* rebuilds so far */
-    int force_rebuild;        /* 1: rebuild at the next step regardless of motion */
+    double skin;                     /* Verlet skin [m] */
+    long long builds;                /* rebuilds so far */
+    int force_rebuild;               /* 1: rebuild at the next step regardless of motion */
     cd_wall walls_ref[CD_MAX_WALLS]; /* the walls at the last build (cd_bp_wall_moved) */
-    size_t n_wall_rows;       /* entries of d.wall_rows (wall_start[n_particles]) */
-    cd_nb_lists d;            /* lists and scratch, where the loops run */
-    size_t cap_rows;          /* rows that keys and gather_rows (twice) hold */
-    size_t cap_old;           /* rows that old_keys, old_active, old_shear hold */
-    size_t cell_cap;          /* cells the cell lists hold */
-    cd_int slot;              /* candidate slot per primitive (doubles when one overflows) */
-    int reorder;              /* neighbor.reorder: 1 cells (the grid cells' order at rebuilds), 0 none;
+    size_t n_wall_rows;              /* entries of d.wall_rows (wall_start[n_particles]) */
+    cd_nb_lists d;                   /* lists and scratch, where the loops run */
+    size_t cap_rows;                 /* rows that keys and gather_rows (twice) hold */
+    size_t cap_old;                  /* rows that old_keys, old_active, old_shear hold */
+    size_t cell_cap;                 /* cells the cell lists hold */
+    cd_int slot;                     /* candidate slot per primitive (doubles when one overflows) */
+    int reorder;                     /* neighbor.reorder: 1 cells (the grid cells' order at rebuilds), 0 none;
                                  CD_NB_REORDER_ALWAYS (tests): at every rebuild that changes the order */
-    int ordered;              /* the order maps of d are set (from the first build after start) */
-    int host_user;            /* host variant: a sync put the columns in user order; the next step
+    int ordered;                     /* the order maps of d are set (from the first build after start) */
+    int host_user;                   /* host variant: a sync put the columns in user order; the next step
                                  puts them back in memory order (src/backend/omp/reorder.c) */
-    long long reorders;       /* rebuilds that moved particles */
-    size_t pair_at_cap;       /* rows d.pair_at holds */
+    long long reorders;              /* rebuilds that moved particles */
+    size_t pair_at_cap;              /* rows d.pair_at holds */
 } cd_neighbors;
 
 /* Scratch of the observables' reductions where the steps run (the offload
  * device's memory; src/backend/omp/observe.c). */
 typedef struct {
-    cd_int *touch;     /* per particle: active contacts (marks the particles that touch) */
-    cd_real *partial;  /* CD_OBS_SLOTS per block */
-    cd_real *total;    /* CD_OBS_SLOTS */
+    cd_int *touch;    /* per particle: active contacts (marks the particles that touch) */
+    cd_real *partial; /* CD_OBS_SLOTS per block */
+    cd_real *total;   /* CD_OBS_SLOTS */
     size_t cap_blocks;
 } cd_sim_obs_scratch;
 
@@ -111,15 +111,15 @@ typedef struct cd_sim {
     int n_shapes;
     cd_neighbors nb;
     cd_sim_obs_scratch obs;
-    double collision_time;    /* smallest pair collision time [s] */
-    double total_mass;        /* sum of the particle masses [kg] (fixed at set-up) */
-    double solid_volume;      /* sum of the particle volumes [m^3] (fixed at set-up) */
-    int threads;              /* OpenMP threads in use */
-    const cd_backend *backend;/* runs the steps; omp unless chosen otherwise */
-    void *backend_data;       /* the backend's own state (device buffers) */
-    char device_request[16];  /* --device: cpu | gpu | auto (OpenCL) */
-    cd_state probe_base;      /* bulk probe: the relaxed base state every probe starts from (zeroed until then) */
-    int snapshot_request;     /* set by a protocol: write a snapshot of this step (then cleared by the run) */
+    double collision_time;     /* smallest pair collision time [s] */
+    double total_mass;         /* sum of the particle masses [kg] (fixed at set-up) */
+    double solid_volume;       /* sum of the particle volumes [m^3] (fixed at set-up) */
+    int threads;               /* OpenMP threads in use */
+    const cd_backend *backend; /* runs the steps; omp unless chosen otherwise */
+    void *backend_data;        /* the backend's own state (device buffers) */
+    char device_request[16];   /* --device: cpu | gpu | auto (OpenCL) */
+    cd_state probe_base;       /* bulk probe: the relaxed base state every probe starts from (zeroed until then) */
+    int snapshot_request;      /* set by a protocol: write a snapshot of this step (then cleared by the run) */
     /* A domain decomposition's say in the rebuild (src/mpi/mpi_backend.c,
      * docs/mpi.md); NULL in one process.  The step calls it after its skin
      * test with that test's answer for this process's particles (0/1) and
@@ -185,14 +185,14 @@ void cd_sim_refresh(cd_sim *sim);
 /* Observables (deterministic sums). */
 typedef struct {
     double kinetic_translational, kinetic_rotational; /* [J] */
-    double kinetic_in_contact; /* kinetic energy of the particles that touch something [J] */
-    double elastic;           /* energy stored in contact springs [J] */
-    double potential;         /* gravitational potential energy -m g.x [J] */
-    double n_contacts;        /* active particle-particle contacts */
-    double n_wall_contacts;   /* active particle-wall contacts */
-    double momentum[3];       /* total linear momentum [kg m/s] */
-    double wall_force[CD_MAX_WALLS][3]; /* force of the particles on each wall [N] */
-    double max_overlap_ratio; /* largest overlap / arm diameter [1] */
+    double kinetic_in_contact;                        /* kinetic energy of the particles that touch something [J] */
+    double elastic;                                   /* energy stored in contact springs [J] */
+    double potential;                                 /* gravitational potential energy -m g.x [J] */
+    double n_contacts;                                /* active particle-particle contacts */
+    double n_wall_contacts;                           /* active particle-wall contacts */
+    double momentum[3];                               /* total linear momentum [kg m/s] */
+    double wall_force[CD_MAX_WALLS][3];               /* force of the particles on each wall [N] */
+    double max_overlap_ratio;                         /* largest overlap / arm diameter [1] */
 } cd_observables;
 /* From the host columns (current after a sync). */
 void cd_sim_observe(const cd_sim *sim, cd_observables *o);

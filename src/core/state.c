@@ -3,35 +3,37 @@
 #include <string.h>
 
 #define CD_GROUP_OF_PARTICLE CD_GROUP_PARTICLE
-#define CD_GROUP_OF_PRIM CD_GROUP_PRIM
-#define CD_GROUP_OF_PAIR CD_GROUP_PAIR
-#define CD_GROUP_OF_WALLC CD_GROUP_WALLC
+#define CD_GROUP_OF_PRIM     CD_GROUP_PRIM
+#define CD_GROUP_OF_PAIR     CD_GROUP_PAIR
+#define CD_GROUP_OF_WALLC    CD_GROUP_WALLC
 #define CD_GROUP_OF_PAIR_OUT CD_GROUP_PAIR_OUT
-#define CD_KIND_OF_REAL CD_KIND_REAL
-#define CD_KIND_OF_INT CD_KIND_INT
+#define CD_KIND_OF_REAL      CD_KIND_REAL
+#define CD_KIND_OF_INT       CD_KIND_INT
 
 const cd_field_info cd_fields[] = {
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) \
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning)                                                     \
     {CD_GROUP_OF_##group, CD_KIND_OF_##h5type, ncomp, sizeof(ctype), offsetof(cd_state, name), #name, unit, meaning},
 #include "fields.def"
 #undef CD_FIELD
 };
 const size_t cd_n_fields = sizeof(cd_fields) / sizeof(cd_fields[0]);
 
-void **cd_field_ptr(cd_state *s, const cd_field_info *f)
-{
-    return (void **)((char *)s + f->offset);
-}
+void **cd_field_ptr(cd_state *s, const cd_field_info *f) { return (void **)((char *)s + f->offset); }
 
 size_t cd_state_rows(const cd_state *s, enum cd_field_group g)
 {
     switch (g) {
-    case CD_GROUP_PARTICLE: return s->n_particles;
-    case CD_GROUP_PRIM: return s->n_prims;
+    case CD_GROUP_PARTICLE:
+        return s->n_particles;
+    case CD_GROUP_PRIM:
+        return s->n_prims;
     case CD_GROUP_PAIR:
-    case CD_GROUP_PAIR_OUT: return s->n_pairs;
-    case CD_GROUP_WALLC: return s->n_prims * s->n_walls;
-    default: return 0;
+    case CD_GROUP_PAIR_OUT:
+        return s->n_pairs;
+    case CD_GROUP_WALLC:
+        return s->n_prims * s->n_walls;
+    default:
+        return 0;
     }
 }
 
@@ -50,7 +52,10 @@ int cd_state_alloc(cd_state *s, size_t n_particles, size_t n_prims, size_t n_wal
     for (size_t k = 0; k < cd_n_fields; k++) {
         size_t rows = group_capacity(s, cd_fields[k].group);
         void *p = calloc(rows > 0 ? rows : 1, cd_fields[k].elem_size);
-        if (!p) { cd_state_free(s); return -1; }
+        if (!p) {
+            cd_state_free(s);
+            return -1;
+        }
         *cd_field_ptr(s, &cd_fields[k]) = p;
     }
     return 0;
@@ -93,7 +98,8 @@ int cd_state_copy(cd_state *dst, const cd_state *src)
     for (size_t k = 0; k < cd_n_fields; k++) {
         void **slot = cd_field_ptr(dst, &cd_fields[k]);
         *slot = *cd_field_ptr(&keep, &cd_fields[k]);
-        memcpy(*slot, *cd_field_ptr((cd_state *)src, &cd_fields[k]), cd_state_rows(src, cd_fields[k].group) * cd_fields[k].elem_size);
+        memcpy(*slot, *cd_field_ptr((cd_state *)src, &cd_fields[k]),
+               cd_state_rows(src, cd_fields[k].group) * cd_fields[k].elem_size);
     }
     return 0;
 }

@@ -8,7 +8,14 @@
 
 /* PAIR_OUT: output columns of the pair rows, derived on the host at sync
  * (fields.def); same rows and capacity as PAIR. */
-enum cd_field_group { CD_GROUP_PARTICLE, CD_GROUP_PRIM, CD_GROUP_PAIR, CD_GROUP_WALLC, CD_GROUP_PAIR_OUT, CD_GROUP_COUNT };
+enum cd_field_group {
+    CD_GROUP_PARTICLE,
+    CD_GROUP_PRIM,
+    CD_GROUP_PAIR,
+    CD_GROUP_WALLC,
+    CD_GROUP_PAIR_OUT,
+    CD_GROUP_COUNT
+};
 
 /* Do the columns of group g have one row per pair row (PAIR, PAIR_OUT)? */
 static inline int cd_group_pair_rows(enum cd_field_group g) { return g == CD_GROUP_PAIR || g == CD_GROUP_PAIR_OUT; }
@@ -21,23 +28,23 @@ typedef struct cd_state {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) ctype *name;
 #include "fields.def"
 #undef CD_FIELD
-    cd_wall walls[CD_MAX_WALLS];   /* current wall positions and motion */
+    cd_wall walls[CD_MAX_WALLS]; /* current wall positions and motion */
     /* State of the protocol driving the run (phase, wall dynamics,
      * convergence checks): doubles saved with every snapshot, so that a
      * protocol resumes in the middle of any phase.  Meaning: src/protocols/protocol.c. */
 #define CD_CONTROL_SLOTS 32
     double control[CD_CONTROL_SLOTS];
-    double time;                   /* simulated time [s] */
-    long long step;                /* steps taken since the start of the run */
+    double time;    /* simulated time [s] */
+    long long step; /* steps taken since the start of the run */
 } cd_state;
 
 /* Description of one column, for generic allocation and I/O. */
 typedef struct {
     enum cd_field_group group;
     enum cd_field_kind kind;
-    int ncomp;           /* scalars per row */
-    size_t elem_size;    /* bytes per row */
-    size_t offset;       /* offset of the column pointer inside cd_state */
+    int ncomp;        /* scalars per row */
+    size_t elem_size; /* bytes per row */
+    size_t offset;    /* offset of the column pointer inside cd_state */
     const char *name, *unit, *meaning;
 } cd_field_info;
 

@@ -29,7 +29,8 @@ static int obs_check(cd_output *o, const cd_observable_info *obs, int n_obs)
         const char *name = obs[i].name;
         if (!name || !*name || strchr(name, '/') || !strcmp(name, ".") || strlen(name) > 200 || obs[i].ncomp < 1)
             return FAIL("%s: observable %d: invalid name \"%s\" or ncomp %d (need a non-empty name without '/' and "
-                        "ncomp >= 1)", o->path, i, name ? name : "(null)", obs[i].ncomp);
+                        "ncomp >= 1)",
+                        o->path, i, name ? name : "(null)", obs[i].ncomp);
         for (int j = 0; j < i; j++)
             if (!strcmp(obs[j].name, name)) return FAIL("%s: observable \"%s\" given twice", o->path, name);
         char p[CDH5_PATH_LEN];
@@ -85,8 +86,8 @@ static int obs_setup(cd_output *o, const cd_observable_info *obs, int n_obs)
             snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(TIME));
             b->time = cdh5_make_clock(o, p, 1);
             snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), name, CDH5_NAME(VALUE));
-            b->value = cdh5_make_dset(o, p, H5T_IEEE_F64LE, b->ncomp > 1 ? 2 : 1, d, m, c,
-                                      obs[i].unit ? obs[i].unit : "1");
+            b->value =
+                cdh5_make_dset(o, p, H5T_IEEE_F64LE, b->ncomp > 1 ? 2 : 1, d, m, c, obs[i].unit ? obs[i].unit : "1");
             if (b->step < 0 || b->time < 0 || b->value < 0) return -1;
             b->rows = 0;
         }
@@ -171,8 +172,8 @@ static cd_output *output_new(const char *path, char *err, size_t errlen)
 
 static void output_free(cd_output *o)
 {
-    hid_t *ds[] = {&o->step, &o->time, &o->walls, &o->c_offset, &o->c_pi, &o->c_pj, &o->w_offset, &o->w_index,
-                   &o->control};
+    hid_t *ds[] = {&o->step, &o->time,     &o->walls,   &o->c_offset, &o->c_pi,
+                   &o->c_pj, &o->w_offset, &o->w_index, &o->control};
     for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++) cdh5_close_dset(ds[i]);
     if (o->wall_type >= 0) H5Tclose(o->wall_type);
     for (size_t k = 0; k < cd_n_fields; k++) {
@@ -207,10 +208,7 @@ static void output_free(cd_output *o)
  * checksum the metadata too, but it marks a file open for writing in its
  * superblock, so a killed run would leave a file that HDF5 refuses to open
  * (tests/unit/test_io_h5.c, killed writer). */
-static hid_t file_access(void)
-{
-    return cdh5_fapl();
-}
+static hid_t file_access(void) { return cdh5_fapl(); }
 
 /* Opens the file that o will write: path itself, created exclusively, or
  * (CD_OUTPUT_REPLACE of an existing path) a file beside it, with the old
@@ -236,14 +234,16 @@ static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
         o->own_lock = open(path, O_RDWR | O_CREAT | O_EXCL | O_NOCTTY | O_CLOEXEC, 0666);
         if (o->own_lock < 0)
             return errno == EEXIST ? FAIL("%s exists (created by another process after the checks?): refused, the "
-                                          "file is left as it is", path)
+                                          "file is left as it is",
+                                          path)
                                    : FAIL("%s: cannot create the output file: %s", path, strerror(errno));
         cdh5_mark(o->own_lock);
     }
     hid_t fapl = file_access();
     /* TRUNC only on the empty file made here (or by mkstemp) */
     o->file = H5Fcreate(target, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    int rc = o->file < 0 ? FAIL("%s: cannot create the output file", target) : 0; /* (before H5Pclose clears the stack) */
+    int rc =
+        o->file < 0 ? FAIL("%s: cannot create the output file", target) : 0; /* (before H5Pclose clears the stack) */
     H5Pclose(fapl);
     if (rc && target == path) unlink(path); /* the empty file made above */
     return rc;
@@ -296,15 +296,9 @@ int cd_output_close(cd_output *o)
     return rc;
 }
 
-void cd_h5_no_atexit(void)
-{
-    H5dont_atexit();
-}
+void cd_h5_no_atexit(void) { H5dont_atexit(); }
 
-const char *cd_output_error(const cd_output *o)
-{
-    return o ? o->err : "";
-}
+const char *cd_output_error(const cd_output *o) { return o ? o->err : ""; }
 
 /* ---- resume ------------------------------------------------------------------ */
 
@@ -347,8 +341,8 @@ static int truncate_snapshots(cd_output *o, long long resume_step)
     }
     if (cdh5_set_rows(o, o->step, CDH5_SNAP_STEP, n) || cdh5_set_rows(o, o->time, CDH5_SNAP_TIME, n) ||
         cdh5_set_rows(o, o->walls, CDH5_WALLS_VALUE, n) || cdh5_set_rows(o, o->control, CDH5_CONTROL_VALUE, n) ||
-        cdh5_set_rows(o, o->c_offset, CDH5_C_OFFSET, n + 1) ||
-        cdh5_set_rows(o, o->w_offset, CDH5_W_OFFSET, n + 1) || cdh5_set_rows(o, o->c_pi, CDH5_PATH(C_PARTICLE_I), (hsize_t)cend) ||
+        cdh5_set_rows(o, o->c_offset, CDH5_C_OFFSET, n + 1) || cdh5_set_rows(o, o->w_offset, CDH5_W_OFFSET, n + 1) ||
+        cdh5_set_rows(o, o->c_pi, CDH5_PATH(C_PARTICLE_I), (hsize_t)cend) ||
         cdh5_set_rows(o, o->c_pj, CDH5_PATH(C_PARTICLE_J), (hsize_t)cend) ||
         cdh5_set_rows(o, o->w_index, CDH5_W_INDEX, (hsize_t)wend))
         return -1;

@@ -12,19 +12,19 @@ typedef struct cd_output cd_output;
 
 /* One named series of the time series (H5MD observables): ncomp values per row. */
 typedef struct {
-    const char *name;  /* dataset group name under /observables */
-    const char *unit;  /* SI unit */
-    int ncomp;         /* values per row (1 for scalars) */
+    const char *name; /* dataset group name under /observables */
+    const char *unit; /* SI unit */
+    int ncomp;        /* values per row (1 for scalars) */
 } cd_observable_info;
 
 /* How an output path may be used (cd_output_check_target, cd_output_create_mode). */
 enum cd_output_mode {
-    CD_OUTPUT_NEW,      /* path must not exist; created exclusively (O_EXCL) */
-    CD_OUTPUT_REPLACE,  /* an existing path is replaced, but only once the new file's first snapshot is
+    CD_OUTPUT_NEW,     /* path must not exist; created exclusively (O_EXCL) */
+    CD_OUTPUT_REPLACE, /* an existing path is replaced, but only once the new file's first snapshot is
                          * committed: the new file is written aside (a mkstemp name in the same folder) and
                          * renamed over path then; the old file is locked (flock) meanwhile and is never
                          * replaced while another process holds it */
-    CD_OUTPUT_RESUME    /* path must exist, be a regular file and not be held by another process */
+    CD_OUTPUT_RESUME   /* path must exist, be a regular file and not be held by another process */
 };
 
 /* Checks, before anything is written, that path may be used as `how` says:

@@ -16,11 +16,16 @@
 static const char *class_name(H5T_class_t c)
 {
     switch (c) {
-    case H5T_INTEGER: return "integers";
-    case H5T_FLOAT: return "floats";
-    case H5T_STRING: return "strings";
-    case H5T_COMPOUND: return "compound records";
-    default: return "values of another class";
+    case H5T_INTEGER:
+        return "integers";
+    case H5T_FLOAT:
+        return "floats";
+    case H5T_STRING:
+        return "strings";
+    case H5T_COMPOUND:
+        return "compound records";
+    default:
+        return "values of another class";
     }
 }
 
@@ -50,9 +55,10 @@ int cd_h5_check_dset(hid_t d, const char *file, const char *dpath, H5T_class_t c
     for (int k = 0; k < rank; k++) {
         hsize_t a = lo ? lo[k] : 0, b = hi && hi[k] ? hi[k] : ~(hsize_t)0;
         if (got[k] < a || got[k] > b) {
-            snprintf(err, errlen, "%s: dataset %s has %llu entries along dimension %d, the layout allows %llu..%llu; "
-                     "the file is refused", file, dpath, (unsigned long long)got[k], k, (unsigned long long)a,
-                     (unsigned long long)b);
+            snprintf(err, errlen,
+                     "%s: dataset %s has %llu entries along dimension %d, the layout allows %llu..%llu; "
+                     "the file is refused",
+                     file, dpath, (unsigned long long)got[k], k, (unsigned long long)a, (unsigned long long)b);
             return -1;
         }
         dm[k] = got[k];
@@ -180,15 +186,18 @@ static herr_t check_tail(hid_t loc, const char *name, const H5O_info_t *info, vo
         count[0] = 1;
         for (int r = 1; r < rank; r++) count[r] = dims[r];
         hid_t ms = H5Screate_simple(rank, count, NULL);
-        ok = buf && ms >= 0 && chunks_fit(d, dcpl, ft, rank, dims, start[0]) && H5Sselect_hyperslab(sp, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
+        ok = buf && ms >= 0 && chunks_fit(d, dcpl, ft, rank, dims, start[0]) &&
+             H5Sselect_hyperslab(sp, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
              H5Dread(d, mt, ms, sp, H5P_DEFAULT, buf) >= 0;
         if (ms >= 0) H5Sclose(ms);
         free(buf);
     }
     if (!ok) {
         t->bad = 1;
-        cdh5_msg(t->err, t->errlen, "%s: dataset /%s is corrupted (its checksum or layout does not match); the file is "
-                 "refused, nothing was read from it or written to it", t->path, name);
+        cdh5_msg(t->err, t->errlen,
+                 "%s: dataset /%s is corrupted (its checksum or layout does not match); the file is "
+                 "refused, nothing was read from it or written to it",
+                 t->path, name);
     }
     if (mt >= 0) H5Tclose(mt);
     if (ft >= 0) H5Tclose(ft);
@@ -213,4 +222,3 @@ int cd_h5_check_tails(const char *path, char *err, size_t errlen)
     cdh5_quiet_end(&q);
     return t.bad ? -1 : 0;
 }
-

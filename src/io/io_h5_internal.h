@@ -15,13 +15,13 @@
 
 /* Short names of the table entries (kernels/runfile.def) the writer and
  * the resume use most. */
-#define CDH5_SNAP_STEP CDH5_PATH(SNAP_STEP)
-#define CDH5_SNAP_TIME CDH5_PATH(SNAP_TIME)
-#define CDH5_WALLS_VALUE CDH5_PATH(WALLS_VALUE)
+#define CDH5_SNAP_STEP     CDH5_PATH(SNAP_STEP)
+#define CDH5_SNAP_TIME     CDH5_PATH(SNAP_TIME)
+#define CDH5_WALLS_VALUE   CDH5_PATH(WALLS_VALUE)
 #define CDH5_CONTROL_VALUE CDH5_PATH(CONTROL_VALUE)
-#define CDH5_C_OFFSET CDH5_PATH(C_OFFSET)
-#define CDH5_W_OFFSET CDH5_PATH(W_OFFSET)
-#define CDH5_W_INDEX CDH5_PATH(W_INDEX)
+#define CDH5_C_OFFSET      CDH5_PATH(C_OFFSET)
+#define CDH5_W_OFFSET      CDH5_PATH(W_OFFSET)
+#define CDH5_W_INDEX       CDH5_PATH(W_INDEX)
 /* Root attribute: snapshots completely on disk (the commit record). */
 #define CDH5_COMMIT_ATTR CDH5_NAME(COMMIT)
 
@@ -37,14 +37,14 @@ void cdh5_wall_units(char *buf, size_t len);
 
 /* ---- writer: io_h5.c, io_h5_write.c, io_h5_snapshot.c ------------------- */
 
-#define CDH5_OBS_BLOCK 1024               /* time-series rows buffered before a write */
-#define CDH5_CLOCK_CHUNK 1024             /* rows per chunk of step, time, offset, observables */
-#define CDH5_SMALL_CHUNK (64u * 1024u)    /* bytes: target chunk of a small per-snapshot dataset */
-#define CDH5_LARGE_CHUNK (1024u * 1024u)  /* bytes: largest chunk */
+#define CDH5_OBS_BLOCK   1024            /* time-series rows buffered before a write */
+#define CDH5_CLOCK_CHUNK 1024            /* rows per chunk of step, time, offset, observables */
+#define CDH5_SMALL_CHUNK (64u * 1024u)   /* bytes: target chunk of a small per-snapshot dataset */
+#define CDH5_LARGE_CHUNK (1024u * 1024u) /* bytes: largest chunk */
 
 typedef struct {
-    hid_t dset;        /* FIXED: the data; SERIES: value; ROWS: the rows */
-    void *fixed;       /* FIXED: what the file holds, to catch changes */
+    hid_t dset;  /* FIXED: the data; SERIES: value; ROWS: the rows */
+    void *fixed; /* FIXED: what the file holds, to catch changes */
     size_t fixed_bytes;
 } cdh5_col;
 
@@ -61,10 +61,10 @@ struct cd_output {
     char err[1024];
     int have_layout;
     size_t n_particles, n_prims, n_walls;
-    hsize_t n_snap, c_rows, w_rows;  /* snapshots, contact rows, wall-contact rows written */
+    hsize_t n_snap, c_rows, w_rows; /* snapshots, contact rows, wall-contact rows written */
     hid_t step, time, walls, wall_type, c_offset, c_pi, c_pj, w_offset, w_index, control;
-    cdh5_col *cols;                  /* one per cd_fields[] entry */
-    int n_obs, width;                /* width: sum of ncomp */
+    cdh5_col *cols;   /* one per cd_fields[] entry */
+    int n_obs, width; /* width: sum of ncomp */
     cdh5_obs *obs;
     size_t buf_n;
     long long *buf_step;
@@ -75,9 +75,9 @@ struct cd_output {
     char tmp_path[1024];
     int old_fd;
     unsigned long long old_dev, old_ino;
-    int own_lock;                    /* descriptor holding capdem's mark on the file (cdh5_mark), or -1 */
-    int io_failed;                   /* a write failed or found no room: nothing more is written */
-    int writing;                     /* inside a snapshot, past its checks */
+    int own_lock;  /* descriptor holding capdem's mark on the file (cdh5_mark), or -1 */
+    int io_failed; /* a write failed or found no room: nothing more is written */
+    int writing;   /* inside a snapshot, past its checks */
 };
 
 /* Makes sure bytes more can be written at the end of the file (the space
@@ -120,7 +120,7 @@ int cdh5_report(cd_output *o);
 int cdh5_commit_output(cd_output *o);
 #define FAIL(...) (cdh5_msg(o->err, sizeof o->err, __VA_ARGS__), cdh5_report(o))
 
-void cdh5_close_id(hid_t *id);   /* group or any object */
+void cdh5_close_id(hid_t *id); /* group or any object */
 void cdh5_close_dset(hid_t *id);
 
 int cdh5_attr_write(cd_output *o, hid_t obj, const char *where, const char *name, hid_t type, hid_t space,
@@ -131,8 +131,8 @@ int cdh5_attr_ints(cd_output *o, hid_t obj, const char *where, const char *name,
 int cdh5_write_commit(cd_output *o, hsize_t n);
 hid_t cdh5_make_group(cd_output *o, const char *path);
 /* Creates a dataset; chunk NULL: contiguous; unit NULL: no unit attribute. */
-hid_t cdh5_make_dset(cd_output *o, const char *path, hid_t ftype, int rank, const hsize_t *dims,
-                     const hsize_t *maxdims, const hsize_t *chunk, const char *unit);
+hid_t cdh5_make_dset(cd_output *o, const char *path, hid_t ftype, int rank, const hsize_t *dims, const hsize_t *maxdims,
+                     const hsize_t *chunk, const char *unit);
 /* 1-D extendible step (int64) or time (double, unit s) dataset. */
 hid_t cdh5_make_clock(cd_output *o, const char *path, int is_time);
 int cdh5_write_all(cd_output *o, hid_t d, const char *path, hid_t mtype, const void *buf);

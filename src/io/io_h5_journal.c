@@ -28,12 +28,12 @@
 #include <zlib.h>
 
 #define JOURNAL_SUFFIX CDH5_NAME(JOURNAL) /* "-journal" (kernels/runfile.def) */
-#define JOURNAL_MAGIC "CAPDEMJ1"
-#define JOURNAL_END "END!"
-#define HEAD_BYTES (8 + 3 * 8)
-#define ENTRY_HEAD (2 * 8)
-#define TAIL_BYTES (4 + 4)
-#define MAX_ADDR (((haddr_t)1 << (8 * sizeof(off_t) - 1)) - 1)
+#define JOURNAL_MAGIC  "CAPDEMJ1"
+#define JOURNAL_END    "END!"
+#define HEAD_BYTES     (8 + 3 * 8)
+#define ENTRY_HEAD     (2 * 8)
+#define TAIL_BYTES     (4 + 4)
+#define MAX_ADDR       (((haddr_t)1 << (8 * sizeof(off_t) - 1)) - 1)
 
 typedef struct {
     haddr_t addr;
@@ -41,8 +41,8 @@ typedef struct {
 } held_write;
 
 typedef struct {
-    H5FD_t pub;  /* first: HDF5 sees this part */
-    int fd;      /* the file; get_handle hands out &fd (a POSIX descriptor) */
+    H5FD_t pub; /* first: HDF5 sees this part */
+    int fd;     /* the file; get_handle hands out &fd (a POSIX descriptor) */
     int writable;
     int drop_on_close;
     dev_t dev;
@@ -62,15 +62,9 @@ typedef struct {
 
 static long long io_count, fault_at = -1;
 
-void cdh5_fault_after(long long n)
-{
-    fault_at = n > 0 ? io_count + n : -1;
-}
+void cdh5_fault_after(long long n) { fault_at = n > 0 ? io_count + n : -1; }
 
-long long cdh5_io_count(void)
-{
-    return io_count;
-}
+long long cdh5_io_count(void) { return io_count; }
 
 /* Counts one write-like call; at the chosen one, half of it happens and the
  * process dies, as a kill in the middle of the call would leave it. */
@@ -182,10 +176,7 @@ static void forget_held(cdj_file *f)
 
 /* ---- the journal -------------------------------------------------------------- */
 
-static void put64(unsigned char *p, uint64_t v)
-{
-    memcpy(p, &v, 8);
-}
+static void put64(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
 
 static uint64_t get64(const unsigned char *p)
 {

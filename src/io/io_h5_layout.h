@@ -14,7 +14,7 @@
 
 /* Groups and datasets of runfile.def: CDH5_PATH(WALLS_VALUE) is "/walls/value". */
 enum cdh5_path_id {
-#define CD_H5_GROUP(id, path, made, meaning) CDH5_PATH_ID_##id,
+#define CD_H5_GROUP(id, path, made, meaning)         CDH5_PATH_ID_##id,
 #define CD_H5_DATASET(id, path, type, unit, meaning) CDH5_PATH_ID_##id,
 #include "runfile.def"
     CDH5_N_PATHS
@@ -35,9 +35,9 @@ extern const char *const cdh5_names[CDH5_N_NAMES];
 
 /* How a column of fields.def is stored. */
 enum cdh5_store {
-    CDH5_FIXED,    /* once, H5MD fixed data: <group>/<name> (rows[, ncomp]) */
-    CDH5_SERIES,   /* per snapshot: <group>/<name>/value (snapshots, rows[, ncomp]) */
-    CDH5_ROWS      /* active rows of all snapshots concatenated: <group>/<name> (rows[, ncomp]) */
+    CDH5_FIXED,  /* once, H5MD fixed data: <group>/<name> (rows[, ncomp]) */
+    CDH5_SERIES, /* per snapshot: <group>/<name>/value (snapshots, rows[, ncomp]) */
+    CDH5_ROWS    /* active rows of all snapshots concatenated: <group>/<name> (rows[, ncomp]) */
 };
 
 enum cdh5_store cdh5_store_of(const cd_field_info *f);
@@ -68,7 +68,10 @@ void cdh5_msg(char *err, size_t errlen, const char *fmt, ...)
     ;
 
 /* Silences HDF5's automatic error printing inside a public function. */
-typedef struct { H5E_auto2_t func; void *data; } cdh5_quiet;
+typedef struct {
+    H5E_auto2_t func;
+    void *data;
+} cdh5_quiet;
 void cdh5_quiet_begin(cdh5_quiet *q);
 void cdh5_quiet_end(const cdh5_quiet *q);
 

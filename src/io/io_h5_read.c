@@ -13,7 +13,7 @@
 #include <string.h>
 
 const char *const cdh5_paths[CDH5_N_PATHS] = {
-#define CD_H5_GROUP(id, path, made, meaning) path,
+#define CD_H5_GROUP(id, path, made, meaning)         path,
 #define CD_H5_DATASET(id, path, type, unit, meaning) path,
 #include "runfile.def"
 };
@@ -42,9 +42,12 @@ enum cdh5_store cdh5_store_of(const cd_field_info *f)
 const char *cdh5_group_path(enum cd_field_group g)
 {
     switch (g) {
-#define CD_H5_COLUMN_GROUP(field_group, id) case CD_GROUP_##field_group: return CDH5_PATH(id);
+#define CD_H5_COLUMN_GROUP(field_group, id)                                                                            \
+    case CD_GROUP_##field_group:                                                                                       \
+        return CDH5_PATH(id);
 #include "runfile.def"
-    default: return "/unknown";
+    default:
+        return "/unknown";
     }
 }
 
@@ -65,21 +68,19 @@ const char *cdh5_column_path(const char *name, char *buf)
 
 void cdh5_field_path(const cd_field_info *f, char *buf, size_t len)
 {
-    snprintf(buf, len, "%s/%s%s", cdh5_group_path(f->group), f->name,
-             cdh5_store_of(f) == CDH5_SERIES ? "/value" : "");
+    snprintf(buf, len, "%s/%s%s", cdh5_group_path(f->group), f->name, cdh5_store_of(f) == CDH5_SERIES ? "/value" : "");
 }
 
-hid_t cdh5_mem_type(const cd_field_info *f)
-{
-    return f->kind == CD_KIND_REAL ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT32;
-}
+hid_t cdh5_mem_type(const cd_field_info *f) { return f->kind == CD_KIND_REAL ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT32; }
 
 int cdh5_field_check(const cd_field_info *f, char *err, size_t errlen)
 {
     size_t scalar = f->kind == CD_KIND_REAL ? sizeof(double) : sizeof(int32_t);
     if (f->ncomp < 1 || f->ncomp > 64 || f->elem_size != (size_t)f->ncomp * scalar) {
-        snprintf(err, errlen, "fields.def: column %s has %zu bytes per row, expected %d x %zu: HDF5 output "
-                 "stores REAL columns as doubles and INT columns as int32", f->name, f->elem_size, f->ncomp, scalar);
+        snprintf(err, errlen,
+                 "fields.def: column %s has %zu bytes per row, expected %d x %zu: HDF5 output "
+                 "stores REAL columns as doubles and INT columns as int32",
+                 f->name, f->elem_size, f->ncomp, scalar);
         return -1;
     }
     return 0;
@@ -102,9 +103,9 @@ static hid_t wall_member_type(hid_t scalar, hsize_t ncomp)
 hid_t cdh5_wall_mem_type(void)
 {
     hid_t t = H5Tcreate(H5T_COMPOUND, sizeof(cd_wall)), m;
-#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                                  \
-    m = wall_member_type(CD_KIND_##type == CD_KIND_INT ? H5T_NATIVE_INT32 : H5T_NATIVE_DOUBLE, ncomp); \
-    H5Tinsert(t, #name, HOFFSET(cd_wall, name), m);                                                 \
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                                                     \
+    m = wall_member_type(CD_KIND_##type == CD_KIND_INT ? H5T_NATIVE_INT32 : H5T_NATIVE_DOUBLE, ncomp);                 \
+    H5Tinsert(t, #name, HOFFSET(cd_wall, name), m);                                                                    \
     H5Tclose(m);
 #include "runfile.def"
     return t;
@@ -114,7 +115,7 @@ void cdh5_wall_units(char *buf, size_t len)
 {
     size_t at = 0;
     buf[0] = 0;
-#define CD_H5_WALL_MEMBER(name, type, ncomp, unit) \
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                                                     \
     if (at < len) at += (size_t)snprintf(buf + at, len - at, "%s" #name " " unit, at ? ", " : "");
 #include "runfile.def"
 }
@@ -193,8 +194,8 @@ long long cdh5_field_rows(hid_t d, const cd_field_info *f, const char *dpath, co
     int vec = f->ncomp > 1, want = (st == CDH5_SERIES ? 2 : 1) + vec;
     int rank = cdh5_dims(d, dims);
     if (rank != want || (vec && dims[rank - 1] != (hsize_t)f->ncomp)) {
-        cdh5_msg(err, errlen, "%s: %s has rank %d (last dimension %llu), column %s needs rank %d%s", file, dpath,
-                 rank, rank > 0 ? (unsigned long long)dims[rank - 1] : 0ULL, f->name, want,
+        cdh5_msg(err, errlen, "%s: %s has rank %d (last dimension %llu), column %s needs rank %d%s", file, dpath, rank,
+                 rank > 0 ? (unsigned long long)dims[rank - 1] : 0ULL, f->name, want,
                  vec ? " with that many components" : "");
         return -1;
     }
@@ -205,8 +206,10 @@ long long cdh5_field_rows(hid_t d, const cd_field_info *f, const char *dpath, co
     int ok = f->kind == CD_KIND_REAL ? (cl == H5T_FLOAT && size == 8) : (cl == H5T_INTEGER && size == 4);
     if (!ok) {
         cdh5_msg(err, errlen, "%s: %s holds %zu-byte %s, column %s needs %s", file, dpath, size,
-                 cl == H5T_FLOAT ? "floats" : cl == H5T_INTEGER ? "integers" : "values", f->name,
-                 f->kind == CD_KIND_REAL ? "doubles" : "int32");
+                 cl == H5T_FLOAT     ? "floats"
+                 : cl == H5T_INTEGER ? "integers"
+                                     : "values",
+                 f->name, f->kind == CD_KIND_REAL ? "doubles" : "int32");
         return -1;
     }
     return (long long)(st == CDH5_SERIES ? dims[1] : dims[0]);
@@ -260,10 +263,7 @@ void cdh5_quiet_begin(cdh5_quiet *q)
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
 }
 
-void cdh5_quiet_end(const cdh5_quiet *q)
-{
-    H5Eset_auto2(H5E_DEFAULT, q->func, q->data);
-}
+void cdh5_quiet_end(const cdh5_quiet *q) { H5Eset_auto2(H5E_DEFAULT, q->func, q->data); }
 
 /* ---- reading ---------------------------------------------------------------- */
 
@@ -292,12 +292,12 @@ typedef struct {
     char *err;
     size_t errlen;
     hid_t file;
-    hid_t *ds;         /* one per cd_fields[] entry */
+    hid_t *ds; /* one per cd_fields[] entry */
     hid_t walls, step, time, c_offset, w_offset, w_index, control;
     long long c0, c1, w0, w1;
     long long *windex;
     void *tmp;
-    int legacy_force;  /* the file predates /contacts/pair_force (rebuilt from F_n n + F_t) */
+    int legacy_force; /* the file predates /contacts/pair_force (rebuilt from F_n n + F_t) */
 } reader;
 
 /* Is field f the pair force, which files written before it existed lack? */
@@ -348,13 +348,14 @@ static int check_snapshot(reader *r, long long k, const cd_state *s)
     const hsize_t ctl_lo[2] = {(hsize_t)k + 1, 1}, ctl_hi[2] = {0, CD_CONTROL_SLOTS}, walls_lo[2] = {(hsize_t)k + 1, 0};
     if (cd_h5_check_dset(r->step, r->path, CDH5_SNAP_STEP, H5T_INTEGER, 1, one_snap, NULL, NULL, r->err, r->errlen) ||
         cd_h5_check_dset(r->time, r->path, CDH5_SNAP_TIME, H5T_FLOAT, 1, one_snap, NULL, NULL, r->err, r->errlen) ||
-        cd_h5_check_dset(r->c_offset, r->path, CDH5_C_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err, r->errlen) ||
-        cd_h5_check_dset(r->w_offset, r->path, CDH5_W_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err, r->errlen) ||
+        cd_h5_check_dset(r->c_offset, r->path, CDH5_C_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err,
+                         r->errlen) ||
+        cd_h5_check_dset(r->w_offset, r->path, CDH5_W_OFFSET, H5T_INTEGER, 1, two_snap, NULL, NULL, r->err,
+                         r->errlen) ||
         cd_h5_check_dset(r->w_index, r->path, CDH5_W_INDEX, H5T_INTEGER, 1, NULL, NULL, NULL, r->err, r->errlen) ||
         cd_h5_check_dset(r->control, r->path, CDH5_CONTROL_VALUE, H5T_FLOAT, 2, ctl_lo, ctl_hi, NULL, r->err,
                          r->errlen) ||
-        cd_h5_check_dset(r->walls, r->path, CDH5_WALLS_VALUE, H5T_COMPOUND, 2, walls_lo, NULL, dims, r->err,
-                         r->errlen))
+        cd_h5_check_dset(r->walls, r->path, CDH5_WALLS_VALUE, H5T_COMPOUND, 2, walls_lo, NULL, dims, r->err, r->errlen))
         return -1;
     if (dims[1] != s->n_walls)
         return rfail(r, "the file holds %llu walls, the state %zu: was the state set up from the same config?",
@@ -426,7 +427,9 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
         case CDH5_FIXED:
             if (cd_state_rows(s, f->group)) e = H5Dread(r->ds[i], mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, col);
             break;
-        case CDH5_SERIES: e = cdh5_read_rows(r->ds[i], (hsize_t)k, 1, mt, col); break;
+        case CDH5_SERIES:
+            e = cdh5_read_rows(r->ds[i], (hsize_t)k, 1, mt, col);
+            break;
         case CDH5_ROWS:
             if (cd_group_pair_rows(f->group)) {
                 e = cdh5_read_rows(r->ds[i], (hsize_t)r->c0, (hsize_t)m, mt, col);
@@ -445,7 +448,8 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
     /* The force on j of a file that stored only its parts: F_n n + F_t,
      * the law's expression (kernels/contact_law.h), so the same bits. */
     if (r->legacy_force)
-        for (long long j = 0; j < m; j++) s->pair_force[j] = cd_contact_force_on_j(s->pair_fn[j], s->pair_normal[j], s->pair_ft[j]);
+        for (long long j = 0; j < m; j++)
+            s->pair_force[j] = cd_contact_force_on_j(s->pair_fn[j], s->pair_normal[j], s->pair_ft[j]);
     cd_wall walls[CD_MAX_WALLS];
     memset(walls, 0, sizeof walls);
     hid_t wt = cdh5_wall_mem_type();
@@ -468,8 +472,25 @@ int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t 
 {
     cdh5_quiet q;
     cdh5_quiet_begin(&q);
-    reader r = {path, err, errlen, H5I_INVALID_HID, NULL, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID,
-                H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, H5I_INVALID_HID, 0, 0, 0, 0, NULL, NULL, 0};
+    reader r = {path,
+                err,
+                errlen,
+                H5I_INVALID_HID,
+                NULL,
+                H5I_INVALID_HID,
+                H5I_INVALID_HID,
+                H5I_INVALID_HID,
+                H5I_INVALID_HID,
+                H5I_INVALID_HID,
+                H5I_INVALID_HID,
+                H5I_INVALID_HID,
+                0,
+                0,
+                0,
+                0,
+                NULL,
+                NULL,
+                0};
     int rc = -1;
     r.ds = malloc(cd_n_fields * sizeof *r.ds);
     if (!r.ds) {

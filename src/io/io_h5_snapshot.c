@@ -9,16 +9,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-_Static_assert(sizeof(cd_wall) == 104, "cd_wall changed: update the wall members of kernels/runfile.def and docs/output.md");
+_Static_assert(sizeof(cd_wall) == 104,
+               "cd_wall changed: update the wall members of kernels/runfile.def and docs/output.md");
 
 /* ---- snapshot layout ------------------------------------------------------ */
 
 static size_t rows_of(const cd_output *o, enum cd_field_group g)
 {
     switch (g) {
-    case CD_GROUP_PARTICLE: return o->n_particles;
-    case CD_GROUP_PRIM: return o->n_prims;
-    default: return 0;
+    case CD_GROUP_PARTICLE:
+        return o->n_particles;
+    case CD_GROUP_PRIM:
+        return o->n_prims;
+    default:
+        return 0;
     }
 }
 
@@ -34,10 +38,7 @@ static int link_clock(cd_output *o, const char *group)
     return 0;
 }
 
-static hsize_t clamp(hsize_t v, hsize_t lo, hsize_t hi)
-{
-    return v < lo ? lo : v > hi ? hi : v;
-}
+static hsize_t clamp(hsize_t v, hsize_t lo, hsize_t hi) { return v < lo ? lo : v > hi ? hi : v; }
 
 /* Creates one column's dataset at the first snapshot. */
 static int create_col(cd_output *o, const cd_state *s, size_t k)
@@ -112,7 +113,8 @@ int cdh5_layout_create(cd_output *o, const cd_state *s)
     cdh5_wall_units(units, sizeof units);
     if (o->walls < 0 || cdh5_attr_str(o, o->walls, CDH5_WALLS_VALUE, CDH5_NAME(WALL_UNITS), units)) return -1;
     hsize_t cd0[2] = {0, CD_CONTROL_SLOTS}, cdm[2] = {H5S_UNLIMITED, CD_CONTROL_SLOTS}, cdc[2] = {64, CD_CONTROL_SLOTS};
-    o->control = cdh5_make_dset(o, CDH5_CONTROL_VALUE, H5T_IEEE_F64LE, 2, cd0, cdm, cdc, "mixed, see docs/protocols.md");
+    o->control =
+        cdh5_make_dset(o, CDH5_CONTROL_VALUE, H5T_IEEE_F64LE, 2, cd0, cdm, cdc, "mixed, see docs/protocols.md");
     if (o->control < 0) return -1;
     if (link_clock(o, CDH5_PATH(CONTACTS)) || link_clock(o, CDH5_PATH(WALL_CONTACTS))) return -1;
     for (size_t k = 0; k < cd_n_fields; k++) {
@@ -167,8 +169,7 @@ static int add_pair_force(cd_output *o, size_t k)
         rc = FAIL("%s: cannot read the contact forces to add /contacts/pair_force", o->path);
     for (long long j = 0; !rc && j < rows; j++) ft[j] = cd_contact_force_on_j(fn[j], nrm[j], ft[j]);
     if (!rc) rc = create_col(o, NULL, k);
-    if (!rc && rows > 0)
-        rc = cdh5_append(o, o->cols[k].dset, "pair_force", 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, ft);
+    if (!rc && rows > 0) rc = cdh5_append(o, o->cols[k].dset, "pair_force", 0, (hsize_t)rows, H5T_NATIVE_DOUBLE, ft);
     for (int i = 0; i < 3; i++) cdh5_close_id(&d[i]);
     free(ft);
     free(nrm);
@@ -246,7 +247,8 @@ static int check_counts(cd_output *o, const cd_state *s)
         const cdh5_col *c = &o->cols[k];
         if (c->fixed && c->fixed_bytes && memcmp(c->fixed, *cd_field_ptr((cd_state *)s, &cd_fields[k]), c->fixed_bytes))
             return FAIL("%s: column %s changed since it was stored as fixed data; capdem stores it once "
-                        "(see docs/output.md), so it must not change during a run", o->path, cd_fields[k].name);
+                        "(see docs/output.md), so it must not change during a run",
+                        o->path, cd_fields[k].name);
     }
     return 0;
 }
@@ -274,7 +276,8 @@ static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g
                 cd_int prim = side[e][idx[r]];
                 p[r] = prim >= 0 && (size_t)prim < s->n_prims ? s->prim_particle[prim] : -1;
             }
-            if (cdh5_append(o, ds[e], e ? CDH5_PATH(C_PARTICLE_J) : CDH5_PATH(C_PARTICLE_I), at, m, H5T_NATIVE_INT32, p))
+            if (cdh5_append(o, ds[e], e ? CDH5_PATH(C_PARTICLE_J) : CDH5_PATH(C_PARTICLE_I), at, m, H5T_NATIVE_INT32,
+                            p))
                 return -1;
         }
     } else {
@@ -322,7 +325,9 @@ static unsigned long long first_snapshot_bytes(const cd_output *o, const cd_stat
         const cd_field_info *f = &cd_fields[k];
         unsigned long long e = f->elem_size, rows = cd_state_rows(s, f->group), row = rows * e;
         switch (cdh5_store_of(f)) {
-        case CDH5_FIXED: b += row; break;
+        case CDH5_FIXED:
+            b += row;
+            break;
         case CDH5_SERIES: /* a chunk of up to 64 KiB of rows, one row, or a row split into 1 MiB chunks */
             b += row > CDH5_LARGE_CHUNK ? row + CDH5_LARGE_CHUNK : row > CDH5_SMALL_CHUNK ? row : CDH5_SMALL_CHUNK;
             break;
@@ -335,7 +340,8 @@ static unsigned long long first_snapshot_bytes(const cd_output *o, const cd_stat
         b += 8192;
     }
     b += 4ULL * CDH5_CLOCK_CHUNK * 8 + 64 * nw1 * sizeof(cd_wall) + 64ULL * CD_CONTROL_SLOTS * 8;
-    b += 2 * (clamp(4 * P, 256, CDH5_LARGE_CHUNK / 4) * 4 + 4ULL * m) + clamp(P, 256, CDH5_LARGE_CHUNK / 8) * 8 + 8ULL * wm;
+    b += 2 * (clamp(4 * P, 256, CDH5_LARGE_CHUNK / 4) * 4 + 4ULL * m) + clamp(P, 256, CDH5_LARGE_CHUNK / 8) * 8 +
+         8ULL * wm;
     for (int i = 0; i < o->n_obs; i++)
         b += cdh5_growth(o->obs[i].value, o->buf_n) + cdh5_growth(o->obs[i].step, o->buf_n) +
              cdh5_growth(o->obs[i].time, o->buf_n);

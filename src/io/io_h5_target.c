@@ -64,8 +64,10 @@ int cdh5_target_lock(const char *path, unsigned long long *dev, unsigned long lo
     if (flock(fd, LOCK_EX | LOCK_NB) < 0) {
         int e = errno;
         if (e == EWOULDBLOCK || e == EAGAIN) {
-            snprintf(err, errlen, "%s is in use by another process (a running capdem, or another program that has "
-                     "it open through HDF5): refused, the file is left as it is", path);
+            snprintf(err, errlen,
+                     "%s is in use by another process (a running capdem, or another program that has "
+                     "it open through HDF5): refused, the file is left as it is",
+                     path);
             close(fd);
             return -1;
         }
@@ -182,8 +184,10 @@ int cd_output_check_target(const char *path, enum cd_output_mode how, const char
         return -1;
     }
     if (how == CD_OUTPUT_NEW) {
-        snprintf(err, errlen, "%s exists: refused, the file is left as it is (pass --overwrite to replace it once "
-                 "the new run's first snapshot is written, --resume to continue it, or choose another --output)", path);
+        snprintf(err, errlen,
+                 "%s exists: refused, the file is left as it is (pass --overwrite to replace it once "
+                 "the new run's first snapshot is written, --resume to continue it, or choose another --output)",
+                 path);
         return -1;
     }
     unsigned long long dev, ino;
@@ -242,5 +246,6 @@ int cdh5_check_linked(cd_output *o)
     if (st.st_nlink > 0) return 0;
     o->io_failed = 1;
     return FAIL("%s was deleted during the run (the file or its folder): the run stops, as what it writes could not "
-                "be read by anyone", o->tmp_path[0] ? o->tmp_path : o->path);
+                "be read by anyone",
+                o->tmp_path[0] ? o->tmp_path : o->path);
 }

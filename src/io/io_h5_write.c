@@ -314,7 +314,12 @@ static int write_shape(cd_output *o, int k, const cd_shape *sh)
     if (!rc) rc = cdh5_attr_str(o, d, p, "columns", "a_x a_y a_z b_x b_y b_z radius");
     cdh5_close_dset(&d);
     if (rc) return rc;
-    struct { const char *name, *unit; const double *v; int rank; hsize_t dims[2]; } items[] = {
+    struct {
+        const char *name, *unit;
+        const double *v;
+        int rank;
+        hsize_t dims[2];
+    } items[] = {
 #define CD_H5_SHAPE_VALUE(name, member, rank, dim0, dim1, unit) {name, unit, &sh->member, rank, {dim0, dim1}},
 #include "runfile.def"
     };
@@ -329,7 +334,7 @@ int cdh5_write_header(cd_output *o, const cd_config *cfg, const cd_shape *shapes
 {
     const char *groups[] = {
 #define CD_H5_GROUP(id, path, made, meaning) CD_H5_IF_##made(path)
-#define CD_H5_IF_HEADER(path) path,
+#define CD_H5_IF_HEADER(path)                path,
 #define CD_H5_IF_WRITER(path)
 #define CD_H5_IF_OPTIONAL(path)
 #include "runfile.def"

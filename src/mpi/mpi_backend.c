@@ -178,10 +178,12 @@ static void report(const cd_mpi_ctx *x)
     double t[4] = {x->t_step, x->t_decide, x->t_migrate, x->t_ghosts}, tmax[4]; /* [s] */
     MPI_Reduce(t, tmax, 4, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     if (x->rank == 0)
-        fprintf(stderr, "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
+        fprintf(stderr,
+                "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
                 "ghosts (%.3g ghosts per owned particle); slowest rank's seconds: step %.3g, rebuild decision %.3g, "
-                "migration %.3g, ghost refresh %.3g\n", x->size, x->migrations, lo[0], hi[0], lo[1], hi[1],
-                sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0, tmax[0], tmax[1], tmax[2], tmax[3]);
+                "migration %.3g, ghost refresh %.3g\n",
+                x->size, x->migrations, lo[0], hi[0], lo[1], hi[1], sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0,
+                tmax[0], tmax[1], tmax[2], tmax[3]);
 }
 
 /* Ends the local state; the context stays for a restart (cd_mpi_end
@@ -304,7 +306,8 @@ static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
  * rows only, summed in the serial order (cd_mpi_wall_load). */
 static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     *load = cd_mpi_wall_load(sim->backend_data, w, sim->s.n_prims);
     return 0;
 }
@@ -318,8 +321,8 @@ static const char *mpi_device(const cd_sim *sim)
     return buf;
 }
 
-static const cd_backend cd_backend_mpi = {"mpi", mpi_start, mpi_step, mpi_sync, mpi_stop, mpi_device, mpi_wall_load,
-                                          mpi_observe};
+static const cd_backend cd_backend_mpi = {"mpi",    mpi_start,  mpi_step,      mpi_sync,
+                                          mpi_stop, mpi_device, mpi_wall_load, mpi_observe};
 
 int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
 {

@@ -64,27 +64,30 @@ int cd_decomp_choose(cd_decomp_grid *g, const cd_config *cfg, int ranks, const d
         long prod = 1;
         for (int a = 0; a < 3; a++) {
             if (!(want[a] >= 1 && want[a] <= 1e6 && want[a] == floor(want[a]))) {
-                snprintf(err, errlen, "%s: mpi.grid = [%g, %g, %g]: expected three integers >= 1 (sub-domains along x, "
-                         "y, z), or [0, 0, 0] to let the ranks and the domain choose", cfg->source_path, want[0],
-                         want[1], want[2]);
+                snprintf(err, errlen,
+                         "%s: mpi.grid = [%g, %g, %g]: expected three integers >= 1 (sub-domains along x, "
+                         "y, z), or [0, 0, 0] to let the ranks and the domain choose",
+                         cfg->source_path, want[0], want[1], want[2]);
                 return -1;
             }
             g->dims[a] = (int)want[a];
             prod *= g->dims[a];
         }
         if (prod != ranks) {
-            snprintf(err, errlen, "%s: mpi.grid = [%d, %d, %d] makes %ld sub-domains, but the run has %d MPI ranks: "
-                     "expected a grid whose product is %d (or [0, 0, 0])", cfg->source_path, g->dims[0], g->dims[1],
-                     g->dims[2], prod, ranks, ranks);
+            snprintf(err, errlen,
+                     "%s: mpi.grid = [%d, %d, %d] makes %ld sub-domains, but the run has %d MPI ranks: "
+                     "expected a grid whose product is %d (or [0, 0, 0])",
+                     cfg->source_path, g->dims[0], g->dims[1], g->dims[2], prod, ranks, ranks);
             return -1;
         }
         for (int a = 0; a < 3; a++)
             if (g->dims[a] > most[a]) {
-                snprintf(err, errlen, "%s: mpi.grid = [%d, %d, %d]: %d sub-domains along %c, but the particle centres "
+                snprintf(err, errlen,
+                         "%s: mpi.grid = [%d, %d, %d]: %d sub-domains along %c, but the particle centres "
                          "span %g m there and a sub-domain must be at least the interaction range %g m wide (largest "
-                         "bounding diameter + skin): at most %ld along %c%s", cfg->source_path, g->dims[0], g->dims[1],
-                         g->dims[2], g->dims[a], axis_name[a], hi[a] - lo[a], range, most[a], axis_name[a],
-                         cfg->dimension == 2 && a == 2 ? " in 2D" : "");
+                         "bounding diameter + skin): at most %ld along %c%s",
+                         cfg->source_path, g->dims[0], g->dims[1], g->dims[2], g->dims[a], axis_name[a], hi[a] - lo[a],
+                         range, most[a], axis_name[a], cfg->dimension == 2 && a == 2 ? " in 2D" : "");
                 return -1;
             }
     } else {
@@ -93,7 +96,8 @@ int cd_decomp_choose(cd_decomp_grid *g, const cd_config *cfg, int ranks, const d
         for (int a = 0; a < 3; a++)
             if (fabs(cfg->gravity[a]) > gmax) gmax = fabs(cfg->gravity[a]), keep = a;
         if (auto_dims(ranks, most, lo, hi, cfg->dimension, keep, g->dims)) {
-            snprintf(err, errlen, "%s: %d MPI ranks: more than the domain can be split into: the particle centres span "
+            snprintf(err, errlen,
+                     "%s: %d MPI ranks: more than the domain can be split into: the particle centres span "
                      "[%g, %g, %g] m and a sub-domain must be at least the interaction range %g m wide (largest "
                      "bounding diameter + skin), so at most %ld x %ld x %ld sub-domains%s; run with fewer ranks",
                      cfg->source_path, ranks, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], range, most[0], most[1],
@@ -119,10 +123,7 @@ static int cell_of(const cd_decomp_grid *g, double x, int a)
     return c >= g->dims[a] ? g->dims[a] - 1 : (int)c;
 }
 
-static int rank_of(const cd_decomp_grid *g, const int c[3])
-{
-    return (c[2] * g->dims[1] + c[1]) * g->dims[0] + c[0];
-}
+static int rank_of(const cd_decomp_grid *g, const int c[3]) { return (c[2] * g->dims[1] + c[1]) * g->dims[0] + c[0]; }
 
 int cd_decomp_owner(const cd_decomp_grid *g, const double x[3])
 {

@@ -46,7 +46,10 @@ static inline int cd_mpi_is_writer(void) { return 1; }
 static inline int cd_mpi_decomposed(void) { return 0; }
 static inline int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err, size_t errlen)
 {
-    (void)sim; (void)backend; (void)err; (void)errlen;
+    (void)sim;
+    (void)backend;
+    (void)err;
+    (void)errlen;
     return 0;
 }
 #endif
@@ -54,12 +57,12 @@ static inline int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err
 /* ---- the Cartesian grid of sub-domains (src/mpi/mpi_decomp.c) -------------
  * Plain C, no MPI: unit-testable in any build. */
 typedef struct {
-    int dims[3];       /* sub-domains along x, y, z (their product: the ranks) */
-    double lo[3];      /* [m] lower corner of the split box (box of the centres at start) */
-    double width[3];   /* [m] width of an inner sub-domain; the outer ones reach to infinity */
-    double range;      /* [m] interaction range: largest bounding diameter + skin */
-    double margin;     /* [m] motion allowed between migrations (ghosts reach range + margin) */
-    double halo;       /* [m] range + margin */
+    int dims[3];     /* sub-domains along x, y, z (their product: the ranks) */
+    double lo[3];    /* [m] lower corner of the split box (box of the centres at start) */
+    double width[3]; /* [m] width of an inner sub-domain; the outer ones reach to infinity */
+    double range;    /* [m] interaction range: largest bounding diameter + skin */
+    double margin;   /* [m] motion allowed between migrations (ghosts reach range + margin) */
+    double halo;     /* [m] range + margin */
 } cd_decomp_grid;
 
 /* Chooses the grid of `ranks` sub-domains over the box of centres lo..hi

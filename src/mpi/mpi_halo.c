@@ -22,14 +22,14 @@ typedef struct {
 } rec_head;
 
 typedef struct {
-    long long gi, gj; /* global primitives */
+    long long gi, gj;      /* global primitives */
     long long rank_in_row; /* gather: the row's place among the rows of primitive gi (0 in a migration) */
 } pair_head;
 
 /* A record found in a received buffer. */
 typedef struct {
-    long long a, b;  /* particle: gid, -; pair: global primitives i, j */
-    const char *at;  /* the record */
+    long long a, b; /* particle: gid, -; pair: global primitives i, j */
+    const char *at; /* the record */
 } rec_ref;
 
 static size_t group_bytes(enum cd_field_group g)
@@ -113,7 +113,10 @@ static rec_ref *parse(const char *buf, size_t n, int pairs, size_t n_walls, size
     for (size_t at = 0; r && at < n; m++) {
         if (m == cap) {
             rec_ref *g = realloc(r, (cap *= 2) * sizeof *r);
-            if (!g) { free(r); return NULL; }
+            if (!g) {
+                free(r);
+                return NULL;
+            }
             r = g;
         }
         long long h[3];
@@ -197,13 +200,19 @@ static int plan_refresh(cd_mpi_ctx *x)
                 nr += x->recv_count[r];
                 x->send_count[r] = x->recv_count[r] = 0;
             }
-            free(x->send_list); free(x->recv_list); free(x->send_buf); free(x->recv_buf);
+            free(x->send_list);
+            free(x->recv_list);
+            free(x->send_buf);
+            free(x->recv_buf);
             x->send_list = malloc(((size_t)ns + 1) * sizeof(int));
             x->recv_list = malloc(((size_t)nr + 1) * sizeof(int));
             /* (one status per rank ahead of each rank's ghosts: cd_mpi_refresh_ghosts) */
             x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
             x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
-            if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) { free(ranks); return -1; }
+            if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) {
+                free(ranks);
+                return -1;
+            }
         }
         for (size_t q = 0; q < s->n_particles; q++) {
             if (x->owned[q]) {
@@ -239,8 +248,18 @@ static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
     if (!rc) rc = cd_state_alloc(&s, N, P, W, K + 16);
     long long *gid = rc ? NULL : malloc((N + 1) * sizeof *gid), *gprim = rc ? NULL : malloc((P + 1) * sizeof *gprim);
     unsigned char *owned = rc ? NULL : malloc(N + 1);
-    if (!rc && (!gid || !gprim || !owned)) { cd_state_free(&s); rc = -1; }
-    if (rc) { free(pr); free(cr); free(gid); free(gprim); free(owned); return -1; }
+    if (!rc && (!gid || !gprim || !owned)) {
+        cd_state_free(&s);
+        rc = -1;
+    }
+    if (rc) {
+        free(pr);
+        free(cr);
+        free(gid);
+        free(gprim);
+        free(owned);
+        return -1;
+    }
     copy_scalars(&s, scal);
     size_t pl = 0;
     x->n_owned = 0;
@@ -258,15 +277,23 @@ static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
     rc = place_pairs(&s, cr, K, gprim);
     free(pr);
     free(cr);
-    if (rc) { cd_state_free(&s); free(gid); free(gprim); free(owned); return -1; }
+    if (rc) {
+        cd_state_free(&s);
+        free(gid);
+        free(gprim);
+        free(owned);
+        return -1;
+    }
     cd_state_free(&x->loc.s);
     x->loc.s = s;
-    free(x->gid); free(x->gprim); free(x->owned);
+    free(x->gid);
+    free(x->gprim);
+    free(x->owned);
     x->gid = gid;
     x->gprim = gprim;
     x->owned = owned;
-    double skin = x->loc.nb.skin; /* [m] */
-    cd_neighbors_free(&x->loc.nb); /* sized for the old rows */
+    double skin = x->loc.nb.skin;           /* [m] */
+    cd_neighbors_free(&x->loc.nb);          /* sized for the old rows */
     cd_neighbors_init(&x->loc.nb, skin, 0); /* local order = global id order (docs/mpi.md) */
     return plan_refresh(x);
 }
@@ -291,7 +318,9 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
     for (size_t k = 0; !rc && k < global->n_pairs; k++)
         if (global->pair_active[k]) at = pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
     if (!rc) rc = assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
-    free(ranks); free(pbuf); free(cbuf);
+    free(ranks);
+    free(pbuf);
+    free(cbuf);
     return rc;
 }
 
@@ -300,7 +329,11 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
 static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen)
 {
     int R = x->size, *rc = calloc((size_t)R * 3 + 1, sizeof(int)), *sd = malloc(((size_t)R + 1) * sizeof(int));
-    if (!rc || !sd) { free(rc); free(sd); return -1; }
+    if (!rc || !sd) {
+        free(rc);
+        free(sd);
+        return -1;
+    }
     int *rd = rc + R;
     MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, x->comm);
     size_t ns = 0, nr = 0;
@@ -362,17 +395,23 @@ static int goes_to(const dest_lists *d, size_t q, int r)
 
 /* Pair row k goes to every rank that an owned particle of it goes to,
  * each rank once: body runs with r set to each of them. */
-#define FOR_PAIR_DESTS(x, d, k, r, body)                                                                     \
-    do {                                                                                                     \
-        cd_state *s_ = &(x)->loc.s;                                                                          \
-        size_t pi_ = (size_t)s_->prim_particle[s_->pair_prim_i[k]], pj_ = (size_t)s_->prim_particle[s_->pair_prim_j[k]]; \
-        if ((x)->owned[pi_])                                                                                 \
-            for (int e_ = 0; e_ < (d)->count[pi_]; e_++) { int r = (d)->ranks[(d)->first[pi_] + e_]; body; } \
-        if ((x)->owned[pj_])                                                                                 \
-            for (int e_ = 0; e_ < (d)->count[pj_]; e_++) {                                                   \
-                int r = (d)->ranks[(d)->first[pj_] + e_];                                                    \
-                if (!(x)->owned[pi_] || !goes_to(d, pi_, r)) { body; }                                       \
-            }                                                                                                \
+#define FOR_PAIR_DESTS(x, d, k, r, body)                                                                               \
+    do {                                                                                                               \
+        cd_state *s_ = &(x)->loc.s;                                                                                    \
+        size_t pi_ = (size_t)s_->prim_particle[s_->pair_prim_i[k]],                                                    \
+               pj_ = (size_t)s_->prim_particle[s_->pair_prim_j[k]];                                                    \
+        if ((x)->owned[pi_])                                                                                           \
+            for (int e_ = 0; e_ < (d)->count[pi_]; e_++) {                                                             \
+                int r = (d)->ranks[(d)->first[pi_] + e_];                                                              \
+                body;                                                                                                  \
+            }                                                                                                          \
+        if ((x)->owned[pj_])                                                                                           \
+            for (int e_ = 0; e_ < (d)->count[pj_]; e_++) {                                                             \
+                int r = (d)->ranks[(d)->first[pj_] + e_];                                                              \
+                if (!(x)->owned[pi_] || !goes_to(d, pi_, r)) {                                                         \
+                    body;                                                                                              \
+                }                                                                                                      \
+            }                                                                                                          \
     } while (0)
 
 int cd_mpi_migrate(cd_mpi_ctx *x)
@@ -417,8 +456,17 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
     cd_state scal = *s; /* the scalars only: assemble replaces s */
     if (!rc) rc = assemble(x, prec, plen, crec, clen, &scal);
     if (!rc) x->migrations++;
-    free(d.first); free(d.count); free(d.ranks);
-    free(pc); free(cc); free(po); free(co); free(pbuf); free(cbuf); free(prec); free(crec);
+    free(d.first);
+    free(d.count);
+    free(d.ranks);
+    free(pc);
+    free(cc);
+    free(po);
+    free(co);
+    free(pbuf);
+    free(cbuf);
+    free(prec);
+    free(crec);
     return rc;
 }
 
@@ -426,7 +474,7 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
 static void ghost_io(cd_state *s, size_t q, double *b, int pack)
 {
     double *cols[] = {&s->position[q].x, &s->orientation[q].w, &s->velocity[q].x, &s->angmom[q].x,
-                      &s->angvel[q].x, &s->force[q].x, &s->torque[q].x};
+                      &s->angvel[q].x,   &s->force[q].x,       &s->torque[q].x};
     int len[] = {3, 4, 3, 3, 3, 3, 3};
     for (int c = 0; c < 7; c++) {
         if (pack) memcpy(b, cols[c], (size_t)len[c] * sizeof(double));
@@ -508,7 +556,10 @@ static int place_serial_rows(cd_state *g, const long long *counts, size_t n_coun
         pair_head h;
         memcpy(&h, r[k].at, sizeof h);
         long long row = first[h.gi] + h.rank_in_row;
-        if (row >= first[h.gi + 1]) { rc = -1; break; } /* cannot happen: the row is among its primitive's */
+        if (row >= first[h.gi + 1]) {
+            rc = -1;
+            break;
+        } /* cannot happen: the row is among its primitive's */
         rows_io(g, CD_GROUP_PAIR, (size_t)row, 1, (char *)r[k].at + sizeof h, 0);
         g->pair_prim_i[row] = (cd_int)h.gi;
         g->pair_prim_j[row] = (cd_int)h.gj;
@@ -571,8 +622,14 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
         free(pr);
         free(cr);
     }
-    free(row0); free(rows); free(counts);
-    free(pbuf); free(cbuf); free(pall); free(call); free(nall);
+    free(row0);
+    free(rows);
+    free(counts);
+    free(pbuf);
+    free(cbuf);
+    free(pall);
+    free(call);
+    free(nall);
     return rc;
 }
 
@@ -621,9 +678,17 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
 
 void cd_mpi_halo_free(cd_mpi_ctx *x)
 {
-    free(x->gid); free(x->gprim); free(x->owned);
-    free(x->send_count); free(x->send_displ); free(x->recv_count); free(x->recv_displ);
-    free(x->send_list); free(x->recv_list); free(x->send_buf); free(x->recv_buf);
+    free(x->gid);
+    free(x->gprim);
+    free(x->owned);
+    free(x->send_count);
+    free(x->send_displ);
+    free(x->recv_count);
+    free(x->recv_displ);
+    free(x->send_list);
+    free(x->recv_list);
+    free(x->send_buf);
+    free(x->recv_buf);
     x->gid = x->gprim = NULL;
     x->owned = NULL;
     x->send_count = x->send_displ = x->recv_count = x->recv_displ = x->send_list = x->recv_list = NULL;

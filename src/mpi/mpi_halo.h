@@ -10,11 +10,11 @@ typedef struct {
     MPI_Comm comm;
     int rank, size;
     cd_decomp_grid grid;
-    const cd_backend *inner;  /* the backend that steps the local state (omp) */
-    cd_sim loc;               /* owned particles and ghosts, in ascending global id */
+    const cd_backend *inner; /* the backend that steps the local state (omp) */
+    cd_sim loc;              /* owned particles and ghosts, in ascending global id */
     /* per local particle and primitive, the global ids (ascending) */
     long long *gid, *gprim;
-    unsigned char *owned;     /* per local particle: 1 owned here, 0 a ghost */
+    unsigned char *owned; /* per local particle: 1 owned here, 0 a ghost */
     size_t n_owned;
     /* the ghost refresh of every step, fixed between migrations: the owned
      * particles each rank gets (send_list, per rank in ascending order) and
@@ -22,9 +22,9 @@ typedef struct {
     int *send_count, *send_displ, *recv_count, *recv_displ; /* per rank, in particles */
     int *send_list, *recv_list;
     double *send_buf, *recv_buf;
-    long long migrations;     /* times the particles went to new owners */
-    int started;              /* the local state runs (start succeeded on every rank) */
-    int ran;                  /* it ran at least once (the closing report) */
+    long long migrations;         /* times the particles went to new owners */
+    int started;                  /* the local state runs (start succeeded on every rank) */
+    int ran;                      /* it ran at least once (the closing report) */
     long last_owned, last_ghosts; /* particles of this rank when it last stopped */
     /* wall-clock seconds of this rank (MPI_Wtime): in the serial step (the
      * decision and migration taken out), deciding the rebuild (waits for

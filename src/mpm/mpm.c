@@ -22,8 +22,8 @@ int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, doubl
     m->ox = ox;
     m->oy = oy;
     size_t nn = (size_t)nx * (size_t)ny, s = n ? n : 1;
-    double **pcols[] = {&m->x, &m->y, &m->vx, &m->vy, &m->mass, &m->vol, &m->half, &m->sxx, &m->syy, &m->sxy,
-                        &m->szz, &m->eps_p, &m->f_xx, &m->f_xy, &m->f_yx, &m->f_yy, &m->ex, &m->ey};
+    double **pcols[] = {&m->x,   &m->y,   &m->vx,    &m->vy,   &m->mass, &m->vol,  &m->half, &m->sxx, &m->syy,
+                        &m->sxy, &m->szz, &m->eps_p, &m->f_xx, &m->f_xy, &m->f_yx, &m->f_yy, &m->ex,  &m->ey};
     int ok = nx >= 4 && ny >= 4;
     for (size_t i = 0; i < sizeof pcols / sizeof pcols[0]; i++) ok &= (*pcols[i] = calloc(s, sizeof(double))) != NULL;
     double **wcols[] = {&m->wx, &m->wy, &m->dwx, &m->dwy};
@@ -44,11 +44,13 @@ int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, doubl
 
 void cd_mpm_free(cd_mpm *m)
 {
-    void *cols[] = {m->x, m->y, m->vx, m->vy, m->mass, m->vol, m->half, m->sxx, m->syy, m->sxy, m->szz, m->eps_p,
-                    m->f_xx, m->f_xy, m->f_yx, m->f_yy, m->ex, m->ey, m->wx, m->wy, m->dwx, m->dwy, m->gm, m->gpx,
-                    m->gpy, m->gfx, m->gfy, m->gvx, m->gvy, m->gnx, m->gny, m->particle, m->bx, m->by, m->order,
-                    m->cell_start, m->pfirst, m->win_i0, m->win_j0, m->win_nx, m->win_ny, m->win_off, m->bnode_body,
-                    m->cn_start, m->cn_entry, m->cn_list, m->cn_active, m->pair_keys};
+    void *cols[] = {m->x,          m->y,        m->vx,       m->vy,       m->mass,      m->vol,      m->half,
+                    m->sxx,        m->syy,      m->sxy,      m->szz,      m->eps_p,     m->f_xx,     m->f_xy,
+                    m->f_yx,       m->f_yy,     m->ex,       m->ey,       m->wx,        m->wy,       m->dwx,
+                    m->dwy,        m->gm,       m->gpx,      m->gpy,      m->gfx,       m->gfy,      m->gvx,
+                    m->gvy,        m->gnx,      m->gny,      m->particle, m->bx,        m->by,       m->order,
+                    m->cell_start, m->pfirst,   m->win_i0,   m->win_j0,   m->win_nx,    m->win_ny,   m->win_off,
+                    m->bnode_body, m->cn_start, m->cn_entry, m->cn_list,  m->cn_active, m->pair_keys};
     for (size_t i = 0; i < sizeof cols / sizeof cols[0]; i++) free(cols[i]);
     memset(m, 0, sizeof *m);
 }
@@ -57,10 +59,13 @@ int cd_mpm_bodies(cd_mpm *m, char *err, size_t errlen)
 {
     int nb = m->n ? m->particle[m->n - 1] + 1 : 0;
     for (size_t p = 0; p < m->n; p++)
-        if (m->particle[p] < 0 || (p > 0 && m->particle[p] != m->particle[p - 1] && m->particle[p] != m->particle[p - 1] + 1) ||
+        if (m->particle[p] < 0 ||
+            (p > 0 && m->particle[p] != m->particle[p - 1] && m->particle[p] != m->particle[p - 1] + 1) ||
             (p == 0 && m->particle[0] != 0)) {
-            snprintf(err, errlen, "material point %zu: particle id %d out of order (expected the ids 0, 1, ... in "
-                     "blocks of contiguous points)", p, m->particle[p]);
+            snprintf(err, errlen,
+                     "material point %zu: particle id %d out of order (expected the ids 0, 1, ... in "
+                     "blocks of contiguous points)",
+                     p, m->particle[p]);
             return -1;
         }
     if (nb < 1) {
@@ -147,8 +152,10 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
     long long bad = -1;
 #pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(n))
     for (size_t p = 0; p < n; p++) {
-        int bx = cd_mpm_weights_1d((m->x[p] - m->ox) / m->h, m->h, m->wx + CD_MPM_STENCIL * p, m->dwx + CD_MPM_STENCIL * p);
-        int by = cd_mpm_weights_1d((m->y[p] - m->oy) / m->h, m->h, m->wy + CD_MPM_STENCIL * p, m->dwy + CD_MPM_STENCIL * p);
+        int bx =
+            cd_mpm_weights_1d((m->x[p] - m->ox) / m->h, m->h, m->wx + CD_MPM_STENCIL * p, m->dwx + CD_MPM_STENCIL * p);
+        int by =
+            cd_mpm_weights_1d((m->y[p] - m->oy) / m->h, m->h, m->wy + CD_MPM_STENCIL * p, m->dwy + CD_MPM_STENCIL * p);
         if (!(bx >= 0 && by >= 0 && bx + CD_MPM_STENCIL <= m->nx && by + CD_MPM_STENCIL <= m->ny)) {
             bad = (long long)p > bad ? (long long)p : bad;
             bx = by = 0;
@@ -158,8 +165,8 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
         double ex = 0, ey = 0; /* [N/m] */
         for (int w = 0; w < m->n_walls; w++) {
             const cd_mpm_wall *W = &m->walls[w];
-            double d = cd_mpm_wall_overlap(m->x[p], m->y[p], m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p],
-                                           m->f_yy[p], W->px, W->py, W->nx, W->ny);
+            double d = cd_mpm_wall_overlap(m->x[p], m->y[p], m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p], m->f_yy[p],
+                                           W->px, W->py, W->nx, W->ny);
             if (d > 0) {
                 ex += m->wall_k * d * W->nx;
                 ey += m->wall_k * d * W->ny;
@@ -170,9 +177,11 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
     }
     if (bad >= 0) {
         size_t p = (size_t)bad;
-        snprintf(err, errlen, "material point %zu at (%.6g, %.6g) m (t = %.9g s, step %lld) left the background mesh "
-                 "[%.6g, %.6g] x [%.6g, %.6g] m: the run blew up, or the set-up leaves too little room", p, m->x[p],
-                 m->y[p], m->time, m->step, m->ox, m->ox + (m->nx - 1) * m->h, m->oy, m->oy + (m->ny - 1) * m->h);
+        snprintf(err, errlen,
+                 "material point %zu at (%.6g, %.6g) m (t = %.9g s, step %lld) left the background mesh "
+                 "[%.6g, %.6g] x [%.6g, %.6g] m: the run blew up, or the set-up leaves too little room",
+                 p, m->x[p], m->y[p], m->time, m->step, m->ox, m->ox + (m->nx - 1) * m->h, m->oy,
+                 m->oy + (m->ny - 1) * m->h);
         return -1;
     }
     /* wall forces: the reaction of the points' penalty forces, summed in point order */
@@ -180,8 +189,8 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
         cd_mpm_wall *W = &m->walls[w];
         double fx = 0, fy = 0;
         for (size_t p = 0; p < n; p++) {
-            double d = cd_mpm_wall_overlap(m->x[p], m->y[p], m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p],
-                                           m->f_yy[p], W->px, W->py, W->nx, W->ny);
+            double d = cd_mpm_wall_overlap(m->x[p], m->y[p], m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p], m->f_yy[p],
+                                           W->px, W->py, W->nx, W->ny);
             if (d > 0) {
                 fx -= m->wall_k * d * W->nx;
                 fy -= m->wall_k * d * W->ny;
@@ -229,24 +238,24 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
  * i-2 .. i+1 and j-2 .. j+1 (window coordinates): visited in that order,
  * each cell's points in index order.  a, b: the node's place in the
  * point's stencil. */
-#define FOR_SUPPORT(m, t, p, a, b, ...)                                                                             \
-    do {                                                                                                            \
-        int k_ = (m)->bnode_body[t], wnx_ = (m)->win_nx[k_], wny_ = (m)->win_ny[k_];                                \
-        size_t off_ = (m)->win_off[k_], loc_ = (t) - off_;                                                          \
-        int li_ = (int)(loc_ % (size_t)wnx_), lj_ = (int)(loc_ / (size_t)wnx_);                                     \
-        int gi_ = (m)->win_i0[k_] + li_, gj_ = (m)->win_j0[k_] + lj_;                                               \
-        for (int cy_ = lj_ - 2; cy_ <= lj_ + 1; cy_++) {                                                            \
-            if (cy_ < 0 || cy_ >= wny_) continue;                                                                   \
-            for (int cx_ = li_ - 2; cx_ <= li_ + 1; cx_++) {                                                        \
-                if (cx_ < 0 || cx_ >= wnx_) continue;                                                               \
-                size_t c_ = off_ + (size_t)cy_ * (size_t)wnx_ + (size_t)cx_;                                        \
-                for (size_t e_ = (m)->cell_start[c_]; e_ < (m)->cell_start[c_ + 1]; e_++) {                         \
-                    size_t p = (m)->order[e_];                                                                      \
-                    int a = gi_ - (m)->bx[p], b = gj_ - (m)->by[p];                                                 \
-                    __VA_ARGS__                                                                                     \
-                }                                                                                                   \
-            }                                                                                                       \
-        }                                                                                                           \
+#define FOR_SUPPORT(m, t, p, a, b, ...)                                                                                \
+    do {                                                                                                               \
+        int k_ = (m)->bnode_body[t], wnx_ = (m)->win_nx[k_], wny_ = (m)->win_ny[k_];                                   \
+        size_t off_ = (m)->win_off[k_], loc_ = (t)-off_;                                                               \
+        int li_ = (int)(loc_ % (size_t)wnx_), lj_ = (int)(loc_ / (size_t)wnx_);                                        \
+        int gi_ = (m)->win_i0[k_] + li_, gj_ = (m)->win_j0[k_] + lj_;                                                  \
+        for (int cy_ = lj_ - 2; cy_ <= lj_ + 1; cy_++) {                                                               \
+            if (cy_ < 0 || cy_ >= wny_) continue;                                                                      \
+            for (int cx_ = li_ - 2; cx_ <= li_ + 1; cx_++) {                                                           \
+                if (cx_ < 0 || cx_ >= wnx_) continue;                                                                  \
+                size_t c_ = off_ + (size_t)cy_ * (size_t)wnx_ + (size_t)cx_;                                           \
+                for (size_t e_ = (m)->cell_start[c_]; e_ < (m)->cell_start[c_ + 1]; e_++) {                            \
+                    size_t p = (m)->order[e_];                                                                         \
+                    int a = gi_ - (m)->bx[p], b = gj_ - (m)->by[p];                                                    \
+                    __VA_ARGS__                                                                                        \
+                }                                                                                                      \
+            }                                                                                                          \
+        }                                                                                                              \
     } while (0)
 
 /* Node mass, momentum and force from the points (the paper's eq. (3):
@@ -262,9 +271,9 @@ static void to_grid(cd_mpm *m)
         double gm = 0, px = 0, py = 0, fx = 0, fy = 0, nx = 0, ny = 0;
         FOR_SUPPORT(m, t, p, a, b, {
             double wa = m->wx[CD_MPM_STENCIL * p + a], wb = m->wy[CD_MPM_STENCIL * p + b];
-            double N = wa * wb;                                  /* [1] */
-            double gx = m->dwx[CD_MPM_STENCIL * p + a] * wb;     /* dN/dx [1/m] */
-            double gy = wa * m->dwy[CD_MPM_STENCIL * p + b];     /* dN/dy [1/m] */
+            double N = wa * wb;                              /* [1] */
+            double gx = m->dwx[CD_MPM_STENCIL * p + a] * wb; /* dN/dx [1/m] */
+            double gy = wa * m->dwy[CD_MPM_STENCIL * p + b]; /* dN/dy [1/m] */
             double mN = N * m->mass[p];
             gm += mN;
             px += mN * m->vx[p];
@@ -388,9 +397,10 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
             bad = (long long)p > bad ? (long long)p : bad;
     }
     if (bad >= 0) {
-        snprintf(err, errlen, "material point %lld is not finite or has a volume <= 0 at step %lld (t = %.9g s): the run "
-                 "blew up; reduce run.dt (limit %.3g s) or check the material", bad, m->step + 1, m->time + dt,
-                 cd_mpm_dt_limit(m));
+        snprintf(err, errlen,
+                 "material point %lld is not finite or has a volume <= 0 at step %lld (t = %.9g s): the run "
+                 "blew up; reduce run.dt (limit %.3g s) or check the material",
+                 bad, m->step + 1, m->time + dt, cd_mpm_dt_limit(m));
         return -1;
     }
     for (int w = 0; w < m->n_walls; w++) {

@@ -12,69 +12,70 @@
 
 /* A rigid plane wall driven at a given velocity. */
 typedef struct {
-    double px, py;   /* a point of the plane [m] */
-    double nx, ny;   /* unit normal into the material [1] */
-    double vx, vy;   /* velocity [m/s] */
-    double fx, fy;   /* force of the material on the wall in the last step [N/m] */
+    double px, py; /* a point of the plane [m] */
+    double nx, ny; /* unit normal into the material [1] */
+    double vx, vy; /* velocity [m/s] */
+    double fx, fy; /* force of the material on the wall in the last step [N/m] */
 } cd_mpm_wall;
 
 typedef struct {
     /* material points (n of them) */
     size_t n;
-    double *x, *y;             /* position [m] */
-    double *vx, *vy;           /* velocity [m/s] */
-    double *mass;              /* [kg/m] */
-    double *vol;               /* volume [m^3/m] */
-    double *half;              /* half the initial side of the point's square [m] */
-    double *sxx, *syy, *sxy, *szz; /* Cauchy stress [Pa] */
-    double *eps_p;             /* equivalent plastic strain [1] */
+    double *x, *y;                     /* position [m] */
+    double *vx, *vy;                   /* velocity [m/s] */
+    double *mass;                      /* [kg/m] */
+    double *vol;                       /* volume [m^3/m] */
+    double *half;                      /* half the initial side of the point's square [m] */
+    double *sxx, *syy, *sxy, *szz;     /* Cauchy stress [Pa] */
+    double *eps_p;                     /* equivalent plastic strain [1] */
     double *f_xx, *f_xy, *f_yx, *f_yy; /* deformation gradient [1] */
-    int *particle;             /* particle (body) id: 0 .. n_bodies-1, the points of a body contiguous */
+    int *particle;                     /* particle (body) id: 0 .. n_bodies-1, the points of a body contiguous */
     /* per-step scratch of the points */
-    int *bx, *by;              /* first node of the stencil in x and y (common mesh) */
+    int *bx, *by;                /* first node of the stencil in x and y (common mesh) */
     double *wx, *wy, *dwx, *dwy; /* 4 weights [1] and gradients [1/m] per point and direction */
-    double *ex, *ey;           /* external (wall) force on the point [N/m] */
-    size_t *order;             /* point indices sorted by (body, cell), stable */
+    double *ex, *ey;             /* external (wall) force on the point [N/m] */
+    size_t *order;               /* point indices sorted by (body, cell), stable */
 
     /* the common background mesh: nodes (i, j) at (ox + i h, oy + j h), i < nx, j < ny */
     int nx, ny;
-    double h, ox, oy;          /* cell size and origin [m] */
+    double h, ox, oy; /* cell size and origin [m] */
 
     /* bodies (docs/mpm.md, "Contact"): each has its own nodes on a window
      * of the common mesh, nodes (i0 + a, j0 + b), a < wnx, b < wny, stored
      * from win_off[k] on; found at the first step from the particle column */
-    int n_bodies;              /* 0 until the first step */
-    size_t *pfirst;            /* points of body k: pfirst[k] .. pfirst[k+1]-1 */
+    int n_bodies;   /* 0 until the first step */
+    size_t *pfirst; /* points of body k: pfirst[k] .. pfirst[k+1]-1 */
     int *win_i0, *win_j0, *win_nx, *win_ny;
-    size_t *win_off;           /* n_bodies + 1 */
+    size_t *win_off;             /* n_bodies + 1 */
     size_t n_bnodes, cap_bnodes; /* body-nodes in use, allocated */
-    int *bnode_body;           /* body of each body-node */
-    size_t *cell_start;        /* first entry in order of each body-cell (indexed like the body-nodes); + 1 */
-    double *gm;                /* node mass [kg/m] */
-    double *gpx, *gpy;         /* node momentum [kg/s] per metre */
-    double *gfx, *gfy;         /* node force [N/m], then acceleration [m/s^2] */
-    double *gvx, *gvy;         /* node velocity [m/s] */
-    double *gnx, *gny;         /* sum m_p grad N(x_p - x_i) [kg/m^2]: minus the node's mass gradient, the body's outward normal */
+    int *bnode_body;             /* body of each body-node */
+    size_t *cell_start;          /* first entry in order of each body-cell (indexed like the body-nodes); + 1 */
+    double *gm;                  /* node mass [kg/m] */
+    double *gpx, *gpy;           /* node momentum [kg/s] per metre */
+    double *gfx, *gfy;           /* node force [N/m], then acceleration [m/s^2] */
+    double *gvx, *gvy;           /* node velocity [m/s] */
+    double *gnx,
+        *gny; /* sum m_p grad N(x_p - x_i) [kg/m^2]: minus the node's mass gradient, the body's outward normal */
 
     /* contact: common nodes holding two or more bodies (src/mpm/mpm_contact.c) */
-    size_t *cn_start;          /* per common node (nx * ny + 1): its body-nodes in cn_entry */
-    size_t *cn_entry;          /* body-nodes sorted by common node, bodies ascending (cap_bnodes) */
-    size_t *cn_list;           /* common nodes with >= 2 bodies (nx * ny) */
-    unsigned *cn_active;       /* per listed node: bit q set when its q-th body pair is in contact (gap <= contact_gap) */
-    size_t n_cn;               /* listed nodes */
-    long long *pair_keys;      /* scratch: k * n_bodies + l of the pairs in contact */
+    size_t *cn_start;     /* per common node (nx * ny + 1): its body-nodes in cn_entry */
+    size_t *cn_entry;     /* body-nodes sorted by common node, bodies ascending (cap_bnodes) */
+    size_t *cn_list;      /* common nodes with >= 2 bodies (nx * ny) */
+    unsigned *cn_active;  /* per listed node: bit q set when its q-th body pair is in contact (gap <= contact_gap) */
+    size_t n_cn;          /* listed nodes */
+    long long *pair_keys; /* scratch: k * n_bodies + l of the pairs in contact */
     size_t cap_pairs;
-    double contact_gap;        /* two bodies' contact acts from this gap between them on [m] */
-    long n_contacts;           /* body pairs in contact (at a node within contact_gap) in the last step */
-    double penetration;        /* deepest overlap of two bodies in the last step, from the contact nodes [m]; 0 if none */
+    double contact_gap; /* two bodies' contact acts from this gap between them on [m] */
+    long n_contacts;    /* body pairs in contact (at a node within contact_gap) in the last step */
+    double penetration; /* deepest overlap of two bodies in the last step, from the contact nodes [m]; 0 if none */
 
     int n_walls;
     cd_mpm_wall walls[CD_MPM_MAX_WALLS];
-    double wall_k;             /* wall penalty stiffness per point [N/m per metre] */
-    double box_h0;             /* distance of walls 0 and 1 at start [m] */
+    double wall_k; /* wall penalty stiffness per point [N/m per metre] */
+    double box_h0; /* distance of walls 0 and 1 at start [m] */
 
     cd_mpm_material mat;
-    double dt, time;           /* [s] */
+    double dt, time; /* [s] */
     long long step;
 } cd_mpm;
 

@@ -173,9 +173,11 @@ int cd_mpm_contact_correct(cd_mpm *m, int phase, char *err, size_t errlen)
     }
     if (bad >= 0) {
         size_t g = (size_t)bad;
-        snprintf(err, errlen, "common node (%zu, %zu) at step %lld: %zu bodies meet there, more than the %d the contact "
-                 "handles: refine the mesh (mpm.cells_per_diameter)", g % (size_t)m->nx, g / (size_t)m->nx, m->step + 1,
-                 m->cn_start[g + 1] - m->cn_start[g], CD_MPM_NODE_BODIES);
+        snprintf(err, errlen,
+                 "common node (%zu, %zu) at step %lld: %zu bodies meet there, more than the %d the contact "
+                 "handles: refine the mesh (mpm.cells_per_diameter)",
+                 g % (size_t)m->nx, g / (size_t)m->nx, m->step + 1, m->cn_start[g + 1] - m->cn_start[g],
+                 CD_MPM_NODE_BODIES);
         return -1;
     }
     if (phase == 0) {

@@ -14,12 +14,12 @@
 
 struct cd_mpm_output {
     hid_t file;
-    char path[CD_PATH_MAX];    /* the name the file gets */
+    char path[CD_PATH_MAX];       /* the name the file gets */
     char aside[CD_PATH_MAX + 16]; /* where it is written until the first snapshot ("" when path itself) */
     hsize_t n_snap, n_series;
     size_t n_points;
     int n_walls;
-    int packing;               /* set-up packing: its measures in the series */
+    int packing; /* set-up packing: its measures in the series */
 };
 
 /* The packing's measures in the series (cd_mpm_packing_measures), and the
@@ -27,9 +27,11 @@ struct cd_mpm_output {
 enum { PACKING_SERIES = 5 };
 static const struct {
     const char *name, *unit;
-} packing_series[PACKING_SERIES] = {
-    {"/mpm/series/packing_fraction", "1"}, {"/mpm/series/stress", "Pa"}, {"/mpm/series/strain", "1"},
-    {"/mpm/series/coordination", "1"}, {"/mpm/series/penetration", "m"}};
+} packing_series[PACKING_SERIES] = {{"/mpm/series/packing_fraction", "1"},
+                                    {"/mpm/series/stress", "Pa"},
+                                    {"/mpm/series/strain", "1"},
+                                    {"/mpm/series/coordination", "1"},
+                                    {"/mpm/series/penetration", "m"}};
 
 static int fail(char *err, size_t errlen, const char *path, const char *what)
 {
@@ -56,7 +58,8 @@ static int make_growing(hid_t file, const char *path, hid_t type, int rank, cons
 {
     hsize_t dims[3] = {0, 0, 0}, maxd[3] = {H5S_UNLIMITED, 0, 0}, chunk[3] = {rows, 1, 1};
     for (int k = 1; k < rank; k++) dims[k] = maxd[k] = chunk[k] = tail[k - 1];
-    hid_t sp = H5Screate_simple(rank, dims, maxd), dcpl = H5Pcreate(H5P_DATASET_CREATE), lcpl = H5Pcreate(H5P_LINK_CREATE);
+    hid_t sp = H5Screate_simple(rank, dims, maxd), dcpl = H5Pcreate(H5P_DATASET_CREATE),
+          lcpl = H5Pcreate(H5P_LINK_CREATE);
     H5Pset_chunk(dcpl, rank, chunk);
     H5Pset_create_intermediate_group(lcpl, 1);
     hid_t d = H5Dcreate2(file, path, type, sp, lcpl, dcpl, H5P_DEFAULT);
@@ -99,8 +102,10 @@ static int write_fixed(hid_t file, const char *path, hid_t ftype, hid_t mtype, i
     hid_t sp = H5Screate_simple(rank, dims, NULL), lcpl = H5Pcreate(H5P_LINK_CREATE);
     H5Pset_create_intermediate_group(lcpl, 1);
     hid_t d = H5Dcreate2(file, path, ftype, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT);
-    int rc = d >= 0 && H5Dwrite(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 && (!unit || attr_str(d, "unit", unit) == 0)
-                 ? 0 : -1;
+    int rc = d >= 0 && H5Dwrite(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 &&
+                     (!unit || attr_str(d, "unit", unit) == 0)
+                 ? 0
+                 : -1;
     if (d >= 0) H5Dclose(d);
     H5Sclose(sp);
     H5Pclose(lcpl);
@@ -155,7 +160,8 @@ cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_conf
     const char *text = cfg->source_text ? cfg->source_text : "";
     hid_t st = H5Tcopy(H5T_C_S1);
     H5Tset_size(st, strlen(text) + 1);
-    int rc = attr_str(o->file, "solver", "mpm") | attr_str(o->file, "creator", "capdem " CAPDEM_VERSION " (commit " CAPDEM_COMMIT ")");
+    int rc = attr_str(o->file, "solver", "mpm") |
+             attr_str(o->file, "creator", "capdem " CAPDEM_VERSION " (commit " CAPDEM_COMMIT ")");
     rc |= write_fixed(o->file, "/parameters/config", st, st, 1, &one, text, NULL);
     H5Tclose(st);
     rc |= write_fixed(o->file, "/mpm/points/particle", H5T_STD_I32LE, H5T_NATIVE_INT, 1, &n, m->particle, NULL);
@@ -229,8 +235,9 @@ int cd_mpm_output_snapshot(cd_mpm_output *o, const cd_mpm *m, char *err, size_t 
     free(buf);
     long long committed = (long long)at + 1;
     hid_t sp = H5Screate(H5S_SCALAR);
-    hid_t a = H5Aexists(f, "n_snapshots") > 0 ? H5Aopen(f, "n_snapshots", H5P_DEFAULT)
-                                               : H5Acreate2(f, "n_snapshots", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t a = H5Aexists(f, "n_snapshots") > 0
+                  ? H5Aopen(f, "n_snapshots", H5P_DEFAULT)
+                  : H5Acreate2(f, "n_snapshots", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
     rc |= a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &committed) >= 0 ? 0 : -1;
     if (a >= 0) H5Aclose(a);
     H5Sclose(sp);
@@ -295,7 +302,9 @@ static int read_row(hid_t file, const char *path, hid_t mtype, hsize_t at, size_
         if (at < dims[0] && row == count) {
             hid_t ms = H5Screate_simple(rank, cnt, NULL);
             rc = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL) >= 0 &&
-                         H5Dread(d, mtype, ms, fs, H5P_DEFAULT, buf) >= 0 ? 0 : -1;
+                         H5Dread(d, mtype, ms, fs, H5P_DEFAULT, buf) >= 0
+                     ? 0
+                     : -1;
             H5Sclose(ms);
         }
     }
@@ -324,7 +333,8 @@ static int same_fixed(hid_t f, const char *path, hid_t mtype, size_t n, size_t s
     hsize_t dims[1] = {0};
     int same = H5Sget_simple_extent_ndims(fs) == 1 && (H5Sget_simple_extent_dims(fs, dims, NULL), dims[0] == n);
     void *buf = same ? malloc(n * size + 1) : NULL;
-    same = same && buf && H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 && memcmp(buf, want, n * size) == 0;
+    same =
+        same && buf && H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 && memcmp(buf, want, n * size) == 0;
     free(buf);
     H5Sclose(fs);
     H5Dclose(d);
@@ -351,7 +361,8 @@ int cd_mpm_read_snapshot(const char *path, cd_mpm *m, char *err, size_t errlen)
             snprintf(err, errlen, "%s: no snapshot to resume from (root attribute n_snapshots)", path);
         } else if (!same_fixed(f, "/mpm/points/mass", D, n, sizeof(double), m->mass) ||
                    !same_fixed(f, "/mpm/points/particle", H5T_NATIVE_INT, n, sizeof(int), m->particle)) {
-            snprintf(err, errlen, "%s: its material points (/mpm/points/mass, particle) differ from those the config "
+            snprintf(err, errlen,
+                     "%s: its material points (/mpm/points/mass, particle) differ from those the config "
                      "sets up now (%zu points): a resume continues the same set-up (was mpm.packing's file changed?)",
                      path, n);
         } else {
@@ -363,14 +374,17 @@ int cd_mpm_read_snapshot(const char *path, cd_mpm *m, char *err, size_t errlen)
                 for (size_t p = 0; p < n; p++) m->x[p] = buf[2 * p], m->y[p] = buf[2 * p + 1];
             if (!bad && !(bad = read_row(f, "/mpm/snapshots/velocity", D, at, 2 * n, buf)))
                 for (size_t p = 0; p < n; p++) m->vx[p] = buf[2 * p], m->vy[p] = buf[2 * p + 1];
-            if (!bad) bad = read_row(f, "/mpm/snapshots/volume", D, at, n, m->vol) ||
-                            read_row(f, "/mpm/snapshots/plastic_strain", D, at, n, m->eps_p);
+            if (!bad)
+                bad = read_row(f, "/mpm/snapshots/volume", D, at, n, m->vol) ||
+                      read_row(f, "/mpm/snapshots/plastic_strain", D, at, n, m->eps_p);
             if (!bad && !(bad = read_row(f, "/mpm/snapshots/stress", D, at, 4 * n, buf)))
                 for (size_t p = 0; p < n; p++)
-                    m->sxx[p] = buf[4 * p], m->syy[p] = buf[4 * p + 1], m->sxy[p] = buf[4 * p + 2], m->szz[p] = buf[4 * p + 3];
+                    m->sxx[p] = buf[4 * p], m->syy[p] = buf[4 * p + 1], m->sxy[p] = buf[4 * p + 2],
+                    m->szz[p] = buf[4 * p + 3];
             if (!bad && !(bad = read_row(f, "/mpm/snapshots/deformation_gradient", D, at, 4 * n, buf)))
                 for (size_t p = 0; p < n; p++)
-                    m->f_xx[p] = buf[4 * p], m->f_xy[p] = buf[4 * p + 1], m->f_yx[p] = buf[4 * p + 2], m->f_yy[p] = buf[4 * p + 3];
+                    m->f_xx[p] = buf[4 * p], m->f_xy[p] = buf[4 * p + 1], m->f_yx[p] = buf[4 * p + 2],
+                    m->f_yy[p] = buf[4 * p + 3];
             if (bad) {
                 snprintf(err, errlen, "%s: cannot read snapshot %lld (of %zu points and %d walls) to resume from", path,
                          k, n, m->n_walls);
@@ -432,8 +446,9 @@ cd_mpm_output *cd_mpm_output_reopen(const char *path, const cd_config *cfg, cons
                 }
                 H5Dclose(d);
             }
-            const char *snaps[] = {"step", "time", "position", "velocity", "volume", "stress", "plastic_strain",
-                                   "deformation_gradient", "wall_position", "wall_force"};
+            const char *snaps[] = {"step",          "time",      "position",       "velocity",
+                                   "volume",        "stress",    "plastic_strain", "deformation_gradient",
+                                   "wall_position", "wall_force"};
             const char *series[] = {"step", "time", "wall_position", "wall_force", "kinetic_energy"};
             char p[96];
             for (size_t k = 0; rc == 0 && k < sizeof snaps / sizeof snaps[0]; k++) {
@@ -461,8 +476,10 @@ cd_mpm_output *cd_mpm_output_reopen(const char *path, const cd_config *cfg, cons
             if (rc == 0) {
                 hid_t ds = H5Dopen2(o->file, p, H5P_DEFAULT), sp = H5Screate(H5S_SCALAR);
                 hid_t a = H5Acreate2(ds, "step", H5T_STD_I64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
-                rc = a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &step) >= 0 && attr_str(ds, "source_path", cfg->source_path) == 0
-                         ? 0 : -1;
+                rc = a >= 0 && H5Awrite(a, H5T_NATIVE_LLONG, &step) >= 0 &&
+                             attr_str(ds, "source_path", cfg->source_path) == 0
+                         ? 0
+                         : -1;
                 if (a >= 0) H5Aclose(a);
                 H5Sclose(sp);
                 H5Dclose(ds);

@@ -22,7 +22,9 @@ static int read_row3(hid_t f, const char *name, long long row, long long n, doub
     hsize_t start[3] = {(hsize_t)row, 0, 0}, count[3] = {1, (hsize_t)n, 3};
     hid_t ms = H5Screate_simple(3, count, NULL);
     int rc = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
-                     H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, buf) >= 0 ? 0 : -1;
+                     H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, buf) >= 0
+                 ? 0
+                 : -1;
     H5Sclose(ms);
     H5Sclose(fs);
     H5Dclose(d);
@@ -43,8 +45,9 @@ static int read_all(hid_t f, const char *name, int rank, long long *dims, double
         if (dims[k] >= 0 && (long long)got[k] != dims[k]) ok = 0;
         dims[k] = (long long)got[k];
     }
-    if (ok && (dbl || ints)) ok = H5Dread(d, dbl ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                                          dbl ? (void *)dbl : (void *)ints) >= 0;
+    if (ok && (dbl || ints))
+        ok = H5Dread(d, dbl ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                     dbl ? (void *)dbl : (void *)ints) >= 0;
     H5Sclose(sp);
     H5Dclose(d);
     return ok ? 0 : -1;
@@ -64,8 +67,10 @@ int cd_mpm_read_packing(const char *path, const char *key_where, cd_mpm_packing 
         H5Pclose(fapl);
         long long committed = 0, dims[3] = {-1, -1, 3}, n, np;
         if (f < 0) {
-            snprintf(err, errlen, "%s: mpm.packing = %s: cannot open it as an HDF5 file; expected a capdem run file of a 2D "
-                     "deposit of spheres", key_where, path);
+            snprintf(err, errlen,
+                     "%s: mpm.packing = %s: cannot open it as an HDF5 file; expected a capdem run file of a 2D "
+                     "deposit of spheres",
+                     key_where, path);
             goto out;
         }
         hid_t a = H5Aexists(f, "n_snapshots") > 0 ? H5Aopen(f, "n_snapshots", H5P_DEFAULT) : -1;
@@ -74,8 +79,10 @@ int cd_mpm_read_packing(const char *path, const char *key_where, cd_mpm_packing 
             H5Aclose(a);
         }
         if (read_all(f, "/particles/all/position/value", 3, dims, NULL, NULL) || committed < 1 || committed > dims[0]) {
-            snprintf(err, errlen, "%s: mpm.packing = %s: no committed snapshot of particle positions (root attribute "
-                     "n_snapshots, /particles/all/position/value); expected a capdem DEM run file", key_where, path);
+            snprintf(err, errlen,
+                     "%s: mpm.packing = %s: no committed snapshot of particle positions (root attribute "
+                     "n_snapshots, /particles/all/position/value); expected a capdem DEM run file",
+                     key_where, path);
             goto out;
         }
         n = dims[1];
@@ -85,14 +92,17 @@ int cd_mpm_read_packing(const char *path, const char *key_where, cd_mpm_packing 
         if (!pos || !count || read_row3(f, "/particles/all/position/value", committed - 1, n, pos) ||
             read_all(f, "/particles/all/prim_count", 1, d1, NULL, count) ||
             read_all(f, "/particles/prims/prim_radius", 1, dp, NULL, NULL)) {
-            snprintf(err, errlen, "%s: mpm.packing = %s: cannot read the particles' positions and primitives", key_where, path);
+            snprintf(err, errlen, "%s: mpm.packing = %s: cannot read the particles' positions and primitives",
+                     key_where, path);
             goto out;
         }
         np = dp[0];
         for (long long i = 0; i < n; i++)
             if (count[i] != 1 || np != n) {
-                snprintf(err, errlen, "%s: mpm.packing = %s: particle %lld has %d primitives; expected spheres (one "
-                         "primitive each)", key_where, path, i, count[i]);
+                snprintf(err, errlen,
+                         "%s: mpm.packing = %s: particle %lld has %d primitives; expected spheres (one "
+                         "primitive each)",
+                         key_where, path, i, count[i]);
                 goto out;
             }
         pk->r = malloc((size_t)n * sizeof(double));
@@ -111,14 +121,17 @@ int cd_mpm_read_packing(const char *path, const char *key_where, cd_mpm_packing 
             double len = 0;
             for (int k = 0; k < 3; k++) len += fabs(ends[3 * i + k] - ends[3 * (n + i) + k]);
             if (len != 0 || !(pk->r[i] > 0)) {
-                snprintf(err, errlen, "%s: mpm.packing = %s: particle %lld is not a sphere (its primitive has length or "
-                         "no radius); expected a deposit of spheres", key_where, path, i);
+                snprintf(err, errlen,
+                         "%s: mpm.packing = %s: particle %lld is not a sphere (its primitive has length or "
+                         "no radius); expected a deposit of spheres",
+                         key_where, path, i);
                 goto out;
             }
             if (last[3 * i + 2] != last[2]) {
-                snprintf(err, errlen, "%s: mpm.packing = %s: particle %lld is at z = %g m, particle 0 at z = %g m; expected "
-                         "a 2D run (physics.dimension: 2, every centre in one plane)", key_where, path, i,
-                         last[3 * i + 2], last[2]);
+                snprintf(err, errlen,
+                         "%s: mpm.packing = %s: particle %lld is at z = %g m, particle 0 at z = %g m; expected "
+                         "a 2D run (physics.dimension: 2, every centre in one plane)",
+                         key_where, path, i, last[3 * i + 2], last[2]);
                 goto out;
             }
             pk->x[i] = last[3 * i];

@@ -5,9 +5,9 @@
 #include <stddef.h>
 
 typedef struct {
-    size_t n;            /* disks */
-    double *x, *y, *r;   /* centres and radii [m] */
-    long long snapshot;  /* the snapshot read (the last committed one) */
+    size_t n;           /* disks */
+    double *x, *y, *r;  /* centres and radii [m] */
+    long long snapshot; /* the snapshot read (the last committed one) */
 } cd_mpm_packing;
 
 /* Reads the centres and radii of the last committed snapshot of the run

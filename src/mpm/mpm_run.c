@@ -50,7 +50,8 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
 {
     char err[1024];
     if (opt->backend && strcmp(opt->backend, "omp")) {
-        fprintf(stderr, "capdem: --backend %s: solver mpm runs on the omp backend only so far (docs/mpm.md)\n", opt->backend);
+        fprintf(stderr, "capdem: --backend %s: solver mpm runs on the omp backend only so far (docs/mpm.md)\n",
+                opt->backend);
         return 2;
     }
     static cd_mpm m;
@@ -66,7 +67,8 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
             return 2;
         }
         if (cfg->steps < m.step) {
-            fprintf(stderr, "capdem: %s: run.steps (or --steps) = %lld, but the run file %s is at step %lld already; on a "
+            fprintf(stderr,
+                    "capdem: %s: run.steps (or --steps) = %lld, but the run file %s is at step %lld already; on a "
                     "resume it is the step to reach, counted from the start of the run: expected an integer >= %lld\n",
                     cfg->source_path, cfg->steps, opt->resume_path, m.step, m.step);
             cd_mpm_free(&m);
@@ -81,9 +83,12 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
         cd_mpm_free(&m);
         return 1;
     }
-    if (opt->resume_path) fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, m.step, m.time);
-    fprintf(stderr, "capdem: mpm: %zu material points, mesh %d x %d nodes (h = %g m), dt = %g s (stability limit / %.1f), "
-            "output %s\n", m.n, m.nx, m.ny, m.h, m.dt, cd_mpm_dt_limit(&m) / m.dt, cfg->output);
+    if (opt->resume_path)
+        fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, m.step, m.time);
+    fprintf(stderr,
+            "capdem: mpm: %zu material points, mesh %d x %d nodes (h = %g m), dt = %g s (stability limit / %.1f), "
+            "output %s\n",
+            m.n, m.nx, m.ny, m.h, m.dt, cd_mpm_dt_limit(&m) / m.dt, cfg->output);
     int status = 0;
     /* the walls' forces of step 0 come from the first step's contact pass */
     if (!opt->resume_path && (cd_mpm_output_series(out, &m, cd_mpm_kinetic_energy(&m), err, sizeof err) ||

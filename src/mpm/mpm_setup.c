@@ -15,23 +15,23 @@ static int in_disk(double x, double y, double r) { return x * x + y * y < r * r;
 
 static int setup_diametral(cd_mpm *m, const cd_config *c, char *err, size_t errlen)
 {
-    double D = c->mpm_diameter, R = 0.5 * D;           /* [m] */
-    double h = D / c->mpm_cells;                        /* cell size [m] */
+    double D = c->mpm_diameter, R = 0.5 * D; /* [m] */
+    double h = D / c->mpm_cells;             /* cell size [m] */
     int pps = c->mpm_points_per_side;
-    double l = h / pps;                                 /* point spacing [m] */
+    double l = h / pps; /* point spacing [m] */
     /* The disk's centre sits on a node, the points on a lattice of spacing l
      * symmetric about it, so the discretised disk is mirror-symmetric. */
-    int kr = (int)ceil(R / l) + 1;                      /* lattice half-width in points */
+    int kr = (int)ceil(R / l) + 1; /* lattice half-width in points */
     size_t n = 0;
     for (int j = -kr; j < kr; j++)
         for (int i = -kr; i < kr; i++) n += in_disk((i + 0.5) * l, (j + 0.5) * l, R);
     /* mesh: the walls and the disk with room to bulge sideways (half a
      * diameter each side) and three cells beyond everything, so that no
      * stencil reaches the edge */
-    int cells_x = (int)ceil((R + 0.5 * D) / h) + 3;    /* cells from the centre to each side */
+    int cells_x = (int)ceil((R + 0.5 * D) / h) + 3; /* cells from the centre to each side */
     int cells_y = (int)ceil(R / h) + 3;
     int nx = 2 * cells_x + 1, ny = 2 * cells_y + 1;
-    double cx = 0, cy = R;                              /* disk centre [m]; bottom wall at y = 0 */
+    double cx = 0, cy = R; /* disk centre [m]; bottom wall at y = 0 */
     if (cd_mpm_alloc(m, n, nx, ny, h, cx - cells_x * h, cy - cells_y * h, err, errlen)) return -1;
     size_t p = 0;
     for (int j = -kr; j < kr; j++)
@@ -87,7 +87,8 @@ static int setup_packing(cd_mpm *m, const cd_config *c, char *err, size_t errlen
     }
     double h = 2 * rmin / c->mpm_cells, l = h / c->mpm_points_per_side; /* [m] */
     /* the mesh: the box and four cells around it, so that no stencil of a point near a wall reaches the edge */
-    int margin = 4, nx = (int)ceil((right - left) / h) + 2 * margin + 1, ny = (int)ceil((top - bottom) / h) + 2 * margin + 1;
+    int margin = 4, nx = (int)ceil((right - left) / h) + 2 * margin + 1,
+        ny = (int)ceil((top - bottom) / h) + 2 * margin + 1;
     double ox = left - margin * h, oy = bottom - margin * h;
     /* the disks that overlap disk k (the DEM's contacts), for the sites two disks hold */
     enum { NEAR = 16 }; /* a disk of a DEM packing touches at most a few others */
@@ -103,8 +104,10 @@ static int setup_packing(cd_mpm *m, const cd_config *c, char *err, size_t errlen
         for (size_t j = 0; j < pk.n; j++)
             if (j != k && hypot(pk.x[k] - pk.x[j], pk.y[k] - pk.y[j]) < pk.r[k] + pk.r[j]) {
                 if (n_near[k] == NEAR) {
-                    snprintf(err, errlen, "%s: mpm.packing = %s: disk %zu overlaps more than %d others; expected a "
-                             "packing of disks that touch", c->source_path, c->mpm_packing, k, NEAR);
+                    snprintf(err, errlen,
+                             "%s: mpm.packing = %s: disk %zu overlaps more than %d others; expected a "
+                             "packing of disks that touch",
+                             c->source_path, c->mpm_packing, k, NEAR);
                     free(near);
                     free(n_near);
                     cd_mpm_packing_free(&pk);
@@ -136,8 +139,10 @@ static int setup_packing(cd_mpm *m, const cd_config *c, char *err, size_t errlen
                     p++;
                 }
             if (p == first) {
-                snprintf(err, errlen, "%s: mpm.cells_per_diameter = %d: disk %zu of %s (radius %g m) holds no material "
-                         "point; expected more cells", c->source_path, c->mpm_cells, k, c->mpm_packing, pk.r[k]);
+                snprintf(err, errlen,
+                         "%s: mpm.cells_per_diameter = %d: disk %zu of %s (radius %g m) holds no material "
+                         "point; expected more cells",
+                         c->source_path, c->mpm_cells, k, c->mpm_packing, pk.r[k]);
                 if (pass == 1) cd_mpm_free(m);
                 free(near);
                 free(n_near);
@@ -158,10 +163,10 @@ static int setup_packing(cd_mpm *m, const cd_config *c, char *err, size_t errlen
     free(near);
     free(n_near);
     m->n_walls = 4;
-    m->walls[0] = (cd_mpm_wall){0, bottom, 0, 1, 0, 0, 0, 0};                    /* bottom, fixed */
-    m->walls[1] = (cd_mpm_wall){0, top, 0, -1, 0, -c->mpm_wall_speed, 0, 0};     /* top, moving down */
-    m->walls[2] = (cd_mpm_wall){left, 0, 1, 0, 0, 0, 0, 0};                      /* left, fixed */
-    m->walls[3] = (cd_mpm_wall){right, 0, -1, 0, 0, 0, 0, 0};                    /* right, fixed */
+    m->walls[0] = (cd_mpm_wall){0, bottom, 0, 1, 0, 0, 0, 0};                /* bottom, fixed */
+    m->walls[1] = (cd_mpm_wall){0, top, 0, -1, 0, -c->mpm_wall_speed, 0, 0}; /* top, moving down */
+    m->walls[2] = (cd_mpm_wall){left, 0, 1, 0, 0, 0, 0, 0};                  /* left, fixed */
+    m->walls[3] = (cd_mpm_wall){right, 0, -1, 0, 0, 0, 0, 0};                /* right, fixed */
     m->box_h0 = top - bottom;
     cd_mpm_packing_free(&pk);
     return 0;
@@ -177,9 +182,11 @@ int cd_mpm_setup(cd_mpm *m, const cd_config *c, char *err, size_t errlen)
     m->dt = c->dt;
     double lim = cd_mpm_dt_limit(m);
     if (c->dt > lim && !c->force_dt) {
-        snprintf(err, errlen, "%s: run.dt = %g: above the explicit step's stability limit %.4g s (min of the mesh's wave "
+        snprintf(err, errlen,
+                 "%s: run.dt = %g: above the explicit step's stability limit %.4g s (min of the mesh's wave "
                  "crossing time h / (c_p + v_wall) and the wall penalty's 2 sqrt(m_p / k), docs/mpm.md); expected "
-                 "run.dt <= %.4g s, or run.force_dt: true", c->source_path, c->dt, lim, lim);
+                 "run.dt <= %.4g s, or run.force_dt: true",
+                 c->source_path, c->dt, lim, lim);
         cd_mpm_free(m);
         return -1;
     }

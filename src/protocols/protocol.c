@@ -43,10 +43,8 @@ void cd_protocol_begin(cd_sim *sim)
 {
     memset(sim->s.control, 0, sizeof sim->s.control);
     const cd_protocol_ops *ops = ops_of(&sim->cfg);
-    if (ops)
-        ops->begin(sim);
-    else
-        cd_proto_enter(sim, CD_PHASE_FREE, NULL);
+    if (ops) ops->begin(sim);
+    else cd_proto_enter(sim, CD_PHASE_FREE, NULL);
 }
 
 long long cd_protocol_steps_until_control(const cd_sim *sim)
@@ -108,10 +106,11 @@ int cd_protocol_resume(cd_sim *sim, const char *path, char *err, size_t errlen)
     if (!whole_in(c[CTL_PHASE], CD_PHASE_FREE, CD_PHASE_DONE) ||
         !whole_in(c[CTL_WALL], 0, sim->s.n_walls ? (double)sim->s.n_walls - 1 : 0) ||
         !whole_in(c[CTL_N_PROBES], 0, CTL_MAX_PROBES)) {
-        snprintf(err, errlen, "%s: dataset /walls/control holds phase %g, wall %g, probes %g: not a state the protocol "
-                 "can be in (phases %d..%d, walls 0..%zu, probes 0..%d); the file is refused", path, c[CTL_PHASE],
-                 c[CTL_WALL], c[CTL_N_PROBES], CD_PHASE_FREE, CD_PHASE_DONE, sim->s.n_walls ? sim->s.n_walls - 1 : 0,
-                 CTL_MAX_PROBES);
+        snprintf(err, errlen,
+                 "%s: dataset /walls/control holds phase %g, wall %g, probes %g: not a state the protocol "
+                 "can be in (phases %d..%d, walls 0..%zu, probes 0..%d); the file is refused",
+                 path, c[CTL_PHASE], c[CTL_WALL], c[CTL_N_PROBES], CD_PHASE_FREE, CD_PHASE_DONE,
+                 sim->s.n_walls ? sim->s.n_walls - 1 : 0, CTL_MAX_PROBES);
         return -1;
     }
     const cd_protocol_ops *ops = ops_of(&sim->cfg);
@@ -133,9 +132,13 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
 
 void cd_protocol_observable_info(const char **names, const char **units)
 {
-    static const char *const n[CD_PROTOCOL_OBSERVABLES] = {"packing_fraction", "coordination", "phase", "wall_load", "pressure"};
+    static const char *const n[CD_PROTOCOL_OBSERVABLES] = {"packing_fraction", "coordination", "phase", "wall_load",
+                                                           "pressure"};
     static const char *const u[CD_PROTOCOL_OBSERVABLES] = {"1", "1", "1", "N", "Pa"};
-    for (int k = 0; k < CD_PROTOCOL_OBSERVABLES; k++) { names[k] = n[k]; units[k] = u[k]; }
+    for (int k = 0; k < CD_PROTOCOL_OBSERVABLES; k++) {
+        names[k] = n[k];
+        units[k] = u[k];
+    }
 }
 
 /* Container volume [m^3] (0 when there is none): up to the piston for the
@@ -146,7 +149,8 @@ static double container_volume(const cd_sim *sim)
     const cd_state *s = &sim->s;
     int w = (int)s->control[CTL_WALL];
     int deposit = c->protocol_kind == CD_PROTOCOL_DEPOSIT;
-    if (c->domain_kind == CD_DOMAIN_BOX) return c->box_width * c->box_thickness * (deposit ? s->walls[w].point.y : c->box_height);
+    if (c->domain_kind == CD_DOMAIN_BOX)
+        return c->box_width * c->box_thickness * (deposit ? s->walls[w].point.y : c->box_height);
     if (c->domain_kind == CD_DOMAIN_CYLINDER)
         return CD_PI * 0.25 * c->cyl_diameter * c->cyl_diameter * (deposit ? s->walls[w].point.y : c->cyl_height);
     if (c->domain_kind == CD_DOMAIN_BALL) return 4.0 / 3.0 * CD_PI * pow(s->walls[0].radius, 3);

@@ -10,13 +10,13 @@
 
 /* Phases (stored in control[CD_CTL_PHASE]). */
 enum {
-    CD_PHASE_FREE = 0,     /* no protocol: plain dynamics for run.steps */
-    CD_PHASE_SETTLE,       /* deposit: particles fall, piston parked at the top */
-    CD_PHASE_COMPRESS,     /* deposit: piston moves down at piston_speed */
-    CD_PHASE_HOLD,         /* deposit: piston holds piston_force; relaxing */
-    CD_PHASE_COMPACT,      /* ball: radius driven by the pressure; relaxing */
-    CD_PHASE_BASE,         /* bulk: ball radius fixed, relaxing the base state */
-    CD_PHASE_PROBE,        /* bulk: strained state relaxing */
+    CD_PHASE_FREE = 0, /* no protocol: plain dynamics for run.steps */
+    CD_PHASE_SETTLE,   /* deposit: particles fall, piston parked at the top */
+    CD_PHASE_COMPRESS, /* deposit: piston moves down at piston_speed */
+    CD_PHASE_HOLD,     /* deposit: piston holds piston_force; relaxing */
+    CD_PHASE_COMPACT,  /* ball: radius driven by the pressure; relaxing */
+    CD_PHASE_BASE,     /* bulk: ball radius fixed, relaxing the base state */
+    CD_PHASE_PROBE,    /* bulk: strained state relaxing */
     CD_PHASE_DONE
 };
 

@@ -38,7 +38,9 @@ static void remove_net_motion(cd_sim *sim, cd_vec3 centre)
     for (size_t q = 0; q < s->n_particles; q++) {
         double m = s->mass[q];
         M += m;
-        P[0] += m * s->velocity[q].x; P[1] += m * s->velocity[q].y; P[2] += m * s->velocity[q].z;
+        P[0] += m * s->velocity[q].x;
+        P[1] += m * s->velocity[q].y;
+        P[2] += m * s->velocity[q].z;
     }
     cd_vec3 vcm = cd_v3(P[0] / M, P[1] / M, P[2] / M);
     for (size_t q = 0; q < s->n_particles; q++) {
@@ -46,7 +48,9 @@ static void remove_net_motion(cd_sim *sim, cd_vec3 centre)
         double m = s->mass[q];
         cd_vec3 r = cd_v3_sub(s->position[q], centre);
         cd_vec3 l = cd_v3_add(cd_v3_scale(cd_v3_cross(r, s->velocity[q]), m), s->angmom[q]);
-        L[0] += l.x; L[1] += l.y; L[2] += l.z;
+        L[0] += l.x;
+        L[1] += l.y;
+        L[2] += l.z;
         double rr[3] = {r.x, r.y, r.z}, r2 = cd_v3_norm2(r);
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++) I[a][b] += m * ((a == b ? r2 : 0) - rr[a] * rr[b]);
@@ -62,7 +66,8 @@ static void remove_net_motion(cd_sim *sim, cd_vec3 centre)
         memcpy(A, I, sizeof A);
         for (int a = 0; a < 3; a++) A[a][c] = L[a];
         w[c] = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
-                A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) / det;
+                A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) /
+               det;
     }
     cd_vec3 omega = cd_v3(w[0], w[1], w[2]);
     for (size_t q = 0; q < s->n_particles; q++)

@@ -34,7 +34,8 @@ static long long steps_until_control(const cd_sim *sim, int phase)
         long long half = (sim->cfg.probe_steps + 1) / 2;
         return elapsed < half ? half - elapsed : 1;
     }
-    default: return 1; /* compaction: the ball responds to the load every step */
+    default:
+        return 1; /* compaction: the ball responds to the load every step */
     }
 }
 
@@ -168,7 +169,8 @@ static int control(cd_sim *sim, int phase, double load, FILE *log, char *err, si
         if (apply_strain(sim, next, err, errlen)) return -1;
         break;
     }
-    default: break;
+    default:
+        break;
     }
     return 0;
 }
@@ -188,8 +190,9 @@ static int resume(cd_sim *sim, const char *path, char *err, size_t errlen)
         if (sim->probe_base.step == base_step) return 0;
         if (sim->probe_base.step < base_step) break;
     }
-    snprintf(err, errlen, "%s: no snapshot of step %lld, the base state of the bulk probe; resume from an earlier checkpoint",
-             path, base_step);
+    snprintf(err, errlen,
+             "%s: no snapshot of step %lld, the base state of the bulk probe; resume from an earlier checkpoint", path,
+             base_step);
     return -1;
 }
 

@@ -14,7 +14,8 @@ static int check(const cd_config *c, char *err, size_t errlen)
         return -1;
     }
     if (!(c->gravity[0] != 0 || c->gravity[1] != 0 || c->gravity[2] != 0)) {
-        snprintf(err, errlen, "%s: physics.gravity = [0, 0, 0]: deposit_compress needs gravity to deposit", c->source_path);
+        snprintf(err, errlen, "%s: physics.gravity = [0, 0, 0]: deposit_compress needs gravity to deposit",
+                 c->source_path);
         return -1;
     }
     return 0;
@@ -100,12 +101,16 @@ static void report_fill(const cd_sim *sim, FILE *log)
 {
     const cd_config *c = &sim->cfg;
     double width = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter; /* [m] */
-    double h = sim->s.walls[(int)sim->s.control[CTL_WALL]].point.y;          /* [m] */
+    double h = sim->s.walls[(int)sim->s.control[CTL_WALL]].point.y;                  /* [m] */
     if (!log) return;
-    fprintf(log, "capdem: packing height %.6g m = %.3g x the %s\n", h, h / width, c->domain_kind == CD_DOMAIN_BOX ? "width" : "diameter");
+    fprintf(log, "capdem: packing height %.6g m = %.3g x the %s\n", h, h / width,
+            c->domain_kind == CD_DOMAIN_BOX ? "width" : "diameter");
     if (c->fill_ratio > 0 && h / width < c->fill_ratio)
-        fprintf(log, "capdem: warning: below protocol.fill_ratio = %g: the packing is denser than protocol.fill_fraction = %g "
-                "expected; set fill_fraction to the packing_fraction this run reached (time series)\n", c->fill_ratio, c->fill_fraction);
+        fprintf(
+            log,
+            "capdem: warning: below protocol.fill_ratio = %g: the packing is denser than protocol.fill_fraction = %g "
+            "expected; set fill_fraction to the packing_fraction this run reached (time series)\n",
+            c->fill_ratio, c->fill_fraction);
 }
 
 static int control(cd_sim *sim, int phase, double load, FILE *log, char *err, size_t errlen)
@@ -144,7 +149,8 @@ static int control(cd_sim *sim, int phase, double load, FILE *log, char *err, si
         }
         break;
     }
-    default: break;
+    default:
+        break;
     }
     return 0;
 }

@@ -48,9 +48,9 @@ static void capsule_closed(double l, double r, double *V, double *A, double *s_a
  * squares of half-side s = sqrt(r^2 - z^2), so
  *   int x^2 dV = int (4/3) s^4 dz = 64/45 r^5   (same for y),
  *   int z^2 dV = int 4 s^2 z^2 dz = 16/15 r^5   (the common normal). */
-#define BICYL_V(r3) (16.0 / 3.0 * (r3))
-#define BICYL_A(r2) (16.0 * (r2))
-#define BICYL_S_IN(r5) (64.0 / 45.0 * (r5))
+#define BICYL_V(r3)        (16.0 / 3.0 * (r3))
+#define BICYL_A(r2)        (16.0 * (r2))
+#define BICYL_S_IN(r5)     (64.0 / 45.0 * (r5))
 #define BICYL_S_NORMAL(r5) (16.0 / 15.0 * (r5))
 
 /* Tricylinder (three radius-r cylinders along x, y, z): volume
@@ -61,7 +61,7 @@ static void capsule_closed(double l, double r, double *V, double *A, double *s_a
  *   int (x^2 + y^2) = r^5/5 (1 - 1/sqrt2),
  *   int z^2 = r^5/15 int_0^{pi/4} sin^3 = r^5/15 (2/3 - 5/(6 sqrt2)),
  * so int x^2 dV = 48/3 (their sum) = 16/5 (11/9 - 23 sqrt2/36) r^5. */
-#define SQRT2 1.41421356237309504880
+#define SQRT2        1.41421356237309504880
 #define TRICYL_V(r3) (8.0 * (2.0 - SQRT2) * (r3))
 #define TRICYL_A(r2) (24.0 * (2.0 - SQRT2) * (r2))
 #define TRICYL_S(r5) (16.0 / 5.0 * (11.0 / 9.0 - 23.0 * SQRT2 / 36.0) * (r5))
@@ -103,8 +103,8 @@ static int check_positive(const char *what, const char *name, double x, const ch
 
 /* ---- named shapes ------------------------------------------------------ */
 
-int cd_shape_make_named(const char *kind, double aspect, double diameter, double density,
-                        cd_shape *out, char *err, size_t errlen)
+int cd_shape_make_named(const char *kind, double aspect, double diameter, double density, cd_shape *out, char *err,
+                        size_t errlen)
 {
     static const char *const names[] = {"sphere", "rod", "cross", "hexapod"};
     int n_arms = -1;
@@ -126,7 +126,7 @@ int cd_shape_make_named(const char *kind, double aspect, double diameter, double
 
     memset(out, 0, sizeof *out);
     snprintf(out->kind, sizeof out->kind, "%s", kind);
-    const double r = 0.5 * diameter;                        /* [m] */
+    const double r = 0.5 * diameter;                              /* [m] */
     const double l = is_sphere ? 0.0 : (aspect - 1.0) * diameter; /* axis length L - d_p [m] */
     /* With aspect 1 every arm is the same ball: keep one primitive, or the
      * contact search would count each touch once per copy. */
@@ -165,19 +165,22 @@ int cd_shape_make_named(const char *kind, double aspect, double diameter, double
             /* each arm loses its halves of two bicylinder surfaces, but its
              * third of the tricylinder surface was removed twice */
             A = 3 * Ac - 3 * BICYL_A(r2) + TRICYL_A(r2);
-            S[0][0] = S[1][1] = S[2][2] =
-                s_ax + 2 * s_perp - 2 * BICYL_S_IN(r5) - BICYL_S_NORMAL(r5) + TRICYL_S(r5);
+            S[0][0] = S[1][1] = S[2][2] = s_ax + 2 * s_perp - 2 * BICYL_S_IN(r5) - BICYL_S_NORMAL(r5) + TRICYL_S(r5);
         }
     } else {
         /* short arms: the caps overlap the other arms */
         double a[3][3], b[3][3], rr[3];
         for (int k = 0; k < n_arms; k++) {
-            a[k][0] = out->a[k].x; a[k][1] = out->a[k].y; a[k][2] = out->a[k].z;
-            b[k][0] = out->b[k].x; b[k][1] = out->b[k].y; b[k][2] = out->b[k].z;
+            a[k][0] = out->a[k].x;
+            a[k][1] = out->a[k].y;
+            a[k][2] = out->a[k].z;
+            b[k][0] = out->b[k].x;
+            b[k][1] = out->b[k].y;
+            b[k][2] = out->b[k].z;
             rr[k] = r;
         }
         cd_union_props p;
-        if (cd_shapes_union_numeric(n_arms, (const double (*)[3])a, (const double (*)[3])b, rr, &p))
+        if (cd_shapes_union_numeric(n_arms, (const double(*)[3])a, (const double(*)[3])b, rr, &p))
             return fail(err, errlen, "%s: numerical mass properties failed", kind);
         V = p.volume;
         A = p.area;
@@ -190,7 +193,7 @@ int cd_shape_make_named(const char *kind, double aspect, double diameter, double
         out->volume_rel_error = p.volume_rel_error;
         out->area_rel_error = p.area_rel_error;
     }
-    fill_mass(out, density, V, A, (const double (*)[3])S);
+    fill_mass(out, density, V, A, (const double(*)[3])S);
     return 0;
 }
 
@@ -233,8 +236,8 @@ static void jacobi3(double m[3][3], double q[3][3])
     }
 }
 
-int cd_shape_make_segments(int n, const double (*a)[3], const double (*b)[3], const double *r,
-                           double density, cd_shape *out, char *err, size_t errlen)
+int cd_shape_make_segments(int n, const double (*a)[3], const double (*b)[3], const double *r, double density,
+                           cd_shape *out, char *err, size_t errlen)
 {
     if (n < 1 || n > CD_MAX_ARMS)
         return fail(err, errlen, "segments: %d segments, expected 1 to %d (CD_MAX_ARMS)", n, CD_MAX_ARMS);
@@ -319,14 +322,14 @@ int cd_shape_make_segments(int n, const double (*a)[3], const double (*b)[3], co
     for (int k = 0; k < 3; k++) Sd[k][k] = lam[order[k]][order[k]];
     out->volume_rel_error = ev;
     out->area_rel_error = ea;
-    fill_mass(out, density, V, A, (const double (*)[3])Sd);
+    fill_mass(out, density, V, A, (const double(*)[3])Sd);
     return 0;
 }
 
 int cd_shape_from_species(const cd_species_config *sp, double density, cd_shape *out, char *err, size_t errlen)
 {
     if (strcmp(sp->shape, "segments") == 0)
-        return cd_shape_make_segments(sp->n_segments, (const double (*)[3])sp->seg_a, (const double (*)[3])sp->seg_b,
+        return cd_shape_make_segments(sp->n_segments, (const double(*)[3])sp->seg_a, (const double(*)[3])sp->seg_b,
                                       sp->seg_radius, density, out, err, errlen);
     return cd_shape_make_named(sp->shape, sp->aspect, sp->diameter, density, out, err, errlen);
 }
@@ -360,10 +363,12 @@ void cd_shape_print_json(const cd_shape *s, void *stream)
         if ((unsigned char)*c >= 0x20) fputc(*c, f);
     }
     fputs("\",\n", f);
-    const struct { const char *key; double v; } scalars[] = {
-        {"aspect", s->aspect},         {"diameter", s->diameter}, {"tip_length", s->tip_length},
-        {"density", s->density},       {"volume", s->volume},     {"area", s->area},
-        {"sphericity", s->sphericity}, {"mass", s->mass},
+    const struct {
+        const char *key;
+        double v;
+    } scalars[] = {
+        {"aspect", s->aspect}, {"diameter", s->diameter}, {"tip_length", s->tip_length}, {"density", s->density},
+        {"volume", s->volume}, {"area", s->area},         {"sphericity", s->sphericity}, {"mass", s->mass},
     };
     for (size_t k = 0; k < sizeof scalars / sizeof scalars[0]; k++) {
         fprintf(f, "  \"%s\": ", scalars[k].key);
@@ -393,7 +398,9 @@ void cd_shape_print_json(const cd_shape *s, void *stream)
     json_num(f, s->volume_rel_error);
     fputs(",\n  \"area_rel_error\": ", f);
     json_num(f, s->area_rel_error);
-    fprintf(f, ",\n  \"method\": \"%s\",\n", s->volume_rel_error == 0 && s->area_rel_error == 0 ? "closed form" : "numeric");
+    fprintf(f, ",\n  \"method\": \"%s\",\n",
+            s->volume_rel_error == 0 && s->area_rel_error == 0 ? "closed form" : "numeric");
     fputs("  \"units\": {\"length\": \"m\", \"density\": \"kg/m^3\", \"volume\": \"m^3\", \"area\": \"m^2\", "
-          "\"mass\": \"kg\", \"inertia\": \"kg m^2\", \"aspect\": \"1\", \"sphericity\": \"1\"}\n}\n", f);
+          "\"mass\": \"kg\", \"inertia\": \"kg m^2\", \"aspect\": \"1\", \"sphericity\": \"1\"}\n}\n",
+          f);
 }

@@ -68,23 +68,26 @@ static uint64_t sig_add(uint64_t h, unsigned x)
 #define TIE 1e-12
 enum {
     SHARE_NONE = 0,
-    SHARE_BALL_A,  /* cap sphere = j's ball at a_j: j's inside is the side +e_j */
-    SHARE_BALL_B,  /* cap sphere = j's ball at b_j: side -e_j */
-    SHARE_ALL,     /* cap sphere = j, a ball; or lateral cylinder = j's cylinder */
-    SHARE_AXIS,    /* cap sphere centred on j's axis with j's radius: it touches
+    SHARE_BALL_A, /* cap sphere = j's ball at a_j: j's inside is the side +e_j */
+    SHARE_BALL_B, /* cap sphere = j's ball at b_j: side -e_j */
+    SHARE_ALL,    /* cap sphere = j, a ball; or lateral cylinder = j's cylinder */
+    SHARE_AXIS,   /* cap sphere centred on j's axis with j's radius: it touches
                     * j's cylinder along its equator and is inside it between
                     * j's end planes */
 };
 
 typedef struct {
-    int i;                   /* the capsule whose surface is swept */
+    int i; /* the capsule whose surface is swept */
     const capsule *c;
-    double sgn;              /* caps: +1 at end b (outward +e), -1 at end a */
-    int nnb, nb[CD_MAX_ARMS]; /* the other capsules that can reach this piece */
+    double sgn;                       /* caps: +1 at end b (outward +e), -1 at end a */
+    int nnb, nb[CD_MAX_ARMS];         /* the other capsules that can reach this piece */
     unsigned char share[CD_MAX_ARMS]; /* SHARE_* per neighbour */
 } piece_ctx;
 
-typedef struct { double lo, hi; unsigned slo, shi; } span;
+typedef struct {
+    double lo, hi;
+    unsigned slo, shi;
+} span;
 
 static int span_cmp(const void *p, const void *q)
 {
@@ -120,14 +123,30 @@ static uint64_t lateral_eval(double theta, void *ctx, double *out)
             double s0 = dot3(w, cj->e), de = dot3(ci->e, cj->e); /* de = +-1 */
             lo = -s0 / de;
             hi = (cj->len - s0) / de;
-            if (lo > hi) { double t = lo; lo = hi; hi = t; }
+            if (lo > hi) {
+                double t = lo;
+                lo = hi;
+                hi = t;
+            }
         } else if (!cd_shn_line_capsule(&P->c[j], q, ci->e, &lo, &hi)) {
             continue;
         }
         unsigned ulo = (unsigned)j, uhi = (unsigned)j;
-        if (lo < 0) { lo = 0; ulo = SRC_CLIP_LO; }
-        if (hi > len) { hi = len; uhi = SRC_CLIP_HI; }
-        if (hi > lo) { s[ns].lo = lo; s[ns].hi = hi; s[ns].slo = ulo; s[ns].shi = uhi; ns++; }
+        if (lo < 0) {
+            lo = 0;
+            ulo = SRC_CLIP_LO;
+        }
+        if (hi > len) {
+            hi = len;
+            uhi = SRC_CLIP_HI;
+        }
+        if (hi > lo) {
+            s[ns].lo = lo;
+            s[ns].hi = hi;
+            s[ns].slo = ulo;
+            s[ns].shi = uhi;
+            ns++;
+        }
     }
     qsort(s, (size_t)ns, sizeof s[0], span_cmp);
     /* Merge into covered intervals; the gaps between them are exposed. */
@@ -138,12 +157,19 @@ static uint64_t lateral_eval(double theta, void *ctx, double *out)
         double lo = s[k].lo, hi = s[k].hi;
         unsigned slo = s[k].slo, shi = s[k].shi;
         for (k++; k < ns && s[k].lo <= hi; k++)
-            if (s[k].hi > hi) { hi = s[k].hi; shi = s[k].shi; }
+            if (s[k].hi > hi) {
+                hi = s[k].hi;
+                shi = s[k].shi;
+            }
         sig = sig_add(sig_add(sig, slo), shi);
-        D1 += lo - t; D2 += 0.5 * (lo * lo - t * t); D3 += (lo * lo * lo - t * t * t) / 3.0;
+        D1 += lo - t;
+        D2 += 0.5 * (lo * lo - t * t);
+        D3 += (lo * lo * lo - t * t * t) / 3.0;
         t = hi;
     }
-    D1 += len - t; D2 += 0.5 * (len * len - t * t); D3 += (len * len * len - t * t * t) / 3.0;
+    D1 += len - t;
+    D2 += 0.5 * (len * len - t * t);
+    D3 += (len * len * len - t * t * t) / 3.0;
     double h = dot3(q, n); /* p.n [m] */
     out[0] = r * D1;
     out[1] = r * h * D1 / 3.0;
@@ -151,7 +177,8 @@ static uint64_t lateral_eval(double theta, void *ctx, double *out)
     int m = 5;
     for (int a = 0; a < 3; a++)
         for (int b = a; b < 3; b++)
-            out[m++] = r * h * (q[a] * q[b] * D1 + (q[a] * ci->e[b] + q[b] * ci->e[a]) * D2 + ci->e[a] * ci->e[b] * D3) / 5.0;
+            out[m++] =
+                r * h * (q[a] * q[b] * D1 + (q[a] * ci->e[b] + q[b] * ci->e[a]) * D2 + ci->e[a] * ci->e[b] * D3) / 5.0;
     return sig_add(sig, (unsigned)ns);
 }
 
@@ -213,8 +240,10 @@ static uint64_t cap_eval(double w, void *ctx, double *out)
      * arcs between them are classified by their midpoints. */
     cut cuts[2 + 16 * CD_MAX_ARMS]; /* per capsule: 2 + 2 sphere, 8 cylinder, 4 plane */
     int nc = 0;
-    cuts[nc].phi = -0.5 * NUM_PI; cuts[nc++].src = SRC_START;
-    cuts[nc].phi = 1.5 * NUM_PI; cuts[nc++].src = SRC_START;
+    cuts[nc].phi = -0.5 * NUM_PI;
+    cuts[nc++].src = SRC_START;
+    cuts[nc].phi = 1.5 * NUM_PI;
+    cuts[nc++].src = SRC_START;
     for (int jj = 0; jj < P->nnb; jj++) {
         int j = P->nb[jj];
         const capsule *cj = &P->c[j];
@@ -252,7 +281,10 @@ static uint64_t cap_eval(double w, void *ctx, double *out)
         double m = 0.5 * (p0 + p1), p[3];
         for (int q = 0; q < 3; q++) p[q] = ctr[q] + rho * (cos(m) * ci->u[q] + sin(m) * ci->v[q]);
         int exposed = !covered_by_others(P, end, p);
-        if (exposed != prev) { sig = sig_add(sig_add(sig, cuts[k].src), (unsigned)exposed); narcs++; }
+        if (exposed != prev) {
+            sig = sig_add(sig_add(sig, cuts[k].src), (unsigned)exposed);
+            narcs++;
+        }
         prev = exposed;
         cd_shn_trig_antideriv(p1, F1);
         if (exposed)
@@ -262,7 +294,11 @@ static uint64_t cap_eval(double w, void *ctx, double *out)
     /* p = ctr + rho (c u + s v); n = (p - end)/r; p.n = end.n + r. */
     double h[3] = {P->sgn * w * dot3(end, ci->e) + r, rho / r * dot3(end, ci->u), rho / r * dot3(end, ci->v)};
     double px[3][3], q6[6], c10[10];
-    for (int a = 0; a < 3; a++) { px[a][0] = ctr[a]; px[a][1] = rho * ci->u[a]; px[a][2] = rho * ci->v[a]; }
+    for (int a = 0; a < 3; a++) {
+        px[a][0] = ctr[a];
+        px[a][1] = rho * ci->u[a];
+        px[a][2] = rho * ci->v[a];
+    }
     const double r2 = r * r;
     out[0] = r2 * I[0];
     out[1] = r2 * (h[0] * I[0] + h[1] * I[1] + h[2] * I[2]) / 3.0;
@@ -320,8 +356,7 @@ static unsigned char sphere_shared(const double *ctr, double r, const capsule *q
 
 /* Surface integrals of every capsule's exposed surface, summed:
  * {A, V, Sx, Sy, Sz, Sxx, Sxy, Sxz, Syy, Syz, Szz} about the reference. */
-static long union_integrals(int n, const capsule *c, const double *weight, double tol_rel, int nsample,
-                            double *tot)
+static long union_integrals(int n, const capsule *c, const double *weight, double tol_rel, int nsample, double *tot)
 {
     long evals = 0;
     for (int k = 0; k < NCOMP; k++) tot[k] = 0;
@@ -362,8 +397,7 @@ static long union_integrals(int n, const capsule *c, const double *weight, doubl
     return evals;
 }
 
-int cd_shapes_union_numeric(int n, const double (*a)[3], const double (*b)[3], const double *r,
-                            cd_union_props *out)
+int cd_shapes_union_numeric(int n, const double (*a)[3], const double (*b)[3], const double *r, cd_union_props *out)
 {
     if (n < 1 || n > CD_MAX_ARMS) return -1;
     capsule c[CD_MAX_ARMS];
@@ -397,7 +431,10 @@ int cd_shapes_union_numeric(int n, const double (*a)[3], const double (*b)[3], c
     for (int k = 0; k < 3; k++) ref[k] /= vol_est;
     double R = 0;
     for (int i = 0; i < m; i++) {
-        for (int k = 0; k < 3; k++) { c[i].a[k] -= ref[k]; c[i].b[k] -= ref[k]; }
+        for (int k = 0; k < 3; k++) {
+            c[i].a[k] -= ref[k];
+            c[i].b[k] -= ref[k];
+        }
         double ra = sqrt(dot3(c[i].a, c[i].a)) + c[i].r, rb = sqrt(dot3(c[i].b, c[i].b)) + c[i].r;
         if (ra > R) R = ra;
         if (rb > R) R = rb;

@@ -39,7 +39,9 @@ void cd_shn_capsule_init(capsule *c, const double *a, const double *b, double r)
     if (c->len > 0) {
         for (int i = 0; i < 3; i++) c->e[i] = d[i] / c->len;
     } else {
-        c->e[0] = 1; c->e[1] = 0; c->e[2] = 0; /* a ball: any axis will do */
+        c->e[0] = 1;
+        c->e[1] = 0;
+        c->e[2] = 0; /* a ball: any axis will do */
     }
     normals_of(c->e, c->u, c->v);
 }
@@ -81,7 +83,10 @@ int cd_shn_line_capsule(const capsule *c, const double *o, const double *d, doub
     const double r2 = c->r * c->r;
 
     sub3(o, c->a, w);
-    if (half_quadratic(dot3(d, w), dot3(w, w) - r2, &t0, &t1)) { L = t0; H = t1; }
+    if (half_quadratic(dot3(d, w), dot3(w, w) - r2, &t0, &t1)) {
+        L = t0;
+        H = t1;
+    }
     if (c->len > 0) {
         double wb[3];
         sub3(o, c->b, wb);
@@ -92,7 +97,10 @@ int cd_shn_line_capsule(const capsule *c, const double *o, const double *d, doub
         /* Infinite cylinder, then the slab 0 <= s <= len along the axis. */
         double we = dot3(w, c->e), de = dot3(d, c->e);
         double wp[3], dp[3];
-        for (int i = 0; i < 3; i++) { wp[i] = w[i] - we * c->e[i]; dp[i] = d[i] - de * c->e[i]; }
+        for (int i = 0; i < 3; i++) {
+            wp[i] = w[i] - we * c->e[i];
+            dp[i] = d[i] - de * c->e[i];
+        }
         double A = dot3(dp, dp), C = dot3(wp, wp) - r2;
         double clo = -INFINITY, chi = INFINITY;
         int hit = 1;
@@ -106,7 +114,11 @@ int cd_shn_line_capsule(const capsule *c, const double *o, const double *d, doub
                 if (we < 0 || we > c->len) hit = 0;
             } else {
                 double s0 = -we / de, s1 = (c->len - we) / de;
-                if (s0 > s1) { double t = s0; s0 = s1; s1 = t; }
+                if (s0 > s1) {
+                    double t = s0;
+                    s0 = s1;
+                    s1 = t;
+                }
                 if (s0 > clo) clo = s0;
                 if (s1 < chi) chi = s1;
                 if (clo > chi) hit = 0;
@@ -142,7 +154,10 @@ static int poly_roots(const double *c, int deg, double lo, double hi, double *ro
     if (deg == 0) return 0;
     if (deg == 1) {
         double x = -c[0] / c[1];
-        if (x >= lo && x <= hi) { roots[0] = x; return 1; }
+        if (x >= lo && x <= hi) {
+            roots[0] = x;
+            return 1;
+        }
         return 0;
     }
     if (deg == 2) { /* closed form (a double root counts: it may be a crossing of the cubic's derivative) */
@@ -164,19 +179,29 @@ static int poly_roots(const double *c, int deg, double lo, double hi, double *ro
     for (int k = 0; k + 1 < np; k++) {
         double p = pts[k], q = pts[k + 1];
         double fp = poly_eval(c, deg, p), fq = poly_eval(c, deg, q);
-        if (fp == 0) { roots[nr++] = p; continue; }
+        if (fp == 0) {
+            roots[nr++] = p;
+            continue;
+        }
         if (fp * fq > 0 || fq == 0) continue; /* a zero at q is the next bracket's p */
         /* Newton from the middle, kept inside the shrinking bracket; a step
          * that leaves it, or does not halve it, is replaced by bisection. */
         double x = 0.5 * (p + q), step_old = q - p;
         for (int it = 0; it < 100; it++) {
             double fx = poly_eval(c, deg, x), dfx = poly_eval(dc, deg - 1, x);
-            if (fx == 0) { p = q = x; break; }
-            if ((fx < 0) == (fp < 0)) p = x; else q = x;
+            if (fx == 0) {
+                p = q = x;
+                break;
+            }
+            if ((fx < 0) == (fp < 0)) p = x;
+            else q = x;
             double xn = dfx != 0 ? x - fx / dfx : 0.5 * (p + q);
             if (!(xn > p && xn < q) || fabs(xn - x) > 0.5 * step_old) xn = 0.5 * (p + q);
             step_old = fabs(xn - x);
-            if (xn == x || q - p <= 4 * DBL_EPSILON) { x = xn; break; }
+            if (xn == x || q - p <= 4 * DBL_EPSILON) {
+                x = xn;
+                break;
+            }
             x = xn;
         }
         roots[nr++] = x;
@@ -192,15 +217,17 @@ static int crossings(double A, double B, double C, unsigned src, cut *out)
     double M = sqrt(A * A + B * B);
     if (!(M > 0) || fabs(C) > M) return 0;
     double base = atan2(B, A), off = acos(C / M);
-    out[0].phi = base - off; out[0].src = src;
-    out[1].phi = base + off; out[1].src = src;
+    out[0].phi = base - off;
+    out[0].src = src;
+    out[1].phi = base + off;
+    out[1].src = src;
     return 2;
 }
 
 /* Angles where the circle ctr + rho (cos phi U + sin phi W) crosses the
  * sphere |p - q| = R: A cos + B sin = C, solved in closed form. */
-int cd_shn_circle_sphere(const double *ctr, double rho, const double *U, const double *W, const double *q,
-                         double R, unsigned src, cut *out)
+int cd_shn_circle_sphere(const double *ctr, double rho, const double *U, const double *W, const double *q, double R,
+                         unsigned src, cut *out)
 {
     double w[3];
     sub3(ctr, q, w);

@@ -15,14 +15,14 @@
 #include <stdint.h>
 
 #define NUM_PI 3.14159265358979323846
-#define NCOMP 11       /* area, V, 3 first moments, 6 second moments */
+#define NCOMP  11 /* area, V, 3 first moments, 6 second moments */
 /* Signature samples per surface piece in the two passes.  A change narrower
  * than the spacing can slip between samples and quadrature nodes; with 256
  * and 1024 the passes miss different things, so such a miss shows up in the
  * reported error (seen at 1e-7 to 1e-6 for 16 random arms, never for the
  * named shapes). */
 #define NS_COARSE 256
-#define NS_FINE 1024
+#define NS_FINE   1024
 
 typedef struct {
     double a[3], b[3];       /* axis ends, relative to the reference point [m] */
@@ -44,7 +44,9 @@ static inline double dot3(const double *p, const double *q) { return p[0] * q[0]
 
 static inline void sub3(const double *p, const double *q, double *o)
 {
-    o[0] = p[0] - q[0]; o[1] = p[1] - q[1]; o[2] = p[2] - q[2];
+    o[0] = p[0] - q[0];
+    o[1] = p[1] - q[1];
+    o[2] = p[2] - q[2];
 }
 
 /* ---- shapes_numeric_geom.c ---------------------------------------------- */
@@ -52,7 +54,10 @@ static inline void sub3(const double *p, const double *q, double *o)
 /* An angle on a circle of latitude of a cap where it may cross another
  * capsule's surface, and the label (SRC_* or capsule index) of that
  * surface. */
-typedef struct { double phi; unsigned src; } cut;
+typedef struct {
+    double phi;
+    unsigned src;
+} cut;
 
 void cd_shn_capsule_init(capsule *c, const double *a, const double *b, double r);
 /* Squared distance from p to the axis segment of c [m^2]. */
@@ -64,12 +69,12 @@ int cd_shn_line_capsule(const capsule *c, const double *o, const double *d, doub
 /* Angles where the circle ctr + rho (cos phi U + sin phi W) crosses a
  * sphere, a plane, or the infinite cylinder of c (within c's slab); each
  * returns the number of cuts written to out. */
-int cd_shn_circle_sphere(const double *ctr, double rho, const double *U, const double *W, const double *q,
-                  double R, unsigned src, cut *out);
+int cd_shn_circle_sphere(const double *ctr, double rho, const double *U, const double *W, const double *q, double R,
+                         unsigned src, cut *out);
 int cd_shn_circle_plane(const double *ctr, double rho, const double *U, const double *W, const double *q,
-                 const double *n, unsigned src, cut *out);
+                        const double *n, unsigned src, cut *out);
 int cd_shn_circle_cylinder(const double *ctr, double rho, const double *U, const double *W, const capsule *c,
-                    unsigned src, cut *out);
+                           unsigned src, cut *out);
 /* Antiderivatives of cos^m sin^n, m + n <= 3 (10 monomials), and products
  * of linear forms x0 + x1 cos + x2 sin in that monomial order. */
 void cd_shn_trig_antideriv(double phi, double *F);
@@ -83,10 +88,10 @@ typedef uint64_t (*pw_fn)(double x, void *ctx, double *out);
 typedef struct {
     pw_fn f;
     void *ctx;
-    const double *weight;    /* per component: makes the error comparable across units */
-    double xres;             /* events are located to this width (parameter units) */
+    const double *weight; /* per component: makes the error comparable across units */
+    double xres;          /* events are located to this width (parameter units) */
     long evals;
-    int events;              /* changes located so far */
+    int events; /* changes located so far */
 } pw_job;
 
 /* Integral over [A, B] of the NCOMP components of J->f, added to acc:

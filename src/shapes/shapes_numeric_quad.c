@@ -12,19 +12,16 @@
 
 /* Kronrod 15-point nodes (positive half, the last is 0) and weights; nodes
  * 1, 3, 5, 7 are the 7-point Gauss nodes with weights gk_g. */
-static const double gk_x[8] = {
-    0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
-    0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
-    0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
-    0.207784955007898467600689403773245, 0.0};
-static const double gk_w[8] = {
-    0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
-    0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
-    0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
-    0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
-static const double gk_g[4] = {
-    0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
-    0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
+static const double gk_x[8] = {0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
+                               0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
+                               0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
+                               0.207784955007898467600689403773245, 0.0};
+static const double gk_w[8] = {0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
+                               0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
+                               0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
+                               0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
+static const double gk_g[4] = {0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
+                               0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
 
 /* Past this many located changes in one integral the signature is no longer
  * trusted (numerical flicker at a degenerate configuration) and plain
@@ -34,7 +31,7 @@ static const double gk_g[4] = {
 /* One analytic piece [p, q] mapped by x = m - h cos(t), t in [0, pi]. */
 typedef struct {
     double p, q, m, h;
-    uint64_t sig;            /* signature inside */
+    uint64_t sig; /* signature inside */
 } pw_piece;
 
 static uint64_t pw_eval(pw_job *J, double x, double *out)
@@ -51,7 +48,8 @@ static double pw_locate(pw_job *J, double x_same, uint64_t s, double x_diff)
     J->events++;
     while (fabs(x_diff - x_same) > J->xres) {
         double m = 0.5 * (x_same + x_diff);
-        if (pw_eval(J, m, tmp) == s) x_same = m; else x_diff = m;
+        if (pw_eval(J, m, tmp) == s) x_same = m;
+        else x_diff = m;
     }
     return 0.5 * (x_same + x_diff);
 }
@@ -100,7 +98,9 @@ static double pw_panel(pw_job *J, const pw_piece *S, double ta, double tb, doubl
 #define PW_MAX_PANELS 200
 static int pw_adapt(pw_job *J, const pw_piece *S, double tol, double *acc, double *x_bad)
 {
-    static _Thread_local struct { double ta, tb, err, K[NCOMP]; } P[PW_MAX_PANELS];
+    static _Thread_local struct {
+        double ta, tb, err, K[NCOMP];
+    } P[PW_MAX_PANELS];
     int np = 1;
     P[0].ta = 0.0;
     P[0].tb = NUM_PI;
@@ -180,6 +180,5 @@ void cd_shn_pw_integrate(pw_job *J, double A, double B, int nsample, double tol,
         sprev = s;
     }
     brk[nb++] = B;
-    for (int k = 0; k + 1 < nb; k++)
-        pw_piecewise(J, brk[k], brk[k + 1], tol * (brk[k + 1] - brk[k]) / (B - A), 0, acc);
+    for (int k = 0; k + 1 < nb; k++) pw_piecewise(J, brk[k], brk[k + 1], tol * (brk[k + 1] - brk[k]) / (B - A), 0, acc);
 }

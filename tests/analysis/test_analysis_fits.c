@@ -203,8 +203,8 @@ static void test_cascade_binned_matches(void **state)
     cd_rng_seed(&r, 16);
     for (size_t i = 0; i < n; i++) f[i] = draw_cascade(&r, gamma);
     cd_an_cascade_fit big, part;
-    assert_int_equal(cd_an_fit_cascade(f, n, &big), 0);        /* binned */
-    assert_int_equal(cd_an_fit_cascade(f, 200000, &part), 0);  /* exact, 2/3 of the samples */
+    assert_int_equal(cd_an_fit_cascade(f, n, &big), 0);       /* binned */
+    assert_int_equal(cd_an_fit_cascade(f, 200000, &part), 0); /* exact, 2/3 of the samples */
     assert_true(big.lo <= gamma && gamma <= big.hi);
     assert_true(fabs(big.gamma - part.gamma) < 0.5 * (part.hi - part.lo));
     free(f);

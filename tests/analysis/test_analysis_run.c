@@ -22,36 +22,35 @@
 #include "analysis/analyze.h"
 #include "core/run.h"
 
-#define RUN_FILE "analysis_e2e.h5"
+#define RUN_FILE    "analysis_e2e.h5"
 #define CONFIG_FILE "analysis_e2e.yaml"
 
 /* Gravity of 1000 m/s^2 settles the particles into a heap within 2500
  * steps (0.02 s): a real contact network in a couple of seconds.  dt is
  * t_col/23 for these hexapods. */
-static const char *config =
-    "run:\n"
-    "  name: analysis-e2e\n"
-    "  seed: 5\n"
-    "  dt: 8.0e-6\n"
-    "  steps: 2500\n"
-    "  snapshot_every: 625\n"
-    "  thermo_every: 25\n"
-    "physics:\n"
-    "  gravity: [0, -1000, 0]\n"
-    "particles:\n"
-    "  - shape: hexapod\n"
-    "    aspect: 3\n"
-    "    diameter: 0.005\n"
-    "    count: 50\n"
-    "    polydispersity: 0.2\n"
-    "domain:\n"
-    "  type: cylinder\n"
-    "  diameter: 0.06\n"
-    "  height: 0.2\n"
-    "init:\n"
-    "  placement: lattice\n"
-    "  clearance: 1.0\n"
-    "  speed: 1.0\n";
+static const char *config = "run:\n"
+                            "  name: analysis-e2e\n"
+                            "  seed: 5\n"
+                            "  dt: 8.0e-6\n"
+                            "  steps: 2500\n"
+                            "  snapshot_every: 625\n"
+                            "  thermo_every: 25\n"
+                            "physics:\n"
+                            "  gravity: [0, -1000, 0]\n"
+                            "particles:\n"
+                            "  - shape: hexapod\n"
+                            "    aspect: 3\n"
+                            "    diameter: 0.005\n"
+                            "    count: 50\n"
+                            "    polydispersity: 0.2\n"
+                            "domain:\n"
+                            "  type: cylinder\n"
+                            "  diameter: 0.06\n"
+                            "  height: 0.2\n"
+                            "init:\n"
+                            "  placement: lattice\n"
+                            "  clearance: 1.0\n"
+                            "  speed: 1.0\n";
 
 static int setup(void **state)
 {
@@ -281,8 +280,8 @@ static void test_json(void **state)
     cJSON *root = cJSON_Parse(text);
     assert_non_null(root);
     assert_true(cJSON_GetObjectItem(root, "step")->valuedouble == 2500);
-    const char *groups[] = {"sample", "normal_forces", "bond_forces", "stress", "branch", "network", "packing",
-                            "modulus", "compaction"};
+    const char *groups[] = {"sample",  "normal_forces", "bond_forces", "stress",    "branch",
+                            "network", "packing",       "modulus",     "compaction"};
     for (size_t k = 0; k < sizeof groups / sizeof groups[0]; k++) {
         cJSON *g = cJSON_GetObjectItem(root, groups[k]);
         if (!g) fail_msg("JSON lacks %s", groups[k]);
@@ -291,7 +290,8 @@ static void test_json(void **state)
     cJSON *net = cJSON_GetObjectItem(root, "network");
     assert_true(cJSON_IsNumber(cJSON_GetObjectItem(net, "Z_c")));
     assert_string_equal(cJSON_GetObjectItem(cJSON_GetObjectItem(net, "units"), "Z_c")->valuestring, "1");
-    cJSON *curve = cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(root, "normal_forces"), "curves"), "pdf");
+    cJSON *curve =
+        cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(root, "normal_forces"), "curves"), "pdf");
     assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItem(curve, "data")), 50);
     cJSON_Delete(root);
 }
@@ -299,10 +299,8 @@ static void test_json(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_bad_input),
-        cmocka_unit_test(test_writes_and_replaces),
-        cmocka_unit_test(test_sane_numbers),
-        cmocka_unit_test(test_contact_points_match_torques),
+        cmocka_unit_test(test_bad_input),    cmocka_unit_test(test_writes_and_replaces),
+        cmocka_unit_test(test_sane_numbers), cmocka_unit_test(test_contact_points_match_torques),
         cmocka_unit_test(test_json),
     };
     return cmocka_run_group_tests(tests, setup, NULL);

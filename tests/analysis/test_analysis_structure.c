@@ -193,7 +193,8 @@ static void check_shells(const cd_an_report *rep, const double *dist, const int 
                 assert_true(fabs(c->data[4 * i] - dist[k]) <= 0.5 * dr + 1e-12);
             }
         }
-        if (fabs(step - expect) > 1e-9) fail_msg("bin %zu (r = %g L): %g neighbours, expected %d", i, c->data[4 * i], step, expect);
+        if (fabs(step - expect) > 1e-9)
+            fail_msg("bin %zu (r = %g L): %g neighbours, expected %d", i, c->data[4 * i], step, expect);
         assert_true((c->data[4 * i + 1] > 0) == (expect > 0));
     }
 }
@@ -351,12 +352,9 @@ static void test_packing_lattice(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_rdf_ideal_gas_3d),
-        cmocka_unit_test(test_rdf_ideal_gas_2d),
-        cmocka_unit_test(test_rdf_ideal_gas_pseudo2d),
-        cmocka_unit_test(test_rdf_cubic_lattice),
-        cmocka_unit_test(test_rdf_hexagonal_lattice_2d),
-        cmocka_unit_test(test_geometry_cylinder_ball),
+        cmocka_unit_test(test_rdf_ideal_gas_3d),         cmocka_unit_test(test_rdf_ideal_gas_2d),
+        cmocka_unit_test(test_rdf_ideal_gas_pseudo2d),   cmocka_unit_test(test_rdf_cubic_lattice),
+        cmocka_unit_test(test_rdf_hexagonal_lattice_2d), cmocka_unit_test(test_geometry_cylinder_ball),
         cmocka_unit_test(test_packing_lattice),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -29,11 +29,10 @@ static const char *settling_hertz =
     "init: {placement: lattice, clearance: 1.0, speed: 2.0}\n";
 
 /* 1,500 hexapods (4,500 primitives) standing in a box, for the wall load. */
-static const char *many =
-    "run: {name: parity_load, dt: 1.0e-5, steps: 0, seed: 22}\n"
-    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 1500}]\n"
-    "domain: {type: box, width: 0.3, height: 0.3, thickness: 0.3}\n"
-    "init: {placement: lattice, clearance: 1.0, speed: 0}\n";
+static const char *many = "run: {name: parity_load, dt: 1.0e-5, steps: 0, seed: 22}\n"
+                          "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 1500}]\n"
+                          "domain: {type: box, width: 0.3, height: 0.3, thickness: 0.3}\n"
+                          "init: {placement: lattice, clearance: 1.0, speed: 0}\n";
 
 /* The OpenCL backend is built, so an OpenCL platform is a dependency
  * (PoCL on a CPU): without one the parity checks fail rather than pass

@@ -12,25 +12,25 @@
 #include "config/config.h"
 
 #define FILE_NAME "configs/bad.yaml"
-#define PI 3.14159265358979323846
+#define PI        3.14159265358979323846
 
 static char err[2048];
 
-#define assert_close(a, b, tol)                                                                 \
-    do {                                                                                        \
-        double a_ = (a), b_ = (b);                                                              \
-        if (!(fabs(a_ - b_) <= (tol))) {                                                        \
-            print_error("%s = %.17g, expected %.17g (tolerance %g)\n", #a, a_, b_, (double)(tol)); \
-            fail();                                                                             \
-        }                                                                                       \
+#define assert_close(a, b, tol)                                                                                        \
+    do {                                                                                                               \
+        double a_ = (a), b_ = (b);                                                                                     \
+        if (!(fabs(a_ - b_) <= (tol))) {                                                                               \
+            print_error("%s = %.17g, expected %.17g (tolerance %g)\n", #a, a_, b_, (double)(tol));                     \
+            fail();                                                                                                    \
+        }                                                                                                              \
     } while (0)
 
-#define assert_contains(text, part)                                          \
-    do {                                                                     \
-        if (!strstr((text), (part))) {                                       \
-            print_error("message \"%s\" does not contain \"%s\"\n", (text), (part)); \
-            fail();                                                          \
-        }                                                                    \
+#define assert_contains(text, part)                                                                                    \
+    do {                                                                                                               \
+        if (!strstr((text), (part))) {                                                                                 \
+            print_error("message \"%s\" does not contain \"%s\"\n", (text), (part));                                   \
+            fail();                                                                                                    \
+        }                                                                                                              \
     } while (0)
 
 /* A small valid run file; tests append or prepend sections to it. */
@@ -59,8 +59,7 @@ static void expect_error(const char *yaml, const char *part1, const char *part2)
     }
     assert_contains(err, FILE_NAME ":");
     assert_contains(err, part1);
-    if (part2)
-        assert_contains(err, part2);
+    if (part2) assert_contains(err, part2);
     assert_null(c.source_text);
     cd_config_free(&c);
 }
@@ -104,49 +103,48 @@ static void test_defaults_are_the_documented_values(void **state)
 static void test_full_config_gives_every_value(void **state)
 {
     (void)state;
-    const char *yaml =
-        "run:\n"
-        "  name: pile\n"
-        "  seed: 12345678901234\n"
-        "  dt: 1e-6\n"
-        "  steps: 1_000_000\n"
-        "  output: out/pile.h5\n"
-        "  snapshot_every: 2e4\n"
-        "  thermo_every: 50\n"
-        "  force_dt: true\n"
-        "physics:\n"
-        "  dimension: 2\n"
-        "  gravity: [0, -1.5, 0.25]\n"
-        "material:\n"
-        "  density: 1200\n"
-        "  kn: 2.0e5\n"
-        "  kt: 7e4\n"
-        "  damping_normal: 0.1\n"
-        "  damping_tangential: 0.05\n"
-        "  friction: 0.3\n"
-        "  wall_friction: 0.2\n"
-        "  friction_limit: total\n"
-        "  parallel_angle: 5\n"
-        "particles:\n"
-        "  - shape: cross\n"
-        "    aspect: 8\n"
-        "    diameter: 0.004\n"
-        "    count: 500\n"
-        "    polydispersity: 0.1\n"
-        "  - shape: sphere\n"
-        "    diameter: 0.01\n"
-        "    count: 3\n"
-        "domain:\n"
-        "  type: box\n"
-        "  width: 0.9\n"
-        "  thickness: 0.03\n"
-        "  height: 2\n"
-        "init:\n"
-        "  placement: random\n"
-        "  clearance: 2\n"
-        "  speed: 0\n"
-        "neighbor:\n"
-        "  skin: 0.0004\n";
+    const char *yaml = "run:\n"
+                       "  name: pile\n"
+                       "  seed: 12345678901234\n"
+                       "  dt: 1e-6\n"
+                       "  steps: 1_000_000\n"
+                       "  output: out/pile.h5\n"
+                       "  snapshot_every: 2e4\n"
+                       "  thermo_every: 50\n"
+                       "  force_dt: true\n"
+                       "physics:\n"
+                       "  dimension: 2\n"
+                       "  gravity: [0, -1.5, 0.25]\n"
+                       "material:\n"
+                       "  density: 1200\n"
+                       "  kn: 2.0e5\n"
+                       "  kt: 7e4\n"
+                       "  damping_normal: 0.1\n"
+                       "  damping_tangential: 0.05\n"
+                       "  friction: 0.3\n"
+                       "  wall_friction: 0.2\n"
+                       "  friction_limit: total\n"
+                       "  parallel_angle: 5\n"
+                       "particles:\n"
+                       "  - shape: cross\n"
+                       "    aspect: 8\n"
+                       "    diameter: 0.004\n"
+                       "    count: 500\n"
+                       "    polydispersity: 0.1\n"
+                       "  - shape: sphere\n"
+                       "    diameter: 0.01\n"
+                       "    count: 3\n"
+                       "domain:\n"
+                       "  type: box\n"
+                       "  width: 0.9\n"
+                       "  thickness: 0.03\n"
+                       "  height: 2\n"
+                       "init:\n"
+                       "  placement: random\n"
+                       "  clearance: 2\n"
+                       "  speed: 0\n"
+                       "neighbor:\n"
+                       "  skin: 0.0004\n";
     cd_config c;
     parse_ok(yaml, &c);
     assert_string_equal(c.name, "pile");
@@ -176,8 +174,8 @@ static void test_full_config_gives_every_value(void **state)
     assert_int_equal(c.species[0].count, 500);
     assert_close(c.species[0].polydispersity, 0.1, 0);
     assert_string_equal(c.species[1].shape, "sphere");
-    assert_close(c.species[1].aspect, 1, 0);            /* sphere default */
-    assert_close(c.species[1].polydispersity, 0, 0);    /* default */
+    assert_close(c.species[1].aspect, 1, 0);         /* sphere default */
+    assert_close(c.species[1].polydispersity, 0, 0); /* default */
     assert_int_equal(c.species[1].count, 3);
     assert_string_equal(c.domain, "box");
     assert_close(c.box_width, 0.9, 0);
@@ -198,8 +196,8 @@ static void test_minimal_config_takes_defaults_and_derives_kt_and_eta_t(void **s
     (void)state;
     cd_config c;
     parse_ok(PARTICLES "material: {kn: 3e5, damping_normal: 0.3}\n", &c);
-    assert_close(c.kt, 1.5e5, 0);     /* 0.5 kn */
-    assert_close(c.eta_t, 0.3, 0);    /* = eta_n */
+    assert_close(c.kt, 1.5e5, 0);  /* 0.5 kn */
+    assert_close(c.eta_t, 0.3, 0); /* = eta_n */
     assert_close(c.dt, 2e-6, 0);
     assert_close(c.friction, 0.5, 0);
     assert_string_equal(c.domain, "none");
@@ -216,7 +214,7 @@ static void test_restitution_sets_damping_ratio(void **state)
     assert_close(c.eta_n, 0.2, 0.003);
     double le = log(0.53);
     assert_close(c.eta_n, -le / sqrt(PI * PI + le * le), 1e-15);
-    assert_close(c.eta_t, c.eta_n, 0);   /* eta_t follows eta_n */
+    assert_close(c.eta_t, c.eta_n, 0); /* eta_t follows eta_n */
     /* and back: e = exp(-pi eta / sqrt(1 - eta^2)) */
     assert_close(exp(-PI * c.eta_n / sqrt(1 - c.eta_n * c.eta_n)), 0.53, 1e-12);
     cd_config_free(&c);
@@ -234,7 +232,8 @@ static void test_contact_law_and_its_keys(void **state)
     parse_ok(PARTICLES, &c);
     assert_int_equal(c.law, 0); /* linear */
     cd_config_free(&c);
-    parse_ok(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.22, restitution: 0.9}\n", &c);
+    parse_ok(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.22, restitution: 0.9}\n",
+             &c);
     assert_int_equal(c.law, 1);
     assert_close(c.young_modulus, 7e10, 0);
     assert_close(c.poisson_ratio, 0.22, 0);
@@ -245,8 +244,8 @@ static void test_contact_law_and_its_keys(void **state)
                  "needed for material.law = hertz_mindlin");
     expect_error(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.3, kn: 1e5}\n",
                  "material.kn = 1e5: does not apply to material.law = hertz_mindlin", NULL);
-    expect_error(PARTICLES "material: {young_modulus: 7e10}\n", "material.young_modulus = 7e10: does not apply to material.law = linear",
-                 NULL);
+    expect_error(PARTICLES "material: {young_modulus: 7e10}\n",
+                 "material.young_modulus = 7e10: does not apply to material.law = linear", NULL);
     expect_error(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.6}\n",
                  "material.poisson_ratio = 0.6", "(-1, 0.5]");
     expect_error(PARTICLES "material: {law: hertz_mindlin, young_modulus: 7e10, poisson_ratio: 0.3}\n"
@@ -258,12 +257,11 @@ static void test_extra_wall_is_normalised_and_takes_wall_friction(void **state)
 {
     (void)state;
     cd_config c;
-    parse_ok(PARTICLES
-             "domain:\n"
-             "  walls:\n"
-             "    - {type: plane, point: [0, 1, 0], normal: [0, -2, 0], velocity: [0, -0.1, 0]}\n"
-             "    - {type: plane, point: [0, 0, 0], normal: [3, 4, 0]}\n"
-             "material: {wall_friction: 0.4}\n",
+    parse_ok(PARTICLES "domain:\n"
+                       "  walls:\n"
+                       "    - {type: plane, point: [0, 1, 0], normal: [0, -2, 0], velocity: [0, -0.1, 0]}\n"
+                       "    - {type: plane, point: [0, 0, 0], normal: [3, 4, 0]}\n"
+                       "material: {wall_friction: 0.4}\n",
              &c);
     assert_int_equal(c.n_extra_walls, 2);
     assert_int_equal(c.extra_walls[0].type, CD_WALL_PLANE);
@@ -324,8 +322,7 @@ static void test_load_reads_file_and_keeps_its_text(void **state)
     cd_config c;
     int rc = cd_config_load(name, &c, err, sizeof err);
     remove(name);
-    if (rc != 0)
-        print_error("%s\n", err);
+    if (rc != 0) print_error("%s\n", err);
     assert_int_equal(rc, 0);
     assert_string_equal(c.name, "loaded");
     assert_string_equal(c.source_path, name);
@@ -414,12 +411,11 @@ static void test_particle_without_required_keys_is_refused(void **state)
 {
     (void)state;
     expect_error("particles:\n  - {aspect: 4, diameter: 0.005, count: 10}\n", "particles[0].shape: missing", NULL);
-    expect_error("particles:\n  - {shape: rod, diameter: 0.005, count: 10}\n", "particles[0].aspect: missing",
-                 "rod");
+    expect_error("particles:\n  - {shape: rod, diameter: 0.005, count: 10}\n", "particles[0].aspect: missing", "rod");
     expect_error("particles:\n  - {shape: rod, aspect: 4, diameter: 0.005, count: 0}\n", "particles[0].count = 0",
                  "integer");
-    expect_error("particles:\n  - {shape: sphere, aspect: 2, diameter: 0.005, count: 1}\n",
-                 "particles[0].aspect = 2", "sphere");
+    expect_error("particles:\n  - {shape: sphere, aspect: 2, diameter: 0.005, count: 1}\n", "particles[0].aspect = 2",
+                 "sphere");
     expect_error("particles:\n  - {shape: segments, count: 1, segments: [[0, 0, 0, 1, 0, 0, 0]]}\n",
                  "particles[0].segments[0]", "radius > 0");
 }
@@ -438,7 +434,8 @@ static void test_count_and_height_rules(void **state)
     expect_error("particles:\n  - {shape: sphere, diameter: 0.005}\n" DEPOSIT "}\n", "protocol.fill_fraction: missing",
                  "(0, 1)");
     expect_error("particles:\n  - {shape: sphere, diameter: 0.005}\n  - {shape: sphere, diameter: 0.004}\n" DEPOSIT
-                 ", fill_fraction: 0.5}\n", "particles[0].count: missing", "single species");
+                 ", fill_fraction: 0.5}\n",
+                 "particles[0].count: missing", "single species");
     expect_error("particles:\n  - {shape: sphere, diameter: 0.005}\n" DEPOSIT ", fill_fraction: 1.5}\n",
                  "protocol.fill_fraction = 1.5", "(0, 1)");
     expect_error(PARTICLES "domain: {type: box, width: 0.1, thickness: 0.1}\ninit: {placement: random}\n",
@@ -446,7 +443,8 @@ static void test_count_and_height_rules(void **state)
 #undef DEPOSIT
     cd_config c;
     parse_ok("particles:\n  - {shape: sphere, diameter: 0.005}\ndomain: {type: cylinder, diameter: 0.05}\n"
-             "protocol: {type: deposit_compress, fill_ratio: 2, fill_fraction: 0.5}\n", &c);
+             "protocol: {type: deposit_compress, fill_ratio: 2, fill_fraction: 0.5}\n",
+             &c);
     assert_int_equal(c.species[0].count, 0); /* picked at set-up */
     assert_true(c.cyl_height == 0);
     cd_config_free(&c);
@@ -466,8 +464,8 @@ static void test_alternative_keys_together_are_refused(void **state)
 static void test_box_without_width_is_refused(void **state)
 {
     (void)state;
-    expect_error(PARTICLES "domain:\n  type: box\n  thickness: 0.1\n  height: 1\n", FILE_NAME ":3: domain.width: missing",
-                 "box");
+    expect_error(PARTICLES "domain:\n  type: box\n  thickness: 0.1\n  height: 1\n",
+                 FILE_NAME ":3: domain.width: missing", "box");
 }
 
 static void test_key_for_another_domain_type_is_refused(void **state)
@@ -521,17 +519,47 @@ static void test_print_keys_lists_every_key(void **state)
     rewind(f);
     assert_int_equal(fread(text, 1, (size_t)n, f), n);
     fclose(f);
-    static const char *const keys[] = {
-        "run.name", "run.seed", "run.dt", "run.steps", "run.output", "run.snapshot_every", "run.thermo_every",
-        "run.force_dt", "physics.dimension", "physics.gravity", "material.density", "material.kn", "material.kt",
-        "material.damping_normal", "material.restitution", "material.damping_tangential", "material.friction",
-        "material.wall_friction", "material.friction_limit", "material.parallel_angle", "particles[].shape",
-        "particles[].aspect", "particles[].diameter", "particles[].segments", "particles[].count",
-        "particles[].polydispersity", "domain.type", "domain.width", "domain.thickness", "domain.height",
-        "domain.diameter", "domain.radius", "domain.walls[].point", "domain.walls[].normal",
-        "domain.walls[].velocity", "init.placement", "init.clearance", "init.gap", "init.speed", "neighbor.skin"};
-    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
-        assert_contains(text, keys[i]);
+    static const char *const keys[] = {"run.name",
+                                       "run.seed",
+                                       "run.dt",
+                                       "run.steps",
+                                       "run.output",
+                                       "run.snapshot_every",
+                                       "run.thermo_every",
+                                       "run.force_dt",
+                                       "physics.dimension",
+                                       "physics.gravity",
+                                       "material.density",
+                                       "material.kn",
+                                       "material.kt",
+                                       "material.damping_normal",
+                                       "material.restitution",
+                                       "material.damping_tangential",
+                                       "material.friction",
+                                       "material.wall_friction",
+                                       "material.friction_limit",
+                                       "material.parallel_angle",
+                                       "particles[].shape",
+                                       "particles[].aspect",
+                                       "particles[].diameter",
+                                       "particles[].segments",
+                                       "particles[].count",
+                                       "particles[].polydispersity",
+                                       "domain.type",
+                                       "domain.width",
+                                       "domain.thickness",
+                                       "domain.height",
+                                       "domain.diameter",
+                                       "domain.radius",
+                                       "domain.walls[].point",
+                                       "domain.walls[].normal",
+                                       "domain.walls[].velocity",
+                                       "init.placement",
+                                       "init.clearance",
+                                       "init.gap",
+                                       "init.speed",
+                                       "neighbor.skin"};
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) assert_contains(text, keys[i]);
     assert_contains(text, "N/m");
     assert_contains(text, "[0, -9.81, 0]");
     free(text);

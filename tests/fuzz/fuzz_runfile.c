@@ -29,7 +29,8 @@ static int do_resume = 1, do_analyze = 1, do_export = 1;
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
-    (void)argc; (void)argv;
+    (void)argc;
+    (void)argv;
     const char *dir = getenv("CAPDEM_FUZZ_DIR");
     if (!dir) dir = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
     snprintf(path, sizeof path, "%s/capdem-fuzz-%ld.h5", dir, (long)getpid());
@@ -74,7 +75,8 @@ static void resume_readers(void)
             cd_config_free(&cfg);
         }
     }
-    if (sim_text && cd_h5_check_tails(path, err, sizeof err) == 0) cd_h5_read_snapshot(path, -1, &sim.s, err, sizeof err);
+    if (sim_text && cd_h5_check_tails(path, err, sizeof err) == 0)
+        cd_h5_read_snapshot(path, -1, &sim.s, err, sizeof err);
     if (text != sim_text) free(text);
 }
 

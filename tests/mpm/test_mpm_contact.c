@@ -17,13 +17,13 @@
 #include "mpm/mpm.h"
 #include "core/sim.h" /* cd_parallel_min_rows */
 
-#define RHO 1000.0  /* [kg/m^3] */
-#define E_ 1.0e7    /* [Pa] */
-#define NU_ 0.3     /* [1] */
-#define D_ 0.01     /* disk diameter [m] */
-#define CELLS 12    /* cells across D */
-#define V_A 1.5     /* disk a's speed towards b [m/s] */
-#define V_B (-0.5)  /* disk b's [m/s] */
+#define RHO   1000.0 /* [kg/m^3] */
+#define E_    1.0e7  /* [Pa] */
+#define NU_   0.3    /* [1] */
+#define D_    0.01   /* disk diameter [m] */
+#define CELLS 12     /* cells across D */
+#define V_A   1.5    /* disk a's speed towards b [m/s] */
+#define V_B   (-0.5) /* disk b's [m/s] */
 
 /* Two disks of diameter D on the x axis, gap_cells cells apart, 2 x 2 points per cell, disk a moving at V_A, b at V_B. */
 static void two_disks(cd_mpm *m, double gap_cells, double dt)
@@ -142,11 +142,11 @@ static void test_two_disks_collide(void **state)
     double restitution = (vb - va) / (V_A - V_B);
     print_message("two disks: %ld steps (dt = %.3g s, limit / 5), %ld in contact; momentum drift %.2e of sum m|v|; "
                   "energy max %.6f, end %.4f of the start; restitution %.3f (va %.3f, vb %.3f m/s); deepest axial "
-                  "overlap %.3g h\n", steps, m.dt, contact_steps, worst_p, emax / e0, ef / e0, restitution, va, vb,
-                  worst_pen / m.h);
+                  "overlap %.3g h\n",
+                  steps, m.dt, contact_steps, worst_p, emax / e0, ef / e0, restitution, va, vb, worst_pen / m.h);
     assert_true(contact_steps > 10);
-    assert_true(vb > va);                /* they parted */
-    assert_true(m.n_contacts == 0);      /* and are apart at the end */
+    assert_true(vb > va);           /* they parted */
+    assert_true(m.n_contacts == 0); /* and are apart at the end */
     assert_true(worst_p < 1e-12);
     assert_true(emax <= 1.01 * e0);
     assert_true(ef > 0.85 * e0);
@@ -177,10 +177,10 @@ static void test_contact_threads_same_bits(void **state)
     assert_int_equal(m[0].n_contacts, m[1].n_contacts);
     size_t n = m[0].n;
     for (int t = 0; t < 2; t++) assert_int_equal(m[t].n, n);
-    double *a[] = {m[0].x, m[0].y, m[0].vx, m[0].vy, m[0].vol, m[0].sxx, m[0].syy, m[0].sxy, m[0].szz, m[0].f_xx,
-                   m[0].f_xy, m[0].f_yx, m[0].f_yy};
-    double *b[] = {m[1].x, m[1].y, m[1].vx, m[1].vy, m[1].vol, m[1].sxx, m[1].syy, m[1].sxy, m[1].szz, m[1].f_xx,
-                   m[1].f_xy, m[1].f_yx, m[1].f_yy};
+    double *a[] = {m[0].x,   m[0].y,   m[0].vx,   m[0].vy,   m[0].vol,  m[0].sxx, m[0].syy,
+                   m[0].sxy, m[0].szz, m[0].f_xx, m[0].f_xy, m[0].f_yx, m[0].f_yy};
+    double *b[] = {m[1].x,   m[1].y,   m[1].vx,   m[1].vy,   m[1].vol,  m[1].sxx, m[1].syy,
+                   m[1].sxy, m[1].szz, m[1].f_xx, m[1].f_xy, m[1].f_yx, m[1].f_yy};
     for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) assert_memory_equal(a[k], b[k], n * sizeof(double));
     assert_memory_equal(&m[0].penetration, &m[1].penetration, sizeof(double));
     cd_mpm_free(&m[0]);

@@ -13,13 +13,14 @@
 #include "mpm_material.h"
 #include "mpm_shape.h"
 
-#define E_ 1.0e7    /* Young's modulus [Pa] (the paper's) */
-#define NU_ 0.45    /* [1] */
-#define SY_ 4.0e5   /* yield stress [Pa] */
+#define E_  1.0e7 /* Young's modulus [Pa] (the paper's) */
+#define NU_ 0.45  /* [1] */
+#define SY_ 4.0e5 /* yield stress [Pa] */
 
 static void close_rel(double got, double want, double scale, double tol, const char *what)
 {
-    if (!(fabs(got - want) <= tol * scale)) fail_msg("%s: %.17g, expected %.17g (tolerance %g x %g)", what, got, want, tol, scale);
+    if (!(fabs(got - want) <= tol * scale))
+        fail_msg("%s: %.17g, expected %.17g (tolerance %g x %g)", what, got, want, tol, scale);
 }
 
 /* Sum_i N_i = 1, sum_i N_i x_i = x, sum_i dN_i = 0 and sum_i dN_i x_i = 1
@@ -151,10 +152,8 @@ static void test_volume_dilation(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_shape_partition),
-        cmocka_unit_test(test_elastic),
-        cmocka_unit_test(test_return_mapping_shear),
-        cmocka_unit_test(test_return_mapping_oedometer),
+        cmocka_unit_test(test_shape_partition),      cmocka_unit_test(test_elastic),
+        cmocka_unit_test(test_return_mapping_shear), cmocka_unit_test(test_return_mapping_oedometer),
         cmocka_unit_test(test_volume_dilation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -19,12 +19,13 @@
 #include "core/sim.h" /* cd_parallel_min_rows */
 
 #define RHO 1000.0 /* [kg/m^3] */
-#define E_ 1.0e7   /* [Pa] */
+#define E_  1.0e7  /* [Pa] */
 #define NU_ 0.3    /* [1] */
 
 static void close_rel(double got, double want, double scale, double tol, const char *what)
 {
-    if (!(fabs(got - want) <= tol * scale)) fail_msg("%s: %.17g, expected %.17g (tolerance %g x %g)", what, got, want, tol, scale);
+    if (!(fabs(got - want) <= tol * scale))
+        fail_msg("%s: %.17g, expected %.17g (tolerance %g x %g)", what, got, want, tol, scale);
 }
 
 /* A block of cx x cy cells of side h [m] filled with 2 x 2 points per
@@ -118,7 +119,7 @@ static void test_patch_uniform_stress(void **state)
         if (interior(&m, p, cx, cy) && v > vmax_in) vmax_in = v;
     }
     print_message("uniform stress: interior |v| <= %.3g m/s, edges up to %.3g m/s (scale %.3g)\n", vmax_in, vmax, edge);
-    assert_true(vmax > 0.1 * edge);      /* the test can see a force */
+    assert_true(vmax > 0.1 * edge);       /* the test can see a force */
     assert_true(vmax_in <= 1e-10 * edge); /* and there is none inside */
     cd_mpm_free(&m);
 }
@@ -215,8 +216,8 @@ static void test_threads_same_bits(void **state)
     size_t n = m[0].n;
     double *cols[2][13];
     for (int t = 0; t < 2; t++) {
-        double *cc[13] = {m[t].x, m[t].y, m[t].vx, m[t].vy, m[t].vol, m[t].sxx, m[t].syy, m[t].sxy, m[t].szz,
-                          m[t].eps_p, m[t].f_xx, m[t].f_xy, m[t].f_yy};
+        double *cc[13] = {m[t].x,   m[t].y,   m[t].vx,    m[t].vy,   m[t].vol,  m[t].sxx, m[t].syy,
+                          m[t].sxy, m[t].szz, m[t].eps_p, m[t].f_xx, m[t].f_xy, m[t].f_yy};
         memcpy(cols[t], cc, sizeof cc);
     }
     double epmax = 0;
@@ -291,7 +292,8 @@ static void test_disk_centre_stress(void **state)
         }
         imbalance = fmax(imbalance, fabs(m.walls[1].fy + m.walls[0].fy) / (2 * P));
         print_message("disk eps_yy %.4f: P = %.5g N/m, centre sigma_xx / solution %.4f, sigma_yy / solution %.4f, "
-                      "sum V sigma_yy / (-P (gap - l)) %.4f\n", eps, P, sx / tx, sy / ty, theorem);
+                      "sum V sigma_yy / (-P (gap - l)) %.4f\n",
+                      eps, P, sx / tx, sy / ty, theorem);
         rx += sx / tx / 4, ry += sy / ty / 4;
         ns++;
     }
@@ -308,12 +310,9 @@ static void test_disk_centre_stress(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_patch_uniform_strain),
-        cmocka_unit_test(test_patch_uniform_stress),
-        cmocka_unit_test(test_volume_pure_dilation),
-        cmocka_unit_test(test_bar_vibration),
-        cmocka_unit_test(test_threads_same_bits),
-        cmocka_unit_test(test_disk_centre_stress),
+        cmocka_unit_test(test_patch_uniform_strain), cmocka_unit_test(test_patch_uniform_stress),
+        cmocka_unit_test(test_volume_pure_dilation), cmocka_unit_test(test_bar_vibration),
+        cmocka_unit_test(test_threads_same_bits),    cmocka_unit_test(test_disk_centre_stress),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -4,15 +4,16 @@
 #include "test_util.h"
 #include <math.h>
 
-static const char *two_spheres =
-    "run: {dt: 1.0e-7, steps: 0}\n"
-    "physics: {gravity: [0, 0, 0]}\n"
-    "material: {density: 1000, kn: 1.0e5, kt: 5.0e4, damping_normal: 0.2, friction: 0.5}\n"
-    "particles: [{shape: sphere, diameter: 0.005, count: 2}]\n"
-    "domain: {type: none}\n"
-    "init: {speed: 0}\n";
+static const char *two_spheres = "run: {dt: 1.0e-7, steps: 0}\n"
+                                 "physics: {gravity: [0, 0, 0]}\n"
+                                 "material: {density: 1000, kn: 1.0e5, kt: 5.0e4, damping_normal: 0.2, friction: 0.5}\n"
+                                 "particles: [{shape: sphere, diameter: 0.005, count: 2}]\n"
+                                 "domain: {type: none}\n"
+                                 "init: {speed: 0}\n";
 
-typedef struct { double e, duration, dt; } collision_t; /* duration, dt [s] */
+typedef struct {
+    double e, duration, dt;
+} collision_t; /* duration, dt [s] */
 
 /* Fires the spheres at each other with relative speed v0 [m/s] along x. */
 static collision_t collide(int clip_normal, double v0, double *t_col_out, double *eta_out)
@@ -30,8 +31,10 @@ static collision_t collide(int clip_normal, double v0, double *t_col_out, double
         cdt_step(&sim, 1);
         int active = 0;
         for (size_t r = 0; r < sim.s.n_pairs; r++) active |= sim.s.pair_active[r];
-        if (active) { in_contact++; started = 1; }
-        else if (started) break;
+        if (active) {
+            in_contact++;
+            started = 1;
+        } else if (started) break;
     }
     collision_t c;
     c.e = (sim.s.velocity[1].x - sim.s.velocity[0].x) / v0;
@@ -80,7 +83,8 @@ static double clipped_restitution(double eta)
         double t = 0.5 * (lo + hi);
         double x = exp(-zw * t) * sin(wd * t) / wd;
         double v = exp(-zw * t) * (cos(wd * t) - zw / wd * sin(wd * t));
-        if (w0 * w0 * x + 2 * zw * v > 0) lo = t; else hi = t;
+        if (w0 * w0 * x + 2 * zw * v > 0) lo = t;
+        else hi = t;
     }
     double t = 0.5 * (lo + hi);
     return -exp(-zw * t) * (cos(wd * t) - zw / wd * sin(wd * t));

@@ -16,7 +16,7 @@
  * measured; the drift bound is 6x the largest measured: a first-order or
  * non-symplectic rotation update drifts by more than that within 1e5
  * steps. */
-#define ENERGY_MAX 1e-3
+#define ENERGY_MAX   1e-3
 #define ENERGY_DRIFT 1e-4
 static void energy_in_box(const char *shape, int dimension)
 {
@@ -51,7 +51,8 @@ static void energy_in_box(const char *shape, int dimension)
         contacts_seen += (long long)(o.n_contacts + o.n_wall_contacts);
     }
     print_message("%s (%dD): relative energy error over 1e5 steps: max %.3g, drift (last - first tenth) %.3g, "
-                  "%lld contacts seen\n", shape, dimension, worst, last - first, contacts_seen);
+                  "%lld contacts seen\n",
+                  shape, dimension, worst, last - first, contacts_seen);
     assert_true(contacts_seen > 400);
     assert_true(worst < ENERGY_MAX);
     assert_true(fabs(last - first) < ENERGY_DRIFT);
@@ -59,8 +60,16 @@ static void energy_in_box(const char *shape, int dimension)
     cd_config_free(&cfg);
 }
 
-static void test_energy_conserved_hexapods_in_box(void **state) { (void)state; energy_in_box("hexapod", 3); }
-static void test_energy_conserved_crosses_2d(void **state) { (void)state; energy_in_box("cross", 2); }
+static void test_energy_conserved_hexapods_in_box(void **state)
+{
+    (void)state;
+    energy_in_box("hexapod", 3);
+}
+static void test_energy_conserved_crosses_2d(void **state)
+{
+    (void)state;
+    energy_in_box("cross", 2);
+}
 
 /* Free collisions (no walls, no gravity, with friction and damping):
  * contact forces are equal and opposite and act at one point, so total
@@ -84,9 +93,16 @@ static void test_momentum_conserved_in_free_collisions(void **state)
         for (size_t q = 0; q < s->n_particles; q++) {
             cd_vec3 p = cd_v3_scale(s->velocity[q], s->mass[q]);
             cd_vec3 l = cd_v3_add(cd_v3_cross(s->position[q], p), s->angmom[q]);
-            P[0] += p.x; P[1] += p.y; P[2] += p.z;
-            L[0] += l.x; L[1] += l.y; L[2] += l.z;
-            if (pass == 0) { scale_p += cd_v3_norm(p); scale_l += cd_v3_norm(l); }
+            P[0] += p.x;
+            P[1] += p.y;
+            P[2] += p.z;
+            L[0] += l.x;
+            L[1] += l.y;
+            L[2] += l.z;
+            if (pass == 0) {
+                scale_p += cd_v3_norm(p);
+                scale_l += cd_v3_norm(l);
+            }
         }
         if (pass == 0) {
             memcpy(P0, P, sizeof P);

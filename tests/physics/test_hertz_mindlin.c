@@ -7,8 +7,9 @@
 #include <math.h>
 
 /* Soft spheres (E = 10 MPa) so that a collision lasts ~1000 steps. */
-#define MATERIAL "material: {law: hertz_mindlin, density: 1000, young_modulus: 1.0e7, poisson_ratio: 0.3, " \
-                 "friction: 0.5, wall_friction: 0.5, friction_limit: total, damping_normal: %g}\n"
+#define MATERIAL                                                                                                       \
+    "material: {law: hertz_mindlin, density: 1000, young_modulus: 1.0e7, poisson_ratio: 0.3, "                         \
+    "friction: 0.5, wall_friction: 0.5, friction_limit: total, damping_normal: %g}\n"
 
 static const double E = 1.0e7, nu = 0.3, d = 0.005; /* [Pa], [1], [m] */
 
@@ -35,8 +36,8 @@ static double hertz_time(double m_eff, double r_eff, double v)
 static double oscillator_restitution(int hertz, double eta)
 {
     double x = 0, v = 1, h = 1e-5;
-#define ACC(X, V) ((X) > 0 ? -fmax(0, hertz ? pow((X), 1.5) + sqrt(5.0) * eta * pow((X), 0.25) * (V) \
-                                            : (X) + 2 * eta * (V)) : 0)
+#define ACC(X, V)                                                                                                      \
+    ((X) > 0 ? -fmax(0, hertz ? pow((X), 1.5) + sqrt(5.0) * eta * pow((X), 0.25) * (V) : (X) + 2 * eta * (V)) : 0)
     while (x >= 0) {
         double k1x = v, k1v = ACC(x, v);
         double k2x = v + 0.5 * h * k1v, k2v = ACC(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
@@ -62,7 +63,9 @@ static void test_same_restitution_as_the_linear_law(void **state)
     }
 }
 
-typedef struct { double e, duration, t_hertz, energy_drift; } collision_t;
+typedef struct {
+    double e, duration, t_hertz, energy_drift;
+} collision_t;
 
 /* Two spheres (wall = 0) or a sphere and a floor (wall = 1) meeting at
  * speed v0 [m/s] with time step dt [s], no gravity. */
@@ -73,8 +76,7 @@ static collision_t collide(int wall, double eta, double v0, double dt)
     char yaml[1024];
     snprintf(yaml, sizeof yaml,
              "run: {dt: %g, steps: 0}\n"
-             "physics: {gravity: [0, 0, 0]}\n" MATERIAL
-             "particles: [{shape: sphere, diameter: %g, count: %d}]\n"
+             "physics: {gravity: [0, 0, 0]}\n" MATERIAL "particles: [{shape: sphere, diameter: %g, count: %d}]\n"
              "domain: {type: none%s}\n"
              "init: {speed: 0}\n",
              dt, eta, d, wall ? 1 : 2, wall ? ", walls: [{type: plane, point: [0, 0, 0], normal: [1, 0, 0]}]" : "");
@@ -96,8 +98,10 @@ static collision_t collide(int wall, double eta, double v0, double dt)
         int active = 0;
         for (size_t r = 0; r < sim.s.n_pairs; r++) active |= sim.s.pair_active[r];
         for (size_t r = 0; r < sim.s.n_prims * sim.s.n_walls; r++) active |= sim.s.wallc_active[r];
-        if (active) { in_contact++; started = 1; }
-        else if (started) break;
+        if (active) {
+            in_contact++;
+            started = 1;
+        } else if (started) break;
         c.energy_drift = fmax(c.energy_drift, fabs(cdt_total_energy(&sim) / e0 - 1));
     }
     double m = sim.s.mass[0];
@@ -176,8 +180,7 @@ static void test_sliding_ball_is_capped_at_mu_fn_then_rolls(void **state)
     char yaml[1024];
     snprintf(yaml, sizeof yaml,
              "run: {dt: 1.0e-6, steps: 0}\n"
-             "physics: {gravity: [0, -9.81, 0]}\n" MATERIAL
-             "particles: [{shape: sphere, diameter: %g, count: 1}]\n"
+             "physics: {gravity: [0, -9.81, 0]}\n" MATERIAL "particles: [{shape: sphere, diameter: %g, count: 1}]\n"
              "domain: {type: none, walls: [{type: plane, point: [0, 0, 0], normal: [0, 1, 0]}]}\n"
              "init: {speed: 0}\n",
              0.2, d);

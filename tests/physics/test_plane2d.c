@@ -20,7 +20,7 @@ static void test_disc_thicker_than_the_slab_touches_only_the_floor(void **state)
     cd_config cfg;
     cdt_setup(&sim, &cfg, yaml);
     assert_int_equal(sim.s.n_walls, 4); /* floor, top, two sides */
-    const double delta = 1e-5;         /* overlap with the floor [m] */
+    const double delta = 1e-5;          /* overlap with the floor [m] */
     cdt_place(&sim, 0, cd_v3(0.025, 0.5 * d - delta, 0.5 * T), cd_q_identity(), cd_v3_zero(), cd_v3_zero());
     assert_int_equal(cd_sim_initial_forces(&sim), 0);
     char err[256];

@@ -9,20 +9,19 @@
 #include <math.h>
 
 /* One free body: a rod whose inertia the tests overwrite. */
-static const char *one_free_body =
-    "run: {dt: 1.0e-5, steps: 0}\n"
-    "physics: {gravity: [0, 0, 0]}\n"
-    "particles: [{shape: %s, aspect: %s, diameter: 0.005, count: 1}]\n"
-    "domain: {type: none}\n"
-    "init: {speed: 0}\n";
+static const char *one_free_body = "run: {dt: 1.0e-5, steps: 0}\n"
+                                   "physics: {gravity: [0, 0, 0]}\n"
+                                   "particles: [{shape: %s, aspect: %s, diameter: 0.005, count: 1}]\n"
+                                   "domain: {type: none}\n"
+                                   "init: {speed: 0}\n";
 
 /* The asymmetric top: distinct moments [kg m^2], a generic start. */
-#define TOP_I cd_v3(1.0e-9, 2.0e-9, 3.5e-9)
+#define TOP_I  cd_v3(1.0e-9, 2.0e-9, 3.5e-9)
 #define TOP_Q0 cd_q_normalize(cd_q(0.9, 0.2, -0.3, 0.25))
 #define TOP_W0 cd_v3(20.0, -35.0, 50.0) /* world angular velocity at t = 0 [rad/s] */
 
-static void setup_body(cd_sim *sim, cd_config *cfg, const char *shape, const char *aspect, cd_vec3 inertia,
-                       cd_quat q0, cd_vec3 w0, double dt)
+static void setup_body(cd_sim *sim, cd_config *cfg, const char *shape, const char *aspect, cd_vec3 inertia, cd_quat q0,
+                       cd_vec3 w0, double dt)
 {
     char yaml[1024];
     snprintf(yaml, sizeof yaml, one_free_body, shape, aspect);
@@ -35,7 +34,10 @@ static void setup_body(cd_sim *sim, cd_config *cfg, const char *shape, const cha
 
 /* ---- reference: Euler's equations and q' = q (0, w_body) / 2 by RK4 ---- */
 
-typedef struct { cd_quat q; cd_vec3 Lb; } top_state;
+typedef struct {
+    cd_quat q;
+    cd_vec3 Lb;
+} top_state;
 
 static top_state top_rate(top_state y, cd_vec3 I)
 {
@@ -87,7 +89,7 @@ static double orientation_error(cd_quat a, cd_quat b)
 
 /* T = 0.25 s is about 2.5 turns of the body (|w| ~ 64 rad/s) and several
  * periods of its tumbling; dt = 1e-3 s gives |w| dt = 0.064. */
-#define TOP_T 0.25
+#define TOP_T  0.25
 #define TOP_DT 1.0e-3
 
 static void test_asymmetric_top_is_second_order(void **state)
@@ -156,7 +158,8 @@ static void test_asymmetric_top_energy_bounded(void **state)
     double qn = sqrt(sim.s.orientation[0].w * sim.s.orientation[0].w + sim.s.orientation[0].x * sim.s.orientation[0].x +
                      sim.s.orientation[0].y * sim.s.orientation[0].y + sim.s.orientation[0].z * sim.s.orientation[0].z);
     print_message("asymmetric top over 2e5 steps: relative energy error max %.3g (first tenth %.3g, last tenth %.3g), "
-                  "|q| - 1 = %.2g\n", worst, first, last, qn - 1);
+                  "|q| - 1 = %.2g\n",
+                  worst, first, last, qn - 1);
     assert_true(worst < 1e-3);
     assert_true(last <= 1.05 * first);
     assert_true(fabs(qn - 1) < 1e-14);
@@ -213,16 +216,22 @@ static void test_anisotropic_drift_is_reversible(void **state)
     assert_true(e < 1e-13);
 }
 
-static void test_sphere_turns_exactly_about_L(void **state) { (void)state; isotropic_exact("sphere", "1"); }
-static void test_hexapod_turns_exactly_about_L(void **state) { (void)state; isotropic_exact("hexapod", "3"); }
+static void test_sphere_turns_exactly_about_L(void **state)
+{
+    (void)state;
+    isotropic_exact("sphere", "1");
+}
+static void test_hexapod_turns_exactly_about_L(void **state)
+{
+    (void)state;
+    isotropic_exact("hexapod", "3");
+}
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_asymmetric_top_is_second_order),
-        cmocka_unit_test(test_asymmetric_top_energy_bounded),
-        cmocka_unit_test(test_anisotropic_drift_is_reversible),
-        cmocka_unit_test(test_sphere_turns_exactly_about_L),
+        cmocka_unit_test(test_asymmetric_top_is_second_order),  cmocka_unit_test(test_asymmetric_top_energy_bounded),
+        cmocka_unit_test(test_anisotropic_drift_is_reversible), cmocka_unit_test(test_sphere_turns_exactly_about_L),
         cmocka_unit_test(test_hexapod_turns_exactly_about_L),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -20,8 +20,13 @@ static const char *preset(const char *name)
 /* Runs a preset (optionally capped at steps) into out; returns the status. */
 static int run_preset(const char *name, const char *out, const char *resume, long long steps)
 {
-    cd_run_options o = {.config_path = preset(name), .resume_path = resume, .output_path = resume ? NULL : out,
-                        .steps = steps, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
+    cd_run_options o = {.config_path = preset(name),
+                        .resume_path = resume,
+                        .output_path = resume ? NULL : out,
+                        .steps = steps,
+                        .quiet = 1,
+                        .overwrite = 1,
+                        .backend = cdt_backend()};
     return cd_run(&o);
 }
 
@@ -84,7 +89,9 @@ static double *read_series(const char *file, const char *name, size_t *n)
     double *v = malloc(*n * sizeof *v);
     assert_non_null(v);
     assert_true(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0);
-    H5Sclose(sp); H5Dclose(d); H5Fclose(f);
+    H5Sclose(sp);
+    H5Dclose(d);
+    H5Fclose(f);
     return v;
 }
 
@@ -112,7 +119,7 @@ static void replace_once(char *text, size_t cap, const char *old, const char *ne
 static void test_piston_hold_position_and_sampled_relaxation(void **state)
 {
     (void)state;
-    const double ratio = 3e-5;           /* [1] the test's relax_ratio */
+    const double ratio = 3e-5;                 /* [1] the test's relax_ratio */
     const long long every = 500, check = 2000; /* [steps] relax_sample = thermo_every; the twin's check_every */
     char yaml[4096], err[2048];
     FILE *in = fopen(preset("deposit_2d_crosses"), "r");
@@ -131,8 +138,12 @@ static void test_piston_hold_position_and_sampled_relaxation(void **state)
     assert_non_null(out);
     fputs(yaml, out);
     fclose(out);
-    cd_run_options o = {.config_path = "proto_hold_position.yaml", .output_path = "proto_hold_position.h5", .steps = -1,
-                        .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
+    cd_run_options o = {.config_path = "proto_hold_position.yaml",
+                        .output_path = "proto_hold_position.h5",
+                        .steps = -1,
+                        .quiet = 1,
+                        .overwrite = 1,
+                        .backend = cdt_backend()};
     assert_int_equal(cd_run(&o), 0);
 
     static cd_sim sim;
@@ -155,7 +166,7 @@ static void test_piston_hold_position_and_sampled_relaxation(void **state)
     assert_int_equal(n, n_rows);
     size_t n_walls = n_pos / n_rows / 3;
     assert_true(w < (int)n_walls);
-#define PISTON_Y(r) pos[((r) * n_walls + (size_t)w) * 3 + 1]
+#define PISTON_Y(r) pos[((r)*n_walls + (size_t)w) * 3 + 1]
     size_t first = n_rows, held = 0;
     for (size_t r = 0; r < n_rows; r++) {
         if (phase[r] < CD_PHASE_HOLD) continue;
@@ -175,8 +186,8 @@ static void test_piston_hold_position_and_sampled_relaxation(void **state)
     }
     print_message("piston held at %.9f m for %zu rows, final load %.3f N (target %.1f N); step %lld, "
                   "largest kinetic/elastic ratio of the last window %.3g (relax_ratio %.0e)\n",
-                  PISTON_Y(first), held, sim.s.control[4], cfg.piston_force, sim.s.step,
-                  ke[worst_row] / eel[worst_row], ratio);
+                  PISTON_Y(first), held, sim.s.control[4], cfg.piston_force, sim.s.step, ke[worst_row] / eel[worst_row],
+                  ratio);
     assert_true(ke[worst_row] / eel[worst_row] < ratio);
 #undef PISTON_Y
     free(phase);
@@ -204,8 +215,10 @@ static void test_deposit_resumed_equals_uninterrupted(void **state)
     assert_memory_equal(a.s.position, b.s.position, a.s.n_particles * sizeof(cd_vec3));
     assert_memory_equal(a.s.velocity, b.s.velocity, a.s.n_particles * sizeof(cd_vec3));
     assert_memory_equal(a.s.control, b.s.control, sizeof a.s.control);
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
     unlink("proto_dep2d.h5");
     unlink("proto_dep2d_part.h5");
 }
@@ -313,13 +326,14 @@ static void test_steps_per_collision_sets_dt(void **state)
     char yaml[512];
     snprintf(yaml, sizeof yaml,
              "run: {steps_per_collision: %g}\nmaterial: {density: %g, kn: %g, damping_normal: %g}\n"
-             "particles: [{shape: sphere, diameter: %g, count: 2}]\n", n, rho, kn, eta, d);
+             "particles: [{shape: sphere, diameter: %g, count: 2}]\n",
+             n, rho, kn, eta, d);
     static cd_sim sim;
     cd_config cfg;
     char err[2048];
     if (cd_config_parse(yaml, "spc.yaml", &cfg, err, sizeof err)) fail_msg("%s", err);
     if (cd_sim_setup(&sim, &cfg, err, sizeof err)) fail_msg("%s", err);
-    double m = rho * CD_PI * d * d * d / 6;                             /* [kg] */
+    double m = rho * CD_PI * d * d * d / 6;                              /* [kg] */
     double t_col = CD_PI / sqrt(0.5 * kn / (0.5 * m) * (1 - eta * eta)); /* [s] */
     print_message("dt %.9g s, t_col / %g = %.9g s\n", sim.p.dt, n, t_col / n);
     assert_true(fabs(sim.p.dt / (t_col / n) - 1) < 1e-12);
@@ -413,10 +427,7 @@ static void test_cylinder_deposit_has_no_angular_momentum_about_the_axis(void **
  * not a theorem: measured at most 0.23 of it (seed 7 at 1e-8, whose base
  * has 3 contacts at the Coulomb limit and 46 within 1 % of it; seed 8 at
  * 1e-6: 0.16). */
-static double bulk_k_bound(double eps, double pressure_ratio)
-{
-    return eps / pressure_ratio + 100 * DBL_EPSILON / eps;
-}
+static double bulk_k_bound(double eps, double pressure_ratio) { return eps / pressure_ratio + 100 * DBL_EPSILON / eps; }
 
 /* Bulk-modulus probe on its CI twin (100 frictional hexapods, strains
  * 1e-10 ... 1e-6, each applied to the same base state at rest, with an
@@ -481,8 +492,10 @@ static void test_bulk_modulus_linear_and_resumable(void **state)
     assert_int_equal(a.s.step, b.s.step);
     assert_memory_equal(a.s.control, b.s.control, sizeof a.s.control);
     assert_memory_equal(a.s.position, b.s.position, a.s.n_particles * sizeof(cd_vec3));
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
     unlink("proto_bulk.h5");
     unlink("proto_bulk_part.h5");
 }

@@ -39,8 +39,7 @@ static void assert_same_particles(const cd_state *a, const cd_state *b)
         if (cd_fields[f].group != CD_GROUP_PARTICLE) continue;
         const void *pa = *(void *const *)((const char *)a + cd_fields[f].offset);
         const void *pb = *(void *const *)((const char *)b + cd_fields[f].offset);
-        if (memcmp(pa, pb, a->n_particles * cd_fields[f].elem_size))
-            fail_msg("column %s differs", cd_fields[f].name);
+        if (memcmp(pa, pb, a->n_particles * cd_fields[f].elem_size)) fail_msg("column %s differs", cd_fields[f].name);
     }
 }
 
@@ -55,8 +54,12 @@ static void test_same_bits_for_one_and_two_threads_and_twice(void **state)
     assert_true(contacts > 10); /* the particles did collide */
     assert_same_particles(&a.s, &b.s);
     assert_same_particles(&b.s, &c.s);
-    cd_sim_free(&a); cd_sim_free(&b); cd_sim_free(&c);
-    cd_config_free(&ca); cd_config_free(&cb); cd_config_free(&cc);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_sim_free(&c);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
+    cd_config_free(&cc);
 }
 
 /* The observables summed where the steps run (cd_sim_observe_step: on the
@@ -89,8 +92,9 @@ static void test_device_observables_equal_host_ones(void **state)
         cd_sim_observe(&sim, &host);
         if (memcmp(&dev, &host, sizeof dev))
             fail_msg("step %lld: observables on the device differ from the host's (elastic %.17g vs %.17g J, "
-                     "kinetic %.17g vs %.17g J, contacts %g vs %g)", sim.s.step, dev.elastic, host.elastic,
-                     dev.kinetic_translational, host.kinetic_translational, dev.n_contacts, host.n_contacts);
+                     "kinetic %.17g vs %.17g J, contacts %g vs %g)",
+                     sim.s.step, dev.elastic, host.elastic, dev.kinetic_translational, host.kinetic_translational,
+                     dev.n_contacts, host.n_contacts);
         contacts += host.n_contacts;
         wall_contacts += host.n_wall_contacts;
     }
@@ -120,8 +124,10 @@ static void test_slot_overflow_changes_nothing(void **state)
     print_message("slots grew from 1 to %d; %zu pair rows\n", (int)b.nb.slot, b.s.n_pairs);
     assert_true(b.nb.slot > 1 && b.s.n_pairs > 0);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
 }
 
 /* Rebuilding the Verlet list every step instead of when the skin is used up
@@ -144,7 +150,10 @@ static void test_history_survives_forced_rebuilds(void **state)
     for (int tries = 0; tries < 1000 && k < 0; tries++) {
         for (size_t r = 0; r < b.s.n_pairs && k < 0; r++)
             if (b.s.pair_active[r] && cd_v3_norm(b.s.pair_shear[r]) > 0) k = (long)r;
-        if (k < 0) { cdt_step(&a, 1); cdt_step(&b, 1); }
+        if (k < 0) {
+            cdt_step(&a, 1);
+            cdt_step(&b, 1);
+        }
     }
     assert_true(k >= 0);
     cd_prim_id pi = b.s.pair_prim_i[k], pj = b.s.pair_prim_j[k];
@@ -171,8 +180,10 @@ static void test_history_survives_forced_rebuilds(void **state)
     cdt_step(&a, 500);
     assert_true(b.nb.builds >= before + 500);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
 }
 
 /* Writes the settling case to cfgpath, runs it to the end into full and
@@ -183,9 +194,15 @@ static void run_full_and_part(const char *cfgpath, const char *full, const char 
     assert_non_null(f);
     fputs(settling, f);
     fclose(f);
-    cd_run_options o1 = {.config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
+    cd_run_options o1 = {
+        .config_path = cfgpath, .output_path = full, .steps = -1, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o1), 0);
-    cd_run_options o2 = {.config_path = cfgpath, .output_path = part, .steps = part_steps, .quiet = 1, .overwrite = 1, .backend = cdt_backend()};
+    cd_run_options o2 = {.config_path = cfgpath,
+                         .output_path = part,
+                         .steps = part_steps,
+                         .quiet = 1,
+                         .overwrite = 1,
+                         .backend = cdt_backend()};
     assert_int_equal(cd_run(&o2), 0);
 }
 
@@ -196,7 +213,8 @@ static void test_resumed_run_equals_uninterrupted(void **state)
     (void)state;
     char cfgpath[] = "det_resume.yaml", full[] = "det_full.h5", part[] = "det_part.h5";
     run_full_and_part(cfgpath, full, part, 1000);
-    cd_run_options o3 = {.config_path = cfgpath, .resume_path = part, .steps = -1, .quiet = 1, .backend = cdt_backend()};
+    cd_run_options o3 = {
+        .config_path = cfgpath, .resume_path = part, .steps = -1, .quiet = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o3), 0);
 
     static cd_sim a, b;
@@ -212,9 +230,13 @@ static void test_resumed_run_equals_uninterrupted(void **state)
     assert_int_equal(a.s.n_pairs, b.s.n_pairs);
     assert_memory_equal(a.s.pair_shear, b.s.pair_shear, a.s.n_pairs * sizeof(cd_vec3));
     assert_int_equal(cd_h5_snapshot_count(full, err, sizeof err), cd_h5_snapshot_count(part, err, sizeof err));
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
-    unlink(cfgpath); unlink(full); unlink(part);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
+    unlink(cfgpath);
+    unlink(full);
+    unlink(part);
 }
 
 /* A run file written before /contacts/pair_force existed (simulated by
@@ -247,7 +269,8 @@ static void test_resumed_file_without_pair_force_equals_uninterrupted(void **sta
         cd_vec3 d = cd_v3_sub(a.s.pair_force[k], b.s.pair_force[k]);
         assert_true(sqrt(cd_v3_norm2(d)) <= 1e-14 * (sqrt(cd_v3_norm2(a.s.pair_force[k])) + 1e-300));
     }
-    cd_run_options o3 = {.config_path = cfgpath, .resume_path = part, .steps = -1, .quiet = 1, .backend = cdt_backend()};
+    cd_run_options o3 = {
+        .config_path = cfgpath, .resume_path = part, .steps = -1, .quiet = 1, .backend = cdt_backend()};
     assert_int_equal(cd_run(&o3), 0);
     if (cd_h5_read_snapshot(full, -1, &a.s, err, sizeof err)) fail_msg("%s", err);
     if (cd_h5_read_snapshot(part, -1, &b.s, err, sizeof err)) fail_msg("%s", err);
@@ -255,9 +278,13 @@ static void test_resumed_file_without_pair_force_equals_uninterrupted(void **sta
     assert_same_particles(&a.s, &b.s);
     assert_int_equal(a.s.n_pairs, b.s.n_pairs);
     assert_memory_equal(a.s.pair_force, b.s.pair_force, a.s.n_pairs * sizeof(cd_vec3));
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
-    unlink(cfgpath); unlink(full); unlink(part);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
+    unlink(cfgpath);
+    unlink(full);
+    unlink(part);
 }
 
 /* Wall candidates (docs/motion.md): a wall that moves into the packing is
@@ -329,14 +356,17 @@ static void test_moving_walls_same_bits_with_rebuild_every_step(void **state)
         wall_contacts += o.n_wall_contacts;
     }
     print_message("%lld rebuilds in 4000 steps (walls moved 4 and 2 mm), %.0f wall contacts seen, %.0f with the piston "
-                  "at the end\n", a.nb.builds - builds0, wall_contacts, piston_contacts(&a));
+                  "at the end\n",
+                  a.nb.builds - builds0, wall_contacts, piston_contacts(&a));
     assert_true(wall_contacts > 100);
     assert_true(piston_contacts(&a) > 0);
     assert_true(a.nb.builds - builds0 > 4); /* the walls' motion alone asks for one every skin/2 */
     assert_true(a.nb.builds - builds0 < 4000);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
 }
 
 int main(void)

@@ -84,12 +84,14 @@ static size_t check_against_brute_force(cd_sim *sim, double box, int dim2, uint6
                 continue;
             }
             if (D > reach) {
-                if (listed) fail_msg("row %zu (%zu, %zu) is listed, its axes %.9g m apart, reach %.9g m", k, i, j, D, reach);
+                if (listed)
+                    fail_msg("row %zu (%zu, %zu) is listed, its axes %.9g m apart, reach %.9g m", k, i, j, D, reach);
                 continue;
             }
             if (!listed)
-                fail_msg("pair (%zu, %zu) (axes %.9g m apart, reach %.9g m) missing: row %zu is (%d, %d)", i, j, D, reach,
-                         k, k < s->n_pairs ? (int)s->pair_prim_i[k] : -1, k < s->n_pairs ? (int)s->pair_prim_j[k] : -1);
+                fail_msg("pair (%zu, %zu) (axes %.9g m apart, reach %.9g m) missing: row %zu is (%d, %d)", i, j, D,
+                         reach, k, k < s->n_pairs ? (int)s->pair_prim_i[k] : -1,
+                         k < s->n_pairs ? (int)s->pair_prim_j[k] : -1);
             k++;
         }
     assert_int_equal(k, s->n_pairs);

@@ -16,12 +16,11 @@
  * rows and wall contacts.  Every sum of the observables is then one block
  * (kernels/observe_items.h), summed in user order.  Seconds on two
  * threads. */
-static const char *pile =
-    "run: {dt: 8.5e-6, steps: 0, seed: 7}\n"
-    "physics: {gravity: [0, -490.5, 0]}\n"
-    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 300, polydispersity: 0.2}]\n"
-    "domain: {type: box, width: 0.06, thickness: 0.06, height: 0.3}\n"
-    "init: {placement: random, exclusion: shape, speed: 0.2}\n";
+static const char *pile = "run: {dt: 8.5e-6, steps: 0, seed: 7}\n"
+                          "physics: {gravity: [0, -490.5, 0]}\n"
+                          "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 300, polydispersity: 0.2}]\n"
+                          "domain: {type: box, width: 0.06, thickness: 0.06, height: 0.3}\n"
+                          "init: {placement: random, exclusion: shape, speed: 0.2}\n";
 
 /* Is column f one a pair row keeps while inactive?  (The point, force,
  * overlap and F_n of an inactive row are whatever its memory row last
@@ -44,7 +43,8 @@ static void assert_same_group(const cd_state *a, const cd_state *b, enum cd_fiel
         for (size_t r = 0; r < n; r++) {
             if (cd_group_pair_rows(g) && !a->pair_active[r] && !kept_inactive(&cd_fields[f])) continue;
             if (memcmp(pa + r * e, pb + r * e, e))
-                fail_msg("step %lld: column %s, row %zu differs between reorder cells and none", step, cd_fields[f].name, r);
+                fail_msg("step %lld: column %s, row %zu differs between reorder cells and none", step,
+                         cd_fields[f].name, r);
         }
     }
 }
@@ -109,8 +109,10 @@ static void check_reorder(int reorder)
      * placement's order, then the cells', which the pile keeps), at
      * every rebuild that changes the cells' order when forced */
     if (!strcmp(cdt_backend(), "omp")) assert_true(a.nb.reorders >= (reorder == CD_NB_REORDER_ALWAYS ? 50 : 1));
-    cd_sim_free(&a); cd_sim_free(&b);
-    cd_config_free(&ca); cd_config_free(&cb);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
 }
 
 static void test_reorder_changes_no_bit(void **state)

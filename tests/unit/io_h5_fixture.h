@@ -17,14 +17,14 @@
 
 #include "io/io_h5.h"
 
-#define NP 5     /* particles */
+#define NP    5  /* particles */
 #define NPRIM 10 /* primitives, two per particle */
-#define NW 2     /* walls */
+#define NW    2  /* walls */
 #define NPAIR 9  /* rows of the pair list */
 
 static const cd_observable_info OBS[2] = {{"energy", "J", 1}, {"momentum", "kg m/s", 3}};
-static const char *CONFIG_TEXT =
-    "run:\n  name: \"io test\"\t# t\xc3\xa4" "b, quote ' and \\\n\nphysics: {dt: 1e-6}\n  \n";
+static const char *CONFIG_TEXT = "run:\n  name: \"io test\"\t# t\xc3\xa4"
+                                 "b, quote ' and \\\n\nphysics: {dt: 1e-6}\n  \n";
 
 /* ---- deterministic random contents ------------------------------------- */
 
@@ -44,10 +44,16 @@ static inline double rand_double(void)
     uint64_t u = next_u64(), bits;
     double d;
     switch (u % 8) {
-    case 0: return -0.0;
-    case 1: bits = (next_u64() & 0x800FFFFFFFFFFFFFULL) | 1; break; /* subnormal */
-    case 2: bits = next_u64(); break;
-    default: return ((double)(next_u64() >> 11) * 0x1.0p-53) * 20.0 - 10.0;
+    case 0:
+        return -0.0;
+    case 1:
+        bits = (next_u64() & 0x800FFFFFFFFFFFFFULL) | 1;
+        break; /* subnormal */
+    case 2:
+        bits = next_u64();
+        break;
+    default:
+        return ((double)(next_u64() >> 11) * 0x1.0p-53) * 20.0 - 10.0;
     }
     memcpy(&d, &bits, sizeof d);
     return d;
@@ -64,8 +70,8 @@ static inline void fill_random(void *col, size_t rows, const cd_field_info *f)
 
 static inline int is_fixed(const char *name)
 {
-    static const char *fixed[] = {"mass", "inertia", "scale", "shape", "prim_first", "prim_count",
-                                  "prim_particle", "prim_a_body", "prim_b_body", "prim_radius"};
+    static const char *fixed[] = {"mass",       "inertia",       "scale",       "shape",       "prim_first",
+                                  "prim_count", "prim_particle", "prim_a_body", "prim_b_body", "prim_radius"};
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
         if (!strcmp(name, fixed[i])) return 1;
     return 0;
@@ -94,9 +100,9 @@ static inline void fill_state(cd_state *s, int j)
     for (int w = 0; w < NW; w++) {
         cd_wall *wl = &s->walls[w];
         wl->type = (cd_int)(next_u64() % 3);
-        double *v[] = {&wl->point.x, &wl->point.y, &wl->point.z, &wl->normal.x, &wl->normal.y, &wl->normal.z,
-                       &wl->velocity.x, &wl->velocity.y, &wl->velocity.z, &wl->radius, &wl->radial_velocity,
-                       &wl->friction};
+        double *v[] = {&wl->point.x,    &wl->point.y,  &wl->point.z,         &wl->normal.x,
+                       &wl->normal.y,   &wl->normal.z, &wl->velocity.x,      &wl->velocity.y,
+                       &wl->velocity.z, &wl->radius,   &wl->radial_velocity, &wl->friction};
         for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) *v[i] = rand_double();
     }
     s->time = j == 0 ? 0.0 : rand_double();

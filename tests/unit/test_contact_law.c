@@ -136,12 +136,9 @@ static void test_params_layout(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_contact_moduli),
-        cmocka_unit_test(test_hertz_normal_force_at_rest),
-        cmocka_unit_test(test_hertz_dashpot),
-        cmocka_unit_test(test_mindlin_tangential_stiffness),
-        cmocka_unit_test(test_mindlin_coulomb_cap),
-        cmocka_unit_test(test_hertz_elastic_energy),
+        cmocka_unit_test(test_contact_moduli),      cmocka_unit_test(test_hertz_normal_force_at_rest),
+        cmocka_unit_test(test_hertz_dashpot),       cmocka_unit_test(test_mindlin_tangential_stiffness),
+        cmocka_unit_test(test_mindlin_coulomb_cap), cmocka_unit_test(test_hertz_elastic_energy),
         cmocka_unit_test(test_params_layout),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

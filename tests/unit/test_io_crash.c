@@ -26,8 +26,8 @@ enum scenario { NEW_RUN, REPLACE_RUN, RESUME_RUN };
 #ifndef SWEEP_STRIDE
 #define SWEEP_STRIDE 1
 #endif
-#define NEW_SNAPS 3   /* snapshots the writer adds */
-#define OLD_SNAPS 3   /* snapshots of the file that REPLACE_RUN replaces and RESUME_RUN resumes */
+#define NEW_SNAPS   3 /* snapshots the writer adds */
+#define OLD_SNAPS   3 /* snapshots of the file that REPLACE_RUN replaces and RESUME_RUN resumes */
 #define RESUME_KEEP 2 /* snapshots RESUME_RUN keeps (it resumes at step 100) */
 
 /* Contents of snapshot j: seed j in the file written before (write_run),

@@ -51,8 +51,8 @@ static void test_point_contact_equals_general_path(void **state)
     rng_state = 4242;
     for (int i = 0; i < 20000; i++) {
         cd_vec3 p = rng_vec(0.01), q = cd_v3_add(p, rng_vec(0.006));
-        if (i % 97 == 0) q = p;                                /* coincident centres */
-        if (i % 89 == 0) p = cd_v3(-0.0, p.y, -0.0);           /* signed zeros */
+        if (i % 97 == 0) q = p;                      /* coincident centres */
+        if (i % 89 == 0) p = cd_v3(-0.0, p.y, -0.0); /* signed zeros */
         double ri = 0.001 + 0.002 * rng_u(), rj = 0.001 + 0.002 * rng_u();
         cd_contact_geom want, got;
         memset(&got, 0, sizeof got);

@@ -17,7 +17,7 @@
 #include "io/io_h5_layout.h"
 
 #define BEGIN_MARK "# ---- BEGIN GENERATED"
-#define END_MARK "# ---- END GENERATED"
+#define END_MARK   "# ---- END GENERATED"
 
 static const char *store_name(enum cdh5_store st)
 {
@@ -36,12 +36,14 @@ static void write_block(FILE *o)
 {
     static const char *const group_names[CD_GROUP_COUNT] = {"particle", "prim", "pair", "wallc", "pair_out"};
     char key[64];
-    fprintf(o, "%s from kernels/runfile.def and kernels/fields.def by tests/unit/test_runfile_layout.c\n"
-               "# (build/tests/test_runfile_layout --write host/capdem_h5.py); edit the tables, not this block.\n",
+    fprintf(o,
+            "%s from kernels/runfile.def and kernels/fields.def by tests/unit/test_runfile_layout.c\n"
+            "# (build/tests/test_runfile_layout --write host/capdem_h5.py); edit the tables, not this block.\n",
             BEGIN_MARK);
     fprintf(o, "# groups and datasets that are not columns: key -> absolute path\nPATH = {\n");
-#define CD_H5_GROUP(id, path, made, meaning) lower(key, #id, sizeof key), fprintf(o, "    \"%s\": \"%s\",\n", key, path);
-#define CD_H5_DATASET(id, path, type, unit, meaning) \
+#define CD_H5_GROUP(id, path, made, meaning)                                                                           \
+    lower(key, #id, sizeof key), fprintf(o, "    \"%s\": \"%s\",\n", key, path);
+#define CD_H5_DATASET(id, path, type, unit, meaning)                                                                   \
     lower(key, #id, sizeof key), fprintf(o, "    \"%s\": \"%s\",\n", key, path);
 #include "../kernels/runfile.def"
     fprintf(o, "}\n# link and attribute names: key -> name\nNAME = {\n");
@@ -58,8 +60,9 @@ static void write_block(FILE *o)
                 group_names[f->group], f->ncomp, f->unit);
     }
     fprintf(o, "}\n# members of the compound /walls/value: (name, type, components, unit)\nWALL_MEMBERS = (\n");
-#define CD_H5_WALL_MEMBER(name, type, ncomp, unit) \
-    fprintf(o, "    (\"%s\", \"%s\", %d, \"%s\"),\n", #name, CD_KIND_##type == CD_KIND_INT ? "int32" : "float64", ncomp, unit);
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                                                     \
+    fprintf(o, "    (\"%s\", \"%s\", %d, \"%s\"),\n", #name, CD_KIND_##type == CD_KIND_INT ? "int32" : "float64",      \
+            ncomp, unit);
 #include "../kernels/runfile.def"
     fprintf(o, ")\n# wall kinds: the member type of /walls/value\n");
 #define CD_H5_WALL_KIND(id, value, name) fprintf(o, "WALL_%s = %d\n", #id, value);
@@ -136,7 +139,8 @@ static void test_python_module_is_generated(void **state)
         int line = 1;
         for (; *a && *a == *b; a++, b++) line += *a == '\n';
         fail_msg("%s differs from kernels/runfile.def + fields.def from line %d: regenerate it with "
-                 "build/tests/test_runfile_layout --write host/capdem_h5.py", path, line);
+                 "build/tests/test_runfile_layout --write host/capdem_h5.py",
+                 path, line);
     }
     free(want);
     free(block);
@@ -203,18 +207,18 @@ static void test_written_file_matches_table(void **state)
     assert_int_equal(cd_output_close(o), 0);
     hid_t f = cdh5_open_ro(path, err, sizeof err);
     if (f < 0) fail_msg("%s", err);
-    /* groups (the optional ones only some files have) */
-#define CD_H5_GROUP(id, path, made, meaning) \
+        /* groups (the optional ones only some files have) */
+#define CD_H5_GROUP(id, path, made, meaning)                                                                           \
     if (strcmp(#made, "OPTIONAL") && !cdh5_exists(f, path)) fail_msg("group %s (%s) is missing", path, #id);
 #include "../kernels/runfile.def"
-    /* datasets: type and unit */
-#define CD_H5_DATASET(id, path, type, unit, meaning)                   \
-    {                                                                  \
-        hid_t d = cdh5_exists(f, path) ? H5Dopen2(f, path, H5P_DEFAULT) : -1; \
-        if (d < 0) fail_msg("dataset %s (%s) is missing", path, #id);   \
-        check_type(d, path, #type);                                    \
-        check_unit(d, path, unit);                                     \
-        H5Dclose(d);                                                   \
+        /* datasets: type and unit */
+#define CD_H5_DATASET(id, path, type, unit, meaning)                                                                   \
+    {                                                                                                                  \
+        hid_t d = cdh5_exists(f, path) ? H5Dopen2(f, path, H5P_DEFAULT) : -1;                                          \
+        if (d < 0) fail_msg("dataset %s (%s) is missing", path, #id);                                                  \
+        check_type(d, path, #type);                                                                                    \
+        check_unit(d, path, unit);                                                                                     \
+        H5Dclose(d);                                                                                                   \
     }
 #include "../kernels/runfile.def"
     /* columns */
@@ -230,12 +234,12 @@ static void test_written_file_matches_table(void **state)
     /* the wall compound: the table's members, in its order, as stored */
     hid_t d = H5Dopen2(f, CDH5_PATH(WALLS_VALUE), H5P_DEFAULT), t = H5Dget_type(d);
     int m = 0;
-#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                       \
-    {                                                                                   \
-        char *got = H5Tget_member_name(t, (unsigned)m);                                 \
-        if (!got || strcmp(got, #name)) fail_msg("/walls/value member %d is %s, the table says %s", m, got, #name); \
-        H5free_memory(got);                                                             \
-        m++;                                                                            \
+#define CD_H5_WALL_MEMBER(name, type, ncomp, unit)                                                                     \
+    {                                                                                                                  \
+        char *got = H5Tget_member_name(t, (unsigned)m);                                                                \
+        if (!got || strcmp(got, #name)) fail_msg("/walls/value member %d is %s, the table says %s", m, got, #name);    \
+        H5free_memory(got);                                                                                            \
+        m++;                                                                                                           \
     }
 #include "../kernels/runfile.def"
     assert_int_equal(H5Tget_nmembers(t), m);

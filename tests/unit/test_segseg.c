@@ -23,8 +23,7 @@ static cd_vec3 rng_dyadic_vec(void) { return cd_v3(rng_dyadic(), rng_dyadic(), r
 static cd_vec3 rng_dyadic_nonzero_vec(void)
 {
     cd_vec3 v;
-    do
-        v = rng_dyadic_vec();
+    do v = rng_dyadic_vec();
     while (cd_v3_norm2(v) < 0.01);
     return v;
 }
@@ -34,11 +33,25 @@ static cd_vec3 rng_dyadic_nonzero_vec(void)
  * so G(s) = min_t |P(s) - Q(t)|^2 is exact; G is convex, and a golden-section
  * search in long double (80-bit on x86) over s converges far below double
  * rounding.  Independent of the algorithm under test. */
-typedef struct { long double x, y, z; } lvec;
-static lvec lv(cd_vec3 v) { lvec r = {v.x, v.y, v.z}; return r; }
+typedef struct {
+    long double x, y, z;
+} lvec;
+static lvec lv(cd_vec3 v)
+{
+    lvec r = {v.x, v.y, v.z};
+    return r;
+}
 static long double ldot(lvec a, lvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static lvec lsub(lvec a, lvec b) { lvec r = {a.x - b.x, a.y - b.y, a.z - b.z}; return r; }
-static lvec laxpy(lvec a, long double s, lvec b) { lvec r = {a.x + s * b.x, a.y + s * b.y, a.z + s * b.z}; return r; }
+static lvec lsub(lvec a, lvec b)
+{
+    lvec r = {a.x - b.x, a.y - b.y, a.z - b.z};
+    return r;
+}
+static lvec laxpy(lvec a, long double s, lvec b)
+{
+    lvec r = {a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
+    return r;
+}
 
 static long double ref_G(lvec p0, lvec d1, lvec q0, lvec d2, long double s)
 {
@@ -68,11 +81,15 @@ static double ref_distance(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1)
     if (g1 < best) best = g1;
     for (it = 0; it < 150; it++) {
         if (f1 <= f2) {
-            hi = x2; x2 = x1; f2 = f1;
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
             x1 = hi - gr * (hi - lo);
             f1 = ref_G(P0, D1, Q0, D2, x1);
         } else {
-            lo = x1; x1 = x2; f1 = f2;
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
             x2 = lo + gr * (hi - lo);
             f2 = ref_G(P0, D1, Q0, D2, x2);
         }
@@ -84,15 +101,32 @@ static double ref_distance(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1)
 
 /* ---- random cases ------------------------------------------------------ */
 enum {
-    CASE_GENERIC, CASE_PARALLEL, CASE_NEAR_PARALLEL, CASE_NEAR_PARALLEL_CROSSING, CASE_OTHER_ANGLES,
-    CASE_COLLINEAR_OVERLAP, CASE_COLLINEAR_DISJOINT, CASE_POINT_I, CASE_POINT_J, CASE_POINT_BOTH,
-    CASE_CROSSING, CASE_SHORT_LONG, CASE_COUNT
+    CASE_GENERIC,
+    CASE_PARALLEL,
+    CASE_NEAR_PARALLEL,
+    CASE_NEAR_PARALLEL_CROSSING,
+    CASE_OTHER_ANGLES,
+    CASE_COLLINEAR_OVERLAP,
+    CASE_COLLINEAR_DISJOINT,
+    CASE_POINT_I,
+    CASE_POINT_J,
+    CASE_POINT_BOTH,
+    CASE_CROSSING,
+    CASE_SHORT_LONG,
+    CASE_COUNT
 };
-static const char *case_name[CASE_COUNT] = {
-    "generic", "exactly parallel", "nearly parallel 1e-9 rad", "nearly parallel crossing 1e-9 rad",
-    "angles 1e-5..1e-15 rad", "collinear overlapping", "collinear disjoint", "zero-length i", "zero-length j",
-    "zero-length both", "crossing (D = 0)", "length ratio 1e-7"
-};
+static const char *case_name[CASE_COUNT] = {"generic",
+                                            "exactly parallel",
+                                            "nearly parallel 1e-9 rad",
+                                            "nearly parallel crossing 1e-9 rad",
+                                            "angles 1e-5..1e-15 rad",
+                                            "collinear overlapping",
+                                            "collinear disjoint",
+                                            "zero-length i",
+                                            "zero-length j",
+                                            "zero-length both",
+                                            "crossing (D = 0)",
+                                            "length ratio 1e-7"};
 
 /* rotate v by angle th about the unit axis k (Rodrigues, k perpendicular to v) */
 static cd_vec3 rotate_perp(cd_vec3 v, cd_vec3 k, double th)
@@ -102,8 +136,7 @@ static cd_vec3 rotate_perp(cd_vec3 v, cd_vec3 k, double th)
 static cd_vec3 random_perp_unit(cd_vec3 v)
 {
     cd_vec3 c;
-    do
-        c = cd_v3_cross(v, rng_vec(1.0));
+    do c = cd_v3_cross(v, rng_vec(1.0));
     while (cd_v3_norm(c) < 1e-3);
     return cd_v3_scale(c, 1.0 / cd_v3_norm(c));
 }
@@ -119,16 +152,24 @@ static void make_case(int kind, cd_vec3 *p0, cd_vec3 *p1, cd_vec3 *q0, cd_vec3 *
     double th;
     switch (kind) {
     case CASE_GENERIC:
-        *p0 = rng_vec(1); *p1 = rng_vec(1); *q0 = rng_vec(1); *q1 = rng_vec(1);
+        *p0 = rng_vec(1);
+        *p1 = rng_vec(1);
+        *q0 = rng_vec(1);
+        *q1 = rng_vec(1);
         break;
     case CASE_PARALLEL:
-        *p0 = rng_dyadic_vec(); d1 = rng_dyadic_nonzero_vec(); *p1 = cd_v3_add(*p0, d1);
-        *q0 = rng_dyadic_vec(); *q1 = cd_v3_add(*q0, cd_v3_scale(d1, rng_ratio()));
+        *p0 = rng_dyadic_vec();
+        d1 = rng_dyadic_nonzero_vec();
+        *p1 = cd_v3_add(*p0, d1);
+        *q0 = rng_dyadic_vec();
+        *q1 = cd_v3_add(*q0, cd_v3_scale(d1, rng_ratio()));
         break;
     case CASE_NEAR_PARALLEL:
     case CASE_NEAR_PARALLEL_CROSSING:
     case CASE_OTHER_ANGLES:
-        *p0 = rng_vec(1); d1 = rng_vec(1); *p1 = cd_v3_add(*p0, d1);
+        *p0 = rng_vec(1);
+        d1 = rng_vec(1);
+        *p1 = cd_v3_add(*p0, d1);
         k = random_perp_unit(d1);
         th = 1e-9;
         if (kind == CASE_OTHER_ANGLES) th = pow(10.0, -5.0 - 10.0 * rng_u());
@@ -144,40 +185,67 @@ static void make_case(int kind, cd_vec3 *p0, cd_vec3 *p1, cd_vec3 *q0, cd_vec3 *
     case CASE_COLLINEAR_OVERLAP:
     case CASE_COLLINEAR_DISJOINT: {
         double mu, kk;
-        *p0 = rng_dyadic_vec(); d1 = rng_dyadic_nonzero_vec(); *p1 = cd_v3_add(*p0, d1);
+        *p0 = rng_dyadic_vec();
+        d1 = rng_dyadic_nonzero_vec();
+        *p1 = cd_v3_add(*p0, d1);
         if (kind == CASE_COLLINEAR_OVERLAP) {
             mu = (double)(rng_next() % 9) / 8.0; /* q0 on segment i */
             kk = rng_ratio();
         } else {
             mu = 1.0 + (double)(1 + rng_next() % 8) / 8.0; /* beyond p1 ... */
-            kk = 0.25 + (double)(rng_next() % 4) / 4.0;   /* ... pointing away */
-            if (rng_next() & 1) { mu = -mu + 1.0; kk = -kk; } /* or before p0 */
+            kk = 0.25 + (double)(rng_next() % 4) / 4.0;    /* ... pointing away */
+            if (rng_next() & 1) {
+                mu = -mu + 1.0;
+                kk = -kk;
+            } /* or before p0 */
         }
         *q0 = cd_v3_axpy(*p0, mu, d1);
         *q1 = cd_v3_axpy(*q0, kk, d1);
         break;
     }
     case CASE_POINT_I:
-        *p0 = rng_vec(1); *p1 = *p0; *q0 = rng_vec(1); *q1 = rng_vec(1);
+        *p0 = rng_vec(1);
+        *p1 = *p0;
+        *q0 = rng_vec(1);
+        *q1 = rng_vec(1);
         break;
     case CASE_POINT_J:
-        *p0 = rng_vec(1); *p1 = rng_vec(1); *q0 = rng_vec(1); *q1 = *q0;
+        *p0 = rng_vec(1);
+        *p1 = rng_vec(1);
+        *q0 = rng_vec(1);
+        *q1 = *q0;
         break;
     case CASE_POINT_BOTH:
-        *p0 = rng_vec(1); *p1 = *p0; *q0 = rng_vec(1); *q1 = *q0;
+        *p0 = rng_vec(1);
+        *p1 = *p0;
+        *q0 = rng_vec(1);
+        *q1 = *q0;
         if (rng_next() % 4 == 0) *q0 = *q1 = *p0;
         break;
     case CASE_CROSSING: {
         /* exact intersection: X = p0 + s d1 = q0 + t d2 with dyadic s, t */
         double s = (double)(rng_next() % 9) / 8.0, t = (double)(rng_next() % 9) / 8.0;
-        X = rng_dyadic_vec(); d1 = rng_dyadic_nonzero_vec(); d2 = rng_dyadic_nonzero_vec();
-        *p0 = cd_v3_axpy(X, -s, d1); *p1 = cd_v3_add(*p0, d1);
-        *q0 = cd_v3_axpy(X, -t, d2); *q1 = cd_v3_add(*q0, d2);
+        X = rng_dyadic_vec();
+        d1 = rng_dyadic_nonzero_vec();
+        d2 = rng_dyadic_nonzero_vec();
+        *p0 = cd_v3_axpy(X, -s, d1);
+        *p1 = cd_v3_add(*p0, d1);
+        *q0 = cd_v3_axpy(X, -t, d2);
+        *q1 = cd_v3_add(*q0, d2);
         break;
     }
     case CASE_SHORT_LONG:
-        *p0 = rng_vec(1); *p1 = cd_v3_add(*p0, rng_vec(1e-7)); *q0 = rng_vec(1); *q1 = rng_vec(1);
-        if (rng_next() & 1) { cd_vec3 tmp0 = *p0, tmp1 = *p1; *p0 = *q0; *p1 = *q1; *q0 = tmp0; *q1 = tmp1; }
+        *p0 = rng_vec(1);
+        *p1 = cd_v3_add(*p0, rng_vec(1e-7));
+        *q0 = rng_vec(1);
+        *q1 = rng_vec(1);
+        if (rng_next() & 1) {
+            cd_vec3 tmp0 = *p0, tmp1 = *p1;
+            *p0 = *q0;
+            *p1 = *q1;
+            *q0 = tmp0;
+            *q1 = tmp1;
+        }
         break;
     default:
         break;
@@ -403,8 +471,7 @@ static void test_reversing_an_axis_changes_nothing(void **state)
             assert_true(fabs(g.distance - h.distance) < 1e-15);
             assert_int_equal(g.parallel, h.parallel);
             assert_true(len(g.point, h.point) < 1e-14);
-            if (g.distance > 1e-9)
-                assert_true(len(g.normal, h.normal) < 1e-9);
+            if (g.distance > 1e-9) assert_true(len(g.normal, h.normal) < 1e-9);
         }
     }
 }
@@ -584,10 +651,8 @@ static void kernels_dir(char *buf, size_t n)
         /* __FILE__ = <root>/tests/unit/test_segseg.c */
         const char *f = __FILE__;
         const char *cut = strstr(f, "tests/unit/test_segseg.c");
-        if (cut)
-            snprintf(buf, n, "%.*skernels", (int)(cut - f), f);
-        else
-            snprintf(buf, n, "kernels");
+        if (cut) snprintf(buf, n, "%.*skernels", (int)(cut - f), f);
+        else snprintf(buf, n, "kernels");
     }
 }
 
@@ -602,7 +667,8 @@ static void test_headers_compile_as_opencl_c_1_2(void **state)
     const char *clang = system("command -v clang-14 > /dev/null 2>&1") == 0 ? "clang-14"
                         : system("command -v clang > /dev/null 2>&1") == 0  ? "clang"
                                                                             : NULL;
-    if (!clang) fail_msg("neither clang-14 nor clang found: install clang-14 (.ci/install-deps) for the OpenCL C check");
+    if (!clang)
+        fail_msg("neither clang-14 nor clang found: install clang-14 (.ci/install-deps) for the OpenCL C check");
     kernels_dir(dir, sizeof dir);
     snprintf(cmd, sizeof cmd,
              "%s -x cl -cl-std=CL1.2 -Xclang -finclude-default-header -fsyntax-only -Wall -Wextra -Werror "

@@ -37,15 +37,23 @@ static void sort3(double *v)
 {
     for (int i = 0; i < 3; i++)
         for (int j = i + 1; j < 3; j++)
-            if (v[j] < v[i]) { double t = v[i]; v[i] = v[j]; v[j] = t; }
+            if (v[j] < v[i]) {
+                double t = v[i];
+                v[i] = v[j];
+                v[j] = t;
+            }
 }
 
 /* Arms of a named shape as plain arrays (for the numeric path). */
 static int arms_of(const cd_shape *s, double a[][3], double b[][3], double *r)
 {
     for (int k = 0; k < s->n_prims; k++) {
-        a[k][0] = s->a[k].x; a[k][1] = s->a[k].y; a[k][2] = s->a[k].z;
-        b[k][0] = s->b[k].x; b[k][1] = s->b[k].y; b[k][2] = s->b[k].z;
+        a[k][0] = s->a[k].x;
+        a[k][1] = s->a[k].y;
+        a[k][2] = s->a[k].z;
+        b[k][0] = s->b[k].x;
+        b[k][1] = s->b[k].y;
+        b[k][2] = s->b[k].z;
         r[k] = s->radius[k];
     }
     return s->n_prims;
@@ -133,7 +141,7 @@ static void test_closed_forms_agree_with_numeric_for_aspect_at_least_2(void **st
             double a[3][3], b[3][3], r[3];
             int n = arms_of(&s, a, b, r);
             cd_union_props p;
-            assert_int_equal(cd_shapes_union_numeric(n, (const double (*)[3])a, (const double (*)[3])b, r, &p), 0);
+            assert_int_equal(cd_shapes_union_numeric(n, (const double(*)[3])a, (const double(*)[3])b, r, &p), 0);
             snprintf(what, sizeof what, "%s aspect %g volume", kinds[k], aspects[q]);
             check_rel(p.volume, s.volume, 1e-10, what);
             assert_true(fabs(p.volume - s.volume) / s.volume <= p.volume_rel_error + 1e-12);
@@ -179,7 +187,10 @@ static void test_short_arms_agree_with_monte_carlo(void **state)
                 for (int j = 0; j < n && !in; j++) in = dist2_to_segment(p, a[j], b[j]) < r[j] * r[j];
                 if (!in) continue;
                 double f[3] = {1, p[0] * p[0], p[2] * p[2]};
-                for (int c = 0; c < 3; c++) { m[c] += f[c]; m2[c] += f[c] * f[c]; }
+                for (int c = 0; c < 3; c++) {
+                    m[c] += f[c];
+                    m2[c] += f[c] * f[c];
+                }
             }
             /* numeric: V, int x^2 dV = (I_yy + I_zz - I_xx) / (2 rho), same for z */
             const double I0 = s.principal[0], I1 = s.principal[1], I2 = s.principal[2];
@@ -203,12 +214,12 @@ static void test_short_arms_agree_with_monte_carlo(void **state)
 static void area_matches_volume_derivative(int n, double a[][3], double b[][3], const double *r, const char *what)
 {
     cd_union_props p, q[4];
-    assert_int_equal(cd_shapes_union_numeric(n, (const double (*)[3])a, (const double (*)[3])b, r, &p), 0);
+    assert_int_equal(cd_shapes_union_numeric(n, (const double(*)[3])a, (const double(*)[3])b, r, &p), 0);
     const double h = 1e-3 * r[0], steps[4] = {1, -1, 2, -2};
     for (int s = 0; s < 4; s++) {
         double rr[CD_MAX_ARMS];
         for (int k = 0; k < n; k++) rr[k] = r[k] + steps[s] * h;
-        assert_int_equal(cd_shapes_union_numeric(n, (const double (*)[3])a, (const double (*)[3])b, rr, &q[s]), 0);
+        assert_int_equal(cd_shapes_union_numeric(n, (const double(*)[3])a, (const double(*)[3])b, rr, &q[s]), 0);
     }
     double dvdr = (8 * (q[0].volume - q[1].volume) - (q[2].volume - q[3].volume)) / (12 * h);
     check_rel(p.area, dvdr, 1e-8, what);
@@ -241,7 +252,7 @@ static void test_irregular_cluster_area_and_volume_are_consistent(void **state)
     double r[5] = {0.3, 0.25, 0.35, 0.2, 0.45}; /* the last is a ball */
     area_matches_volume_derivative(5, a, b, r, "irregular cluster area vs dV/dr");
     cd_union_props p;
-    assert_int_equal(cd_shapes_union_numeric(5, (const double (*)[3])a, (const double (*)[3])b, r, &p), 0);
+    assert_int_equal(cd_shapes_union_numeric(5, (const double(*)[3])a, (const double(*)[3])b, r, &p), 0);
     uint64_t seed = 7;
     const double lo[3] = {-1.5, -1.7, -1.3}, hi[3] = {2.0, 1.9, 1.6}; /* box holding every arm [m] */
     const double box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
@@ -251,7 +262,10 @@ static void test_irregular_cluster_area_and_volume_are_consistent(void **state)
         double x[3];
         for (int c = 0; c < 3; c++) x[c] = lo[c] + (hi[c] - lo[c]) * uniform01(&seed);
         for (int j = 0; j < 5; j++)
-            if (dist2_to_segment(x, a[j], b[j]) < r[j] * r[j]) { hits++; break; }
+            if (dist2_to_segment(x, a[j], b[j]) < r[j] * r[j]) {
+                hits++;
+                break;
+            }
     }
     double f = (double)hits / N;
     check_abs(p.volume, box * f, 4 * box * sqrt(f * (1 - f) / N), "irregular cluster volume (Monte Carlo, 4 sigma)");
@@ -268,7 +282,9 @@ static void test_irregular_cluster_area_and_volume_are_consistent(void **state)
 static void test_sphericity_matches_table_S1(void **state)
 {
     (void)state;
-    static const struct { double alpha, cross, star, cross_ours, star_ours; } rows[] = {
+    static const struct {
+        double alpha, cross, star, cross_ours, star_ours;
+    } rows[] = {
         {1.1, 0.995, 0.995, 0.998, 0.999}, {1.7, 0.933, 0.933, 0.933, 0.933}, {2.25, 0.842, 0.809, 0.842, 0.809},
         {3, 0.754, 0.702, 0.754, 0.702},   {4, 0.677, 0.619, 0.677, 0.619},   {6, 0.585, 0.526, 0.585, 0.526},
         {8.5, 0.518, 0.462, 0.518, 0.461}, {11, 0.473, 0.419, 0.473, 0.419},
@@ -359,7 +375,8 @@ static void test_tilted_offset_rod_gives_rod_principal_moments(void **state)
     assert_int_equal(cd_shape_make_named("rod", 4.0, 0.003, 1500, &rod, err, sizeof err), 0);
     double a[1][3], b[1][3], r[1];
     moved_arms(&rod, a, b, r);
-    assert_int_equal(cd_shape_make_segments(1, (const double (*)[3])a, (const double (*)[3])b, r, 1500, &seg, err, sizeof err), 0);
+    assert_int_equal(
+        cd_shape_make_segments(1, (const double(*)[3])a, (const double(*)[3])b, r, 1500, &seg, err, sizeof err), 0);
     assert_string_equal(seg.kind, "segments");
     for (int i = 0; i < 3; i++) check_rel(seg.principal[i], rod.principal[i], 1e-13, "rod principal moment");
     check_rel(seg.volume, rod.volume, 1e-14, "rod volume");
@@ -383,7 +400,8 @@ static void test_moved_cross_and_hexapod_match_closed_forms(void **state)
         assert_int_equal(cd_shape_make_named(kinds[k], 3.0, 0.002, 800, &named, err, sizeof err), 0);
         double a[3][3], b[3][3], r[3];
         int n = moved_arms(&named, a, b, r);
-        assert_int_equal(cd_shape_make_segments(n, (const double (*)[3])a, (const double (*)[3])b, r, 800, &seg, err, sizeof err), 0);
+        assert_int_equal(
+            cd_shape_make_segments(n, (const double(*)[3])a, (const double(*)[3])b, r, 800, &seg, err, sizeof err), 0);
         check_rel(seg.volume, named.volume, 1e-10, "moved shape volume");
         check_rel(seg.area, named.area, 1e-10, "moved shape area");
         double pn[3], ps[3];
@@ -412,17 +430,21 @@ static void test_tripod_is_centred_and_principal(void **state)
     const double tips[3][3] = {{0.03, 0.0, 0.004}, {-0.012, 0.021, 0.0}, {-0.006, -0.015, 0.017}};
     double a[3][3], b[3][3], r[3] = {0.004, 0.003, 0.0035};
     for (int k = 0; k < 3; k++)
-        for (int i = 0; i < 3; i++) { a[k][i] = o[i]; b[k][i] = o[i] + tips[k][i]; }
+        for (int i = 0; i < 3; i++) {
+            a[k][i] = o[i];
+            b[k][i] = o[i] + tips[k][i];
+        }
     cd_shape s;
     char err[256];
-    assert_int_equal(cd_shape_make_segments(3, (const double (*)[3])a, (const double (*)[3])b, r, 1000, &s, err, sizeof err), 0);
+    assert_int_equal(
+        cd_shape_make_segments(3, (const double(*)[3])a, (const double(*)[3])b, r, 1000, &s, err, sizeof err), 0);
     assert_true(s.volume_rel_error > 0 && s.volume_rel_error < 1e-6);
     assert_true(s.principal[0] <= s.principal[1] && s.principal[1] <= s.principal[2]);
     assert_true(s.inertia[0][1] == 0 && s.inertia[0][2] == 0 && s.inertia[1][2] == 0);
     double a2[3][3], b2[3][3], r2[3];
     arms_of(&s, a2, b2, r2);
     cd_union_props p;
-    assert_int_equal(cd_shapes_union_numeric(3, (const double (*)[3])a2, (const double (*)[3])b2, r2, &p), 0);
+    assert_int_equal(cd_shapes_union_numeric(3, (const double(*)[3])a2, (const double(*)[3])b2, r2, &p), 0);
     const double size = s.bounding_radius, tr = p.central[0][0] + p.central[1][1] + p.central[2][2];
     for (int i = 0; i < 3; i++) {
         check_abs(p.com[i], 0, 1e-10 * size, "tripod centre of mass at the origin");
@@ -463,10 +485,10 @@ static void test_shared_surfaces_are_counted_once(void **state)
     double sa[2][3] = {{-h, 0, 0}, {0, 0, 0}}, sb[2][3] = {{0, 0, 0}, {h, 0, 0}};
     double oa[2][3] = {{-0.6, 0, 0}, {0.6, 0, 0}}, ob[2][3] = {{h, 0, 0}, {-h, 0, 0}};
     cd_union_props p;
-    assert_int_equal(cd_shapes_union_numeric(2, (const double (*)[3])sa, (const double (*)[3])sb, ra, &p), 0);
+    assert_int_equal(cd_shapes_union_numeric(2, (const double(*)[3])sa, (const double(*)[3])sb, ra, &p), 0);
     check_rel(p.volume, rod.volume, 1e-12, "split rod volume");
     check_rel(p.area, rod.area, 1e-12, "split rod area");
-    assert_int_equal(cd_shapes_union_numeric(2, (const double (*)[3])oa, (const double (*)[3])ob, ra, &p), 0);
+    assert_int_equal(cd_shapes_union_numeric(2, (const double(*)[3])oa, (const double(*)[3])ob, ra, &p), 0);
     check_rel(p.volume, rod.volume, 1e-12, "overlapping collinear rods volume");
     check_rel(p.area, rod.area, 1e-12, "overlapping collinear rods area");
     check_rel(p.central[0][0], (rod.principal[1] + rod.principal[2] - rod.principal[0]) / 2, 1e-12,
@@ -475,8 +497,8 @@ static void test_shared_surfaces_are_counted_once(void **state)
     double ta[3][3] = {{0}}, tb[3][3] = {{1.5, 0.2, 0}, {-0.5, 1.2, 0.3}, {-0.4, -0.9, 0.8}}, tr[3] = {0.5, 0.5, 0.5};
     double ub[3][3] = {{-0.4, -0.9, 0.8}, {1.5, 0.2, 0}, {-0.5, 1.2, 0.3}};
     cd_union_props q;
-    assert_int_equal(cd_shapes_union_numeric(3, (const double (*)[3])ta, (const double (*)[3])tb, tr, &p), 0);
-    assert_int_equal(cd_shapes_union_numeric(3, (const double (*)[3])ta, (const double (*)[3])ub, tr, &q), 0);
+    assert_int_equal(cd_shapes_union_numeric(3, (const double(*)[3])ta, (const double(*)[3])tb, tr, &p), 0);
+    assert_int_equal(cd_shapes_union_numeric(3, (const double(*)[3])ta, (const double(*)[3])ub, tr, &q), 0);
     /* each result is within its own bound (~1e-10) of the truth */
     check_rel(q.volume, p.volume, 2 * p.volume_rel_error, "tripod volume independent of arm order");
     check_rel(q.area, p.area, 2 * p.area_rel_error, "tripod area independent of arm order");
@@ -489,7 +511,10 @@ static void test_shared_surfaces_are_counted_once(void **state)
         double x[3];
         for (int c = 0; c < 3; c++) x[c] = lo + (hi - lo) * uniform01(&seed);
         for (int j = 0; j < 3; j++)
-            if (dist2_to_segment(x, ta[j], tb[j]) < tr[j] * tr[j]) { hits++; break; }
+            if (dist2_to_segment(x, ta[j], tb[j]) < tr[j] * tr[j]) {
+                hits++;
+                break;
+            }
     }
     double box = pow(hi - lo, 3), f = (double)hits / N;
     check_abs(p.volume, box * f, 4 * box * sqrt(f * (1 - f) / N), "tripod volume (Monte Carlo, 4 sigma)");
@@ -527,7 +552,10 @@ static void test_species_dispatch_on_shape(void **state)
     sp.n_segments = 2;
     const double a[2][3] = {{-0.01, 0, 0}, {0, -0.006, 0.002}}, b[2][3] = {{0.01, 0, 0}, {0, 0.006, 0.002}};
     for (int k = 0; k < 2; k++)
-        for (int i = 0; i < 3; i++) { sp.seg_a[k][i] = a[k][i]; sp.seg_b[k][i] = b[k][i]; }
+        for (int i = 0; i < 3; i++) {
+            sp.seg_a[k][i] = a[k][i];
+            sp.seg_b[k][i] = b[k][i];
+        }
     sp.seg_radius[0] = 0.002;
     sp.seg_radius[1] = 0.0015;
     assert_int_equal(cd_shape_from_species(&sp, 900, &s1, err, sizeof err), 0);
@@ -558,14 +586,17 @@ static void test_invalid_parameters_are_rejected_with_a_message(void **state)
     expect_error(cd_shape_make_named("blob", 3.0, 0.01, 1000, &s, err, sizeof err), err, "blob", "hexapod");
     expect_error(cd_shape_make_named("hexapod", NAN, 0.01, 1000, &s, err, sizeof err), err, "aspect", "nan");
     double a[CD_MAX_ARMS + 1][3] = {{0}}, b[CD_MAX_ARMS + 1][3] = {{0}}, r[CD_MAX_ARMS + 1];
-    for (int k = 0; k <= CD_MAX_ARMS; k++) { b[k][0] = 1; r[k] = 0.1; }
-    expect_error(cd_shape_make_segments(CD_MAX_ARMS + 1, (const double (*)[3])a, (const double (*)[3])b, r, 1000, &s, err,
+    for (int k = 0; k <= CD_MAX_ARMS; k++) {
+        b[k][0] = 1;
+        r[k] = 0.1;
+    }
+    expect_error(cd_shape_make_segments(CD_MAX_ARMS + 1, (const double(*)[3])a, (const double(*)[3])b, r, 1000, &s, err,
                                         sizeof err),
                  err, "17", "expected 1 to 16");
-    expect_error(cd_shape_make_segments(0, (const double (*)[3])a, (const double (*)[3])b, r, 1000, &s, err, sizeof err),
+    expect_error(cd_shape_make_segments(0, (const double(*)[3])a, (const double(*)[3])b, r, 1000, &s, err, sizeof err),
                  err, "0 segments", "expected");
     r[1] = -0.2;
-    expect_error(cd_shape_make_segments(2, (const double (*)[3])a, (const double (*)[3])b, r, 1000, &s, err, sizeof err),
+    expect_error(cd_shape_make_segments(2, (const double(*)[3])a, (const double(*)[3])b, r, 1000, &s, err, sizeof err),
                  err, "segment 1 radius", "-0.2");
 }
 
@@ -584,10 +615,22 @@ static void test_json_has_every_key_and_round_trips(void **state)
     assert_non_null(text);
     assert_int_equal(fread(text, 1, (size_t)len, f), (size_t)len);
     fclose(f);
-    const char *keys[] = {"\"kind\": \"hexapod\"", "\"aspect\"", "\"diameter\"", "\"tip_length\"", "\"density\"",
-                          "\"volume\"", "\"area\"", "\"sphericity\"", "\"mass\"", "\"inertia\": [[",
-                          "\"principal_moments\"", "\"bounding_radius\"", "\"arms\"", "\"radius\"",
-                          "\"volume_rel_error\"", "\"area_rel_error\""};
+    const char *keys[] = {"\"kind\": \"hexapod\"",
+                          "\"aspect\"",
+                          "\"diameter\"",
+                          "\"tip_length\"",
+                          "\"density\"",
+                          "\"volume\"",
+                          "\"area\"",
+                          "\"sphericity\"",
+                          "\"mass\"",
+                          "\"inertia\": [[",
+                          "\"principal_moments\"",
+                          "\"bounding_radius\"",
+                          "\"arms\"",
+                          "\"radius\"",
+                          "\"volume_rel_error\"",
+                          "\"area_rel_error\""};
     for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
         if (!strstr(text, keys[k])) {
             print_error("JSON lacks %s:\n%s\n", keys[k], text);
@@ -617,11 +660,15 @@ static void test_numeric_shapes_are_fast(void **state)
     for (int k = 0; k < 8; k++) { /* arms along 8 directions of a star */
         double th = 0.9 * k, ph = 0.4 + 0.37 * k;
         double d[3] = {sin(ph) * cos(th), sin(ph) * sin(th), cos(ph)};
-        for (int i = 0; i < 3; i++) { a[k][i] = 0.002 * d[i]; b[k][i] = 0.012 * d[i]; }
+        for (int i = 0; i < 3; i++) {
+            a[k][i] = 0.002 * d[i];
+            b[k][i] = 0.012 * d[i];
+        }
         r[k] = 0.002 + 0.0002 * k;
     }
     t0 = clock();
-    assert_int_equal(cd_shape_make_segments(8, (const double (*)[3])a, (const double (*)[3])b, r, 1000, &s, err, sizeof err), 0);
+    assert_int_equal(
+        cd_shape_make_segments(8, (const double(*)[3])a, (const double(*)[3])b, r, 1000, &s, err, sizeof err), 0);
     double t_star = (double)(clock() - t0) / CLOCKS_PER_SEC;
     print_message("hexapod aspect 1.5: %.3f s, 8-arm star: %.3f s (CPU)\n", t_hex, t_star);
     assert_true(t_hex < 0.5);

@@ -11,7 +11,7 @@
 #include "walls.h"
 
 #define SIN2DEG 0.034899496702500969 /* sin(2 degrees) */
-#define DEG (CD_PI / 180.0)
+#define DEG     (CD_PI / 180.0)
 
 static double dist(cd_vec3 a, cd_vec3 b) { return cd_v3_norm(cd_v3_sub(a, b)); }
 
@@ -66,8 +66,7 @@ static void test_plane_tilted_segment_touches_with_lower_end(void **state)
     cd_wall_contact(&w, cd_v3(0, 0, 0.4), cd_v3(2 * cos(3 * DEG), 0, 0.4 + 2 * sin(3 * DEG)), 0.5, SIN2DEG, &g);
     assert_int_equal(g.parallel, 0);
     assert_true(dist(g.point, cd_v3(0, 0, -0.05)) < 1e-15);
-    cd_wall_contact_rule(&w, cd_v3(0, 0, 0.4), cd_v3(2 * cos(3 * DEG), 0, 0.4 + 2 * sin(3 * DEG)), 0.5, SIN2DEG, 1,
-                         &g);
+    cd_wall_contact_rule(&w, cd_v3(0, 0, 0.4), cd_v3(2 * cos(3 * DEG), 0, 0.4 + 2 * sin(3 * DEG)), 0.5, SIN2DEG, 1, &g);
     double wpar = 2 - sin(3 * DEG) / SIN2DEG;
     assert_int_equal(g.parallel, 0);
     assert_true(dist(g.point, cd_v3(wpar * cos(3 * DEG), 0, -0.05)) < 1e-15);

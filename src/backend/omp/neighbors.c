@@ -21,7 +21,7 @@
 
 /* Particles per chunk of the bounds pass, entries per chunk of a prefix
  * sum: a few thousand items at 1e6 particles, enough for any device. */
-#define CD_NB_CHUNK 256
+#define CD_NB_CHUNK   256
 #define CD_SCAN_CHUNK 1024
 /* Candidate slots per primitive at the first build (a hexapod arm in a
  * dense packing with a skin of 0.1 d has about 10); they double whenever a
@@ -40,11 +40,12 @@ void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder)
 void cd_neighbors_free(cd_neighbors *nb)
 {
     cd_nb_lists *d = &nb->d;
-    void *all[] = {d->gather_start, d->gather_rows, d->wall_start, d->wall_rows, d->grid, d->part_bound,
-                   d->partial, d->part_cell, d->cell_count, d->cell_start, d->cell_parts, d->pair_count,
-                   d->pair_offset, d->cand, d->keys, d->old_keys, d->old_active, d->old_shear, d->count,
-                   d->chunk_sum, d->part_uid, d->part_at, d->prim_uid, d->prim_at, d->pair_at, d->pair_ustart,
-                   d->part_src, d->prim_src, d->new_first, d->sort_keys, d->sort_vals, d->hist, d->move};
+    void *all[] = {d->gather_start, d->gather_rows, d->wall_start, d->wall_rows,  d->grid,       d->part_bound,
+                   d->partial,      d->part_cell,   d->cell_count, d->cell_start, d->cell_parts, d->pair_count,
+                   d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active, d->old_shear,
+                   d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,   d->prim_at,
+                   d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,  d->sort_keys,
+                   d->sort_vals,    d->hist,        d->move};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -217,10 +218,10 @@ static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
     CD_STEP_FOR(N, firstprivate(c, d, o))
     for (cd_int q = 0; q < N; q++) cd_nb_item_gather_sort(c, o, q, d.gather_start, d.gather_rows);
 
-    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
     for (cd_int q = 0; q < N; q++) d.count[q] = cd_item_wall_candidates(c, q, walls, W, skin, 0);
     cd_nb_scan(d.count, N, d.wall_start, d.chunk_sum);
-    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
     for (cd_int q = 0; q < N; q++) cd_item_wall_candidates(c, q, walls, W, skin, d.wall_rows + d.wall_start[q]);
     cd_int n_rows = 0;
     if (cd_dev_get(&n_rows, d.wall_start + N, sizeof n_rows)) return -1;
@@ -278,8 +279,8 @@ int cd_neighbors_build(cd_sim *sim)
     CD_STEP_FOR(P, firstprivate(c, d, o))
     for (cd_int i = 0; i < P; i++) cd_nb_item_place(c, i, d.pair_offset, d.cand, slot, d.keys, o);
     CD_STEP_FOR(n_new, firstprivate(c, d) CD_DEV(is_device_ptr(prim_src)))
-    for (cd_int k = 0; k < n_new; k++) cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active,
-                                                        d.old_shear, prim_src);
+    for (cd_int k = 0; k < n_new; k++)
+        cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active, d.old_shear, prim_src);
     if (particle_lists(sim, c, d) || cd_reorder_pair_rows(sim)) return -1;
     CD_STEP_FOR(P, firstprivate(c))
     for (cd_int i = 0; i < P; i++) {

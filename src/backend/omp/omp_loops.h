@@ -43,10 +43,11 @@ static inline size_t cd_wide_min(void)
 /* Host devices: teams of one thread each (host threads), one team for a
  * small loop.  No inner parallel: a serialized one (if (parallel : 0))
  * trips an assertion of libomp 14 (kmp_runtime.cpp(1122), th_task_team). */
-#define CD_STEP_FOR(rows, ...) \
-    CD_PRAGMA(omp target teams distribute num_teams((size_t)(rows) >= wide_min_ ? omp_get_max_threads() : 1) __VA_ARGS__)
+#define CD_STEP_FOR(rows, ...)                                                                                         \
+    CD_PRAGMA(omp target teams distribute num_teams((size_t)(rows) >= wide_min_ ? omp_get_max_threads() : 1)           \
+                  __VA_ARGS__)
 #else
-#define CD_STEP_FOR(rows, ...) \
+#define CD_STEP_FOR(rows, ...)                                                                                         \
     CD_PRAGMA(omp target teams distribute parallel for if (parallel : (size_t)(rows) >= wide_min_) __VA_ARGS__)
 #endif
 /* Clauses only the offload variant needs. */

@@ -57,7 +57,7 @@ cd_order cd_sim_host_order(const cd_sim *sim)
 void cd_reorder_forget(cd_sim *sim)
 {
     cd_nb_lists *d = &sim->nb.d;
-    cd_int **ints[] = {&d->part_uid, &d->part_at, &d->prim_uid, &d->prim_at, &d->pair_at, &d->pair_ustart,
+    cd_int **ints[] = {&d->part_uid, &d->part_at,  &d->prim_uid,  &d->prim_at,   &d->pair_at, &d->pair_ustart,
                        &d->part_src, &d->prim_src, &d->new_first, &d->sort_vals, &d->hist};
     for (size_t k = 0; k < sizeof ints / sizeof ints[0]; k++) {
         cd_dev_free(*ints[k]);
@@ -79,7 +79,9 @@ static size_t largest_column(const cd_state *s)
     size_t most = 0;
     for (size_t f = 0; f < cd_n_fields; f++) {
         enum cd_field_group g = cd_fields[f].group;
-        size_t rows = g == CD_GROUP_PARTICLE ? s->n_particles : g == CD_GROUP_PRIM || g == CD_GROUP_WALLC ? s->n_prims : 0;
+        size_t rows = g == CD_GROUP_PARTICLE                      ? s->n_particles
+                      : g == CD_GROUP_PRIM || g == CD_GROUP_WALLC ? s->n_prims
+                                                                  : 0;
         if (rows * cd_fields[f].elem_size > most) most = rows * cd_fields[f].elem_size;
     }
     return most;
@@ -169,10 +171,7 @@ static cd_int *sort_particles(cd_sim *sim, const cd_grid *g)
 
 /* Is field f moved with its rows?  The reference ends are not: the build
  * sets them at its end. */
-static int moves(const cd_field_info *f)
-{
-    return strcmp(f->name, "prim_a_ref") && strcmp(f->name, "prim_b_ref");
-}
+static int moves(const cd_field_info *f) { return strcmp(f->name, "prim_a_ref") && strcmp(f->name, "prim_b_ref"); }
 
 int cd_reorder_build(cd_sim *sim, int *moved)
 {
@@ -216,8 +215,8 @@ int cd_reorder_build(cd_sim *sim, int *moved)
     size_t K = s->n_pairs;
     CD_STEP_FOR(K, firstprivate(c) reduction(+ : excess) CD_DEV(is_device_ptr(slot_of) map(tofrom : excess)))
     for (size_t k = 0; k < K; k++)
-        excess += 8L * cd_reorder_item_row_span(c, (cd_long)k, slot_of) -
-                  7L * cd_reorder_item_row_span(c, (cd_long)k, NULL);
+        excess +=
+            8L * cd_reorder_item_row_span(c, (cd_long)k, slot_of) - 7L * cd_reorder_item_row_span(c, (cd_long)k, NULL);
     if (excess >= 0 && !forced) return 0;
 
     /* the primitives follow their particles: new first primitives, and

@@ -40,11 +40,11 @@ cd_cols cd_sim_host_cols(cd_state *s)
 /* ---- device residency (offload variant) -------------------------------- */
 #if CD_OFFLOAD
 typedef struct {
-    void **host;       /* per field of cd_fields: host address mapped (NULL: none) */
-    size_t *bytes;     /* per field: bytes mapped */
-    double *part;      /* per-chunk partial sums of the wall load (mapped) */
+    void **host;   /* per field of cd_fields: host address mapped (NULL: none) */
+    size_t *bytes; /* per field: bytes mapped */
+    double *part;  /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
-    cd_cols dev;       /* device addresses of the columns */
+    cd_cols dev; /* device addresses of the columns */
 } cd_off;
 
 
@@ -52,7 +52,7 @@ static void off_map(void *p, size_t bytes)
 {
     char *c = p;
     if (c && bytes) {
-#pragma omp target enter data map(to : c[0:bytes])
+#pragma omp target enter data map(to : c [0:bytes])
     }
 }
 
@@ -60,7 +60,7 @@ static void off_unmap(void *p, size_t bytes)
 {
     char *c = p;
     if (c && bytes) {
-#pragma omp target exit data map(delete : c[0:bytes])
+#pragma omp target exit data map(delete : c [0:bytes])
     }
 }
 
@@ -68,7 +68,7 @@ static void off_from(void *p, size_t bytes)
 {
     char *c = p;
     if (c && bytes) {
-#pragma omp target update from(c[0:bytes])
+#pragma omp target update from(c [0:bytes])
     }
 }
 
@@ -142,8 +142,10 @@ static int off_acquire(cd_sim *sim, char *err, size_t errlen)
     static int warned = 0;
     if (omp_get_num_devices() == 0) {
         if (offload_mandatory()) {
-            snprintf(err, errlen, "built for %s offload and OMP_TARGET_OFFLOAD=MANDATORY, but the OpenMP runtime "
-                     "finds no offload device (docs/offload.md)", CAPDEM_OFFLOAD_VARIANT);
+            snprintf(err, errlen,
+                     "built for %s offload and OMP_TARGET_OFFLOAD=MANDATORY, but the OpenMP runtime "
+                     "finds no offload device (docs/offload.md)",
+                     CAPDEM_OFFLOAD_VARIANT);
             return -1;
         }
         if (!warned)
@@ -159,7 +161,10 @@ static int off_acquire(cd_sim *sim, char *err, size_t errlen)
     o->bytes = calloc(cd_n_fields, sizeof *o->bytes);
     o->part_n = sim->s.n_prims / CD_LOAD_CHUNK + 1;
     o->part = calloc(o->part_n, sizeof(double));
-    if (!o->host || !o->bytes || !o->part) { off_release(sim); return -1; }
+    if (!o->host || !o->bytes || !o->part) {
+        off_release(sim);
+        return -1;
+    }
     for (size_t f = 0; f < cd_n_fields; f++) off_map_field(sim, o, f);
     off_map(o->part, o->part_n * sizeof(double));
     off_refresh_cols(sim, o);
@@ -282,7 +287,7 @@ static void wall_forces(cd_sim *sim)
     cd_int blend = sim->p.parallel_blend;
     size_t n = W ? sim->nb.n_wall_rows : 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, d, law) CD_DEV(map(to : walls[0:CD_MAX_WALLS])))
+    CD_STEP_FOR(n, firstprivate(c, d, law) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
     for (size_t e = 0; e < n; e++) cd_item_wall_row(c, d.wall_rows[e], walls, W, law, dt, sin_parallel, blend);
 }
 
@@ -322,22 +327,22 @@ static void compute_forces(cd_sim *sim, int kick)
  * them instead of inlining them, 1.15x the instructions of the step
  * (callgrind). */
 __attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd_law_params law, cd_real dt,
-                                                 cd_real sin_parallel, cd_int blend)
+                                                         cd_real sin_parallel, cd_int blend)
 {
 #pragma omp for schedule(static) nowait
     for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
 }
 
 __attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, size_t n, const cd_wall *walls,
-                                                 cd_int W, cd_law_params law, cd_real dt, cd_real sin_parallel,
-                                                 cd_int blend)
+                                                         cd_int W, cd_law_params law, cd_real dt, cd_real sin_parallel,
+                                                         cd_int blend)
 {
 #pragma omp for schedule(static)
     for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], walls, W, law, dt, sin_parallel, blend);
 }
 
-__attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 g, cd_int dim,
-                                                          cd_real dt, cd_real limit2, int next)
+__attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 g,
+                                                                  cd_int dim, cd_real dt, cd_real limit2, int next)
 {
     int moved = 0;
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
@@ -390,7 +395,8 @@ static int forces_and_advance(cd_sim *sim, int next)
 void cd_sim_refresh(cd_sim *sim)
 {
     cd_state *s = &sim->s;
-    for (size_t q = 0; q < s->n_particles; q++) s->angvel[q] = cd_rigid_angvel(s->orientation[q], s->angmom[q], s->inertia[q]);
+    for (size_t q = 0; q < s->n_particles; q++)
+        s->angvel[q] = cd_rigid_angvel(s->orientation[q], s->angmom[q], s->inertia[q]);
     cd_cols c = cd_sim_host_cols(s);
     size_t n = s->n_prims;
     CD_HOST_FOR(n, firstprivate(c))
@@ -402,8 +408,10 @@ void cd_sim_refresh(cd_sim *sim)
 static int report_bad(const cd_state *s, long bad, char *err, size_t errlen)
 {
     if (bad < 0) return 0;
-    snprintf(err, errlen, "non-finite position or velocity of particle %ld at step %lld (t = %.9g s): "
-             "the run blew up; reduce run.dt or check the material parameters", bad, s->step, s->time);
+    snprintf(err, errlen,
+             "non-finite position or velocity of particle %ld at step %lld (t = %.9g s): "
+             "the run blew up; reduce run.dt or check the material parameters",
+             bad, s->step, s->time);
     return -1;
 }
 
@@ -496,8 +504,10 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
         if (sim->rebuild_hook && (rebuild = sim->rebuild_hook(sim, rebuild, err, errlen)) < 0) return -1;
         int rc = rebuild ? cd_neighbors_build(sim) : 0;
         if (rc == CD_NB_BLOWUP) {
-            snprintf(err, errlen, "particle centres spread beyond any container (or not finite) at step %lld (t = "
-                     "%.9g s): the run blew up; reduce run.dt or check the material parameters", s->step, s->time);
+            snprintf(err, errlen,
+                     "particle centres spread beyond any container (or not finite) at step %lld (t = "
+                     "%.9g s): the run blew up; reduce run.dt or check the material parameters",
+                     s->step, s->time);
             return -1;
         }
         if (rc) {
@@ -544,8 +554,7 @@ static const char *omp_device(const cd_sim *sim)
     if (omp_get_num_devices() > 0)
         snprintf(buf, sizeof buf, "%s offload device %d of %d", CAPDEM_OFFLOAD_VARIANT, omp_get_default_device(),
                  omp_get_num_devices());
-    else
-        snprintf(buf, sizeof buf, "host (built for %s offload, no offload device found)", CAPDEM_OFFLOAD_VARIANT);
+    else snprintf(buf, sizeof buf, "host (built for %s offload, no offload device found)", CAPDEM_OFFLOAD_VARIANT);
 #else
     snprintf(buf, sizeof buf, "host, %d OpenMP thread(s)", sim->threads);
 #endif
@@ -559,7 +568,8 @@ static const char *omp_device(const cd_sim *sim)
 static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     cd_off *o = sim->backend_data;
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     if (!o) { /* not started: the host columns are current */
         *load = cd_sim_wall_load_host(sim, w);
         return 0;
@@ -579,26 +589,29 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     return 0;
 }
 #define CD_OMP_WALL_LOAD omp_wall_load
-#define CD_OMP_OBSERVE cd_omp_observe_device /* src/backend/omp/observe.c */
+#define CD_OMP_OBSERVE   cd_omp_observe_device /* src/backend/omp/observe.c */
 #else
 /* Host threads: the host columns are the step's, summed in user order
  * whatever their memory order, without a sync (which would put them in
  * user order and back). */
 static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     *load = cd_sim_wall_load_host(sim, w);
     return 0;
 }
 
 static int omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
-    (void)err; (void)errlen;
+    (void)err;
+    (void)errlen;
     cd_observables_slots(sim, slots);
     return 0;
 }
 #define CD_OMP_WALL_LOAD omp_wall_load
-#define CD_OMP_OBSERVE omp_observe
+#define CD_OMP_OBSERVE   omp_observe
 #endif
 
-const cd_backend cd_backend_omp = {"omp", omp_start, omp_step, omp_sync, omp_stop, omp_device, CD_OMP_WALL_LOAD, CD_OMP_OBSERVE};
+const cd_backend cd_backend_omp = {"omp",    omp_start,  omp_step,         omp_sync,
+                                   omp_stop, omp_device, CD_OMP_WALL_LOAD, CD_OMP_OBSERVE};

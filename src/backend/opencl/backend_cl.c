@@ -147,8 +147,10 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
     /* The host's walls are current after every call (read back below); a
      * protocol may have changed their motion since. */
     if (s->n_walls)
-        cd_cl_check(cl, clEnqueueWriteBuffer(cl->queue, cl->walls, CL_FALSE, 0, s->n_walls * sizeof(cd_wall), s->walls,
-                                             0, NULL, NULL), "uploading the walls");
+        cd_cl_check(cl,
+                    clEnqueueWriteBuffer(cl->queue, cl->walls, CL_FALSE, 0, s->n_walls * sizeof(cd_wall), s->walls, 0,
+                                         NULL, NULL),
+                    "uploading the walls");
     set_step_args(cl, sim);
     memcpy(cl->host_walls, s->walls, sizeof cl->host_walls);
     size_t items = s->n_particles > s->n_walls ? s->n_particles : s->n_walls;
@@ -174,8 +176,10 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
     cd_int flags[2] = {0, -1};
     cd_cl_run(cl, CD_CLK_CHECK_FINITE, s->n_particles);
     if (s->n_walls && !cl->status)
-        cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->walls, CL_FALSE, 0, s->n_walls * sizeof(cd_wall), s->walls,
-                                            0, NULL, NULL), "reading the walls");
+        cd_cl_check(cl,
+                    clEnqueueReadBuffer(cl->queue, cl->walls, CL_FALSE, 0, s->n_walls * sizeof(cd_wall), s->walls, 0,
+                                        NULL, NULL),
+                    "reading the walls");
     if (!cl->status)
         cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->flags, CL_TRUE, 0, sizeof flags, flags, 0, NULL, NULL),
                     "reading the state check");
@@ -242,7 +246,8 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     if ((size_t)n_blocks + 1 > cl->obs_cap_blocks) {
         if (cl->obs_part) clReleaseMemObject(cl->obs_part);
         cl->obs_cap_blocks = (size_t)n_blocks + 1 + (size_t)n_blocks / 4;
-        cl->obs_part = cd_cl_buffer(cl, cl->obs_cap_blocks * CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
+        cl->obs_part =
+            cd_cl_buffer(cl, cl->obs_cap_blocks * CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
     }
     cd_cl_fill_int(cl, cl->obs_touch, 0, 0, (size_t)N);
     cd_cl_arg(cl, CD_CLK_OBS_TOUCH_PAIRS, F, sizeof n_pairs, &n_pairs);
@@ -276,8 +281,10 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_MERGE, 2, sizeof cl->obs_total, &cl->obs_total);
     cd_cl_run(cl, CD_CLK_OBS_MERGE, 1);
     if (!cl->status)
-        cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->obs_total, CL_TRUE, 0, CD_OBS_SLOTS * sizeof(double), slots,
-                                            0, NULL, NULL), "reading the observables");
+        cd_cl_check(cl,
+                    clEnqueueReadBuffer(cl->queue, cl->obs_total, CL_TRUE, 0, CD_OBS_SLOTS * sizeof(double), slots, 0,
+                                        NULL, NULL),
+                    "reading the observables");
     if (cl->status) return fail(sim, err, errlen);
     return 0;
 }

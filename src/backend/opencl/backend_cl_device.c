@@ -17,15 +17,36 @@ static const struct {
     const char *name;
     int cols;
 } kernel_table[CD_CLK_COUNT] = {
-    {"cd_cl_advance", 1},      {"cd_cl_pair_forces", 1}, {"cd_cl_wall_forces", 1},
-    {"cd_cl_gather_kick", 1},  {"cd_cl_check_finite", 1}, {"cd_cl_wall_load", 1},   {"cd_cl_wall_load_sum", 0},   {"cd_cl_bounds", 1},
-    {"cd_cl_grid", 0},         {"cd_cl_bin", 1},          {"cd_cl_cell_fill", 0},   {"cd_cl_pair_collect", 1},
-    {"cd_cl_pair_place", 1},   {"cd_cl_pair_fill", 1},    {"cd_cl_pair_keys", 1},   {"cd_cl_pair_carry", 1},
+    {"cd_cl_advance", 1},
+    {"cd_cl_pair_forces", 1},
+    {"cd_cl_wall_forces", 1},
+    {"cd_cl_gather_kick", 1},
+    {"cd_cl_check_finite", 1},
+    {"cd_cl_wall_load", 1},
+    {"cd_cl_wall_load_sum", 0},
+    {"cd_cl_bounds", 1},
+    {"cd_cl_grid", 0},
+    {"cd_cl_bin", 1},
+    {"cd_cl_cell_fill", 0},
+    {"cd_cl_pair_collect", 1},
+    {"cd_cl_pair_place", 1},
+    {"cd_cl_pair_fill", 1},
+    {"cd_cl_pair_keys", 1},
+    {"cd_cl_pair_carry", 1},
     {"cd_cl_gather_count", 1},
-    {"cd_cl_gather_fill", 1},  {"cd_cl_gather_sort", 0},  {"cd_cl_scan_blocks", 0}, {"cd_cl_scan_top", 0},
-    {"cd_cl_scan_fill", 0},    {"cd_cl_wall_cand_count", 1}, {"cd_cl_wall_cand_fill", 1},
-    {"cd_cl_obs_touch_pairs", 1}, {"cd_cl_obs_touch_walls", 1}, {"cd_cl_obs_particles", 1},
-    {"cd_cl_obs_pairs", 1},    {"cd_cl_obs_walls", 1},    {"cd_cl_obs_merge", 0},
+    {"cd_cl_gather_fill", 1},
+    {"cd_cl_gather_sort", 0},
+    {"cd_cl_scan_blocks", 0},
+    {"cd_cl_scan_top", 0},
+    {"cd_cl_scan_fill", 0},
+    {"cd_cl_wall_cand_count", 1},
+    {"cd_cl_wall_cand_fill", 1},
+    {"cd_cl_obs_touch_pairs", 1},
+    {"cd_cl_obs_touch_walls", 1},
+    {"cd_cl_obs_particles", 1},
+    {"cd_cl_obs_pairs", 1},
+    {"cd_cl_obs_walls", 1},
+    {"cd_cl_obs_merge", 0},
 };
 
 int cd_cl_kernel_takes_cols(enum cd_cl_kernel k) { return kernel_table[k].cols; }
@@ -33,20 +54,34 @@ int cd_cl_kernel_takes_cols(enum cd_cl_kernel k) { return kernel_table[k].cols; 
 const char *cd_cl_error_name(cl_int code)
 {
     switch (code) {
-    case CL_DEVICE_NOT_FOUND: return "CL_DEVICE_NOT_FOUND";
-    case CL_OUT_OF_RESOURCES: return "CL_OUT_OF_RESOURCES";
-    case CL_OUT_OF_HOST_MEMORY: return "CL_OUT_OF_HOST_MEMORY";
-    case CL_MEM_OBJECT_ALLOCATION_FAILURE: return "CL_MEM_OBJECT_ALLOCATION_FAILURE";
-    case CL_BUILD_PROGRAM_FAILURE: return "CL_BUILD_PROGRAM_FAILURE";
-    case CL_INVALID_VALUE: return "CL_INVALID_VALUE";
-    case CL_INVALID_KERNEL_ARGS: return "CL_INVALID_KERNEL_ARGS";
-    case CL_INVALID_ARG_SIZE: return "CL_INVALID_ARG_SIZE";
-    case CL_INVALID_ARG_INDEX: return "CL_INVALID_ARG_INDEX";
-    case CL_INVALID_WORK_GROUP_SIZE: return "CL_INVALID_WORK_GROUP_SIZE";
-    case CL_INVALID_BUFFER_SIZE: return "CL_INVALID_BUFFER_SIZE";
-    case CL_INVALID_KERNEL_NAME: return "CL_INVALID_KERNEL_NAME";
-    case -1001: return "CL_PLATFORM_NOT_FOUND_KHR";
-    default: return "OpenCL error";
+    case CL_DEVICE_NOT_FOUND:
+        return "CL_DEVICE_NOT_FOUND";
+    case CL_OUT_OF_RESOURCES:
+        return "CL_OUT_OF_RESOURCES";
+    case CL_OUT_OF_HOST_MEMORY:
+        return "CL_OUT_OF_HOST_MEMORY";
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE:
+        return "CL_MEM_OBJECT_ALLOCATION_FAILURE";
+    case CL_BUILD_PROGRAM_FAILURE:
+        return "CL_BUILD_PROGRAM_FAILURE";
+    case CL_INVALID_VALUE:
+        return "CL_INVALID_VALUE";
+    case CL_INVALID_KERNEL_ARGS:
+        return "CL_INVALID_KERNEL_ARGS";
+    case CL_INVALID_ARG_SIZE:
+        return "CL_INVALID_ARG_SIZE";
+    case CL_INVALID_ARG_INDEX:
+        return "CL_INVALID_ARG_INDEX";
+    case CL_INVALID_WORK_GROUP_SIZE:
+        return "CL_INVALID_WORK_GROUP_SIZE";
+    case CL_INVALID_BUFFER_SIZE:
+        return "CL_INVALID_BUFFER_SIZE";
+    case CL_INVALID_KERNEL_NAME:
+        return "CL_INVALID_KERNEL_NAME";
+    case -1001:
+        return "CL_PLATFORM_NOT_FOUND_KHR";
+    default:
+        return "OpenCL error";
     }
 }
 
@@ -87,10 +122,14 @@ int cd_cl_run(cd_cl *cl, enum cd_cl_kernel k, size_t n)
     if (n == 0) return 0;
     size_t global = n, local = cl->local, *lp = &local;
     switch (k) {
-    case CD_CLK_GRID: case CD_CLK_SCAN_TOP: case CD_CLK_WALL_LOAD_SUM:
+    case CD_CLK_GRID:
+    case CD_CLK_SCAN_TOP:
+    case CD_CLK_WALL_LOAD_SUM:
         global = local = 1; /* one work-item */
         break;
-    case CD_CLK_BOUNDS: case CD_CLK_SCAN_BLOCKS: case CD_CLK_SCAN_FILL:
+    case CD_CLK_BOUNDS:
+    case CD_CLK_SCAN_BLOCKS:
+    case CD_CLK_SCAN_FILL:
         lp = NULL; /* exactly n chunks, few: let the runtime group them */
         break;
     default:
@@ -114,7 +153,10 @@ static void sb_add(strbuf *b, const char *s, size_t n)
     if (b->len + n + 1 > b->cap) {
         size_t cap = 2 * (b->len + n + 1) + 4096;
         char *q = realloc(b->p, cap);
-        if (!q) { b->oom = 1; return; }
+        if (!q) {
+            b->oom = 1;
+            return;
+        }
         b->p = q;
         b->cap = cap;
     }
@@ -142,7 +184,10 @@ static char *read_file(const char *path)
     size_t n;
     while ((n = fread(chunk, 1, sizeof chunk, f)) > 0) sb_add(&b, chunk, n);
     fclose(f);
-    if (b.oom || !b.p) { free(b.p); return NULL; }
+    if (b.oom || !b.p) {
+        free(b.p);
+        return NULL;
+    }
     return b.p;
 }
 
@@ -265,7 +310,8 @@ static int choose_device(cd_cl *cl, const char *request, char *err, size_t errle
     cl_uint np = 0;
     cl_int rc = clGetPlatformIDs(0, NULL, &np);
     if (rc != CL_SUCCESS || np == 0) {
-        snprintf(err, errlen, "OpenCL: no platform found (%s): install an OpenCL driver, e.g. the Debian package "
+        snprintf(err, errlen,
+                 "OpenCL: no platform found (%s): install an OpenCL driver, e.g. the Debian package "
                  "pocl-opencl-icd for CPUs or the GPU vendor's ICD, or use --backend omp",
                  rc != CL_SUCCESS ? cd_cl_error_name(rc) : "the ICD loader lists none");
         return -1;
@@ -285,8 +331,10 @@ static int choose_device(cd_cl *cl, const char *request, char *err, size_t errle
         if (!want || !*want || contains_nocase(pname, want)) keep[nk++] = plat[i];
     }
     if (nk == 0) {
-        snprintf(err, errlen, "OpenCL: CAPDEM_OPENCL_PLATFORM=%s matches no platform (there are: %s); unset it or "
-                 "use part of one of those names", want, names);
+        snprintf(err, errlen,
+                 "OpenCL: CAPDEM_OPENCL_PLATFORM=%s matches no platform (there are: %s); unset it or "
+                 "use part of one of those names",
+                 want, names);
         return -1;
     }
     /* Candidates in order of preference; the first with fp64 wins. */
@@ -294,7 +342,10 @@ static int choose_device(cd_cl *cl, const char *request, char *err, size_t errle
                                CL_DEVICE_TYPE_ACCELERATOR | CL_DEVICE_TYPE_CUSTOM};
     int n_types = 3;
     if (!strcmp(req, "gpu")) n_types = 1;
-    if (!strcmp(req, "cpu")) { order[0] = CL_DEVICE_TYPE_CPU; n_types = 1; }
+    if (!strcmp(req, "cpu")) {
+        order[0] = CL_DEVICE_TYPE_CPU;
+        n_types = 1;
+    }
     char first_no_fp64[256] = "";
     for (int t = 0; t < n_types; t++)
         for (cl_uint i = 0; i < nk; i++) {
@@ -312,11 +363,15 @@ static int choose_device(cd_cl *cl, const char *request, char *err, size_t errle
             }
         }
     if (first_no_fp64[0]) {
-        snprintf(err, errlen, "OpenCL: device '%s' has no double precision (cl_khr_fp64), which capdem needs; "
-                 "choose another device (--device, CAPDEM_OPENCL_PLATFORM) or use --backend omp", first_no_fp64);
+        snprintf(err, errlen,
+                 "OpenCL: device '%s' has no double precision (cl_khr_fp64), which capdem needs; "
+                 "choose another device (--device, CAPDEM_OPENCL_PLATFORM) or use --backend omp",
+                 first_no_fp64);
     } else {
-        snprintf(err, errlen, "OpenCL: no %s device on platform(s) %s; use --device auto, another "
-                 "CAPDEM_OPENCL_PLATFORM, or --backend omp", !strcmp(req, "auto") ? "" : req, names);
+        snprintf(err, errlen,
+                 "OpenCL: no %s device on platform(s) %s; use --device auto, another "
+                 "CAPDEM_OPENCL_PLATFORM, or --backend omp",
+                 !strcmp(req, "auto") ? "" : req, names);
     }
     return -1;
 }
@@ -326,7 +381,10 @@ static int build_program(cd_cl *cl, char *err, size_t errlen)
     strbuf src = {0};
     for (int i = 0; i < cd_cl_n_sources; i++) {
         if (!cd_cl_sources[i].program) continue;
-        if (expand(&src, cd_cl_sources[i].name, 0, err, errlen)) { free(src.p); return -1; }
+        if (expand(&src, cd_cl_sources[i].name, 0, err, errlen)) {
+            free(src.p);
+            return -1;
+        }
     }
     if (src.oom || !src.p) {
         free(src.p);
@@ -352,8 +410,10 @@ static int build_program(cd_cl *cl, char *err, size_t errlen)
             log[n] = 0;
             fprintf(stderr, "capdem: OpenCL build log for %s:\n%s\n", cl->desc, log);
         }
-        snprintf(err, errlen, "OpenCL: the kernels failed to build on %s with %s (%d); the compiler's log is above. "
-                 "Start of the log: %.400s", cl->desc, cd_cl_error_name(rc), (int)rc, log ? log : "(none)");
+        snprintf(err, errlen,
+                 "OpenCL: the kernels failed to build on %s with %s (%d); the compiler's log is above. "
+                 "Start of the log: %.400s",
+                 cl->desc, cd_cl_error_name(rc), (int)rc, log ? log : "(none)");
         free(log);
         return -1;
     }
@@ -366,7 +426,8 @@ static int build_program(cd_cl *cl, char *err, size_t errlen)
         }
         size_t wg = 0;
         if (clGetKernelWorkGroupInfo(cl->k[k], cl->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL) ==
-                CL_SUCCESS && wg > 0 && wg < cl->local)
+                CL_SUCCESS &&
+            wg > 0 && wg < cl->local)
             cl->local = wg; /* a work-group size every kernel accepts */
     }
     return 0;

@@ -106,7 +106,7 @@ static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
 {
     cd_int W = (cd_int)sim->s.n_walls;
     cd_real skin = sim->nb.skin; /* [m] */
-    cl->n_wall_rows = 0; /* without walls the passes run too: wall_start all 0 for the gather */
+    cl->n_wall_rows = 0;         /* without walls the passes run too: wall_start all 0 for the gather */
     for (int k = CD_CLK_WALL_CAND_COUNT; k <= CD_CLK_WALL_CAND_FILL; k++) {
         cd_cl_arg(cl, k, F, sizeof N, &N);
         cd_cl_arg(cl, k, F + 1, sizeof cl->walls, &cl->walls);
@@ -120,8 +120,9 @@ static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
     cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 5, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_run(cl, CD_CLK_WALL_CAND_FILL, (size_t)N);
     if (!cl->status)
-        cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->wall_start, CL_TRUE, (size_t)N * sizeof(cd_int),
-                                            sizeof cl->n_wall_rows, &cl->n_wall_rows, 0, NULL, NULL),
+        cd_cl_check(cl,
+                    clEnqueueReadBuffer(cl->queue, cl->wall_start, CL_TRUE, (size_t)N * sizeof(cd_int),
+                                        sizeof cl->n_wall_rows, &cl->n_wall_rows, 0, NULL, NULL),
                     "reading the number of wall candidates");
     memcpy(sim->nb.walls_ref, cl->host_walls, sizeof sim->nb.walls_ref);
 }
@@ -147,11 +148,15 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
         /* the one wait of a rebuild: how many pairs (to size the buffers),
          * and whether a slot overflowed */
         if (!cl->status)
-            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->pair_offset, CL_FALSE, (size_t)P * sizeof(cd_int),
-                                                sizeof n_new, &n_new, 0, NULL, NULL), "reading the number of pairs");
+            cd_cl_check(cl,
+                        clEnqueueReadBuffer(cl->queue, cl->pair_offset, CL_FALSE, (size_t)P * sizeof(cd_int),
+                                            sizeof n_new, &n_new, 0, NULL, NULL),
+                        "reading the number of pairs");
         if (!cl->status)
-            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->flags, CL_TRUE, 2 * sizeof(cd_int), sizeof overflow,
-                                                &overflow, 0, NULL, NULL), "reading the number of pairs");
+            cd_cl_check(cl,
+                        clEnqueueReadBuffer(cl->queue, cl->flags, CL_TRUE, 2 * sizeof(cd_int), sizeof overflow,
+                                            &overflow, 0, NULL, NULL),
+                        "reading the number of pairs");
     }
     if (cl->status) return -1;
 
