@@ -379,7 +379,7 @@ rows = [l for l in open(sys.argv[1], errors="replace") if l.startswith('"')]
 tot = collections.defaultdict(lambda: [0.0, 0])
 for r in csv.DictReader(rows):
     if r.get("Metric Name") != "gpu__time_duration.sum": continue
-    v = float(r["Metric Value"].replace(",", "")) * {"nsecond": 1e-3, "usecond": 1, "msecond": 1e3, "second": 1e6}.get(r["Metric Unit"], 1)
+    v = float(r["Metric Value"].replace(",", "")) * {"nsecond": 1e-3, "ns": 1e-3, "usecond": 1, "us": 1, "msecond": 1e3, "ms": 1e3, "second": 1e6, "s": 1e6}.get(r["Metric Unit"], 1)
     k = r["Kernel Name"][:90]
     tot[k][0] += v; tot[k][1] += 1
 all_us = sum(t for t, n in tot.values())
