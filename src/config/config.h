@@ -15,8 +15,11 @@
 /* neighbor.reorder: the memory order of the particles (src/backend/omp/reorder.c). */
 enum { CD_REORDER_CELLS = 0, CD_REORDER_NONE = 1 };
 
+/* particles[].shape, stored as the index of its choice (config_schema.c). */
+enum cd_shape_kind { CD_SHAPE_SPHERE, CD_SHAPE_ROD, CD_SHAPE_CROSS, CD_SHAPE_HEXAPOD, CD_SHAPE_SEGMENTS };
+
 typedef struct {
-    char shape[32];                                      /* sphere | rod | cross | hexapod | segments */
+    int shape;                                           /* enum cd_shape_kind */
     double aspect;                                       /* alpha = L / d_p [1] (named shapes) */
     double diameter;                                     /* arm diameter d_p [m] (named shapes) */
     int n_segments;                                      /* shape: segments */

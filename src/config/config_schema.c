@@ -28,6 +28,9 @@
 #define MPM_PACKING   2u
 
 _Static_assert(CD_WALL_PLANE == 0, "domain.walls[].type stores the index of \"plane\" in its choices");
+_Static_assert(CD_SHAPE_SPHERE == 0 && CD_SHAPE_ROD == 1 && CD_SHAPE_CROSS == 2 && CD_SHAPE_HEXAPOD == 3 &&
+                   CD_SHAPE_SEGMENTS == 4,
+               "particles[].shape stores the index of its choice");
 _Static_assert(CD_LAW_LINEAR == 0 && CD_LAW_HERTZ_MINDLIN == 1, "material.law stores the index of its choice");
 
 #define CFG(f)       .target = CD_TGT_CONFIG, .offset = offsetof(cd_config, f)
@@ -125,7 +128,7 @@ const cd_key cd_config_keys[] = {
      .max_items = CD_MAX_SPECIES, .item_target = CD_TGT_SPECIES, .count_offset = offsetof(cd_config, n_species),
      .item_size = sizeof(cd_species_config), .label = "particle species",
      .meaning = "one mapping per kind of particle (keys particles[].*)"},
-    {"particles[].shape", CD_KT_ENUM, "-", NULL, SPC_SIZED(shape), ALWAYS, .flags = CD_KF_SELECTOR,
+    {"particles[].shape", CD_KT_ENUM, "-", NULL, SPC(shape), ALWAYS, .flags = CD_KF_SELECTOR,
      .choices = "sphere|rod|cross|hexapod|segments", .label = "particle shape",
      .meaning = "named shape, or segments for arms given one by one"},
     {"particles[].aspect", CD_KT_REAL, "1", "1", SPC(aspect), GE(1), .applies = S_NAMED,
