@@ -1,5 +1,5 @@
 /* Time series of the whole run (/observables): the compaction curve and the
- * fit (Z - Z_c) ~ (Phi - Phi_c)^(1/2) above jamming (seed 002, eq. 17).
+ * fit (Z - Z_c) ~ (Phi - Phi_c)^(1/2) above jamming (Nezamabadi et al. 2022, eq. 17).
  *
  * The compaction curve gathers, per time-series row: time, contacts,
  * energies, and where the walls say it: the piston (the plane wall facing

@@ -1,4 +1,4 @@
-/* Protocols of SPEC section 6 (see protocol.h and docs/protocols.md): the
+/* Protocols of docs/references.md, Protocols (see protocol.h and docs/protocols.md): the
  * driver shared by all of them -- phases, the relaxation test, resume
  * checks, the protocol observables -- and the table of their operations
  * (protocol_internal.h), selected by protocol.type. */

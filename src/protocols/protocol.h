@@ -1,6 +1,6 @@
-/* The procedures of SPEC section 6 that a run file selects with
- * protocol.type: deposit and compress (seed 000), radial compaction in a
- * pressure-driven ball and the bulk-modulus probe (seed 001).  A protocol
+/* The procedures of docs/references.md, Protocols that a run file selects with
+ * protocol.type: deposit and compress (Conzelmann et al.), radial compaction in a
+ * pressure-driven ball and the bulk-modulus probe (Tran et al. 2024).  A protocol
  * moves the walls between steps and decides when the run is done; all its
  * state lives in sim->s.control, so it resumes from any snapshot. */
 #ifndef CD_PROTOCOL_H
