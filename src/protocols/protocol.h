@@ -39,10 +39,9 @@ long long cd_protocol_steps_until_control(const cd_sim *sim);
  * 0 to go on, -1 on error (message in err). */
 int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen);
 
-/* Extra time-series columns: packing fraction, coordination, phase,
- * pressure / load on the driven wall. */
-#define CD_PROTOCOL_OBSERVABLES 5
-void cd_protocol_observable_info(const char **names, const char **units);
+/* The PROTOCOL observables of kernels/observables.def (packing fraction,
+ * coordination, phase, load on the driven wall, ball pressure):
+ * values[CD_POBS_<id>] (src/core/observables.h). */
 void cd_protocol_observables(const cd_sim *sim, const cd_observables *o, double *values);
 
 /* Results of the bulk probe, appended as rows: strain, pressure change, K. */
