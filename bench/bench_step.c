@@ -7,7 +7,7 @@
  *                [--tile KX,KZ] [--shuffle SEED] [--reorder cells|none]
  *
  * A case (bench_cases.c) is a shape, a size distribution, a dimension and a
- * time step, with the SPEC 3 material.  N particles are deposited from a
+ * time step, with the default material (docs/references.md, Contact law).  N particles are deposited from a
  * lattice into a box of square cross-section (columns about 4x as tall as
  * wide), settled for S steps (default: the case's) under a strengthened
  * gravity (50 g, which shortens the fall without changing the contact law),

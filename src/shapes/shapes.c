@@ -1,6 +1,6 @@
 /* Shape catalogue: named clusters of spherocylinders (sphere, rod, cross,
  * hexapod) and general segment lists, with the mass properties of the union
- * of their arms (SPEC section 1, docs/shapes.md).
+ * of their arms (docs/references.md, Particles, docs/shapes.md).
  *
  * Closed forms are used wherever the union decomposes into known pieces:
  * the sphere, one capsule, and crosses / hexapods with aspect >= 2, where

@@ -1,5 +1,5 @@
 /* Shape catalogue: rigid clusters of spherocylinders sharing one centre,
- * with the mass properties of the union of their arms (SPEC section 1). */
+ * with the mass properties of the union of their arms (docs/references.md, Particles). */
 #ifndef CD_SHAPES_H
 #define CD_SHAPES_H
 #include <stddef.h>

@@ -1,5 +1,5 @@
 /* Shape catalogue: closed forms, the numerical union method, the principal
- * frame of general segment lists, Table S1 of seed 000, errors and JSON. */
+ * frame of general segment lists, Table S1 of Conzelmann et al., errors and JSON. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -271,7 +271,7 @@ static void test_irregular_cluster_area_and_volume_are_consistent(void **state)
     check_abs(p.volume, box * f, 4 * box * sqrt(f * (1 - f) / N), "irregular cluster volume (Monte Carlo, 4 sigma)");
 }
 
-/* ---- Table S1 of seed 000 --------------------------------------------- */
+/* ---- Table S1 of Conzelmann et al. --------------------------------------------- */
 
 /* Sphericity of crosses and stars against Table S1 (3 decimals).  Where the
  * exact value differs, the row says what this code gives (docs/shapes.md):
