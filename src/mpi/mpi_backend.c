@@ -177,13 +177,28 @@ static void report(const cd_mpi_ctx *x)
     MPI_Reduce(mine, sum, 2, MPI_LONG, MPI_SUM, 0, x->comm);
     double t[4] = {x->t_step, x->t_decide, x->t_migrate, x->t_ghosts}, tmax[4]; /* [s] */
     MPI_Reduce(t, tmax, 4, MPI_DOUBLE, MPI_MAX, 0, x->comm);
-    if (x->rank == 0)
+    /* sent per ghost refresh and per migration: messages, bytes */
+    double refreshes = x->refreshes > 0 ? (double)x->refreshes : 1,
+           migrations = x->migrations > 0 ? (double)x->migrations : 1;
+    double c[4] = {(double)x->refresh_msgs / refreshes, (double)x->refresh_bytes / refreshes,
+                   (double)x->migrate_msgs / migrations, (double)x->migrate_bytes / migrations},
+           cmax[4], csum[4];
+    MPI_Reduce(c, cmax, 4, MPI_DOUBLE, MPI_MAX, 0, x->comm);
+    MPI_Reduce(c, csum, 4, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    if (x->rank == 0) {
         fprintf(stderr,
                 "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
                 "ghosts (%.3g ghosts per owned particle); slowest rank's seconds: step %.3g, rebuild decision %.3g, "
                 "migration %.3g, ghost refresh %.3g\n",
                 x->size, x->migrations, lo[0], hi[0], lo[1], hi[1], sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0,
                 tmax[0], tmax[1], tmax[2], tmax[3]);
+        fprintf(
+            stderr,
+            "capdem: MPI traffic: sent per rank (mean, max): per step %.4g, %.4g messages and %.6g, %.6g bytes; per "
+            "migration %.4g, %.4g messages and %.6g, %.6g bytes\n",
+            csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
+            cmax[3]);
+    }
 }
 
 /* Ends the local state; the context stays for a restart (cd_mpi_end

@@ -160,3 +160,30 @@ int cd_decomp_ghost_ranks(const cd_decomp_grid *g, const double x[3], int skip, 
             }
     return n; /* ascending: z slowest, x fastest, as rank_of numbers them */
 }
+
+void cd_decomp_box(const cd_decomp_grid *g, int r, double lo[3], double hi[3])
+{
+    int c[3] = {r % g->dims[0], r / g->dims[0] % g->dims[1], r / (g->dims[0] * g->dims[1])};
+    for (int a = 0; a < 3; a++) {
+        lo[a] = c[a] > 0 ? g->lo[a] + c[a] * g->width[a] : -INFINITY;
+        hi[a] = c[a] < g->dims[a] - 1 ? g->lo[a] + (c[a] + 1) * g->width[a] : INFINITY;
+    }
+}
+
+int cd_decomp_neighbors(const cd_decomp_grid *g, int rank, double reach, int *out)
+{
+    int n = 0, ranks = g->dims[0] * g->dims[1] * g->dims[2];
+    double alo[3], ahi[3], blo[3], bhi[3];
+    cd_decomp_box(g, rank, alo, ahi);
+    for (int r = 0; r < ranks; r++) {
+        if (r == rank) continue;
+        cd_decomp_box(g, r, blo, bhi);
+        double d2 = 0; /* [m^2] box to box; lo is never +inf nor hi -inf: no inf - inf */
+        for (int a = 0; a < 3; a++) {
+            double gap = fmax(0, fmax(blo[a] - ahi[a], alo[a] - bhi[a]));
+            d2 += gap * gap;
+        }
+        if (d2 <= reach * reach) out[n++] = r;
+    }
+    return n;
+}

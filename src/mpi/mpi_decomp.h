@@ -79,5 +79,12 @@ int cd_decomp_owner(const cd_decomp_grid *g, const double x[3]);
 /* The ranks other than skip whose sub-domain comes within the halo of x,
  * ascending, into out (room for every rank); returns how many. */
 int cd_decomp_ghost_ranks(const cd_decomp_grid *g, const double x[3], int skip, int *out);
+/* The sub-domain of rank r [m]: lo..hi, the outer faces at -/+infinity. */
+void cd_decomp_box(const cd_decomp_grid *g, int r, double lo[3], double hi[3]);
+/* The ranks other than `rank` whose sub-domain comes within `reach` [m] of
+ * rank's (box to box, Euclidean), ascending, into out (room for every
+ * rank); returns how many.  Symmetric: r is a neighbour of s when s is one
+ * of r.  The ghost refresh and the migration talk to these ranks only. */
+int cd_decomp_neighbors(const cd_decomp_grid *g, int rank, double reach, int *out);
 
 #endif

@@ -336,6 +336,13 @@ static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char *
     }
     int *rd = rc + R;
     MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, x->comm);
+    x->migrate_msgs += R - 1; /* the counts: one int to every other rank */
+    x->migrate_bytes += (long long)(R - 1) * (long long)sizeof(int);
+    for (int r = 0; r < R; r++)
+        if (r != x->rank && sc[r] > 0) {
+            x->migrate_msgs++;
+            x->migrate_bytes += sc[r];
+        }
     size_t ns = 0, nr = 0;
     for (int r = 0; r < R; r++) {
         sd[r] = (int)ns;
@@ -501,6 +508,12 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
             ghost_io(s, (size_t)x->send_list[x->send_displ[r] + k], x->send_buf + (size_t)(sd[r] + 1 + k * G), 1);
     }
     MPI_Alltoallv(x->send_buf, sc, sd, MPI_DOUBLE, x->recv_buf, rcv, rd, MPI_DOUBLE, x->comm);
+    x->refreshes++;
+    for (int r = 0; r < R; r++)
+        if (r != x->rank) {
+            x->refresh_msgs++;
+            x->refresh_bytes += (long long)sc[r] * (long long)sizeof(double);
+        }
     int first = R;
     for (int r = 0; r < R; r++) {
         if (x->recv_buf[rd[r]] != 0 && r < first) first = r;

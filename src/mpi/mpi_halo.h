@@ -30,6 +30,11 @@ typedef struct {
      * decision and migration taken out), deciding the rebuild (waits for
      * the slowest rank included), migrating, refreshing ghosts */
     double t_step, t_decide, t_migrate, t_ghosts;
+    /* what this rank sent to other ranks (exact, for docs/mpi.md "Speed"):
+     * messages and bytes of the ghost refreshes (refreshes of them) and of
+     * the migrations (the collectives that agree on decisions and statuses
+     * not counted: one int each) */
+    long long refreshes, refresh_msgs, refresh_bytes, migrate_msgs, migrate_bytes;
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,

@@ -103,12 +103,52 @@ static void test_owner_and_ghosts(void **state)
     assert_int_equal(r[1], 2);
 }
 
+/* Neighbours: the sub-domains within reach, box to box; on a 3 x 1 x 3
+ * grid of 1 m cells the centre one has all eight, a corner one three, and
+ * a reach of 1 m or more brings the opposite corner in only past
+ * sqrt(2) m; the relation is symmetric. */
+static void test_neighbors(void **state)
+{
+    (void)state;
+    char err[512];
+    cd_decomp_grid g;
+    cd_config c = config(3, 0, 0, 0);
+    c.mpi_grid[0] = 3, c.mpi_grid[1] = 1, c.mpi_grid[2] = 3;
+    double lo[3] = {0, 0, 0}, hi[3] = {3, 1, 3}; /* [m] */
+    assert_int_equal(cd_decomp_choose(&g, &c, 9, lo, hi, 0.1, 0, err, sizeof err), 0);
+    double blo[3], bhi[3];
+    cd_decomp_box(&g, 4, blo, bhi); /* the centre: x 1..2, z 1..2, y open */
+    assert_true(blo[0] == 1 && bhi[0] == 2 && blo[2] == 1 && bhi[2] == 2);
+    assert_true(isinf(blo[1]) && blo[1] < 0 && isinf(bhi[1]));
+    cd_decomp_box(&g, 0, blo, bhi);
+    assert_true(isinf(blo[0]) && blo[0] < 0 && bhi[0] == 1);
+    int r[9];
+    assert_int_equal(cd_decomp_neighbors(&g, 4, 0.1, r), 8);
+    assert_int_equal(r[0], 0);
+    assert_int_equal(r[7], 8);
+    assert_int_equal(cd_decomp_neighbors(&g, 0, 0.1, r), 3);
+    assert_int_equal(r[0], 1);
+    assert_int_equal(r[1], 3);
+    assert_int_equal(r[2], 4);
+    assert_int_equal(cd_decomp_neighbors(&g, 0, 1.0, r), 5); /* + 2 and 6, 1 m away; 8 is sqrt(2) m away */
+    assert_int_equal(cd_decomp_neighbors(&g, 0, 1.5, r), 8);
+    for (int a = 0; a < 9; a++)
+        for (int b = 0; b < 9; b++) {
+            int n = cd_decomp_neighbors(&g, a, 1.2, r), ab = 0, ba = 0;
+            for (int k = 0; k < n; k++) ab |= r[k] == b;
+            n = cd_decomp_neighbors(&g, b, 1.2, r);
+            for (int k = 0; k < n; k++) ba |= r[k] == a;
+            assert_int_equal(ab, ba);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_auto_grid),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_owner_and_ghosts),
+        cmocka_unit_test(test_neighbors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
