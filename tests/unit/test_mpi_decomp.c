@@ -130,7 +130,7 @@ static void test_neighbors(void **state)
     assert_int_equal(r[0], 1);
     assert_int_equal(r[1], 3);
     assert_int_equal(r[2], 4);
-    assert_int_equal(cd_decomp_neighbors(&g, 0, 1.0, r), 5); /* + 2 and 6, 1 m away; 8 is sqrt(2) m away */
+    assert_int_equal(cd_decomp_neighbors(&g, 0, 1.0, r), 7); /* + 2, 5, 6, 7: 1 m away; 8 is sqrt(2) m away */
     assert_int_equal(cd_decomp_neighbors(&g, 0, 1.5, r), 8);
     for (int a = 0; a < 9; a++)
         for (int b = 0; b < 9; b++) {
