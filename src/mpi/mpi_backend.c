@@ -187,11 +187,12 @@ static void report(const cd_mpi_ctx *x)
     MPI_Reduce(c, csum, 4, MPI_DOUBLE, MPI_SUM, 0, x->comm);
     if (x->rank == 0) {
         fprintf(stderr,
-                "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
+                "capdem: MPI: %d ranks, %lld migrations (%lld through all ranks); per rank now %ld..%ld owned "
+                "particles and %ld..%ld "
                 "ghosts (%.3g ghosts per owned particle); slowest rank's seconds: step %.3g, rebuild decision %.3g, "
                 "migration %.3g, ghost refresh %.3g\n",
-                x->size, x->migrations, lo[0], hi[0], lo[1], hi[1], sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0,
-                tmax[0], tmax[1], tmax[2], tmax[3]);
+                x->size, x->migrations, x->far_migrations, lo[0], hi[0], lo[1], hi[1],
+                sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0, tmax[0], tmax[1], tmax[2], tmax[3]);
         fprintf(
             stderr,
             "capdem: MPI traffic: sent per rank (mean, max): per step %.4g, %.4g messages and %.6g, %.6g bytes; per "

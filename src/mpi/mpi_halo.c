@@ -206,9 +206,8 @@ static int plan_refresh(cd_mpi_ctx *x)
             free(x->recv_buf);
             x->send_list = malloc(((size_t)ns + 1) * sizeof(int));
             x->recv_list = malloc(((size_t)nr + 1) * sizeof(int));
-            /* (one status per rank ahead of each rank's ghosts: cd_mpi_refresh_ghosts) */
-            x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
-            x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
+            x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
+            x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
             if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) {
                 free(ranks);
                 return -1;
@@ -298,11 +297,29 @@ static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
     return plan_refresh(x);
 }
 
+/* The ranks this one talks to: those whose sub-domain comes within the
+ * halo (ghosts) and the skin (room for the motion between migrations) of
+ * its own. */
+static int find_neighbors(cd_mpi_ctx *x)
+{
+    free(x->neighbors);
+    free(x->requests);
+    x->neighbors = malloc(((size_t)x->size + 1) * sizeof(int));
+    if (!x->neighbors) return -1;
+    x->n_neighbors = cd_decomp_neighbors(&x->grid, x->rank, x->grid.halo + x->loc.nb.skin, x->neighbors);
+    x->requests = malloc((2 * (size_t)x->n_neighbors + 1) * sizeof(MPI_Request));
+    return x->requests ? 0 : -1;
+}
+
 int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
 {
     size_t W = global->n_walls, pb = 0, cb = 0;
     int *ranks = malloc((size_t)x->size * sizeof *ranks);
     double p[3];
+    if (find_neighbors(x)) {
+        free(ranks);
+        return -1;
+    }
     for (size_t q = 0; q < global->n_particles; q++) pb += particle_bytes(global->prim_count[q], W);
     for (size_t k = 0; k < global->n_pairs; k++) cb += global->pair_active[k] ? pair_bytes() : 0;
     char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *at = pbuf;
@@ -358,14 +375,23 @@ static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char *
     return *recv ? 0 : -1;
 }
 
-/* Growable list of ranks per owned particle: the ranks a particle goes to
- * at a migration (its new owner first). */
+/* Per local particle, the ranks that hold it after a migration: its owner
+ * by its centre now first, then the ranks whose sub-domain its halo
+ * reaches.  Every rank that holds a particle finds the same list (the same
+ * position bits, refreshed every step). */
 typedef struct {
     int *first, *count, *ranks;
     size_t n, cap;
 } dest_lists;
 
-static int dests_of_owned(cd_mpi_ctx *x, dest_lists *d)
+static void dests_free(dest_lists *d)
+{
+    free(d->first);
+    free(d->count);
+    free(d->ranks);
+}
+
+static int dests_of_local(cd_mpi_ctx *x, dest_lists *d)
 {
     cd_state *s = &x->loc.s;
     size_t N = s->n_particles;
@@ -377,7 +403,6 @@ static int dests_of_owned(cd_mpi_ctx *x, dest_lists *d)
     if (!d->first || !d->count || !d->ranks) return -1;
     double p[3];
     for (size_t q = 0; q < N; q++) {
-        if (!x->owned[q]) continue;
         if (d->n + (size_t)x->size + 1 > d->cap) {
             int *g = realloc(d->ranks, (d->cap *= 2) * sizeof(int));
             if (!g) return -1;
@@ -392,7 +417,7 @@ static int dests_of_owned(cd_mpi_ctx *x, dest_lists *d)
     return 0;
 }
 
-/* Does particle q (owned) go to rank r? */
+/* Will rank r hold particle q? */
 static int goes_to(const dest_lists *d, size_t q, int r)
 {
     for (int k = 0; k < d->count[q]; k++)
@@ -400,80 +425,236 @@ static int goes_to(const dest_lists *d, size_t q, int r)
     return 0;
 }
 
-/* Pair row k goes to every rank that an owned particle of it goes to,
- * each rank once: body runs with r set to each of them. */
-#define FOR_PAIR_DESTS(x, d, k, r, body)                                                                               \
-    do {                                                                                                               \
-        cd_state *s_ = &(x)->loc.s;                                                                                    \
-        size_t pi_ = (size_t)s_->prim_particle[s_->pair_prim_i[k]],                                                    \
-               pj_ = (size_t)s_->prim_particle[s_->pair_prim_j[k]];                                                    \
-        if ((x)->owned[pi_])                                                                                           \
-            for (int e_ = 0; e_ < (d)->count[pi_]; e_++) {                                                             \
-                int r = (d)->ranks[(d)->first[pi_] + e_];                                                              \
-                body;                                                                                                  \
-            }                                                                                                          \
-        if ((x)->owned[pj_])                                                                                           \
-            for (int e_ = 0; e_ < (d)->count[pj_]; e_++) {                                                             \
-                int r = (d)->ranks[(d)->first[pj_] + e_];                                                              \
-                if (!(x)->owned[pi_] || !goes_to(d, pi_, r)) {                                                         \
-                    body;                                                                                              \
-                }                                                                                                      \
-            }                                                                                                          \
-    } while (0)
+/* Does rank r (not this one) hold a ghost of owned particle q now: is q
+ * in the ghost refresh to r (planned at the last migration from the ranks
+ * q went to; the list per rank ascending)? */
+static int ghost_now(const cd_mpi_ctx *x, size_t q, int r)
+{
+    const int *l = x->send_list + x->send_displ[r];
+    int lo = 0, hi = x->send_count[r];
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (l[mid] < (int)q) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < x->send_count[r] && l[lo] == (int)q;
+}
+
+/* Does this rank send particle q to rank r at this migration?  Its owner
+ * sends it to each new holder, and to its new owner (which may hold a
+ * ghost of it: the owner's record replaces that, so that what a rank
+ * owns comes from the previous owner, every column). */
+static int sends(const cd_mpi_ctx *x, const dest_lists *d, size_t q, int r)
+{
+    if (!x->owned[q] || r == x->rank || !goes_to(d, q, r)) return 0;
+    return !ghost_now(x, q, r) || d->ranks[d->first[q]] == r;
+}
+
+/* Does this rank keep its copy of particle q?  When it still holds q, but
+ * not when it comes to own a particle it held as a ghost (the previous
+ * owner sends it). */
+static int keeps(const cd_mpi_ctx *x, const dest_lists *d, size_t q)
+{
+    if (!goes_to(d, q, x->rank)) return 0;
+    return x->owned[q] || d->ranks[d->first[q]] != x->rank;
+}
+
+/* The ranks that get pair row k from this rank (into out, room for twice
+ * the ranks): those to which it sends one of the row's particles and
+ * which will hold the other one too (a rank that keeps both has the row:
+ * every rank builds the rows among all its particles).  Each rank once. */
+static int row_dests(const cd_mpi_ctx *x, const dest_lists *d, size_t k, int *out)
+{
+    const cd_state *s = &x->loc.s;
+    size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
+    int n = 0;
+    for (int e = 0; x->owned[a] && e < d->count[a]; e++) {
+        int r = d->ranks[d->first[a] + e];
+        if (sends(x, d, a, r) && goes_to(d, b, r)) out[n++] = r;
+    }
+    for (int e = 0; x->owned[b] && e < d->count[b]; e++) {
+        int r = d->ranks[d->first[b] + e];
+        if (sends(x, d, b, r) && goes_to(d, a, r) && !sends(x, d, a, r)) out[n++] = r;
+    }
+    return n;
+}
+
+/* Bytes that travel at a migration, per destination rank: a head (the
+ * particle records' length), the particle records, the pair records. */
+typedef struct {
+    long long particle_bytes;
+} move_head;
+
+enum { TAG_GHOSTS = 1, TAG_MIGRATE = 2 };
+
+/* Sends out[r] (len[r] bytes, for every rank) and receives what the
+ * others send into *in (*inlen bytes, the senders in rank order):
+ * point to point with the neighbours (one message each way, empty ones
+ * included, the receiver learning the length from the message) when
+ * every destination is one, else an MPI_Alltoallv over all ranks (far:
+ * agreed by all).  0, or -1 (out of memory). */
+static int move_bytes(cd_mpi_ctx *x, char *const *out, const int *len, int far, char **in, size_t *inlen)
+{
+    int R = x->size;
+    if (far) {
+        size_t total = 0;
+        for (int r = 0; r < R; r++) total += (size_t)len[r];
+        char *flat = malloc(total + 1), *at = flat;
+        if (!flat) MPI_Abort(x->comm, 1); /* the others wait in the exchange */
+        for (int r = 0; r < R; r++) {
+            memcpy(at, out[r], (size_t)len[r]);
+            at += len[r];
+        }
+        int rc = exchange_bytes(x, flat, len, in, inlen);
+        free(flat);
+        x->far_migrations++;
+        return rc;
+    }
+    int nb = x->n_neighbors, *rlen = malloc(((size_t)nb + 1) * sizeof(int));
+    if (!rlen) MPI_Abort(x->comm, 1);
+    for (int k = 0; k < nb; k++) {
+        int r = x->neighbors[k];
+        MPI_Isend(out[r], len[r], MPI_BYTE, r, TAG_MIGRATE, x->comm, &x->requests[k]);
+        x->migrate_msgs++;
+        x->migrate_bytes += len[r];
+    }
+    size_t total = 0;
+    for (int k = 0; k < nb; k++) {
+        MPI_Status st;
+        MPI_Probe(x->neighbors[k], TAG_MIGRATE, x->comm, &st);
+        MPI_Get_count(&st, MPI_BYTE, &rlen[k]);
+        total += (size_t)rlen[k];
+    }
+    *in = malloc(total + 1);
+    *inlen = total;
+    if (!*in) MPI_Abort(x->comm, 1);
+    char *at = *in;
+    for (int k = 0; k < nb; k++) {
+        MPI_Recv(at, rlen[k], MPI_BYTE, x->neighbors[k], TAG_MIGRATE, x->comm, MPI_STATUS_IGNORE);
+        at += rlen[k];
+    }
+    MPI_Waitall(nb, x->requests, MPI_STATUSES_IGNORE);
+    free(rlen);
+    return 0;
+}
+
+/* Appends the particle and pair records of the messages in (inlen bytes,
+ * each a move_head and its records) to the kept ones (pbuf, cbuf: room
+ * made here). */
+static int split_moved(const char *in, size_t inlen, char **pbuf, size_t *plen, char **cbuf, size_t *clen)
+{
+    char *p = realloc(*pbuf, *plen + inlen + 1), *c = p ? realloc(*cbuf, *clen + inlen + 1) : NULL;
+    if (p) *pbuf = p;
+    if (c) *cbuf = c;
+    if (!p || !c) return -1;
+    for (size_t at = 0; at < inlen;) { /* a message: head, particle records, a row count, pair records */
+        move_head h;
+        long long rows;
+        memcpy(&h, in + at, sizeof h);
+        at += sizeof h;
+        memcpy(*pbuf + *plen, in + at, (size_t)h.particle_bytes);
+        *plen += (size_t)h.particle_bytes;
+        at += (size_t)h.particle_bytes;
+        memcpy(&rows, in + at, sizeof rows);
+        at += sizeof rows;
+        memcpy(*cbuf + *clen, in + at, (size_t)rows * pair_bytes());
+        *clen += (size_t)rows * pair_bytes();
+        at += (size_t)rows * pair_bytes();
+    }
+    return 0;
+}
 
 int cd_mpi_migrate(cd_mpi_ctx *x)
 {
     cd_state *s = &x->loc.s;
     int R = x->size;
-    size_t W = s->n_walls;
+    size_t W = s->n_walls, N = s->n_particles;
     dest_lists d = {0};
-    int *pc = calloc((size_t)R, sizeof(int)), *cc = calloc((size_t)R, sizeof(int));
-    size_t *po = calloc((size_t)R + 1, sizeof(size_t)), *co = calloc((size_t)R + 1, sizeof(size_t));
-    char *pbuf = NULL, *cbuf = NULL, *prec = NULL, *crec = NULL;
-    size_t plen = 0, clen = 0;
-    int rc = pc && cc && po && co ? dests_of_owned(x, &d) : -1;
-    for (size_t q = 0; !rc && q < s->n_particles; q++)
-        for (int k = 0; x->owned[q] && k < d.count[q]; k++)
-            pc[d.ranks[d.first[q] + k]] += (int)particle_bytes(s->prim_count[q], W);
-    for (size_t k = 0; !rc && k < s->n_pairs; k++)
-        if (s->pair_active[k]) FOR_PAIR_DESTS(x, &d, k, r, cc[r] += (int)pair_bytes());
+    int *len = calloc((size_t)R + 1, sizeof(int)), *rows = calloc((size_t)R + 1, sizeof(int));
+    int *rd = malloc((2 * (size_t)R + 1) * sizeof(int));
+    size_t *pl = calloc((size_t)R + 1, sizeof(size_t));
+    char **out = calloc((size_t)R + 1, sizeof(char *)), *in = NULL, *pbuf = NULL, *cbuf = NULL;
+    size_t inlen = 0, plen = 0, clen = 0, kept_p = 0, kept_c = 0;
+    int rc = len && rows && rd && pl && out ? dests_of_local(x, &d) : -1;
+    /* what goes where: particle records, then the pair rows */
+    for (size_t q = 0; !rc && q < N; q++) {
+        for (int e = 0; x->owned[q] && e < d.count[q]; e++)
+            if (sends(x, &d, q, d.ranks[d.first[q] + e]))
+                pl[d.ranks[d.first[q] + e]] += particle_bytes(s->prim_count[q], W);
+        if (keeps(x, &d, q)) kept_p += particle_bytes(s->prim_count[q], W);
+    }
+    for (size_t k = 0; !rc && k < s->n_pairs; k++) {
+        if (!s->pair_active[k]) continue;
+        int n = row_dests(x, &d, k, rd);
+        for (int e = 0; e < n; e++) rows[rd[e]]++;
+        size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
+        if (keeps(x, &d, a) && keeps(x, &d, b)) kept_c += pair_bytes();
+    }
+    int far = 0;
     for (int r = 0; !rc && r < R; r++) {
-        po[r + 1] = po[r] + (size_t)pc[r];
-        co[r + 1] = co[r] + (size_t)cc[r];
-    }
-    if (!rc) {
-        pbuf = malloc(po[R] + 1);
-        cbuf = malloc(co[R] + 1);
-        rc = pbuf && cbuf ? 0 : -1;
-    }
-    for (size_t q = 0; !rc && q < s->n_particles; q++)
-        for (int k = 0; x->owned[q] && k < d.count[q]; k++) {
-            int r = d.ranks[d.first[q] + k];
-            char *end = pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], pbuf + po[r]);
-            po[r] = (size_t)(end - pbuf);
+        size_t n =
+            pl[r] || rows[r] ? sizeof(move_head) + pl[r] + sizeof(long long) + (size_t)rows[r] * pair_bytes() : 0;
+        len[r] = (int)n;
+        out[r] = malloc(n + 1);
+        if (!out[r]) rc = -1;
+        else if (n) {
+            move_head h = {(long long)pl[r]};
+            memcpy(out[r], &h, sizeof h);
+            long long nr = rows[r];
+            memcpy(out[r] + sizeof h + pl[r], &nr, sizeof nr);
         }
-    for (size_t k = 0; !rc && k < s->n_pairs; k++)
-        if (s->pair_active[k])
-            FOR_PAIR_DESTS(x, &d, k, r, {
-                char *end = pack_pair(s, k, x->gprim[s->pair_prim_i[k]], x->gprim[s->pair_prim_j[k]], 0, cbuf + co[r]);
-                co[r] = (size_t)(end - cbuf);
-            });
-    if (!rc) rc = exchange_bytes(x, pbuf, pc, &prec, &plen);
-    if (!rc) rc = exchange_bytes(x, cbuf, cc, &crec, &clen);
+        int near = r == x->rank;
+        for (int k = 0; k < x->n_neighbors && !near; k++) near = x->neighbors[k] == r;
+        far |= n > 0 && !near;
+        pl[r] = sizeof(move_head); /* now: where the next particle record goes */
+        rows[r] = 0;               /* and how many pair records are in */
+    }
+    pbuf = rc ? NULL : malloc(kept_p + 1);
+    cbuf = rc ? NULL : malloc(kept_c + 1);
+    if (!rc && (!pbuf || !cbuf)) rc = -1;
+    /* pack: the records sent, the copies kept (the local ones, no message) */
+    char *pk = pbuf, *ck = cbuf;
+    for (size_t q = 0; !rc && q < N; q++) {
+        long long gp = x->gprim[s->prim_first[q]];
+        for (int e = 0; x->owned[q] && e < d.count[q]; e++) {
+            int r = d.ranks[d.first[q] + e];
+            if (sends(x, &d, q, r)) pl[r] = (size_t)(pack_particle(s, q, x->gid[q], gp, out[r] + pl[r]) - out[r]);
+        }
+        if (keeps(x, &d, q)) pk = pack_particle(s, q, x->gid[q], gp, pk);
+    }
+    for (size_t k = 0; !rc && k < s->n_pairs; k++) {
+        if (!s->pair_active[k]) continue;
+        long long gi = x->gprim[s->pair_prim_i[k]], gj = x->gprim[s->pair_prim_j[k]];
+        int n = row_dests(x, &d, k, rd);
+        for (int e = 0; e < n; e++) {
+            int r = rd[e];
+            size_t at = pl[r] + sizeof(long long) + (size_t)rows[r]++ * pair_bytes();
+            pack_pair(s, k, gi, gj, 0, out[r] + at);
+        }
+        size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
+        if (keeps(x, &d, a) && keeps(x, &d, b)) ck = pack_pair(s, k, gi, gj, 0, ck);
+    }
+    /* a particle beyond the neighbours (it moved far, or is not finite):
+     * this migration goes through all ranks, which all must know */
+    int any_far = 0;
+    if (!rc) MPI_Allreduce(&far, &any_far, 1, MPI_INT, MPI_LOR, x->comm);
+    if (!rc) rc = move_bytes(x, out, len, any_far, &in, &inlen);
+    plen = rc ? 0 : (size_t)(pk - pbuf);
+    clen = rc ? 0 : (size_t)(ck - cbuf);
+    if (!rc) rc = split_moved(in, inlen, &pbuf, &plen, &cbuf, &clen);
     cd_state scal = *s; /* the scalars only: assemble replaces s */
-    if (!rc) rc = assemble(x, prec, plen, crec, clen, &scal);
+    if (!rc) rc = assemble(x, pbuf, plen, cbuf, clen, &scal);
     if (!rc) x->migrations++;
-    free(d.first);
-    free(d.count);
-    free(d.ranks);
-    free(pc);
-    free(cc);
-    free(po);
-    free(co);
+    dests_free(&d);
+    for (int r = 0; out && r < R; r++) free(out[r]);
+    free(out);
+    free(len);
+    free(rows);
+    free(rd);
+    free(pl);
+    free(in);
     free(pbuf);
     free(cbuf);
-    free(prec);
-    free(crec);
     return rc;
 }
 
@@ -493,34 +674,34 @@ static void ghost_io(cd_state *s, size_t q, double *b, int pack)
 int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
 {
     cd_state *s = &x->loc.s;
-    int R = x->size, G = CD_MPI_GHOST_DOUBLES;
-    int *sc = calloc((size_t)R * 4, sizeof(int));
-    if (!sc) MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
-    int *sd = sc + R, *rcv = sc + 2 * R, *rd = sc + 3 * R;
-    /* to every rank: this rank's status, then the ghosts it owns there */
-    for (int r = 0; r < R; r++) {
-        sc[r] = 1 + x->send_count[r] * G;
-        sd[r] = r + x->send_displ[r] * G;
-        rcv[r] = 1 + x->recv_count[r] * G;
-        rd[r] = r + x->recv_displ[r] * G;
-        x->send_buf[sd[r]] = failed;
-        for (int k = 0; k < x->send_count[r]; k++)
-            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + k], x->send_buf + (size_t)(sd[r] + 1 + k * G), 1);
+    int G = CD_MPI_GHOST_DOUBLES, n = 0, who = failed ? x->rank : x->size, first = x->size;
+    MPI_Iallreduce(&who, &first, 1, MPI_INT, MPI_MIN, x->comm, &x->requests[n++]);
+    /* the ghosts of a neighbour here, the owned particles it has ghosts of
+     * (the counts known on both sides since the last migration) */
+    for (int k = 0; k < x->n_neighbors; k++) {
+        int r = x->neighbors[k];
+        if (x->recv_count[r])
+            MPI_Irecv(x->recv_buf + (size_t)x->recv_displ[r] * G, x->recv_count[r] * G, MPI_DOUBLE, r, TAG_GHOSTS,
+                      x->comm, &x->requests[n++]);
     }
-    MPI_Alltoallv(x->send_buf, sc, sd, MPI_DOUBLE, x->recv_buf, rcv, rd, MPI_DOUBLE, x->comm);
+    for (int k = 0; k < x->n_neighbors; k++) {
+        int r = x->neighbors[k];
+        if (!x->send_count[r]) continue;
+        double *b = x->send_buf + (size_t)x->send_displ[r] * G;
+        for (int e = 0; e < x->send_count[r]; e++)
+            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + e], b + (size_t)e * G, 1);
+        MPI_Isend(b, x->send_count[r] * G, MPI_DOUBLE, r, TAG_GHOSTS, x->comm, &x->requests[n++]);
+        x->refresh_msgs++;
+        x->refresh_bytes += (long long)x->send_count[r] * G * (long long)sizeof(double);
+    }
+    MPI_Waitall(n, x->requests, MPI_STATUSES_IGNORE);
+    for (int k = 0; k < x->n_neighbors; k++) {
+        int r = x->neighbors[k];
+        for (int e = 0; e < x->recv_count[r]; e++)
+            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G,
+                     0);
+    }
     x->refreshes++;
-    for (int r = 0; r < R; r++)
-        if (r != x->rank) {
-            x->refresh_msgs++;
-            x->refresh_bytes += (long long)sc[r] * (long long)sizeof(double);
-        }
-    int first = R;
-    for (int r = 0; r < R; r++) {
-        if (x->recv_buf[rd[r]] != 0 && r < first) first = r;
-        for (int k = 0; k < x->recv_count[r]; k++)
-            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + k], x->recv_buf + (size_t)(rd[r] + 1 + k * G), 0);
-    }
-    free(sc);
     return first;
 }
 
@@ -702,6 +883,11 @@ void cd_mpi_halo_free(cd_mpi_ctx *x)
     free(x->recv_list);
     free(x->send_buf);
     free(x->recv_buf);
+    free(x->neighbors);
+    free(x->requests);
+    x->neighbors = NULL;
+    x->requests = NULL;
+    x->n_neighbors = 0;
     x->gid = x->gprim = NULL;
     x->owned = NULL;
     x->send_count = x->send_displ = x->recv_count = x->recv_displ = x->send_list = x->recv_list = NULL;

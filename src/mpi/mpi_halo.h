@@ -22,6 +22,12 @@ typedef struct {
     int *send_count, *send_displ, *recv_count, *recv_displ; /* per rank, in particles */
     int *send_list, *recv_list;
     double *send_buf, *recv_buf;
+    /* the ranks whose sub-domain comes within the halo and the skin of this
+     * one's (cd_decomp_neighbors): the only ones it exchanges with, but for
+     * a migration that finds a particle beyond them (then all ranks) */
+    int n_neighbors, *neighbors;
+    MPI_Request *requests;        /* room for two per neighbour and one */
+    long long far_migrations;     /* migrations that had to talk to all ranks */
     long long migrations;         /* times the particles went to new owners */
     int started;                  /* the local state runs (start succeeded on every rank) */
     int ran;                      /* it ran at least once (the closing report) */
@@ -43,18 +49,25 @@ typedef struct {
 
 /* The local state of this rank cut from a global state (every rank holds
  * the same one at start): owned particles, ghosts, the active pair rows
- * among them; the ghost refresh planned.  0, or -1 (out of memory). */
+ * among them; the neighbours and the ghost refresh planned.  0, or -1 (out
+ * of memory). */
 int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global);
-/* Every owned particle to its owner by its centre now, with ghosts to the
- * ranks within the interaction range, their primitive and wall-contact
- * rows and the active pair rows (history); the local state replaced.
+/* Every particle to the ranks that hold it by its centre now (its owner,
+ * and as a ghost the ranks within the interaction range): a rank keeps
+ * the copies it has and gets, from the particle's owner, only the ones
+ * it lacks and the particles it comes to own, with their primitive and
+ * wall-contact rows and the active pair rows (history) it lacks; the
+ * local state is rebuilt from both.  Point to point with the neighbours
+ * (one message each), with all ranks when a particle went beyond them.
  * Collective.  0, or -1 (out of memory). */
 int cd_mpi_migrate(cd_mpi_ctx *x);
 /* The ghosts' pose, velocities, force and torque from their owners, after
- * a step (the serial step leaves them computed from partial forces), and
- * with them every rank's status (failed: 0 or 1), so that the ranks agree
- * to go on or stop in the same message.  Collective.  Returns the lowest
- * rank that failed, or the rank count when none did. */
+ * a step (the serial step leaves them computed from partial forces): a
+ * message to and from each neighbour that has ghosts of the other; and,
+ * overlapped with them, every rank's status (failed: 0 or 1, one
+ * MPI_Iallreduce), so that the ranks agree to go on or stop at the same
+ * step.  Collective.  Returns the lowest rank that failed, or the rank
+ * count when none did. */
 int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
 /* The owned rows of every rank into global, on every rank: particles,
  * primitives and wall-contact rows at their global row, the pair rows at
