@@ -180,11 +180,12 @@ static void report(const cd_mpi_ctx *x)
     /* sent per ghost refresh and per migration: messages, bytes */
     double refreshes = x->refreshes > 0 ? (double)x->refreshes : 1,
            migrations = x->migrations > 0 ? (double)x->migrations : 1;
-    double c[4] = {(double)x->refresh_msgs / refreshes, (double)x->refresh_bytes / refreshes,
-                   (double)x->migrate_msgs / migrations, (double)x->migrate_bytes / migrations},
-           cmax[4], csum[4];
-    MPI_Reduce(c, cmax, 4, MPI_DOUBLE, MPI_MAX, 0, x->comm);
-    MPI_Reduce(c, csum, 4, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    double c[5] = {(double)x->refresh_msgs / refreshes, (double)x->refresh_bytes / refreshes,
+                   (double)x->migrate_msgs / migrations, (double)x->migrate_bytes / migrations,
+                   (double)x->migrate_records / migrations},
+           cmax[5], csum[5];
+    MPI_Reduce(c, cmax, 5, MPI_DOUBLE, MPI_MAX, 0, x->comm);
+    MPI_Reduce(c, csum, 5, MPI_DOUBLE, MPI_SUM, 0, x->comm);
     if (x->rank == 0) {
         fprintf(stderr,
                 "capdem: MPI: %d ranks, %lld migrations (%lld through all ranks); per rank now %ld..%ld owned "
@@ -196,9 +197,9 @@ static void report(const cd_mpi_ctx *x)
         fprintf(
             stderr,
             "capdem: MPI traffic: sent per rank (mean, max): per step %.4g, %.4g messages and %.6g, %.6g bytes; per "
-            "migration %.4g, %.4g messages and %.6g, %.6g bytes\n",
+            "migration %.4g, %.4g messages and %.6g, %.6g bytes, %.4g, %.4g particle records\n",
             csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
-            cmax[3]);
+            cmax[3], csum[4] / x->size, cmax[4]);
     }
 }
 
@@ -360,6 +361,8 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     x->comm = MPI_COMM_WORLD;
     MPI_Comm_rank(x->comm, &x->rank);
     MPI_Comm_size(x->comm, &x->size);
+    const char *all = getenv("CAPDEM_MPI_ALL_RANKS"); /* the fallback path of a migration, for its test */
+    x->all_ranks = all && !strcmp(all, "1");
     x->inner = sim->backend ? sim->backend : &cd_backend_omp;
     sim->backend = &cd_backend_mpi;
     sim->backend_data = x;

@@ -618,7 +618,9 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
         long long gp = x->gprim[s->prim_first[q]];
         for (int e = 0; x->owned[q] && e < d.count[q]; e++) {
             int r = d.ranks[d.first[q] + e];
-            if (sends(x, &d, q, r)) pl[r] = (size_t)(pack_particle(s, q, x->gid[q], gp, out[r] + pl[r]) - out[r]);
+            if (!sends(x, &d, q, r)) continue;
+            pl[r] = (size_t)(pack_particle(s, q, x->gid[q], gp, out[r] + pl[r]) - out[r]);
+            x->migrate_records++;
         }
         if (keeps(x, &d, q)) pk = pack_particle(s, q, x->gid[q], gp, pk);
     }
@@ -637,6 +639,7 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
     /* a particle beyond the neighbours (it moved far, or is not finite):
      * this migration goes through all ranks, which all must know */
     int any_far = 0;
+    far |= x->all_ranks;
     if (!rc) MPI_Allreduce(&far, &any_far, 1, MPI_INT, MPI_LOR, x->comm);
     if (!rc) rc = move_bytes(x, out, len, any_far, &in, &inlen);
     plen = rc ? 0 : (size_t)(pk - pbuf);

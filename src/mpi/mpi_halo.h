@@ -28,6 +28,7 @@ typedef struct {
     int n_neighbors, *neighbors;
     MPI_Request *requests;        /* room for two per neighbour and one */
     long long far_migrations;     /* migrations that had to talk to all ranks */
+    int all_ranks;                /* every migration through all ranks (CAPDEM_MPI_ALL_RANKS=1: tests that path) */
     long long migrations;         /* times the particles went to new owners */
     int started;                  /* the local state runs (start succeeded on every rank) */
     int ran;                      /* it ran at least once (the closing report) */
@@ -38,9 +39,9 @@ typedef struct {
     double t_step, t_decide, t_migrate, t_ghosts;
     /* what this rank sent to other ranks (exact, for docs/mpi.md "Speed"):
      * messages and bytes of the ghost refreshes (refreshes of them) and of
-     * the migrations (the collectives that agree on decisions and statuses
+     * the migrations, with the particle records among them (the collectives that agree on decisions and statuses
      * not counted: one int each) */
-    long long refreshes, refresh_msgs, refresh_bytes, migrate_msgs, migrate_bytes;
+    long long refreshes, refresh_msgs, refresh_bytes, migrate_msgs, migrate_bytes, migrate_records;
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,

@@ -8,11 +8,29 @@
 # the settling pile leaves empty; crosses dragged across 4 sub-domains by
 # a sliding floor.  The runs must have contacts at the last snapshot,
 # particles that changed owner, and ghosts, or the comparison proves
-# little.
+# little.  On 4 slabs the ranks talk to their neighbours only and the
+# migrations send only what changes; every migration forced through all
+# ranks (the fallback) keeps the bits.
 # usage: test_mpi_bitwise.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
 . "$src/tests/mpi/mpi_common.sh"
+
+# Point to point (docs/mpi.md, "Communication"): the crosses on 4 slabs
+# across x, each with at most 2 neighbours: no rank sends more than 2
+# messages per step or per migration (an exchange with all ranks: 3), and
+# the migrations send the particles that change owner and the ghost copies
+# that appear: under one particle record per migration and rank (the
+# crosses settle, few cross a cut; re-sending every owned particle with
+# its ghost copies would be 10 to 20).
+traffic_checks() {
+  local t
+  t=$(grep 'capdem: MPI traffic:' err)
+  # "per step A, B messages and C, D bytes; per migration E, F messages and G, H bytes, I, J particle records"
+  read -r step_max mig_max records <<< "$(sed -n 's/.*per step [0-9.e+-]*, \([0-9.e+-]*\) messages.*per migration [0-9.e+-]*, \([0-9.e+-]*\) messages.*bytes, \([0-9.e+-]*\), [0-9.e+-]* particle records.*/\1 \2 \3/p' <<< "$t")"
+  if awk -v a="${step_max:-9}" -v b="${mig_max:-9}" -v c="${records:-99}" 'BEGIN { exit !(a <= 2 && b <= 2 && c < 1) }'; then ok
+  else bad "crosses_2d: 4 ranks: expected at most 2 messages per step and per migration and under 1 record per migration, got: $t"; fi
+}
 
 for case in hexapod_pile crosses_2d; do
   cfg="$src/tests/mpi/$case.yaml"
@@ -30,7 +48,16 @@ for case in hexapod_pile crosses_2d; do
     ghosts=$(sed -n 's/.*and [0-9]*\.\.\([0-9]*\) ghosts.*/\1/p' <<< "$line")
     if [ "${migrations:-0}" -ge 10 ] && [ "${ghosts:-0}" -ge 1 ]; then ok
     else bad "$case: $np ranks: expected migrations and ghosts, got: $line"; fi
+    [ "$case.$np" = crosses_2d.4 ] && traffic_checks
   done
+  # The migrations' fallback through all ranks (a particle beyond the
+  # neighbours; forced here for every migration): the same bits.
+  if [ "$case" = crosses_2d ]; then
+    if CAPDEM_MPI_ALL_RANKS=1 mpi 3 run "$cfg" --output all3.h5 --quiet 2> err && same serial.h5 all3.h5; then ok
+    else bad "$case: 3 ranks, every migration through all ranks: failed or differs from the serial run"; head -20 diff.txt; fi
+    if grep -q 'capdem: MPI: 3 ranks, \([0-9]*\) migrations (\1 through all ranks)' err; then ok
+    else bad "$case: expected every migration through all ranks: $(grep 'MPI:' err)"; fi
+  fi
   rm -f ./*.h5
 done
 # Sub-domains stacked along gravity (mpi.grid [1, 3, 1]): the top one
