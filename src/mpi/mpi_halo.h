@@ -33,6 +33,7 @@ typedef struct {
     int started;                  /* the local state runs (start succeeded on every rank) */
     int ran;                      /* it ran at least once (the closing report) */
     long last_owned, last_ghosts; /* particles of this rank when it last stopped */
+    long start_owned;             /* owned particles at the first start */
     /* wall-clock seconds of this rank (MPI_Wtime): in the serial step (the
      * decision and migration taken out), deciding the rebuild (waits for
      * the slowest rank included), migrating, refreshing ghosts */

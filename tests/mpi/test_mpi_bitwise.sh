@@ -8,9 +8,10 @@
 # the settling pile leaves empty; crosses dragged across 4 sub-domains by
 # a sliding floor.  The runs must have contacts at the last snapshot,
 # particles that changed owner, and ghosts, or the comparison proves
-# little.  On 4 slabs the ranks talk to their neighbours only and the
-# migrations send only what changes; every migration forced through all
-# ranks (the fallback) keeps the bits.
+# little.  The same with recursive coordinate bisection.  On 4 slabs the
+# ranks talk to their neighbours only and the migrations send only what
+# changes; every migration forced through all ranks (the fallback) keeps
+# the bits.
 # usage: test_mpi_bitwise.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
@@ -69,6 +70,18 @@ rm -f ./*.h5
 if mpi 3 run stacked.yaml --output mpi3.h5 --quiet 2> err && same serial.h5 mpi3.h5; then ok
 else bad "stacked: 3 ranks: failed or differs from the serial run"; head -20 diff.txt; fi
 if grep -q 'per rank now 0\.\.' err; then ok; else bad "stacked: expected a rank without particles: $(grep 'MPI:' err)"; fi
+# Recursive coordinate bisection (mpi.decomposition: rcb): the hexapod
+# pile on 3 ranks, the crosses on 4, with the serial bits.
+for c in hexapod_pile.3 crosses_2d.4; do
+  case=${c%.*} np=${c#*.}
+  { printf 'mpi:\n  decomposition: rcb\n'; cat "$src/tests/mpi/$case.yaml"; } > rcb.yaml
+  rm -f ./*.h5
+  "$capdem" run rcb.yaml --output serial.h5 --quiet 2> err || bad "rcb $case: the serial run failed"
+  if mpi "$np" run rcb.yaml --output rcb.h5 --quiet 2> err && same serial.h5 rcb.h5; then ok
+  else bad "rcb $case: $np ranks: failed or differs from the serial run"; head -20 diff.txt; fi
+  if grep -q 'sub-domains by recursive coordinate bisection' err; then ok
+  else bad "rcb $case: not cut by rcb: $(head -1 err)"; fi
+done
 # Migration under shear: a sliding floor drags 2D crosses across 4
 # sub-domains; at least 5 of them end in another sub-domain (x slabs of
 # the start box) than they began in, with their contacts.

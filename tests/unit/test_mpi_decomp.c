@@ -142,13 +142,69 @@ static void test_neighbors(void **state)
         }
 }
 
+/* Recursive coordinate bisection of a settled pile: points filling the
+ * bottom tenth of a 1 m box.  Every rank owns its share of the particles
+ * (to one per cut), whatever the rank count; the boxes tile space (every
+ * point's owner box holds it) and no cut goes across the pile's height;
+ * 2D never cuts z; a given mpi.grid is refused. */
+static void test_rcb(void **state)
+{
+    (void)state;
+    enum { N = 2000 };
+    static double xyz[3 * N]; /* [m] */
+    unsigned long long seed = 12345;
+    for (int q = 0; q < N; q++)
+        for (int a = 0; a < 3; a++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL; /* an LCG: reproducible */
+            double u = (double)(seed >> 11) / 9007199254740992.0;
+            xyz[3 * q + a] = a == 1 ? 0.1 * u : u;
+        }
+    char err[512];
+    static cd_decomp_grid g;
+    cd_config c = config(3, 0, -9.81, 0);
+    c.mpi_decomposition = CD_DECOMP_RCB;
+    for (int ranks = 1; ranks <= 7; ranks++) {
+        assert_int_equal(cd_decomp_make(&g, &c, ranks, xyz, N, 0.01, 0, err, sizeof err), 0);
+        assert_int_equal(g.kind, CD_DECOMP_RCB);
+        int count[7] = {0};
+        for (int q = 0; q < N; q++) {
+            int r = cd_decomp_owner(&g, xyz + 3 * q);
+            count[r]++;
+            double lo[3], hi[3];
+            cd_decomp_box(&g, r, lo, hi);
+            for (int a = 0; a < 3; a++) assert_true(lo[a] <= xyz[3 * q + a] && xyz[3 * q + a] <= hi[a]);
+            int ghosts[7], n = cd_decomp_ghost_ranks(&g, xyz + 3 * q, r, ghosts);
+            for (int k = 0; k < n; k++) assert_true(ghosts[k] != r);
+        }
+        int lo = N, hi = 0;
+        for (int r = 0; r < ranks; r++) lo = count[r] < lo ? count[r] : lo, hi = count[r] > hi ? count[r] : hi;
+        assert_true(hi - lo <= 2);        /* N / ranks, rounded down at up to 2 cuts on the way */
+        for (int r = 0; r < ranks; r++) { /* the pile is wide, not tall: no cut across y */
+            double lo3[3], hi3[3];
+            cd_decomp_box(&g, r, lo3, hi3);
+            assert_true(isinf(lo3[1]) && isinf(hi3[1]));
+        }
+    }
+    /* 2D (the pile flat in z): never a cut across z */
+    cd_config c2 = config(2, 0, -9.81, 0);
+    c2.mpi_decomposition = CD_DECOMP_RCB;
+    for (int q = 0; q < N; q++) xyz[3 * q + 2] = 0;
+    assert_int_equal(cd_decomp_make(&g, &c2, 4, xyz, N, 0.01, 0, err, sizeof err), 0);
+    for (int r = 0; r < 4; r++) {
+        double lo3[3], hi3[3];
+        cd_decomp_box(&g, r, lo3, hi3);
+        assert_true(isinf(lo3[2]) && isinf(hi3[2]));
+    }
+    c.mpi_grid[0] = 2, c.mpi_grid[1] = 1, c.mpi_grid[2] = 1; /* a cartesian grid's key */
+    assert_int_equal(cd_decomp_make(&g, &c, 2, xyz, N, 0.01, 0, err, sizeof err), -1);
+    assert_non_null(strstr(err, "expected no mpi.grid"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_auto_grid),
-        cmocka_unit_test(test_refusals),
-        cmocka_unit_test(test_owner_and_ghosts),
-        cmocka_unit_test(test_neighbors),
+        cmocka_unit_test(test_auto_grid), cmocka_unit_test(test_refusals), cmocka_unit_test(test_owner_and_ghosts),
+        cmocka_unit_test(test_neighbors), cmocka_unit_test(test_rcb),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
