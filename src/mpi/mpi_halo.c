@@ -1,6 +1,7 @@
 /* The exchanges of the MPI decomposition (docs/mpi.md, "Design"): the
- * local state cut from the global one, migration at neighbour-list
- * rebuilds, the ghost refresh of every step, the gather to rank 0.
+ * local state cut from the global one and assembled from records (the
+ * migration at neighbour-list rebuilds, src/mpi/mpi_migrate.c, sends
+ * them), the ghost refresh of every step, the gather on every rank.
  *
  * A rank's local state is an ordinary cd_state whose particles are its
  * owned ones and its ghosts, in ascending global id, each with all its
@@ -40,13 +41,13 @@ static size_t group_bytes(enum cd_field_group g)
     return b;
 }
 
-static size_t particle_bytes(long long n_prims, size_t n_walls)
+size_t cd_mpi_particle_bytes(long long n_prims, size_t n_walls)
 {
     return sizeof(rec_head) + group_bytes(CD_GROUP_PARTICLE) +
            (size_t)n_prims * (group_bytes(CD_GROUP_PRIM) + n_walls * group_bytes(CD_GROUP_WALLC));
 }
 
-static size_t pair_bytes(void) { return sizeof(pair_head) + group_bytes(CD_GROUP_PAIR); }
+size_t cd_mpi_pair_bytes(void) { return sizeof(pair_head) + group_bytes(CD_GROUP_PAIR); }
 
 /* Rows [row, row + n) of every column of group g to b (pack = 1) or from
  * b; returns the end of those bytes in b. */
@@ -64,7 +65,7 @@ static char *rows_io(cd_state *s, enum cd_field_group g, size_t row, size_t n, c
 }
 
 /* Particle q of s with global id gid and first global primitive gp. */
-static char *pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b)
+char *cd_mpi_pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b)
 {
     rec_head h = {gid, gp, s->prim_count[q], 0};
     memcpy(b, &h, sizeof h);
@@ -89,7 +90,7 @@ static void unpack_particle(cd_state *s, size_t l, size_t pl, const char *rec)
     for (size_t k = 0; k < n; k++) s->prim_particle[pl + k] = (cd_int)l;
 }
 
-static char *pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b)
+char *cd_mpi_pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b)
 {
     pair_head h = {gi, gj, rank_in_row};
     memcpy(b, &h, sizeof h);
@@ -122,7 +123,7 @@ static rec_ref *parse(const char *buf, size_t n, int pairs, size_t n_walls, size
         long long h[3];
         memcpy(h, buf + at, sizeof h);
         r[m] = (rec_ref){h[0], pairs ? h[1] : 0, buf + at};
-        at += pairs ? pair_bytes() : particle_bytes(h[2], n_walls);
+        at += pairs ? cd_mpi_pair_bytes() : cd_mpi_particle_bytes(h[2], n_walls);
     }
     if (r) qsort(r, m, sizeof *r, cmp_ref);
     *count = m;
@@ -171,14 +172,6 @@ static void copy_scalars(cd_state *dst, const cd_state *src)
     dst->step = src->step;
 }
 
-static double *pos3(const cd_state *s, size_t q, double x[3])
-{
-    x[0] = s->position[q].x;
-    x[1] = s->position[q].y;
-    x[2] = s->position[q].z;
-    return x;
-}
-
 /* The ghost refresh until the next migration: owned particles to the
  * ranks whose halo they are in, ghosts from their owners, both in
  * ascending global id (the same lists, seen from either side). */
@@ -215,13 +208,13 @@ static int plan_refresh(cd_mpi_ctx *x)
         }
         for (size_t q = 0; q < s->n_particles; q++) {
             if (x->owned[q]) {
-                int n = cd_decomp_ghost_ranks(&x->grid, pos3(s, q, p), x->rank, ranks);
+                int n = cd_decomp_ghost_ranks(&x->grid, cd_mpi_pos3(s, q, p), x->rank, ranks);
                 for (int k = 0; k < n; k++) {
                     if (pass) x->send_list[x->send_displ[ranks[k]] + x->send_count[ranks[k]]] = (int)q;
                     x->send_count[ranks[k]]++;
                 }
             } else {
-                int o = cd_decomp_owner(&x->grid, pos3(s, q, p));
+                int o = cd_decomp_owner(&x->grid, cd_mpi_pos3(s, q, p));
                 if (pass) x->recv_list[x->recv_displ[o] + x->recv_count[o]] = (int)q;
                 x->recv_count[o]++;
             }
@@ -233,7 +226,7 @@ static int plan_refresh(cd_mpi_ctx *x)
 
 /* The local state from received records (particles: pbuf, pair rows:
  * cbuf), the scalars of scal; the neighbour list to be rebuilt. */
-static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal)
+int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal)
 {
     size_t W = scal->n_walls, N = 0, K = 0, P = 0;
     rec_ref *pr = parse(pbuf, plen, 0, W, &N), *cr = parse(cbuf, clen, 1, W, &K);
@@ -270,7 +263,7 @@ static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
         for (long long k = 0; k < h.n_prims; k++) gprim[pl + (size_t)k] = h.gprim_first + k;
         pl += (size_t)h.n_prims;
         double p[3];
-        owned[q] = cd_decomp_owner(&x->grid, pos3(&s, q, p)) == x->rank;
+        owned[q] = cd_decomp_owner(&x->grid, cd_mpi_pos3(&s, q, p)) == x->rank;
         x->n_owned += owned[q];
     }
     rc = place_pairs(&s, cr, K, gprim);
@@ -320,21 +313,22 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
         free(ranks);
         return -1;
     }
-    for (size_t q = 0; q < global->n_particles; q++) pb += particle_bytes(global->prim_count[q], W);
-    for (size_t k = 0; k < global->n_pairs; k++) cb += global->pair_active[k] ? pair_bytes() : 0;
+    for (size_t q = 0; q < global->n_particles; q++) pb += cd_mpi_particle_bytes(global->prim_count[q], W);
+    for (size_t k = 0; k < global->n_pairs; k++) cb += global->pair_active[k] ? cd_mpi_pair_bytes() : 0;
     char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *at = pbuf;
     int rc = ranks && pbuf && cbuf ? 0 : -1;
     for (size_t q = 0; !rc && q < global->n_particles; q++) {
-        int o = cd_decomp_owner(&x->grid, pos3(global, q, p)), here = o == x->rank;
+        int o = cd_decomp_owner(&x->grid, cd_mpi_pos3(global, q, p)), here = o == x->rank;
         int n = cd_decomp_ghost_ranks(&x->grid, p, o, ranks);
         for (int k = 0; k < n && !here; k++) here = ranks[k] == x->rank;
-        if (here) at = pack_particle(global, q, (long long)q, global->prim_first[q], at);
+        if (here) at = cd_mpi_pack_particle(global, q, (long long)q, global->prim_first[q], at);
     }
     size_t plen = rc ? 0 : (size_t)(at - pbuf);
     at = cbuf;
     for (size_t k = 0; !rc && k < global->n_pairs; k++)
-        if (global->pair_active[k]) at = pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
-    if (!rc) rc = assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
+        if (global->pair_active[k])
+            at = cd_mpi_pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
+    if (!rc) rc = cd_mpi_assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
     free(ranks);
     free(pbuf);
     free(cbuf);
@@ -343,7 +337,7 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
 
 /* Alltoallv of bytes: send (sc[r] bytes to rank r, in rank order) into a
  * new buffer *recv of *rlen bytes. */
-static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen)
+int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen)
 {
     int R = x->size, *rc = calloc((size_t)R * 3 + 1, sizeof(int)), *sd = malloc(((size_t)R + 1) * sizeof(int));
     if (!rc || !sd) {
@@ -375,292 +369,6 @@ static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char *
     return *recv ? 0 : -1;
 }
 
-/* Per local particle, the ranks that hold it after a migration: its owner
- * by its centre now first, then the ranks whose sub-domain its halo
- * reaches.  Every rank that holds a particle finds the same list (the same
- * position bits, refreshed every step). */
-typedef struct {
-    int *first, *count, *ranks;
-    size_t n, cap;
-} dest_lists;
-
-static void dests_free(dest_lists *d)
-{
-    free(d->first);
-    free(d->count);
-    free(d->ranks);
-}
-
-static int dests_of_local(cd_mpi_ctx *x, dest_lists *d)
-{
-    cd_state *s = &x->loc.s;
-    size_t N = s->n_particles;
-    d->first = calloc(N + 1, sizeof(int));
-    d->count = calloc(N + 1, sizeof(int));
-    d->cap = 2 * N + (size_t)x->size + 16;
-    d->ranks = malloc(d->cap * sizeof(int));
-    d->n = 0;
-    if (!d->first || !d->count || !d->ranks) return -1;
-    double p[3];
-    for (size_t q = 0; q < N; q++) {
-        if (d->n + (size_t)x->size + 1 > d->cap) {
-            int *g = realloc(d->ranks, (d->cap *= 2) * sizeof(int));
-            if (!g) return -1;
-            d->ranks = g;
-        }
-        int o = cd_decomp_owner(&x->grid, pos3(s, q, p));
-        d->first[q] = (int)d->n;
-        d->ranks[d->n] = o;
-        d->count[q] = 1 + cd_decomp_ghost_ranks(&x->grid, p, o, d->ranks + d->n + 1);
-        d->n += (size_t)d->count[q];
-    }
-    return 0;
-}
-
-/* Will rank r hold particle q? */
-static int goes_to(const dest_lists *d, size_t q, int r)
-{
-    for (int k = 0; k < d->count[q]; k++)
-        if (d->ranks[d->first[q] + k] == r) return 1;
-    return 0;
-}
-
-/* Does rank r (not this one) hold a ghost of owned particle q now: is q
- * in the ghost refresh to r (planned at the last migration from the ranks
- * q went to; the list per rank ascending)? */
-static int ghost_now(const cd_mpi_ctx *x, size_t q, int r)
-{
-    const int *l = x->send_list + x->send_displ[r];
-    int lo = 0, hi = x->send_count[r];
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        if (l[mid] < (int)q) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo < x->send_count[r] && l[lo] == (int)q;
-}
-
-/* Does this rank send particle q to rank r at this migration?  Its owner
- * sends it to each new holder, and to its new owner (which may hold a
- * ghost of it: the owner's record replaces that, so that what a rank
- * owns comes from the previous owner, every column). */
-static int sends(const cd_mpi_ctx *x, const dest_lists *d, size_t q, int r)
-{
-    if (!x->owned[q] || r == x->rank || !goes_to(d, q, r)) return 0;
-    return !ghost_now(x, q, r) || d->ranks[d->first[q]] == r;
-}
-
-/* Does this rank keep its copy of particle q?  When it still holds q, but
- * not when it comes to own a particle it held as a ghost (the previous
- * owner sends it). */
-static int keeps(const cd_mpi_ctx *x, const dest_lists *d, size_t q)
-{
-    if (!goes_to(d, q, x->rank)) return 0;
-    return x->owned[q] || d->ranks[d->first[q]] != x->rank;
-}
-
-/* The ranks that get pair row k from this rank (into out, room for twice
- * the ranks): those to which it sends one of the row's particles and
- * which will hold the other one too (a rank that keeps both has the row:
- * every rank builds the rows among all its particles).  Each rank once. */
-static int row_dests(const cd_mpi_ctx *x, const dest_lists *d, size_t k, int *out)
-{
-    const cd_state *s = &x->loc.s;
-    size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
-    int n = 0;
-    for (int e = 0; x->owned[a] && e < d->count[a]; e++) {
-        int r = d->ranks[d->first[a] + e];
-        if (sends(x, d, a, r) && goes_to(d, b, r)) out[n++] = r;
-    }
-    for (int e = 0; x->owned[b] && e < d->count[b]; e++) {
-        int r = d->ranks[d->first[b] + e];
-        if (sends(x, d, b, r) && goes_to(d, a, r) && !sends(x, d, a, r)) out[n++] = r;
-    }
-    return n;
-}
-
-/* Bytes that travel at a migration, per destination rank: a head (the
- * particle records' length), the particle records, the pair records. */
-typedef struct {
-    long long particle_bytes;
-} move_head;
-
-enum { TAG_GHOSTS = 1, TAG_MIGRATE = 2 };
-
-/* Sends out[r] (len[r] bytes, for every rank) and receives what the
- * others send into *in (*inlen bytes, the senders in rank order):
- * point to point with the neighbours (one message each way, empty ones
- * included, the receiver learning the length from the message) when
- * every destination is one, else an MPI_Alltoallv over all ranks (far:
- * agreed by all).  0, or -1 (out of memory). */
-static int move_bytes(cd_mpi_ctx *x, char *const *out, const int *len, int far, char **in, size_t *inlen)
-{
-    int R = x->size;
-    if (far) {
-        size_t total = 0;
-        for (int r = 0; r < R; r++) total += (size_t)len[r];
-        char *flat = malloc(total + 1), *at = flat;
-        if (!flat) MPI_Abort(x->comm, 1); /* the others wait in the exchange */
-        for (int r = 0; r < R; r++) {
-            memcpy(at, out[r], (size_t)len[r]);
-            at += len[r];
-        }
-        int rc = exchange_bytes(x, flat, len, in, inlen);
-        free(flat);
-        x->far_migrations++;
-        return rc;
-    }
-    int nb = x->n_neighbors, *rlen = malloc(((size_t)nb + 1) * sizeof(int));
-    if (!rlen) MPI_Abort(x->comm, 1);
-    for (int k = 0; k < nb; k++) {
-        int r = x->neighbors[k];
-        MPI_Isend(out[r], len[r], MPI_BYTE, r, TAG_MIGRATE, x->comm, &x->requests[k]);
-        x->migrate_msgs++;
-        x->migrate_bytes += len[r];
-    }
-    size_t total = 0;
-    for (int k = 0; k < nb; k++) {
-        MPI_Status st;
-        MPI_Probe(x->neighbors[k], TAG_MIGRATE, x->comm, &st);
-        MPI_Get_count(&st, MPI_BYTE, &rlen[k]);
-        total += (size_t)rlen[k];
-    }
-    *in = malloc(total + 1);
-    *inlen = total;
-    if (!*in) MPI_Abort(x->comm, 1);
-    char *at = *in;
-    for (int k = 0; k < nb; k++) {
-        MPI_Recv(at, rlen[k], MPI_BYTE, x->neighbors[k], TAG_MIGRATE, x->comm, MPI_STATUS_IGNORE);
-        at += rlen[k];
-    }
-    MPI_Waitall(nb, x->requests, MPI_STATUSES_IGNORE);
-    free(rlen);
-    return 0;
-}
-
-/* Appends the particle and pair records of the messages in (inlen bytes,
- * each a move_head and its records) to the kept ones (pbuf, cbuf: room
- * made here). */
-static int split_moved(const char *in, size_t inlen, char **pbuf, size_t *plen, char **cbuf, size_t *clen)
-{
-    char *p = realloc(*pbuf, *plen + inlen + 1), *c = p ? realloc(*cbuf, *clen + inlen + 1) : NULL;
-    if (p) *pbuf = p;
-    if (c) *cbuf = c;
-    if (!p || !c) return -1;
-    for (size_t at = 0; at < inlen;) { /* a message: head, particle records, a row count, pair records */
-        move_head h;
-        long long rows;
-        memcpy(&h, in + at, sizeof h);
-        at += sizeof h;
-        memcpy(*pbuf + *plen, in + at, (size_t)h.particle_bytes);
-        *plen += (size_t)h.particle_bytes;
-        at += (size_t)h.particle_bytes;
-        memcpy(&rows, in + at, sizeof rows);
-        at += sizeof rows;
-        memcpy(*cbuf + *clen, in + at, (size_t)rows * pair_bytes());
-        *clen += (size_t)rows * pair_bytes();
-        at += (size_t)rows * pair_bytes();
-    }
-    return 0;
-}
-
-int cd_mpi_migrate(cd_mpi_ctx *x)
-{
-    cd_state *s = &x->loc.s;
-    int R = x->size;
-    size_t W = s->n_walls, N = s->n_particles;
-    dest_lists d = {0};
-    int *len = calloc((size_t)R + 1, sizeof(int)), *rows = calloc((size_t)R + 1, sizeof(int));
-    int *rd = malloc((2 * (size_t)R + 1) * sizeof(int));
-    size_t *pl = calloc((size_t)R + 1, sizeof(size_t));
-    char **out = calloc((size_t)R + 1, sizeof(char *)), *in = NULL, *pbuf = NULL, *cbuf = NULL;
-    size_t inlen = 0, plen = 0, clen = 0, kept_p = 0, kept_c = 0;
-    int rc = len && rows && rd && pl && out ? dests_of_local(x, &d) : -1;
-    /* what goes where: particle records, then the pair rows */
-    for (size_t q = 0; !rc && q < N; q++) {
-        for (int e = 0; x->owned[q] && e < d.count[q]; e++)
-            if (sends(x, &d, q, d.ranks[d.first[q] + e]))
-                pl[d.ranks[d.first[q] + e]] += particle_bytes(s->prim_count[q], W);
-        if (keeps(x, &d, q)) kept_p += particle_bytes(s->prim_count[q], W);
-    }
-    for (size_t k = 0; !rc && k < s->n_pairs; k++) {
-        if (!s->pair_active[k]) continue;
-        int n = row_dests(x, &d, k, rd);
-        for (int e = 0; e < n; e++) rows[rd[e]]++;
-        size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
-        if (keeps(x, &d, a) && keeps(x, &d, b)) kept_c += pair_bytes();
-    }
-    int far = 0;
-    for (int r = 0; !rc && r < R; r++) {
-        size_t n =
-            pl[r] || rows[r] ? sizeof(move_head) + pl[r] + sizeof(long long) + (size_t)rows[r] * pair_bytes() : 0;
-        len[r] = (int)n;
-        out[r] = malloc(n + 1);
-        if (!out[r]) rc = -1;
-        else if (n) {
-            move_head h = {(long long)pl[r]};
-            memcpy(out[r], &h, sizeof h);
-            long long nr = rows[r];
-            memcpy(out[r] + sizeof h + pl[r], &nr, sizeof nr);
-        }
-        int near = r == x->rank;
-        for (int k = 0; k < x->n_neighbors && !near; k++) near = x->neighbors[k] == r;
-        far |= n > 0 && !near;
-        pl[r] = sizeof(move_head); /* now: where the next particle record goes */
-        rows[r] = 0;               /* and how many pair records are in */
-    }
-    pbuf = rc ? NULL : malloc(kept_p + 1);
-    cbuf = rc ? NULL : malloc(kept_c + 1);
-    if (!rc && (!pbuf || !cbuf)) rc = -1;
-    /* pack: the records sent, the copies kept (the local ones, no message) */
-    char *pk = pbuf, *ck = cbuf;
-    for (size_t q = 0; !rc && q < N; q++) {
-        long long gp = x->gprim[s->prim_first[q]];
-        for (int e = 0; x->owned[q] && e < d.count[q]; e++) {
-            int r = d.ranks[d.first[q] + e];
-            if (!sends(x, &d, q, r)) continue;
-            pl[r] = (size_t)(pack_particle(s, q, x->gid[q], gp, out[r] + pl[r]) - out[r]);
-            x->migrate_records++;
-        }
-        if (keeps(x, &d, q)) pk = pack_particle(s, q, x->gid[q], gp, pk);
-    }
-    for (size_t k = 0; !rc && k < s->n_pairs; k++) {
-        if (!s->pair_active[k]) continue;
-        long long gi = x->gprim[s->pair_prim_i[k]], gj = x->gprim[s->pair_prim_j[k]];
-        int n = row_dests(x, &d, k, rd);
-        for (int e = 0; e < n; e++) {
-            int r = rd[e];
-            size_t at = pl[r] + sizeof(long long) + (size_t)rows[r]++ * pair_bytes();
-            pack_pair(s, k, gi, gj, 0, out[r] + at);
-        }
-        size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
-        if (keeps(x, &d, a) && keeps(x, &d, b)) ck = pack_pair(s, k, gi, gj, 0, ck);
-    }
-    /* a particle beyond the neighbours (it moved far, or is not finite):
-     * this migration goes through all ranks, which all must know */
-    int any_far = 0;
-    far |= x->all_ranks;
-    if (!rc) MPI_Allreduce(&far, &any_far, 1, MPI_INT, MPI_LOR, x->comm);
-    if (!rc) rc = move_bytes(x, out, len, any_far, &in, &inlen);
-    plen = rc ? 0 : (size_t)(pk - pbuf);
-    clen = rc ? 0 : (size_t)(ck - cbuf);
-    if (!rc) rc = split_moved(in, inlen, &pbuf, &plen, &cbuf, &clen);
-    cd_state scal = *s; /* the scalars only: assemble replaces s */
-    if (!rc) rc = assemble(x, pbuf, plen, cbuf, clen, &scal);
-    if (!rc) x->migrations++;
-    dests_free(&d);
-    for (int r = 0; out && r < R; r++) free(out[r]);
-    free(out);
-    free(len);
-    free(rows);
-    free(rd);
-    free(pl);
-    free(in);
-    free(pbuf);
-    free(cbuf);
-    return rc;
-}
-
 /* The ghost columns of particle q to or from b. */
 static void ghost_io(cd_state *s, size_t q, double *b, int pack)
 {
@@ -684,8 +392,8 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
     for (int k = 0; k < x->n_neighbors; k++) {
         int r = x->neighbors[k];
         if (x->recv_count[r])
-            MPI_Irecv(x->recv_buf + (size_t)x->recv_displ[r] * G, x->recv_count[r] * G, MPI_DOUBLE, r, TAG_GHOSTS,
-                      x->comm, &x->requests[n++]);
+            MPI_Irecv(x->recv_buf + (size_t)x->recv_displ[r] * G, x->recv_count[r] * G, MPI_DOUBLE, r,
+                      CD_MPI_TAG_GHOSTS, x->comm, &x->requests[n++]);
     }
     for (int k = 0; k < x->n_neighbors; k++) {
         int r = x->neighbors[k];
@@ -693,7 +401,7 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
         double *b = x->send_buf + (size_t)x->send_displ[r] * G;
         for (int e = 0; e < x->send_count[r]; e++)
             ghost_io(s, (size_t)x->send_list[x->send_displ[r] + e], b + (size_t)e * G, 1);
-        MPI_Isend(b, x->send_count[r] * G, MPI_DOUBLE, r, TAG_GHOSTS, x->comm, &x->requests[n++]);
+        MPI_Isend(b, x->send_count[r] * G, MPI_DOUBLE, r, CD_MPI_TAG_GHOSTS, x->comm, &x->requests[n++]);
         x->refresh_msgs++;
         x->refresh_bytes += (long long)x->send_count[r] * G * (long long)sizeof(double);
     }
@@ -780,7 +488,7 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
     }
     for (size_t q = 0; q < s->n_particles; q++) {
         if (!x->owned[q]) continue;
-        pb += particle_bytes(s->prim_count[q], s->n_walls);
+        pb += cd_mpi_particle_bytes(s->prim_count[q], s->n_walls);
         for (cd_int i = s->prim_first[q]; i < s->prim_first[q] + s->prim_count[q]; i++)
             if (rows[i]) {
                 counts[2 * nc] = x->gprim[i];
@@ -789,17 +497,17 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
             }
     }
     for (size_t k = 0; k < s->n_pairs; k++) /* each row once: by the owner of its particle i */
-        if (s->pair_active[k] && x->owned[s->prim_particle[s->pair_prim_i[k]]]) cb += pair_bytes();
+        if (s->pair_active[k] && x->owned[s->prim_particle[s->pair_prim_i[k]]]) cb += cd_mpi_pair_bytes();
     char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *pall = NULL, *call = NULL, *nall = NULL;
     if (!pbuf || !cbuf) MPI_Abort(x->comm, 1);
     char *at = pbuf;
     for (size_t q = 0; q < s->n_particles; q++)
-        if (x->owned[q]) at = pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], at);
+        if (x->owned[q]) at = cd_mpi_pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], at);
     at = cbuf;
     for (size_t k = 0; k < s->n_pairs; k++) {
         cd_int i = s->pair_prim_i[k];
         if (s->pair_active[k] && x->owned[s->prim_particle[i]])
-            at = pack_pair(s, k, x->gprim[i], x->gprim[s->pair_prim_j[k]], (long long)k - row0[i], at);
+            at = cd_mpi_pack_pair(s, k, x->gprim[i], x->gprim[s->pair_prim_j[k]], (long long)k - row0[i], at);
     }
     size_t plen, clen, nlen;
     int rc = allgather_bytes(x, pbuf, (int)pb, &pall, &plen);

@@ -84,4 +84,33 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global);
 double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
 void cd_mpi_halo_free(cd_mpi_ctx *x);
 
+/* ---- records, shared by src/mpi/mpi_halo.c and src/mpi/mpi_migrate.c ------
+ * A particle travels as one record of bytes (a head, every column of
+ * fields.def of the particle, its primitives and their wall-contact rows),
+ * a pair row as its two global primitives and its columns. */
+enum { CD_MPI_TAG_GHOSTS = 1, CD_MPI_TAG_MIGRATE = 2 };
+size_t cd_mpi_particle_bytes(long long n_prims, size_t n_walls);
+size_t cd_mpi_pair_bytes(void);
+/* Particle q of s (global id gid, first global primitive gp), or pair row
+ * k (global primitives gi, gj; rank_in_row: cd_mpi_gather's), packed at
+ * b; returns the end of the record. */
+char *cd_mpi_pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b);
+char *cd_mpi_pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b);
+/* The local state from particle records (pbuf) and pair records (cbuf),
+ * in ascending global id, a key given twice taken once, the scalars of
+ * scal; ownership by the centre, the ghost refresh planned, the list to
+ * be rebuilt.  0, or -1 (out of memory). */
+int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal);
+/* MPI_Alltoallv of bytes over all ranks: sc[r] bytes to rank r (in rank
+ * order in send) into a new buffer *recv of *rlen bytes.  0, or -1. */
+int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen);
+
+static inline double *cd_mpi_pos3(const cd_state *s, size_t q, double x[3])
+{
+    x[0] = s->position[q].x;
+    x[1] = s->position[q].y;
+    x[2] = s->position[q].z;
+    return x;
+}
+
 #endif
