@@ -68,18 +68,25 @@ static void test_refusals(void **state)
     assert_non_null(strstr(err, "expected three integers >= 1"));
 }
 
+/* g: the nx x ny x nz grid (mpi.grid) over the box 0..hi [m], gravity-free. */
+static void given_grid(cd_decomp_grid *g, int nx, int ny, int nz, const double hi[3], double range, double margin)
+{
+    char err[512];
+    cd_config c = config(3, 0, 0, 0);
+    c.mpi_grid[0] = nx, c.mpi_grid[1] = ny, c.mpi_grid[2] = nz;
+    double lo[3] = {0, 0, 0};
+    assert_int_equal(cd_decomp_choose(g, &c, nx * ny * nz, lo, hi, range, margin, err, sizeof err), 0);
+}
+
 /* Owners by the centre (outer sub-domains open to infinity, NaN to the
  * first); ghosts in every sub-domain within the halo, corners by the
  * Euclidean distance, ascending, never the owner. */
 static void test_owner_and_ghosts(void **state)
 {
     (void)state;
-    char err[512];
     cd_decomp_grid g;
-    cd_config c = config(3, 0, 0, 0);
-    c.mpi_grid[0] = 2, c.mpi_grid[1] = 1, c.mpi_grid[2] = 2;
-    double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 2};
-    assert_int_equal(cd_decomp_choose(&g, &c, 4, lo, hi, 0.1, 0.05, err, sizeof err), 0);
+    double hi[3] = {2, 1, 2}; /* [m] */
+    given_grid(&g, 2, 1, 2, hi, 0.1, 0.05);
     assert_true(fabs(g.halo - 0.15) < 1e-15);
     double a[3] = {0.5, 0.5, 0.5}, b[3] = {1.5, 0.5, 0.5}, cc[3] = {0.5, 0.5, 1.5}, far[3] = {-7, 9, 30};
     assert_int_equal(cd_decomp_owner(&g, a), 0);
@@ -110,12 +117,9 @@ static void test_owner_and_ghosts(void **state)
 static void test_neighbors(void **state)
 {
     (void)state;
-    char err[512];
     cd_decomp_grid g;
-    cd_config c = config(3, 0, 0, 0);
-    c.mpi_grid[0] = 3, c.mpi_grid[1] = 1, c.mpi_grid[2] = 3;
-    double lo[3] = {0, 0, 0}, hi[3] = {3, 1, 3}; /* [m] */
-    assert_int_equal(cd_decomp_choose(&g, &c, 9, lo, hi, 0.1, 0, err, sizeof err), 0);
+    double hi[3] = {3, 1, 3}; /* [m] */
+    given_grid(&g, 3, 1, 3, hi, 0.1, 0);
     double blo[3], bhi[3];
     cd_decomp_box(&g, 4, blo, bhi); /* the centre: x 1..2, z 1..2, y open */
     assert_true(blo[0] == 1 && bhi[0] == 2 && blo[2] == 1 && bhi[2] == 2);
