@@ -1,7 +1,8 @@
-/* The Cartesian grid of sub-domains of an MPI run (src/mpi/mpi_decomp.c,
- * docs/mpi.md): the grid chosen from the ranks and the domain, refusals of
- * grids the domain cannot hold, the owner of a point and the ranks whose
- * halo holds it.  Plain C: runs in every build, with or without MPI. */
+/* The sub-domains of an MPI run (src/mpi/mpi_decomp.c, docs/mpi.md): the
+ * Cartesian grid chosen from the ranks and the domain, refusals of grids
+ * the domain cannot hold, the owner of a point and the ranks whose halo
+ * holds it, the neighbours a rank talks to, and recursive coordinate
+ * bisection.  Plain C: runs in every build, with or without MPI. */
 #include "test_util.h"
 #include <math.h>
 #include "mpi/mpi_decomp.h"
