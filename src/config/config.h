@@ -97,7 +97,7 @@ typedef struct {
     int reorder; /* neighbor.reorder: CD_REORDER_CELLS | CD_REORDER_NONE (src/backend/omp/reorder.c) */
 
     /* MPI domain decomposition (docs/mpi.md; read by the MPI build only) */
-    int mpi_decomposition; /* 0: cartesian */
+    int mpi_decomposition; /* CD_DECOMP_CARTESIAN (0) or CD_DECOMP_RCB (1), src/mpi/mpi_decomp.h */
     double mpi_grid[3];    /* sub-domains along x, y, z; [0, 0, 0]: chosen from the ranks and the domain */
 
     /* protocol (docs/references.md, Protocols; src/protocols/protocol.c) */

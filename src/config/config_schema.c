@@ -199,10 +199,12 @@ const cd_key cd_config_keys[] = {
 
     /* MPI domain decomposition (docs/mpi.md): how `mpirun -np R` splits space */
     {"mpi.decomposition", CD_KT_ENUM, "-", "cartesian", CFG(mpi_decomposition), .flags = CD_KF_RESUMABLE,
-     .choices = "cartesian", .label = "MPI decomposition",
-     .meaning = "cartesian: a grid of sub-domains, one per rank (MPI build, docs/mpi.md)"},
+     .choices = "cartesian|rcb", .label = "MPI decomposition",
+     .meaning = "cartesian: a grid of sub-domains, one per rank; rcb: recursive coordinate bisection of the "
+                "particle centres into sub-domains of equal particle counts (MPI build, docs/mpi.md)"},
     {"mpi.grid", CD_KT_VEC3, "-", "[0, 0, 0]", CFG(mpi_grid), .flags = CD_KF_RESUMABLE, .label = "MPI grid",
-     .meaning = "sub-domains along x, y, z, their product the ranks; [0, 0, 0]: chosen from the ranks and the domain"},
+     .meaning = "cartesian: sub-domains along x, y, z, their product the ranks; [0, 0, 0]: chosen from the ranks and "
+                "the domain (not with rcb)"},
 
     /* protocol */
     {"protocol.type", CD_KT_ENUM, "-", "none", CFG_SIZED(protocol), .flags = CD_KF_SELECTOR,

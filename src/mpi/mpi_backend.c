@@ -171,19 +171,39 @@ static double interaction_range(const cd_sim *sim)
  * work).  Collective: every rank ends the run at the same point. */
 static void report(const cd_mpi_ctx *x)
 {
-    long mine[2] = {x->last_owned, x->last_ghosts}, lo[2], hi[2], sum[2];
-    MPI_Reduce(mine, lo, 2, MPI_LONG, MPI_MIN, 0, x->comm);
-    MPI_Reduce(mine, hi, 2, MPI_LONG, MPI_MAX, 0, x->comm);
-    MPI_Reduce(mine, sum, 2, MPI_LONG, MPI_SUM, 0, x->comm);
+    long mine[3] = {x->last_owned, x->last_ghosts, x->start_owned}, lo[3], hi[3], sum[3];
+    MPI_Reduce(mine, lo, 3, MPI_LONG, MPI_MIN, 0, x->comm);
+    MPI_Reduce(mine, hi, 3, MPI_LONG, MPI_MAX, 0, x->comm);
+    MPI_Reduce(mine, sum, 3, MPI_LONG, MPI_SUM, 0, x->comm);
     double t[4] = {x->t_step, x->t_decide, x->t_migrate, x->t_ghosts}, tmax[4]; /* [s] */
     MPI_Reduce(t, tmax, 4, MPI_DOUBLE, MPI_MAX, 0, x->comm);
-    if (x->rank == 0)
+    /* sent per ghost refresh and per migration: messages, bytes */
+    double refreshes = x->refreshes > 0 ? (double)x->refreshes : 1,
+           migrations = x->migrations > 0 ? (double)x->migrations : 1;
+    double c[5] = {(double)x->refresh_msgs / refreshes, (double)x->refresh_bytes / refreshes,
+                   (double)x->migrate_msgs / migrations, (double)x->migrate_bytes / migrations,
+                   (double)x->migrate_records / migrations},
+           cmax[5], csum[5];
+    MPI_Reduce(c, cmax, 5, MPI_DOUBLE, MPI_MAX, 0, x->comm);
+    MPI_Reduce(c, csum, 5, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    if (x->rank == 0) {
         fprintf(stderr,
-                "capdem: MPI: %d ranks, %lld migrations; per rank now %ld..%ld owned particles and %ld..%ld "
-                "ghosts (%.3g ghosts per owned particle); slowest rank's seconds: step %.3g, rebuild decision %.3g, "
-                "migration %.3g, ghost refresh %.3g\n",
-                x->size, x->migrations, lo[0], hi[0], lo[1], hi[1], sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0,
-                tmax[0], tmax[1], tmax[2], tmax[3]);
+                "capdem: MPI: %d ranks, %lld migrations (%lld through all ranks); per rank now %ld..%ld owned "
+                "particles and %ld..%ld "
+                "ghosts (%.3g ghosts per owned particle); imbalance (max / mean owned particles) at the start %.4g, "
+                "now %.4g; slowest rank's seconds: step %.3g, rebuild decision %.3g, migration %.3g, ghost refresh "
+                "%.3g\n",
+                x->size, x->migrations, x->far_migrations, lo[0], hi[0], lo[1], hi[1],
+                sum[0] > 0 ? (double)sum[1] / (double)sum[0] : 0.0,
+                sum[2] > 0 ? (double)hi[2] * x->size / (double)sum[2] : 0.0,
+                sum[0] > 0 ? (double)hi[0] * x->size / (double)sum[0] : 0.0, tmax[0], tmax[1], tmax[2], tmax[3]);
+        fprintf(
+            stderr,
+            "capdem: MPI traffic: sent per rank (mean, max): per step %.4g, %.4g messages and %.6g, %.6g bytes; per "
+            "migration %.4g, %.4g messages and %.6g, %.6g bytes, %.4g, %.4g particle records\n",
+            csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
+            cmax[3], csum[4] / x->size, cmax[4]);
+    }
 }
 
 /* Ends the local state; the context stays for a restart (cd_mpi_end
@@ -208,22 +228,25 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     cd_mpi_halo_free(x);
     x->started = 0;
     const cd_state *s = &sim->s;
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t q = 0; q < s->n_particles; q++) {
-        double p[3] = {s->position[q].x, s->position[q].y, s->position[q].z};
-        for (int a = 0; a < 3; a++)
-            if (isfinite(p[a])) {
-                lo[a] = p[a] < lo[a] ? p[a] : lo[a];
-                hi[a] = p[a] > hi[a] ? p[a] : hi[a];
-            }
+    /* The sub-domains are cut at the first start and kept for a restart
+     * (the bulk probe's, from a compacted packing that it might not split
+     * as well): the bits do not depend on them. */
+    if (!x->ran) {
+        double *xyz = malloc((3 * s->n_particles + 1) * sizeof *xyz); /* [m] the centres */
+        if (!xyz) {
+            snprintf(err, errlen, "out of memory while cutting the domain for %d MPI ranks", x->size);
+            return -1;
+        }
+        for (size_t q = 0; q < s->n_particles; q++) {
+            xyz[3 * q] = s->position[q].x;
+            xyz[3 * q + 1] = s->position[q].y;
+            xyz[3 * q + 2] = s->position[q].z;
+        }
+        int rc =
+            cd_decomp_make(&x->grid, &sim->cfg, x->size, xyz, s->n_particles, interaction_range(sim), 0, err, errlen);
+        free(xyz);
+        if (rc) return -1; /* every rank: the same data, the same refusal */
     }
-    for (int a = 0; a < 3; a++)
-        if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0;
-    /* The grid is chosen at the first start and kept for a restart (the
-     * bulk probe's, from a compacted packing that it might not split as
-     * well): the bits do not depend on it. */
-    if (!x->ran && cd_decomp_choose(&x->grid, &sim->cfg, x->size, lo, hi, interaction_range(sim), 0, err, errlen))
-        return -1; /* every rank: the same data, the same refusal */
 
     sim->nb.reorder = 0; /* the replicated state stays in global id order too */
     cd_sim *loc = &x->loc;
@@ -253,6 +276,7 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     /* (a rank without particles has no list to build and no forces) */
     if (!rc) rc = x->inner->start(loc, compute && loc->s.n_particles > 0, err, errlen);
     if (agree_failure(x, rc, err, errlen)) return -1;
+    if (!x->ran) x->start_owned = (long)x->n_owned;
     x->started = x->ran = 1;
     /* the ghosts' forces from their owners (a start computes them from
      * the pairs this rank sees) */
@@ -316,8 +340,12 @@ static const char *mpi_device(const cd_sim *sim)
 {
     static char buf[192];
     const cd_mpi_ctx *x = sim->backend_data;
-    snprintf(buf, sizeof buf, "%d MPI ranks (sub-domains %d x %d x %d), each: %s", x->size, x->grid.dims[0],
-             x->grid.dims[1], x->grid.dims[2], x->inner->device(&x->loc));
+    if (x->grid.kind == CD_DECOMP_RCB)
+        snprintf(buf, sizeof buf, "%d MPI ranks (sub-domains by recursive coordinate bisection), each: %s", x->size,
+                 x->inner->device(&x->loc));
+    else
+        snprintf(buf, sizeof buf, "%d MPI ranks (sub-domains %d x %d x %d), each: %s", x->size, x->grid.dims[0],
+                 x->grid.dims[1], x->grid.dims[2], x->inner->device(&x->loc));
     return buf;
 }
 
@@ -344,6 +372,8 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     x->comm = MPI_COMM_WORLD;
     MPI_Comm_rank(x->comm, &x->rank);
     MPI_Comm_size(x->comm, &x->size);
+    const char *all = getenv("CAPDEM_MPI_ALL_RANKS"); /* the fallback path of a migration, for its test */
+    x->all_ranks = all && !strcmp(all, "1");
     x->inner = sim->backend ? sim->backend : &cd_backend_omp;
     sim->backend = &cd_backend_mpi;
     sim->backend_data = x;

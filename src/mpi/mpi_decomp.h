@@ -54,15 +54,29 @@ static inline int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err
 }
 #endif
 
-/* ---- the Cartesian grid of sub-domains (src/mpi/mpi_decomp.c) -------------
- * Plain C, no MPI: unit-testable in any build. */
+/* ---- the sub-domains (src/mpi/mpi_decomp.c) --------------------------------
+ * A Cartesian grid, or a recursive coordinate bisection (rcb) of the
+ * particle centres into boxes of equal particle counts.  Plain C, no MPI:
+ * unit-testable in any build. */
+#define CD_DECOMP_CARTESIAN 0 /* mpi.decomposition's choices, in order */
+#define CD_DECOMP_RCB       1
+#define CD_RCB_MAX_RANKS    256 /* rcb: the ranks its tree has room for */
+
 typedef struct {
-    int dims[3];     /* sub-domains along x, y, z (their product: the ranks) */
+    int kind;        /* CD_DECOMP_CARTESIAN or CD_DECOMP_RCB */
+    int dims[3];     /* sub-domains along x, y, z (their product: the ranks; rcb: ranks x 1 x 1) */
     double lo[3];    /* [m] lower corner of the split box (box of the centres at start) */
     double width[3]; /* [m] width of an inner sub-domain; the outer ones reach to infinity */
     double range;    /* [m] interaction range: largest bounding diameter + skin */
     double margin;   /* [m] motion allowed between migrations (ghosts reach range + margin) */
     double halo;     /* [m] range + margin */
+    /* rcb: the tree in preorder, node k splitting ranks [r0, r0 + n) at
+     * cut[k] [m] along axis[k] (-1: a leaf) into the lower n / 2 (below the
+     * cut: child k + 1) and the rest (child k + 2 (n / 2)); the box of each
+     * rank [m] (outer faces at -/+infinity) */
+    signed char rcb_axis[2 * CD_RCB_MAX_RANKS];
+    double rcb_cut[2 * CD_RCB_MAX_RANKS];
+    double rcb_lo[CD_RCB_MAX_RANKS][3], rcb_hi[CD_RCB_MAX_RANKS][3];
 } cd_decomp_grid;
 
 /* Chooses the grid of `ranks` sub-domains over the box of centres lo..hi
@@ -73,11 +87,30 @@ typedef struct {
  * be split into).  0, or -1 with a message naming the key (exit 2). */
 int cd_decomp_choose(cd_decomp_grid *g, const cd_config *cfg, int ranks, const double lo[3], const double hi[3],
                      double range, double margin, char *err, size_t errlen);
+/* The sub-domains of mpi.decomposition for `ranks` ranks over the n
+ * particle centres xyz (3 n doubles [m]): cartesian (cd_decomp_choose on
+ * their box) or rcb: the centres cut in two along the longest extent of
+ * their box (never z in 2D) at the place that gives the lower half of the
+ * ranks its share of the particles, each half again, down to one rank:
+ * equal particle counts (to one particle per cut) wherever the particles
+ * are, a settled pile included.  Refused (exit 2): rcb with mpi.grid given,
+ * more ranks than particles or than CD_RCB_MAX_RANKS, a sub-domain
+ * narrower than the interaction range where it is bounded.  Deterministic:
+ * every rank finds the same.  0, or -1 with a message naming the key. */
+int cd_decomp_make(cd_decomp_grid *g, const cd_config *cfg, int ranks, const double *xyz, size_t n, double range,
+                   double margin, char *err, size_t errlen);
 /* The rank whose sub-domain holds the point x [m] (outer sub-domains reach
  * to infinity; a non-finite coordinate counts as the lowest). */
 int cd_decomp_owner(const cd_decomp_grid *g, const double x[3]);
 /* The ranks other than skip whose sub-domain comes within the halo of x,
  * ascending, into out (room for every rank); returns how many. */
 int cd_decomp_ghost_ranks(const cd_decomp_grid *g, const double x[3], int skip, int *out);
+/* The sub-domain of rank r [m]: lo..hi, the outer faces at -/+infinity. */
+void cd_decomp_box(const cd_decomp_grid *g, int r, double lo[3], double hi[3]);
+/* The ranks other than `rank` whose sub-domain comes within `reach` [m] of
+ * rank's (box to box, Euclidean), ascending, into out (room for every
+ * rank); returns how many.  Symmetric: r is a neighbour of s when s is one
+ * of r.  The ghost refresh and the migration talk to these ranks only. */
+int cd_decomp_neighbors(const cd_decomp_grid *g, int rank, double reach, int *out);
 
 #endif

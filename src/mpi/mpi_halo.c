@@ -1,6 +1,7 @@
 /* The exchanges of the MPI decomposition (docs/mpi.md, "Design"): the
- * local state cut from the global one, migration at neighbour-list
- * rebuilds, the ghost refresh of every step, the gather to rank 0.
+ * local state cut from the global one and assembled from records (the
+ * migration at neighbour-list rebuilds, src/mpi/mpi_migrate.c, sends
+ * them), the ghost refresh of every step, the gather on every rank.
  *
  * A rank's local state is an ordinary cd_state whose particles are its
  * owned ones and its ghosts, in ascending global id, each with all its
@@ -40,13 +41,13 @@ static size_t group_bytes(enum cd_field_group g)
     return b;
 }
 
-static size_t particle_bytes(long long n_prims, size_t n_walls)
+size_t cd_mpi_particle_bytes(long long n_prims, size_t n_walls)
 {
     return sizeof(rec_head) + group_bytes(CD_GROUP_PARTICLE) +
            (size_t)n_prims * (group_bytes(CD_GROUP_PRIM) + n_walls * group_bytes(CD_GROUP_WALLC));
 }
 
-static size_t pair_bytes(void) { return sizeof(pair_head) + group_bytes(CD_GROUP_PAIR); }
+size_t cd_mpi_pair_bytes(void) { return sizeof(pair_head) + group_bytes(CD_GROUP_PAIR); }
 
 /* Rows [row, row + n) of every column of group g to b (pack = 1) or from
  * b; returns the end of those bytes in b. */
@@ -64,7 +65,7 @@ static char *rows_io(cd_state *s, enum cd_field_group g, size_t row, size_t n, c
 }
 
 /* Particle q of s with global id gid and first global primitive gp. */
-static char *pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b)
+char *cd_mpi_pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b)
 {
     rec_head h = {gid, gp, s->prim_count[q], 0};
     memcpy(b, &h, sizeof h);
@@ -89,7 +90,7 @@ static void unpack_particle(cd_state *s, size_t l, size_t pl, const char *rec)
     for (size_t k = 0; k < n; k++) s->prim_particle[pl + k] = (cd_int)l;
 }
 
-static char *pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b)
+char *cd_mpi_pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b)
 {
     pair_head h = {gi, gj, rank_in_row};
     memcpy(b, &h, sizeof h);
@@ -122,7 +123,7 @@ static rec_ref *parse(const char *buf, size_t n, int pairs, size_t n_walls, size
         long long h[3];
         memcpy(h, buf + at, sizeof h);
         r[m] = (rec_ref){h[0], pairs ? h[1] : 0, buf + at};
-        at += pairs ? pair_bytes() : particle_bytes(h[2], n_walls);
+        at += pairs ? cd_mpi_pair_bytes() : cd_mpi_particle_bytes(h[2], n_walls);
     }
     if (r) qsort(r, m, sizeof *r, cmp_ref);
     *count = m;
@@ -171,14 +172,6 @@ static void copy_scalars(cd_state *dst, const cd_state *src)
     dst->step = src->step;
 }
 
-static double *pos3(const cd_state *s, size_t q, double x[3])
-{
-    x[0] = s->position[q].x;
-    x[1] = s->position[q].y;
-    x[2] = s->position[q].z;
-    return x;
-}
-
 /* The ghost refresh until the next migration: owned particles to the
  * ranks whose halo they are in, ghosts from their owners, both in
  * ascending global id (the same lists, seen from either side). */
@@ -206,9 +199,8 @@ static int plan_refresh(cd_mpi_ctx *x)
             free(x->recv_buf);
             x->send_list = malloc(((size_t)ns + 1) * sizeof(int));
             x->recv_list = malloc(((size_t)nr + 1) * sizeof(int));
-            /* (one status per rank ahead of each rank's ghosts: cd_mpi_refresh_ghosts) */
-            x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
-            x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + (size_t)R) * sizeof(double));
+            x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
+            x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
             if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) {
                 free(ranks);
                 return -1;
@@ -216,13 +208,13 @@ static int plan_refresh(cd_mpi_ctx *x)
         }
         for (size_t q = 0; q < s->n_particles; q++) {
             if (x->owned[q]) {
-                int n = cd_decomp_ghost_ranks(&x->grid, pos3(s, q, p), x->rank, ranks);
+                int n = cd_decomp_ghost_ranks(&x->grid, cd_mpi_pos3(s, q, p), x->rank, ranks);
                 for (int k = 0; k < n; k++) {
                     if (pass) x->send_list[x->send_displ[ranks[k]] + x->send_count[ranks[k]]] = (int)q;
                     x->send_count[ranks[k]]++;
                 }
             } else {
-                int o = cd_decomp_owner(&x->grid, pos3(s, q, p));
+                int o = cd_decomp_owner(&x->grid, cd_mpi_pos3(s, q, p));
                 if (pass) x->recv_list[x->recv_displ[o] + x->recv_count[o]] = (int)q;
                 x->recv_count[o]++;
             }
@@ -234,7 +226,7 @@ static int plan_refresh(cd_mpi_ctx *x)
 
 /* The local state from received records (particles: pbuf, pair rows:
  * cbuf), the scalars of scal; the neighbour list to be rebuilt. */
-static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal)
+int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal)
 {
     size_t W = scal->n_walls, N = 0, K = 0, P = 0;
     rec_ref *pr = parse(pbuf, plen, 0, W, &N), *cr = parse(cbuf, clen, 1, W, &K);
@@ -271,7 +263,7 @@ static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
         for (long long k = 0; k < h.n_prims; k++) gprim[pl + (size_t)k] = h.gprim_first + k;
         pl += (size_t)h.n_prims;
         double p[3];
-        owned[q] = cd_decomp_owner(&x->grid, pos3(&s, q, p)) == x->rank;
+        owned[q] = cd_decomp_owner(&x->grid, cd_mpi_pos3(&s, q, p)) == x->rank;
         x->n_owned += owned[q];
     }
     rc = place_pairs(&s, cr, K, gprim);
@@ -298,26 +290,45 @@ static int assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
     return plan_refresh(x);
 }
 
+/* The ranks this one talks to: those whose sub-domain comes within the
+ * halo (ghosts) and the skin (room for the motion between migrations) of
+ * its own. */
+static int find_neighbors(cd_mpi_ctx *x)
+{
+    free(x->neighbors);
+    free(x->requests);
+    x->neighbors = malloc(((size_t)x->size + 1) * sizeof(int));
+    if (!x->neighbors) return -1;
+    x->n_neighbors = cd_decomp_neighbors(&x->grid, x->rank, x->grid.halo + x->loc.nb.skin, x->neighbors);
+    x->requests = malloc((2 * (size_t)x->n_neighbors + 1) * sizeof(MPI_Request));
+    return x->requests ? 0 : -1;
+}
+
 int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
 {
     size_t W = global->n_walls, pb = 0, cb = 0;
     int *ranks = malloc((size_t)x->size * sizeof *ranks);
     double p[3];
-    for (size_t q = 0; q < global->n_particles; q++) pb += particle_bytes(global->prim_count[q], W);
-    for (size_t k = 0; k < global->n_pairs; k++) cb += global->pair_active[k] ? pair_bytes() : 0;
+    if (find_neighbors(x)) {
+        free(ranks);
+        return -1;
+    }
+    for (size_t q = 0; q < global->n_particles; q++) pb += cd_mpi_particle_bytes(global->prim_count[q], W);
+    for (size_t k = 0; k < global->n_pairs; k++) cb += global->pair_active[k] ? cd_mpi_pair_bytes() : 0;
     char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *at = pbuf;
     int rc = ranks && pbuf && cbuf ? 0 : -1;
     for (size_t q = 0; !rc && q < global->n_particles; q++) {
-        int o = cd_decomp_owner(&x->grid, pos3(global, q, p)), here = o == x->rank;
+        int o = cd_decomp_owner(&x->grid, cd_mpi_pos3(global, q, p)), here = o == x->rank;
         int n = cd_decomp_ghost_ranks(&x->grid, p, o, ranks);
         for (int k = 0; k < n && !here; k++) here = ranks[k] == x->rank;
-        if (here) at = pack_particle(global, q, (long long)q, global->prim_first[q], at);
+        if (here) at = cd_mpi_pack_particle(global, q, (long long)q, global->prim_first[q], at);
     }
     size_t plen = rc ? 0 : (size_t)(at - pbuf);
     at = cbuf;
     for (size_t k = 0; !rc && k < global->n_pairs; k++)
-        if (global->pair_active[k]) at = pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
-    if (!rc) rc = assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
+        if (global->pair_active[k])
+            at = cd_mpi_pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
+    if (!rc) rc = cd_mpi_assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
     free(ranks);
     free(pbuf);
     free(cbuf);
@@ -326,7 +337,7 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
 
 /* Alltoallv of bytes: send (sc[r] bytes to rank r, in rank order) into a
  * new buffer *recv of *rlen bytes. */
-static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen)
+int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen)
 {
     int R = x->size, *rc = calloc((size_t)R * 3 + 1, sizeof(int)), *sd = malloc(((size_t)R + 1) * sizeof(int));
     if (!rc || !sd) {
@@ -336,6 +347,13 @@ static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char *
     }
     int *rd = rc + R;
     MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, x->comm);
+    x->migrate_msgs += R - 1; /* the counts: one int to every other rank */
+    x->migrate_bytes += (long long)(R - 1) * (long long)sizeof(int);
+    for (int r = 0; r < R; r++)
+        if (r != x->rank && sc[r] > 0) {
+            x->migrate_msgs++;
+            x->migrate_bytes += sc[r];
+        }
     size_t ns = 0, nr = 0;
     for (int r = 0; r < R; r++) {
         sd[r] = (int)ns;
@@ -349,125 +367,6 @@ static int exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char *
     free(rc);
     free(sd);
     return *recv ? 0 : -1;
-}
-
-/* Growable list of ranks per owned particle: the ranks a particle goes to
- * at a migration (its new owner first). */
-typedef struct {
-    int *first, *count, *ranks;
-    size_t n, cap;
-} dest_lists;
-
-static int dests_of_owned(cd_mpi_ctx *x, dest_lists *d)
-{
-    cd_state *s = &x->loc.s;
-    size_t N = s->n_particles;
-    d->first = calloc(N + 1, sizeof(int));
-    d->count = calloc(N + 1, sizeof(int));
-    d->cap = 2 * N + (size_t)x->size + 16;
-    d->ranks = malloc(d->cap * sizeof(int));
-    d->n = 0;
-    if (!d->first || !d->count || !d->ranks) return -1;
-    double p[3];
-    for (size_t q = 0; q < N; q++) {
-        if (!x->owned[q]) continue;
-        if (d->n + (size_t)x->size + 1 > d->cap) {
-            int *g = realloc(d->ranks, (d->cap *= 2) * sizeof(int));
-            if (!g) return -1;
-            d->ranks = g;
-        }
-        int o = cd_decomp_owner(&x->grid, pos3(s, q, p));
-        d->first[q] = (int)d->n;
-        d->ranks[d->n] = o;
-        d->count[q] = 1 + cd_decomp_ghost_ranks(&x->grid, p, o, d->ranks + d->n + 1);
-        d->n += (size_t)d->count[q];
-    }
-    return 0;
-}
-
-/* Does particle q (owned) go to rank r? */
-static int goes_to(const dest_lists *d, size_t q, int r)
-{
-    for (int k = 0; k < d->count[q]; k++)
-        if (d->ranks[d->first[q] + k] == r) return 1;
-    return 0;
-}
-
-/* Pair row k goes to every rank that an owned particle of it goes to,
- * each rank once: body runs with r set to each of them. */
-#define FOR_PAIR_DESTS(x, d, k, r, body)                                                                               \
-    do {                                                                                                               \
-        cd_state *s_ = &(x)->loc.s;                                                                                    \
-        size_t pi_ = (size_t)s_->prim_particle[s_->pair_prim_i[k]],                                                    \
-               pj_ = (size_t)s_->prim_particle[s_->pair_prim_j[k]];                                                    \
-        if ((x)->owned[pi_])                                                                                           \
-            for (int e_ = 0; e_ < (d)->count[pi_]; e_++) {                                                             \
-                int r = (d)->ranks[(d)->first[pi_] + e_];                                                              \
-                body;                                                                                                  \
-            }                                                                                                          \
-        if ((x)->owned[pj_])                                                                                           \
-            for (int e_ = 0; e_ < (d)->count[pj_]; e_++) {                                                             \
-                int r = (d)->ranks[(d)->first[pj_] + e_];                                                              \
-                if (!(x)->owned[pi_] || !goes_to(d, pi_, r)) {                                                         \
-                    body;                                                                                              \
-                }                                                                                                      \
-            }                                                                                                          \
-    } while (0)
-
-int cd_mpi_migrate(cd_mpi_ctx *x)
-{
-    cd_state *s = &x->loc.s;
-    int R = x->size;
-    size_t W = s->n_walls;
-    dest_lists d = {0};
-    int *pc = calloc((size_t)R, sizeof(int)), *cc = calloc((size_t)R, sizeof(int));
-    size_t *po = calloc((size_t)R + 1, sizeof(size_t)), *co = calloc((size_t)R + 1, sizeof(size_t));
-    char *pbuf = NULL, *cbuf = NULL, *prec = NULL, *crec = NULL;
-    size_t plen = 0, clen = 0;
-    int rc = pc && cc && po && co ? dests_of_owned(x, &d) : -1;
-    for (size_t q = 0; !rc && q < s->n_particles; q++)
-        for (int k = 0; x->owned[q] && k < d.count[q]; k++)
-            pc[d.ranks[d.first[q] + k]] += (int)particle_bytes(s->prim_count[q], W);
-    for (size_t k = 0; !rc && k < s->n_pairs; k++)
-        if (s->pair_active[k]) FOR_PAIR_DESTS(x, &d, k, r, cc[r] += (int)pair_bytes());
-    for (int r = 0; !rc && r < R; r++) {
-        po[r + 1] = po[r] + (size_t)pc[r];
-        co[r + 1] = co[r] + (size_t)cc[r];
-    }
-    if (!rc) {
-        pbuf = malloc(po[R] + 1);
-        cbuf = malloc(co[R] + 1);
-        rc = pbuf && cbuf ? 0 : -1;
-    }
-    for (size_t q = 0; !rc && q < s->n_particles; q++)
-        for (int k = 0; x->owned[q] && k < d.count[q]; k++) {
-            int r = d.ranks[d.first[q] + k];
-            char *end = pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], pbuf + po[r]);
-            po[r] = (size_t)(end - pbuf);
-        }
-    for (size_t k = 0; !rc && k < s->n_pairs; k++)
-        if (s->pair_active[k])
-            FOR_PAIR_DESTS(x, &d, k, r, {
-                char *end = pack_pair(s, k, x->gprim[s->pair_prim_i[k]], x->gprim[s->pair_prim_j[k]], 0, cbuf + co[r]);
-                co[r] = (size_t)(end - cbuf);
-            });
-    if (!rc) rc = exchange_bytes(x, pbuf, pc, &prec, &plen);
-    if (!rc) rc = exchange_bytes(x, cbuf, cc, &crec, &clen);
-    cd_state scal = *s; /* the scalars only: assemble replaces s */
-    if (!rc) rc = assemble(x, prec, plen, crec, clen, &scal);
-    if (!rc) x->migrations++;
-    free(d.first);
-    free(d.count);
-    free(d.ranks);
-    free(pc);
-    free(cc);
-    free(po);
-    free(co);
-    free(pbuf);
-    free(cbuf);
-    free(prec);
-    free(crec);
-    return rc;
 }
 
 /* The ghost columns of particle q to or from b. */
@@ -486,28 +385,34 @@ static void ghost_io(cd_state *s, size_t q, double *b, int pack)
 int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
 {
     cd_state *s = &x->loc.s;
-    int R = x->size, G = CD_MPI_GHOST_DOUBLES;
-    int *sc = calloc((size_t)R * 4, sizeof(int));
-    if (!sc) MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
-    int *sd = sc + R, *rcv = sc + 2 * R, *rd = sc + 3 * R;
-    /* to every rank: this rank's status, then the ghosts it owns there */
-    for (int r = 0; r < R; r++) {
-        sc[r] = 1 + x->send_count[r] * G;
-        sd[r] = r + x->send_displ[r] * G;
-        rcv[r] = 1 + x->recv_count[r] * G;
-        rd[r] = r + x->recv_displ[r] * G;
-        x->send_buf[sd[r]] = failed;
-        for (int k = 0; k < x->send_count[r]; k++)
-            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + k], x->send_buf + (size_t)(sd[r] + 1 + k * G), 1);
+    int G = CD_MPI_GHOST_DOUBLES, n = 0, who = failed ? x->rank : x->size, first = x->size;
+    MPI_Iallreduce(&who, &first, 1, MPI_INT, MPI_MIN, x->comm, &x->requests[n++]);
+    /* the ghosts of a neighbour here, the owned particles it has ghosts of
+     * (the counts known on both sides since the last migration) */
+    for (int k = 0; k < x->n_neighbors; k++) {
+        int r = x->neighbors[k];
+        if (x->recv_count[r])
+            MPI_Irecv(x->recv_buf + (size_t)x->recv_displ[r] * G, x->recv_count[r] * G, MPI_DOUBLE, r,
+                      CD_MPI_TAG_GHOSTS, x->comm, &x->requests[n++]);
     }
-    MPI_Alltoallv(x->send_buf, sc, sd, MPI_DOUBLE, x->recv_buf, rcv, rd, MPI_DOUBLE, x->comm);
-    int first = R;
-    for (int r = 0; r < R; r++) {
-        if (x->recv_buf[rd[r]] != 0 && r < first) first = r;
-        for (int k = 0; k < x->recv_count[r]; k++)
-            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + k], x->recv_buf + (size_t)(rd[r] + 1 + k * G), 0);
+    for (int k = 0; k < x->n_neighbors; k++) {
+        int r = x->neighbors[k];
+        if (!x->send_count[r]) continue;
+        double *b = x->send_buf + (size_t)x->send_displ[r] * G;
+        for (int e = 0; e < x->send_count[r]; e++)
+            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + e], b + (size_t)e * G, 1);
+        MPI_Isend(b, x->send_count[r] * G, MPI_DOUBLE, r, CD_MPI_TAG_GHOSTS, x->comm, &x->requests[n++]);
+        x->refresh_msgs++;
+        x->refresh_bytes += (long long)x->send_count[r] * G * (long long)sizeof(double);
     }
-    free(sc);
+    MPI_Waitall(n, x->requests, MPI_STATUSES_IGNORE);
+    for (int k = 0; k < x->n_neighbors; k++) {
+        int r = x->neighbors[k];
+        for (int e = 0; e < x->recv_count[r]; e++)
+            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G,
+                     0);
+    }
+    x->refreshes++;
     return first;
 }
 
@@ -583,7 +488,7 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
     }
     for (size_t q = 0; q < s->n_particles; q++) {
         if (!x->owned[q]) continue;
-        pb += particle_bytes(s->prim_count[q], s->n_walls);
+        pb += cd_mpi_particle_bytes(s->prim_count[q], s->n_walls);
         for (cd_int i = s->prim_first[q]; i < s->prim_first[q] + s->prim_count[q]; i++)
             if (rows[i]) {
                 counts[2 * nc] = x->gprim[i];
@@ -592,17 +497,17 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
             }
     }
     for (size_t k = 0; k < s->n_pairs; k++) /* each row once: by the owner of its particle i */
-        if (s->pair_active[k] && x->owned[s->prim_particle[s->pair_prim_i[k]]]) cb += pair_bytes();
+        if (s->pair_active[k] && x->owned[s->prim_particle[s->pair_prim_i[k]]]) cb += cd_mpi_pair_bytes();
     char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *pall = NULL, *call = NULL, *nall = NULL;
     if (!pbuf || !cbuf) MPI_Abort(x->comm, 1);
     char *at = pbuf;
     for (size_t q = 0; q < s->n_particles; q++)
-        if (x->owned[q]) at = pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], at);
+        if (x->owned[q]) at = cd_mpi_pack_particle(s, q, x->gid[q], x->gprim[s->prim_first[q]], at);
     at = cbuf;
     for (size_t k = 0; k < s->n_pairs; k++) {
         cd_int i = s->pair_prim_i[k];
         if (s->pair_active[k] && x->owned[s->prim_particle[i]])
-            at = pack_pair(s, k, x->gprim[i], x->gprim[s->pair_prim_j[k]], (long long)k - row0[i], at);
+            at = cd_mpi_pack_pair(s, k, x->gprim[i], x->gprim[s->pair_prim_j[k]], (long long)k - row0[i], at);
     }
     size_t plen, clen, nlen;
     int rc = allgather_bytes(x, pbuf, (int)pb, &pall, &plen);
@@ -689,6 +594,11 @@ void cd_mpi_halo_free(cd_mpi_ctx *x)
     free(x->recv_list);
     free(x->send_buf);
     free(x->recv_buf);
+    free(x->neighbors);
+    free(x->requests);
+    x->neighbors = NULL;
+    x->requests = NULL;
+    x->n_neighbors = 0;
     x->gid = x->gprim = NULL;
     x->owned = NULL;
     x->send_count = x->send_displ = x->recv_count = x->recv_displ = x->send_list = x->recv_list = NULL;

@@ -22,14 +22,27 @@ typedef struct {
     int *send_count, *send_displ, *recv_count, *recv_displ; /* per rank, in particles */
     int *send_list, *recv_list;
     double *send_buf, *recv_buf;
+    /* the ranks whose sub-domain comes within the halo and the skin of this
+     * one's (cd_decomp_neighbors): the only ones it exchanges with, but for
+     * a migration that finds a particle beyond them (then all ranks) */
+    int n_neighbors, *neighbors;
+    MPI_Request *requests;        /* room for two per neighbour and one */
+    long long far_migrations;     /* migrations that had to talk to all ranks */
+    int all_ranks;                /* every migration through all ranks (CAPDEM_MPI_ALL_RANKS=1: tests that path) */
     long long migrations;         /* times the particles went to new owners */
     int started;                  /* the local state runs (start succeeded on every rank) */
     int ran;                      /* it ran at least once (the closing report) */
     long last_owned, last_ghosts; /* particles of this rank when it last stopped */
+    long start_owned;             /* owned particles at the first start */
     /* wall-clock seconds of this rank (MPI_Wtime): in the serial step (the
      * decision and migration taken out), deciding the rebuild (waits for
      * the slowest rank included), migrating, refreshing ghosts */
     double t_step, t_decide, t_migrate, t_ghosts;
+    /* what this rank sent to other ranks (exact, for docs/mpi.md "Speed"):
+     * messages and bytes of the ghost refreshes (refreshes of them) and of
+     * the migrations, with the particle records among them (the collectives that agree on decisions and statuses
+     * not counted: one int each) */
+    long long refreshes, refresh_msgs, refresh_bytes, migrate_msgs, migrate_bytes, migrate_records;
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,
@@ -38,18 +51,25 @@ typedef struct {
 
 /* The local state of this rank cut from a global state (every rank holds
  * the same one at start): owned particles, ghosts, the active pair rows
- * among them; the ghost refresh planned.  0, or -1 (out of memory). */
+ * among them; the neighbours and the ghost refresh planned.  0, or -1 (out
+ * of memory). */
 int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global);
-/* Every owned particle to its owner by its centre now, with ghosts to the
- * ranks within the interaction range, their primitive and wall-contact
- * rows and the active pair rows (history); the local state replaced.
+/* Every particle to the ranks that hold it by its centre now (its owner,
+ * and as a ghost the ranks within the interaction range): a rank keeps
+ * the copies it has and gets, from the particle's owner, only the ones
+ * it lacks and the particles it comes to own, with their primitive and
+ * wall-contact rows and the active pair rows (history) it lacks; the
+ * local state is rebuilt from both.  Point to point with the neighbours
+ * (one message each), with all ranks when a particle went beyond them.
  * Collective.  0, or -1 (out of memory). */
 int cd_mpi_migrate(cd_mpi_ctx *x);
 /* The ghosts' pose, velocities, force and torque from their owners, after
- * a step (the serial step leaves them computed from partial forces), and
- * with them every rank's status (failed: 0 or 1), so that the ranks agree
- * to go on or stop in the same message.  Collective.  Returns the lowest
- * rank that failed, or the rank count when none did. */
+ * a step (the serial step leaves them computed from partial forces): a
+ * message to and from each neighbour that has ghosts of the other; and,
+ * overlapped with them, every rank's status (failed: 0 or 1, one
+ * MPI_Iallreduce), so that the ranks agree to go on or stop at the same
+ * step.  Collective.  Returns the lowest rank that failed, or the rank
+ * count when none did. */
 int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
 /* The owned rows of every rank into global, on every rank: particles,
  * primitives and wall-contact rows at their global row, the pair rows at
@@ -63,5 +83,34 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global);
  * from the nonzero rows alone: every rank's, on every rank.  Collective. */
 double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
 void cd_mpi_halo_free(cd_mpi_ctx *x);
+
+/* ---- records, shared by src/mpi/mpi_halo.c and src/mpi/mpi_migrate.c ------
+ * A particle travels as one record of bytes (a head, every column of
+ * fields.def of the particle, its primitives and their wall-contact rows),
+ * a pair row as its two global primitives and its columns. */
+enum { CD_MPI_TAG_GHOSTS = 1, CD_MPI_TAG_MIGRATE = 2 };
+size_t cd_mpi_particle_bytes(long long n_prims, size_t n_walls);
+size_t cd_mpi_pair_bytes(void);
+/* Particle q of s (global id gid, first global primitive gp), or pair row
+ * k (global primitives gi, gj; rank_in_row: cd_mpi_gather's), packed at
+ * b; returns the end of the record. */
+char *cd_mpi_pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b);
+char *cd_mpi_pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b);
+/* The local state from particle records (pbuf) and pair records (cbuf),
+ * in ascending global id, a key given twice taken once, the scalars of
+ * scal; ownership by the centre, the ghost refresh planned, the list to
+ * be rebuilt.  0, or -1 (out of memory). */
+int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal);
+/* MPI_Alltoallv of bytes over all ranks: sc[r] bytes to rank r (in rank
+ * order in send) into a new buffer *recv of *rlen bytes.  0, or -1. */
+int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen);
+
+static inline double *cd_mpi_pos3(const cd_state *s, size_t q, double x[3])
+{
+    x[0] = s->position[q].x;
+    x[1] = s->position[q].y;
+    x[2] = s->position[q].z;
+    return x;
+}
 
 #endif

@@ -22,12 +22,20 @@ refused() {
   ok
 }
 
-{ printf 'mpi:\n  decomposition: rcb\n'; cat "$base"; } > unknown_decomposition.yaml
-refused unknown_decomposition 3 'unknown_decomposition\.yaml:2: mpi\.decomposition = rcb: expected cartesian'
+{ printf 'mpi:\n  decomposition: metis\n'; cat "$base"; } > unknown_decomposition.yaml
+refused unknown_decomposition 3 'unknown_decomposition\.yaml:2: mpi\.decomposition = metis: expected one of cartesian, rcb'
+{ printf 'mpi:\n  decomposition: rcb\n  grid: [3, 1, 1]\n'; cat "$base"; } > rcb_grid.yaml
+refused rcb_grid 3 'rcb_grid\.yaml: mpi\.grid = \[3, 1, 1\] with mpi\.decomposition = rcb: expected no mpi\.grid'
 
 # one column of three crosses: centres 2 lattice spacings apart in y, none in x
 sed 's/count: 30/count: 3/; s/width: 0.15/width: 0.025/' "$base" > too_many_ranks.yaml
 refused too_many_ranks 3 'too_many_ranks\.yaml: 3 MPI ranks: more than the domain can be split into.*at most 1 x 2 x 1'
+# rcb cuts the column between the first and second cross: the lower
+# sub-domain holds half a spacing of centres, under the interaction range;
+# and it has one rank per particle at most
+{ printf 'mpi:\n  decomposition: rcb\n'; cat too_many_ranks.yaml; } > rcb_narrow.yaml
+refused rcb_narrow 2 'rcb_narrow\.yaml: 2 MPI ranks with mpi\.decomposition = rcb: more than the domain can be split into: the sub-domain of rank 0 spans 0\.0117 m along y'
+refused rcb_narrow 4 'rcb_narrow\.yaml: 4 MPI ranks with mpi\.decomposition = rcb: expected at most 256 ranks and at most one per particle \(3 particles\)'
 
 { printf 'mpi:\n  grid: [2, 2, 1]\n'; cat "$base"; } > grid_product.yaml
 refused grid_product 3 'grid_product\.yaml: mpi\.grid = \[2, 2, 1\] makes 4 sub-domains, but the run has 3 MPI ranks'
