@@ -5,7 +5,7 @@
 #include "bench_cases.h"
 
 /* Time steps: t_col/20 or below for the lightest pair (0.8 d spheres:
- * t_col = 5.9e-5 s, dt = 2e-6 s as SPEC 3; crosses 0.7 L: 6e-6 s as
+ * t_col = 5.9e-5 s, dt = 2e-6 s as docs/references.md, Contact law; crosses 0.7 L: 6e-6 s as
  * configs/crosses_2d.yaml; hexapods: 1e-5 s, t_col/21 at alpha 3).
  * Settling steps: the fall of the tallest column (1e4 particles) under 50 g
  * plus the time for the contacts per particle to level off. */

@@ -1,6 +1,6 @@
 /* The defined cases of capdem-bench (docs/performance.md, "Bench cases"):
  * shape, size distribution, dimension, time step and the box they settle in.
- * Material: the SPEC 3 defaults (rho 1000 kg/m^3, k_n 1e5 N/m, k_t 0.5 k_n,
+ * Material: the default material of docs/references.md, Contact law (rho 1000 kg/m^3, k_n 1e5 N/m, k_t 0.5 k_n,
  * eta_n = eta_t = 0.2, mu 0.5, frictionless walls). */
 #ifndef CD_BENCH_CASES_H
 #define CD_BENCH_CASES_H

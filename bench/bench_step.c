@@ -7,7 +7,7 @@
  *                [--tile KX,KZ] [--shuffle SEED] [--reorder cells|none]
  *
  * A case (bench_cases.c) is a shape, a size distribution, a dimension and a
- * time step, with the SPEC 3 material.  N particles are deposited from a
+ * time step, with the default material (docs/references.md, Contact law).  N particles are deposited from a
  * lattice into a box of square cross-section (columns about 4x as tall as
  * wide), settled for S steps (default: the case's) under a strengthened
  * gravity (50 g, which shortens the fall without changing the contact law),
@@ -327,10 +327,9 @@ int main(int argc, char **argv)
                    "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}, "
                    "\"rows\": {\"prims\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, \"walls\": %zu, "
                    "\"wall_contacts\": %.0f}}\n",
-                   case_label, n, sim.backend->name, strcmp(names[k], "omp") ? sim.backend->device(&sim) : "host",
-                   round_threads[k], steps, wall, cpu, (double)n * steps / wall, contacts * steps / wall,
-                   2 * o.n_contacts / (double)n, sim.s.n_pairs, (double)state_bytes(&sim) / (double)n, t_settle,
-                   sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
+                   case_label, n, sim.backend->name, sim.backend->device(&sim), round_threads[k], steps, wall, cpu,
+                   (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n, sim.s.n_pairs,
+                   (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
                    sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
                    moved / (double)n, kernels, sim.s.n_prims, sim.s.n_pairs, after.n_contacts, sim.s.n_walls,
                    after.n_wall_contacts);

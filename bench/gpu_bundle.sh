@@ -227,8 +227,11 @@ pack payload-lib.tar.xz lib lib.cxx
 pack payload-bin.tar.xz bin inputs
 
 # The part of the source tree the tests read through CAPDEM_SOURCE_DIR
-# (presets, example configs, kernels), unpacked: small, and readable there.
+# (presets, example configs, kernels, and host/capdem_h5.py, which
+# test_runfile_layout checks against the C tables), unpacked: small, and
+# readable there.
 cp -r "$ROOT/configs" "$ROOT/kernels" "$OUT/src/"
+mkdir -p "$OUT/src/host" && cp "$ROOT/host/capdem_h5.py" "$OUT/src/host/"
 cp "$ROOT/bench/gpu/run_on_gpu.sh" "$OUT/"
 chmod +x "$OUT/run_on_gpu.sh"
 {

@@ -20,7 +20,7 @@ import os
 import h5py
 import numpy as np
 
-# ---- BEGIN GENERATED from kernels/runfile.def and kernels/fields.def by tests/unit/test_runfile_layout.c
+# ---- BEGIN GENERATED from kernels/runfile.def, fields.def and observables.def by tests/unit/test_runfile_layout.c
 # (build/tests/test_runfile_layout --write host/capdem_h5.py); edit the tables, not this block.
 # groups and datasets that are not columns: key -> absolute path
 PATH = {
@@ -121,6 +121,26 @@ WALL_KIND_NAME = {
     0: "plane",
     1: "cylinder",
     2: "sphere",
+}
+# time series of a DEM run, /observables/<name>: name -> (unit, components per row, meaning);
+# W: the number of walls
+OBSERVABLES = {
+    "kinetic_energy_translational": ("J", "1", "translational kinetic energy, sum of m v^2 / 2"),
+    "kinetic_energy_rotational": ("J", "1", "rotational kinetic energy, sum of L . omega / 2"),
+    "kinetic_energy_in_contact": ("J", "1", "kinetic energy of the particles that touch something (rattlers left out)"),
+    "elastic_energy": ("J", "1", "energy stored in the normal and tangential springs of every contact"),
+    "potential_energy": ("J", "1", "gravitational potential energy, -sum of m g . x"),
+    "contacts": ("1", "1", "active particle-particle contacts (primitive pairs)"),
+    "wall_contacts": ("1", "1", "active primitive-wall contacts"),
+    "momentum": ("kg m/s", "3", "total linear momentum"),
+    "wall_force": ("N", "3 W", "force of the particles on each wall"),
+    "wall_position": ("m", "3 W", "reference point of each wall"),
+    "wall_radius": ("m", "W", "radius of each wall (0 for a plane)"),
+    "packing_fraction": ("1", "1", "solid volume over the container's (up to the piston, or the ball); 0 without a container"),
+    "coordination": ("1", "1", "2 contacts / particles, rattlers included"),
+    "phase": ("1", "1", "protocol phase (docs/protocols.md)"),
+    "wall_load": ("N", "1", "load on the protocol's driven wall at the last control"),
+    "pressure": ("Pa", "1", "ball: wall load over the ball's area; else 0"),
 }
 # ---- END GENERATED
 
@@ -241,10 +261,12 @@ def config_text(f):
 
 
 def observable(f, name):
-    """(step, time, value) arrays of the time series /observables/<name>."""
+    """(step, time, value) arrays of the time series /observables/<name>
+    (a DEM run's: the keys of OBSERVABLES)."""
     g = dataset(f, "observables")
     if name not in g:
-        raise LayoutError("%s: no observable %s" % (f.filename, name))
+        known = "" if name in OBSERVABLES else " (not one of the OBSERVABLES of kernels/observables.def either)"
+        raise LayoutError("%s: no observable %s%s" % (f.filename, name, known))
     s = g[name]
     return s[NAME["step"]][:], s[NAME["time"]][:], s[NAME["value"]][:]
 

@@ -180,7 +180,7 @@ def plot_compaction(root, outdir, made):
         found = [c for c in kind if c in t and varies(c)]
         if found:
             panels.append(found[0])
-    # SPEC 7: stress and Z against the packing fraction
+    # docs/references.md, Analysis: stress and Z against the packing fraction
     phi = next((c for c in kinds[2] if c in panels), None)
     against = [c for c in panels if c != phi] if phi else []
     jam = table(root.get("jamming"), "data")

@@ -26,7 +26,7 @@ sys.dont_write_bytecode = True  # no host/__pycache__ in the worktree
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="study", required=True)
-    p1 = sub.add_parser("study1", help="hexapods under radial compaction (seed 001)")
+    p1 = sub.add_parser("study1", help="hexapods under radial compaction (Tran et al. 2024)")
     p1.add_argument("--build", default="build", help="build folder holding capdem")
     p1.add_argument("--out", default="runs/validation", help="output folder (runs under OUT/study1)")
     p1.add_argument("--alphas", default="3,9,1,1.5,2,5,7", help="frictionless aspect ratios, in run order")
@@ -52,9 +52,9 @@ def main():
     p1.add_argument("--ci", action="store_true",
                     help="the CI presets' relaxation check (energy steady to 1e-3 every 2000 steps, not 1e-4 "
                          "every 5000); case folders get a _ci suffix")
-    for name, what in (("study2", "2D crosses, deposit and compress (seed 000)"),
-                       ("study3", "3D stars in a cylinder, deposit and compress (seed 000)"),
-                       ("study4", "spheres in the 2D box and the cylinder (seed 000, Mueth)")):
+    for name, what in (("study2", "2D crosses, deposit and compress (Conzelmann et al.)"),
+                       ("study3", "3D stars in a cylinder, deposit and compress (Conzelmann et al.)"),
+                       ("study4", "spheres in the 2D box and the cylinder (Conzelmann et al., Mueth)")):
         p = sub.add_parser(name, help=what)
         p.add_argument("--build", default="build", help="build folder holding capdem")
         p.add_argument("--out", default="runs/validation", help="output folder (runs under OUT/%s)" % name)

@@ -1,4 +1,4 @@
-"""Studies 2-4 of docs/validation.md (seed 000): deposit and compress.
+"""Studies 2-4 of docs/validation.md (Conzelmann et al.): deposit and compress.
 
 Used by host/validate.py (`validate.py study2|study3|study4 ...`); the run,
 resume, lock and timing machinery is validate_runs.py's (shared with study
@@ -6,9 +6,9 @@ resume, lock and timing machinery is validate_runs.py's (shared with study
 
   study2  2D crosses in a box of width 30 L, psi 0.995, 0.754, 0.585, 0.473
   study3  3D stars (hexapods) in a cylinder of diameter 6 L, psi 0.995, 0.702, 0.526, 0.419
-  study4  spheres, 2D box of width 30 d_p and cylinder of diameter 10 d_p (seed 000's references)
+  study4  spheres, 2D box of width 30 d_p and cylinder of diameter 10 d_p (Conzelmann et al.'s references)
 
-The aspect ratio of each psi is seed 000's Table S1.  The count follows the
+The aspect ratio of each psi is Conzelmann et al.'s Table S1.  The count follows the
 paper's rule (compressed packing at least twice as high as the box is wide,
 or as the cylinder's diameter) with an upper estimate of the packing
 fraction (PHI_GUESS below), so that the rule holds; each run's H/W is
@@ -30,7 +30,7 @@ REPO = vr.REPO
 ARM_D = vr.ARM_D
 DENSITY = 1000.0  # [kg/m^3], the templates' material.density
 
-# Table S1 of seed 000: sphericity -> aspect ratio L / d_p.
+# Table S1 of Conzelmann et al.: sphericity -> aspect ratio L / d_p.
 STUDIES = {
     "study2": {"dim": 2, "shape": "cross", "domain": "box", "size_L": 30.0,
                "psis": [(0.995, 1.1), (0.754, 3.0), (0.585, 6.0), (0.473, 11.0)],
@@ -44,26 +44,26 @@ STUDIES = {
                                  "template": "configs/validation/study3/deposit_cylinder.yaml"})]},
 }
 
-# Mueth, Jaeger, Nagel, PRE 57 (1998) 3164, fit of eq. (1) of seed 000 to
+# Mueth, Jaeger, Nagel, PRE 57 (1998) 3164, fit of eq. (1) of Conzelmann et al. to
 # their 3D glass-sphere packings: a = 3.0, b = 0.75, beta = 1.5 (the values
-# are from Mueth et al., not from the seed's text).
+# are from Mueth et al., not from Conzelmann et al.'s text).
 MUETH = {"a": 3.0, "b": 0.75, "beta": 1.5}
 
 
 def k_paper_2d(psi):
-    """Seed 000, Fig. 6a's caption: linear fit to the 2D tail exponents (the
+    """Conzelmann et al., Fig. 6a's caption: linear fit to the 2D tail exponents (the
     issue's reference).  It rises as psi falls (1.43 to 1.52 over the study's
     psi), against the paper's own text (k_paper_2d_text)."""
     return 0.18 * (1.0 - psi) + 1.43
 
 
-# Seed 000's text: "In 2D packings, k decreases slightly with decreasing psi,
+# Conzelmann et al.'s text: "In 2D packings, k decreases slightly with decreasing psi,
 # i.e. k = 1.42 for psi = 0.995 and k = 1.32 for psi = 0.47" (psi, k).
 K_TEXT_2D = ((0.995, 1.42), (0.47, 1.32))
 
 
 def k_paper_2d_text(psi):
-    """The straight line through seed 000's two 2D values in its text (the
+    """The straight line through Conzelmann et al.'s two 2D values in its text (the
     caption's fit with the sign of its slope turned: 1.43 - 0.18 (1 - psi)
     is within 0.02 of it)."""
     (p1, k1), (p0, k0) = K_TEXT_2D
@@ -71,21 +71,21 @@ def k_paper_2d_text(psi):
 
 
 def k_paper_3d(psi):
-    """Seed 000: k = 1.38 +- 0.14 for psi >= 0.7, else the fit -2.03 (1 - psi)^2.43 + 1.29."""
+    """Conzelmann et al.: k = 1.38 +- 0.14 for psi >= 0.7, else the fit -2.03 (1 - psi)^2.43 + 1.29."""
     return 1.38 if psi >= 0.7 else -2.03 * (1.0 - psi) ** 2.43 + 1.29
 
 
 def rdf_peaks_paper(alpha):
-    """Seed 000 eq. (11) in units of L: D_1 = sqrt(d^2 + ((L + d)/2)^2), D_2 = 2 D_1, D_3 = 3 D_1."""
+    """Conzelmann et al. eq. (11) in units of L: D_1 = sqrt(d^2 + ((L + d)/2)^2), D_2 = 2 D_1, D_3 = 3 D_1."""
     L, d = alpha, 1.0
     d1 = math.sqrt(d * d + ((L + d) / 2.0) ** 2) / L
     return [d1, 2 * d1, 3 * d1]
 
 
 def polydispersity(dim, psi):
-    """Seed 000 (section II): 2D 0.3 for psi > 0.88, 0.15 for 0.88 >= psi (the
-    paper states 0.15 down to 0.75 and nothing below: SPEC's 0.15 is kept);
-    3D 0.2 (stated for psi > 0.86; SPEC's 0.2 below)."""
+    """Conzelmann et al. (section II): 2D 0.3 for psi > 0.88, 0.15 for 0.88 >= psi (the
+    paper states 0.15 down to 0.75 and nothing below: the default 0.15 of docs/references.md, Particles, is kept);
+    3D 0.2 (stated for psi > 0.86; the default 0.2 below)."""
     if dim == 2:
         return 0.3 if psi > 0.88 else 0.15
     return 0.2
@@ -96,7 +96,7 @@ def polydispersity(dim, psi):
 # deposit_2d_crosses), alpha 6 0.60 (compressed), alpha 11 0.40 (settled
 # 0.36, less the 10 % the piston took off the height at alpha 6).  The
 # count uses 1.2 x these (walls take a larger share of a 10 L box than of
-# 30 L), capped at 0.91.  seed 000 Fig. S1 gives the trend (a figure only).
+# 30 L), capped at 0.91.  Conzelmann et al. Fig. S1 gives the trend (a figure only).
 PHI_2D_CROSSES = {3: 0.75, 6: 0.60, 11: 0.40}
 
 
@@ -105,9 +105,9 @@ def phi_guess(dim, shape, alpha):
     2D discs and near-discs (alpha 1.1): 0.91, the hexagonal packing of
     equal discs (0.907) rounded up (0.84, random close packing, was too
     low: capdem's polydisperse discs of study 4 reached 0.909 and only
-    H/W = 1.85); thinner crosses pack looser (seed 000 Fig. S1): 1.2 x
+    H/W = 1.85); thinner crosses pack looser (Conzelmann et al. Fig. S1): 1.2 x
     capdem's pilot values (PHI_2D_CROSSES), which halves the count at
-    alpha = 11 where 0.91 gave H/W near 4; 3D stars: seed 001's
+    alpha = 11 where 0.91 gave H/W near 4; 3D stars: Tran et al. 2024's
     frictionless fit at eta = 1 - 1/alpha (friction only lowers it);
     spheres 0.64."""
     if dim == 2:
@@ -136,7 +136,7 @@ def area_2d(shape, alpha, n=1500):
 class DepositCase(vr.RunCase):
     def __init__(self, study, tag, spec, psi, alpha, seed, n, out, capdem, size_l=None):
         self.study, self.spec, self.psi, self.capdem = study, spec, psi, capdem
-        self.alpha, self.mu, self.ci = alpha, 0.5, False  # SPEC 3 friction
+        self.alpha, self.mu, self.ci = alpha, 0.5, False  # default friction (docs/references.md, Contact law)
         self.dim, self.shape = spec["dim"], spec["shape"]
         self.poly = 0.2 if self.shape == "sphere" else polydispersity(self.dim, psi)
         props = vr.shape_props(capdem, self.shape, alpha, DENSITY)
@@ -211,7 +211,7 @@ def analyse(case, capdem, force=False):
 
 def pdf_type(pdf):
     """'A' when P(f) has its maximum at 0.5 <= f <= 1.5 and rises to it from the
-    first bin (a peak near f = 1, seed 000 Fig. 1), else 'B'."""
+    first bin (a peak near f = 1, Conzelmann et al. Fig. 1), else 'B'."""
     f, p = pdf[:, 0], pdf[:, 1]
     sel = f <= 3.0
     k = int(np.argmax(p[sel]))
@@ -269,7 +269,7 @@ def metrics(case):
            "mueth_a": nf.get("mueth_a"), "mueth_b": nf.get("mueth_b"), "mueth_beta": nf.get("mueth_beta"),
            "pf_type": pdf_type(pdf), "stress_tail_k": st.get("tail_k"),
            # P(i), the first stress invariant over its mean: the same type test, and its first bin
-           # (seed 000: a pronounced peak at i = 1 for 2D crosses above psi_crit that disappears
+           # (Conzelmann et al.: a pronounced peak at i = 1 for 2D crosses above psi_crit that disappears
            # below it "as lim_{i -> 0} P(i) increases with decreasing psi")
            "stress_type": pdf_type(np.array(st["curves"]["pdf"]["data"])),
            "stress_p0": float(st["curves"]["pdf"]["data"][0][1]),
@@ -368,7 +368,7 @@ def aggregate(rows):
             g["rdf_peaks_paper"] = rdf_peaks_paper(g["alpha"]) if g["psi"] < 0.9 else [1.0, 1.91]
         elif study == "study3":
             g["k_paper"] = k_paper_3d(g["psi"])
-        elif study == "study4":  # seed 000: its 2D fit at psi = 1; Murphy et al.'s 3D spheres
+        elif study == "study4":  # Conzelmann et al.: its 2D fit at psi = 1; Murphy et al.'s 3D spheres
             g["k_paper"] = k_paper_2d(1.0) if key.startswith("sphere2d") else 1.4
         out.append(g)
     return out
@@ -393,14 +393,14 @@ def print_table(agg):
 def markdown(agg):
     """The table of docs/validation.md for one study (mean +- standard error
     over seeds; one seed: its value)."""
-    cols = ["ψ (α)", "N", "seeds", "H / W", "Φ", "k, max. likelihood", "k, least squares", "seed 000 k",
+    cols = ["ψ (α)", "N", "seeds", "H / W", "Φ", "k, max. likelihood", "k, least squares", "Conzelmann et al. k",
             "P(f) type", "type, particle pairs", "contacts / touching pair", "P(i) tail k"]
     study = agg[0]["study"] if agg else ""
-    if study == "study2":  # after "seed 000 k" (the caption's fit); P(i)'s type and first bin
-        cols.insert(cols.index("seed 000 k") + 1, "seed 000 k, text")
+    if study == "study2":  # after "Conzelmann et al. k" (the caption's fit); P(i)'s type and first bin
+        cols.insert(cols.index("Conzelmann et al. k") + 1, "Conzelmann et al. k, text")
         cols += ["P(i) type", "P(i) first bin"]
     if study == "study2" or study == "study4":
-        cols += ["G(r) peaks / L (seed 000)"]
+        cols += ["G(r) peaks / L (Conzelmann et al.)"]
     if study == "study4":
         cols += ["Mueth a, b, β (Mueth: 3.0, 0.75, 1.5)"]
     if study == "study2":
@@ -414,7 +414,7 @@ def markdown(agg):
                  ", ".join(g["types"]), ", ".join(g["pair_types"]), vr.pm(g, "contacts_per_pair", 2),
                  vr.pm(g, "stress_tail_k", 2)]
         if study == "study2":
-            cells.insert(cols.index("seed 000 k, text"), vr.ref(g.get("k_paper_text")))
+            cells.insert(cols.index("Conzelmann et al. k, text"), vr.ref(g.get("k_paper_text")))
             cells += [", ".join(g["stress_types"]), vr.pm(g, "stress_p0", 2)]
         if study in ("study2", "study4"):
             peaks = g.get("rdf_peaks") or []
@@ -461,10 +461,10 @@ def figures(outdir, rows, agg, study):
         fig, ax = plt.subplots(figsize=(5.5, 4))
         ps = np.linspace(0.4, 1.0, 100)
         ax.plot(ps, [k_paper_2d(p) if study == "study2" else k_paper_3d(p) for p in ps], "k--",
-                label="seed 000 fit" + (" (Fig. 6a caption)" if study == "study2" else ""))
+                label="Conzelmann et al. fit" + (" (Fig. 6a caption)" if study == "study2" else ""))
         if study == "study2":
             ax.plot(ps, [k_paper_2d_text(p) for p in ps], ":", color="grey",
-                    label="seed 000 text: k = 1.42 at 0.995, 1.32 at 0.47")
+                    label="Conzelmann et al. text: k = 1.42 at 0.995, 1.32 at 0.47")
             ax.plot(*zip(*K_TEXT_2D), "kx")
         gs = [g for g in agg if g["study"] == study and g.get("k") is not None]
         ax.errorbar([g["psi"] for g in gs], [g["k"] for g in gs], [g["k_se"] or 0 for g in gs], fmt="o",

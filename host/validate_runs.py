@@ -15,7 +15,7 @@ import time
 import capdem_h5
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ARM_D = 0.005  # arm diameter [m] (SPEC 3)
+ARM_D = 0.005  # arm diameter [m] (docs/references.md, Contact law)
 PHASE_DONE = 7  # the protocols' last phase (/walls/control slot 0): the run is done
 
 

@@ -1,6 +1,6 @@
 """Study 1 of docs/validation.md, run by host/validate.py study1.
 
-Study 1 (seed 001): hexapods of aspect ratio alpha under radial compaction
+Study 1 (Tran et al. 2024): hexapods of aspect ratio alpha under radial compaction
 at p L / k_n = 1e-5, frictionless, and alpha = 3, 9 again at mu = 0.4.  For
 each case (alpha, mu, seed) the driver
 
@@ -53,7 +53,7 @@ STUDY1_SHAPES = {1.0: ("sphere", 4.0e-6), 1.5: ("hexapod", 6.5e-6), 2.0: ("hexap
                  3.0: ("hexapod", 1.0e-5), 5.0: ("hexapod", 1.5e-5), 7.0: ("hexapod", 2.0e-5),
                  9.0: ("hexapod", 2.0e-5)}
 
-# Seed 001 (Tran et al. 2024), as its text states them (figures are not in
+# Tran et al. 2024, as its text states them (figures are not in
 # the extracted text; only the numbers the text gives are used).
 PAPER1 = {
     "n_particles": 8385,
@@ -69,12 +69,12 @@ PAPER1 = {
 
 
 def eta_of(alpha):
-    """Seed 001 eq. (4): eta = 1 - 1/alpha."""
+    """Tran et al. 2024, eq. (4): eta = 1 - 1/alpha."""
     return 1.0 - 1.0 / alpha
 
 
 def phi_fit(eta):
-    """Seed 001 eq. (6) with a = 0.85, b = 1.5, Phi_0 = 0.62."""
+    """Tran et al. 2024, eq. (6) with a = 0.85, b = 1.5, Phi_0 = 0.62."""
     return 0.62 + 0.85 * eta ** 2 - 1.5 * eta ** 3
 
 
@@ -101,7 +101,7 @@ class Case(RunCase):
     def write_config(self, steps):
         shape, dt = STUDY1_SHAPES[self.alpha]
         # Start: 1.5 x the radius at which the particles would fill the ball to
-        # seed 001's fit Phi(eta) (solid fraction Phi / 3.4), placed at random
+        # Tran et al. 2024's fit Phi(eta) (solid fraction Phi / 3.4), placed at random
         # with only their arms kept apart (init.exclusion: shape).
         v = shape_props(self.capdem, shape, self.alpha)["volume"]
         radius = START_RADIUS_FACTOR * (3.0 * self.n * v / (4.0 * math.pi * phi_fit(eta_of(self.alpha)))) ** (1.0 / 3.0)
@@ -155,7 +155,7 @@ def ball_radius(pk):
 def inner_contact_density(pk):
     """Contacts per volume within half the ball radius over the ball's mean,
     from capdem analyze's contact-density profile (counts per radial bin):
-    seed 001 (Fig. 3b) finds n_c nearly constant from one particle size out
+    Tran et al. 2024 (Fig. 3b) find n_c nearly constant from one particle size out
     of the centre to the wall, so a homogeneous packing gives about 1; a
     hollow shell of particles jammed at the wall (the ball swept them up
     faster than they could fill the inside) gives about 0."""
@@ -356,8 +356,8 @@ def figures(outdir, cases, agg, n, agg_all=None):
 
     # packing fraction
     fig, ax = plt.subplots(figsize=(5.5, 4))
-    ax.plot(et, phi_fit(et), "k--", label="seed 001 fit 0.62 + 0.85η² − 1.5η³")
-    paper_points(ax, PAPER1["phi_text"], "seed 001 text")
+    ax.plot(et, phi_fit(et), "k--", label="Tran et al. 2024 fit 0.62 + 0.85η² − 1.5η³")
+    paper_points(ax, PAPER1["phi_text"], "Tran et al. 2024 text")
     for mu, (m, c, lab) in styles.items():
         x, y, e = series("phi_container", mu)
         if len(x):
@@ -384,13 +384,13 @@ def figures(outdir, cases, agg, n, agg_all=None):
         ax.legend(fontsize=8)
         save(fig, fname)
 
-    eta_figure("lambda", PAPER1["lambda"], "seed 001 text (α = 1, 9)", "interlocking λ = 1 − <l>/L", "study1_lambda.png")
-    eta_figure("valence", PAPER1["valence"], "seed 001 text", "valence Z_c / Z", "study1_valence.png")
+    eta_figure("lambda", PAPER1["lambda"], "Tran et al. 2024 text (α = 1, 9)", "interlocking λ = 1 − <l>/L", "study1_lambda.png")
+    eta_figure("valence", PAPER1["valence"], "Tran et al. 2024 text", "valence Z_c / Z", "study1_valence.png")
     # coordination
     fig, ax = plt.subplots(figsize=(5.5, 4))
-    paper_points(ax, PAPER1["Z_c"], "seed 001 Z_c (text)")
+    paper_points(ax, PAPER1["Z_c"], "Tran et al. 2024 Z_c (text)")
     zs = sorted((eta_of(a), v) for a, v in PAPER1["Z"].items())
-    ax.plot([p[0] for p in zs], [p[1] for p in zs], "kx", ms=9, label="seed 001 Z (text)")
+    ax.plot([p[0] for p in zs], [p[1] for p in zs], "kx", ms=9, label="Tran et al. 2024 Z (text)")
     for mu, (m, c, lab) in styles.items():
         for key, fill, name in (("Z_c", "full", "Z_c"), ("Z_c_walls", "none", "Z_c with wall contacts"),
                                 ("Z", "full", "Z")):
@@ -425,7 +425,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
     ax.legend(fontsize=8)
     save(fig, "study1_bond_forces.png")
     # contact density against the distance from the ball centre (seed 1 of each case):
-    # flat for a homogeneous packing (seed 001 Fig. 3b), zero inside for a hollow shell
+    # flat for a homogeneous packing (Tran et al. 2024 Fig. 3b), zero inside for a hollow shell
     fig, ax = plt.subplots(figsize=(5.5, 4))
     firsts = {}
     for case in sorted(cases, key=lambda c: (c.mu, c.alpha, c.seed)):
@@ -469,7 +469,7 @@ def figures(outdir, cases, agg, n, agg_all=None):
                             textcoords="offset points", xytext=(3, -10), fontsize=7)
         ax.set_xlabel("N^(-1/3) (grey line: the paper's N = 8385)")
         ax.set_ylabel("packing fraction Φ")
-        ax.set_title("finite size (dashed: seed 001 fit; dotted: line through the ball's Φ)", fontsize=9)
+        ax.set_title("finite size (dashed: Tran et al. 2024 fit; dotted: line through the ball's Φ)", fontsize=9)
         ax.legend(fontsize=7)
         save(fig, "study1_phi_finite_size.png")
     print("figures: %s (%s)" % (outdir, ", ".join(written)))

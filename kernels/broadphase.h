@@ -66,7 +66,7 @@ CD_INLINE void cd_bp_bounds_add(cd_real *lo, cd_real *hi, cd_real *rmax, cd_vec3
  * and skin [m]: cells of edge 2 rmax + skin (so that candidates lie in
  * neighbouring cells), enlarged until there are at most 8 n_prims + 64
  * cells, so that memory and the empty-cell scan stay linear in N. */
-CD_INLINE void cd_grid_make(cd_grid *g, const cd_real *lo, const cd_real *hi, cd_real rmax, cd_real skin,
+CD_INLINE void cd_grid_make(CD_NOESCAPE cd_grid *g, const cd_real *lo, const cd_real *hi, cd_real rmax, cd_real skin,
                             cd_long n_prims)
 {
     g->cell = 2 * rmax + skin;
@@ -83,14 +83,14 @@ CD_INLINE void cd_grid_make(cd_grid *g, const cd_real *lo, const cd_real *hi, cd
 }
 
 /* Cell coordinate of x along axis, clamped to the grid. */
-CD_INLINE cd_long cd_grid_coord(const cd_grid *g, cd_real x, int axis)
+CD_INLINE cd_long cd_grid_coord(CD_NOESCAPE const cd_grid *g, cd_real x, int axis)
 {
     cd_long c = (cd_long)floor((x - g->lo[axis]) / g->cell);
     return c < 0 ? 0 : (c >= g->dim[axis] ? g->dim[axis] - 1 : c);
 }
 
 /* Cell index of point p [m] (x fastest). */
-CD_INLINE cd_long cd_grid_cell_of(const cd_grid *g, cd_vec3 p)
+CD_INLINE cd_long cd_grid_cell_of(CD_NOESCAPE const cd_grid *g, cd_vec3 p)
 {
     return (cd_grid_coord(g, p.z, 2) * g->dim[1] + cd_grid_coord(g, p.y, 1)) * g->dim[0] + cd_grid_coord(g, p.x, 0);
 }

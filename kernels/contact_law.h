@@ -1,4 +1,4 @@
-/* The contact laws (SPEC section 3; docs/contacts.md): the linear
+/* The contact laws (docs/references.md, Contact law; docs/contacts.md): the linear
  * spring-dashpot and Hertz-Mindlin, each with a Coulomb-capped tangential
  * spring.  One call updates one contact: its tangential history and the
  * force it exerts.  Used for particle-particle and particle-wall contacts
@@ -22,10 +22,11 @@ typedef struct {
     cd_real mu;         /* Coulomb friction coefficient [1] */
     cd_real e_eff;      /* Hertz-Mindlin: contact modulus E* = E / (2 (1 - nu^2)) [Pa] */
     cd_real g_eff;      /* Hertz-Mindlin: contact shear modulus G* = E / (4 (2 - nu) (1 + nu)) [Pa] */
-    cd_int limit_total; /* 0: limit mu F_n,elastic (seed 000); 1: mu F_n (seed 001, LAMMPS) */
-    cd_int clip_normal; /* 1: F_n = max(0, ...) as SPEC 3; 0: allow the damping to pull (textbook oscillator) */
-    cd_int law;         /* CD_LAW_* */
-    cd_int pad_;        /* keeps the size a multiple of 8 bytes on every backend */
+    cd_int limit_total; /* 0: limit mu F_n,elastic (Conzelmann et al.); 1: mu F_n (Tran et al. 2024, LAMMPS) */
+    /* 1: F_n = max(0, ...) (docs/references.md, Contact law); 0: the damping may pull (textbook oscillator) */
+    cd_int clip_normal;
+    cd_int law;  /* CD_LAW_* */
+    cd_int pad_; /* keeps the size a multiple of 8 bytes on every backend */
 } cd_law_params;
 
 typedef struct {

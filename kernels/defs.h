@@ -39,8 +39,20 @@ typedef uint64_t cd_ulong;
 #endif
 
 #define CD_INLINE static inline
-#define CD_R(x)   ((cd_real)(x))
-#define CD_PI     CD_R(3.14159265358979323846)
+/* A pointer parameter the function neither keeps nor hands on.  Clang's
+ * OpenMP offload otherwise keeps every local whose address reaches a
+ * call that is not inlined yet in device heap memory ("globalization",
+ * remark OMP113): on the H100 the neighbour build's kernels that passed a
+ * local grid by address ran 50-400 times slower than their arithmetic
+ * (docs/performance.md, "First GPU runs").  Only Clang knows it; OpenCL C
+ * has no globalization. */
+#if defined(__clang__) && !defined(__OPENCL_VERSION__)
+#define CD_NOESCAPE __attribute__((noescape))
+#else
+#define CD_NOESCAPE
+#endif
+#define CD_R(x) ((cd_real)(x))
+#define CD_PI   CD_R(3.14159265358979323846)
 
 /* Named index types: what an integer indexes is part of its type name. */
 typedef cd_int cd_particle_id; /* index into particle columns */

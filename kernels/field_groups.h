@@ -6,14 +6,18 @@
  * offload mapping) expand fields.def through it, so a device never holds,
  * binds or copies an output-only column.  PAIR_OUT is the last group of
  * fields.def: the device columns are the first ones of cd_fields[].
- * Device-safe: C11 and OpenCL C 1.2 (variadic macros are C99). */
+ * Device-safe: C11 and OpenCL C 1.2, whose compilers may refuse variadic
+ * macros (NVIDIA's does: "variadic macros not supported in OpenCL"), so
+ * each takes one argument; a list entry that needs a comma writes
+ * CD_COMMA, expanded only after the argument is taken. */
 #ifndef CD_FIELD_GROUPS_H
 #define CD_FIELD_GROUPS_H
 
-#define CD_ON_DEVICE_PARTICLE(...) __VA_ARGS__
-#define CD_ON_DEVICE_PRIM(...)     __VA_ARGS__
-#define CD_ON_DEVICE_PAIR(...)     __VA_ARGS__
-#define CD_ON_DEVICE_WALLC(...)    __VA_ARGS__
-#define CD_ON_DEVICE_PAIR_OUT(...)
+#define CD_COMMA                 ,
+#define CD_ON_DEVICE_PARTICLE(x) x
+#define CD_ON_DEVICE_PRIM(x)     x
+#define CD_ON_DEVICE_PAIR(x)     x
+#define CD_ON_DEVICE_WALLC(x)    x
+#define CD_ON_DEVICE_PAIR_OUT(x)
 
 #endif

@@ -1,5 +1,5 @@
 /* Plain data shared by the narrow phase, the wall contacts and the contact
- * law (SPEC section 2). */
+ * law (docs/references.md, Contacts). */
 #ifndef CD_GEOM_TYPES_H
 #define CD_GEOM_TYPES_H
 #include "defs.h"

@@ -1,5 +1,6 @@
 /* The observables of the state (energies, contact counts, momentum, wall
- * forces, largest overlap) as fixed-order reductions: rows in blocks of
+ * forces, largest overlap; their SUM and MAX rows of kernels/observables.def
+ * give the slots) as fixed-order reductions: rows in blocks of
  * CD_OBS_BLOCK, each block summed in row order into its own slots, then
  * the blocks merged in order (particles, pairs, wall rows).  Rows are
  * visited in user order (cd_order, kernels/reorder_items.h; the identity
@@ -16,19 +17,37 @@
 #include "reorder_items.h"
 
 #define CD_OBS_BLOCK 4096
-/* Slots of a partial sum: summed ... */
-#define CD_OBS_KT   0  /* translational kinetic energy [J] */
-#define CD_OBS_KR   1  /* rotational kinetic energy [J] */
-#define CD_OBS_EL   2  /* elastic energy of the contact springs [J] */
-#define CD_OBS_PE   3  /* gravitational potential energy [J] */
-#define CD_OBS_NC   4  /* active pair contacts */
-#define CD_OBS_NW   5  /* active wall contacts */
-#define CD_OBS_PX   6  /* momentum x, y, z [kg m/s] */
-#define CD_OBS_KC   9  /* kinetic energy of the particles that touch something [J] */
-#define CD_OBS_WALL 10 /* force on wall w, 3 per wall [N] */
-/* ... and merged by maximum */
-#define CD_OBS_MAXOV (CD_OBS_WALL + 3 * CD_MAX_WALLS) /* largest overlap / arm diameter [1] */
-#define CD_OBS_SLOTS (CD_OBS_MAXOV + 1)
+
+/* Components of an observable (kernels/observables.def) in the slots:
+ * every wall of CD_MAX_WALLS has its place, used or not. */
+#define CD_OBS_SLOTS_ONE   1
+#define CD_OBS_SLOTS_VEC3  3
+#define CD_OBS_SLOTS_WALL1 CD_MAX_WALLS
+#define CD_OBS_SLOTS_WALL3 (3 * CD_MAX_WALLS)
+
+/* The slots of a partial sum, from kernels/observables.def: CD_OBS_<id> is
+ * the first slot of observable id.  The SUM observables come first, in the
+ * table's order, merged by sum; from CD_OBS_SUMS on the MAX ones, merged by
+ * maximum. */
+#define CD_OBS_SLOT_(id, count) CD_OBS_##id, CD_OBS_LAST_##id = CD_OBS_##id + CD_OBS_SLOTS_##count - 1,
+#define CD_OBS_NO_SLOT_(id, count)
+#define CD_OBS_SUM_PASS_SUM      CD_OBS_SLOT_
+#define CD_OBS_SUM_PASS_MAX      CD_OBS_NO_SLOT_
+#define CD_OBS_SUM_PASS_WALLS    CD_OBS_NO_SLOT_
+#define CD_OBS_SUM_PASS_PROTOCOL CD_OBS_NO_SLOT_
+#define CD_OBS_MAX_PASS_SUM      CD_OBS_NO_SLOT_
+#define CD_OBS_MAX_PASS_MAX      CD_OBS_SLOT_
+#define CD_OBS_MAX_PASS_WALLS    CD_OBS_NO_SLOT_
+#define CD_OBS_MAX_PASS_PROTOCOL CD_OBS_NO_SLOT_
+enum cd_obs_slot {
+#define CD_OBSERVABLE(id, name, unit, count, source, member, meaning) CD_OBS_SUM_PASS_##source(id, count)
+#include "observables.def"
+    CD_OBS_SUMS,
+    CD_OBS_BEFORE_MAX_ = CD_OBS_SUMS - 1,
+#define CD_OBSERVABLE(id, name, unit, count, source, member, meaning) CD_OBS_MAX_PASS_##source(id, count)
+#include "observables.def"
+    CD_OBS_SLOTS
+};
 
 CD_DEVICE_BEGIN
 
@@ -115,14 +134,16 @@ CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_wall
     }
 }
 
-/* One item: the n_blocks partial slots merged in order into total. */
+/* One item: the n_blocks partial slots merged in order into total: the
+ * SUM slots added, the MAX slots by maximum. */
 CD_INLINE void cd_obs_merge(const CD_GLOBAL cd_real *partial, cd_long n_blocks, CD_GLOBAL cd_real *total)
 {
     cd_obs_clear(total);
     for (cd_long b = 0; b < n_blocks; b++) {
         const CD_GLOBAL cd_real *p = partial + b * CD_OBS_SLOTS;
-        for (int k = 0; k < CD_OBS_MAXOV; k++) total[k] += p[k];
-        if (p[CD_OBS_MAXOV] > total[CD_OBS_MAXOV]) total[CD_OBS_MAXOV] = p[CD_OBS_MAXOV];
+        for (int k = 0; k < CD_OBS_SUMS; k++) total[k] += p[k];
+        for (int k = CD_OBS_SUMS; k < CD_OBS_SLOTS; k++)
+            if (p[k] > total[k]) total[k] = p[k];
     }
 }
 

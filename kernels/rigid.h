@@ -1,4 +1,4 @@
-/* Rigid-body motion of one particle (SPEC section 4; docs/motion.md):
+/* Rigid-body motion of one particle (docs/references.md, Motion; docs/motion.md):
  * velocity Verlet for the centre of mass; for the rotation, an isotropic
  * body (three equal moments as stored) turns exactly about the fixed axis of
  * L (one sin/cos), an anisotropic one by the symmetric splitting x/2, y/2,

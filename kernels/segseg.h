@@ -1,4 +1,4 @@
-/* Narrow phase between two spherocylinders (SPEC section 2).
+/* Narrow phase between two spherocylinders (docs/references.md, Contacts).
  *
  * Device-safe: compiled as C11 (host, OpenMP declare target) and as
  * OpenCL C 1.2.  Only static inline functions, pointer parameters point to
@@ -34,7 +34,7 @@
 
 CD_DEVICE_BEGIN
 
-/* Closest points of two segments (SPEC 2, narrow phase).
+/* Closest points of two segments (docs/references.md, Contacts, narrow phase).
  * Inputs: end points p0, p1 of segment i and q0, q1 of segment j [m].
  * Outputs: *s, *t in [0, 1] [1], parameters of a closest pair P(s), Q(t).
  *
@@ -106,7 +106,7 @@ CD_INLINE void cd_segseg_closest(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1,
 
 /* Length of v [same unit as v] and, when it is not zero, the unit vector
  * along v in *u [1].  Safe against underflow of |v|^2.  Returns 0 (and
- * leaves *u unchanged) for the zero vector.  (SPEC 2: D and n.) */
+ * leaves *u unchanged) for the zero vector.  (docs/references.md, Contacts: D and n.) */
 CD_INLINE cd_real cd_segseg_normalize(cd_vec3 v, cd_vec3 *u)
 {
     cd_real l2 = cd_v3_dot(v, v);
@@ -129,7 +129,7 @@ CD_INLINE cd_real cd_segseg_normalize(cd_vec3 v, cd_vec3 *u)
 }
 
 /* A deterministic unit vector perpendicular to the non-zero vector u [1]
- * (SPEC 2: normal when the axes touch).  It depends on the line of u only,
+ * (docs/references.md, Contacts: normal when the axes touch).  It depends on the line of u only,
  * not on its sign or length: u is first oriented so that its component of
  * largest magnitude is positive, then crossed with the coordinate axis of
  * smallest |u_k| (first index on ties).  u = 0 gives (0, 0, 1). */
@@ -152,7 +152,7 @@ CD_INLINE cd_vec3 cd_segseg_any_perpendicular(cd_vec3 u)
     return n;
 }
 
-/* Unit normal used when the axes touch, D = 0 (SPEC 2; deep overlap) [1].
+/* Unit normal used when the axes touch, D = 0 (docs/references.md, Contacts; deep overlap) [1].
  * d1, d2: axis vectors of i and j [m]; wm = mid_j - mid_i, from the centre
  * of segment i to the centre of segment j [m].
  * Non-parallel non-degenerate axes: n = +-(d1 x d2)/|d1 x d2|, the common
@@ -192,7 +192,7 @@ CD_INLINE cd_vec3 cd_segseg_touch_normal(cd_vec3 d1, cd_vec3 d2, cd_vec3 wm)
  * whose squared sine is cross2 / norm2 (norm2 > 0; compared by products,
  * so that the common case, far from the cut-off, costs no division), with
  * the cut-off sin_parallel [1]
- * (SPEC 2): 1 below the cut-off (the paper's parallel contact point), else
+ * (docs/references.md, Contacts): 1 below the cut-off (the paper's parallel contact point), else
  * 0 (the closest points).  With blend (material.parallel_blend) the step
  * becomes a ramp: 0 only at or above twice the cut-off's sine, linear in
  * the sine between.  Without it the point jumps by up to half an arm's
@@ -208,12 +208,12 @@ CD_INLINE cd_real cd_parallel_weight(cd_real cross2, cd_real norm2, cd_real sin_
     return CD_R(2) - sqrt(cross2 / norm2) / sin_parallel;
 }
 
-/* Contact geometry of two spherocylinders (SPEC 2): cd_segseg_contact, or
+/* Contact geometry of two spherocylinders (docs/references.md, Contacts): cd_segseg_contact, or
  * cd_segseg_contact_at when the closest-point parameters s, t [1] of
  * cd_segseg_closest are at hand.
  * Inputs: axis ends p0, p1 and radius ri of primitive i, q0, q1 and rj of
  * primitive j [m]; sin_parallel [1] = sine of the parallel cut-off angle
- * (SPEC default: sin(2 degrees)); <= 0 disables the parallel rule.
+ * (default sin(2 degrees), docs/references.md, Contacts); <= 0 disables the parallel rule.
  * Output *g: distance D [m], overlap ri + rj - D [m], unit normal n from i to
  * j [1], contact point [m], parallel flag.
  *

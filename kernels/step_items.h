@@ -1,5 +1,5 @@
 /* One work item of each loop of the time step (docs/architecture.md, "A time
- * step"; SPEC sections 2-4).  The OpenMP loops of src/backend/omp/step_omp.c and the
+ * step"; docs/references.md, Contacts, Contact law, Motion).  The OpenMP loops of src/backend/omp/step_omp.c and the
  * OpenCL kernels of kernels/cl/ are thin wrappers that call these for one
  * particle, primitive or pair, so both backends run the same arithmetic in
  * the same order and can agree bit for bit.  No item writes a row another
@@ -19,7 +19,7 @@
 
 CD_DEVICE_BEGIN
 
-/* Half kick of particle q over h = dt/2 [s] (SPEC 4), then its angular
+/* Half kick of particle q over h = dt/2 [s] (docs/references.md, Motion), then its angular
  * velocity from the new angular momentum. */
 CD_INLINE void cd_item_kick(cd_cols c, cd_particle_id q, cd_real h)
 {
@@ -30,7 +30,7 @@ CD_INLINE void cd_item_kick(cd_cols c, cd_particle_id q, cd_real h)
     c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, c.inertia[q]);
 }
 
-/* Drift of particle q over dt [s]: position and free rotation (SPEC 4). */
+/* Drift of particle q over dt [s]: position and free rotation (docs/references.md, Motion). */
 CD_INLINE void cd_item_drift(cd_cols c, cd_particle_id q, cd_real dt)
 {
     cd_vec3 x = c.position[q], w;
@@ -129,7 +129,7 @@ CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real l
     return cd_advance_from(c, q, c.velocity[q], c.angmom[q], c.force[q], c.torque[q], c.mass[q], dt, limit2);
 }
 
-/* Contact geometry of pair row k (SPEC 2): closest points of the two axes
+/* Contact geometry of pair row k (docs/references.md, Contacts): closest points of the two axes
  * and, from them, the contact point, normal and overlap.  Fills g always
  * (the host's output pass, src/io/pair_output.c, needs the normal of every
  * active row). */
@@ -150,7 +150,7 @@ CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force
 }
 
 /* Pair row k of the Verlet list: narrow phase and contact law with history
- * (SPEC 2-3).  law: particle-particle law, dt [s], sin_parallel [1],
+ * (docs/references.md, Contacts, Contact law).  law: particle-particle law, dt [s], sin_parallel [1],
  * parallel_blend 0/1 (material.parallel_blend).  An active row keeps what
  * the next step and the gather need: history, point, force on j, F_n and
  * the overlap (the observables' elastic energy); the normal, F_t and the
@@ -215,8 +215,8 @@ CD_INLINE void cd_wall_row_clear(cd_cols c, cd_long row)
     c.wallc_fn[row] = 0;
 }
 
-/* Wall-contact row `row` = i n_walls + w: primitive i against wall w (SPEC
- * 2, walls; SPEC 3).  The step runs it for the candidate rows of the last
+/* Wall-contact row `row` = i n_walls + w: primitive i against wall w
+ * (docs/references.md, Contacts (walls), Contact law).  The step runs it for the candidate rows of the last
  * neighbour-list build only (cd_item_wall_candidates).  wall_law: the
  * particle-wall law (its mu is replaced by the wall's friction). */
 CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall *walls, cd_int n_walls,

@@ -1,4 +1,4 @@
-/* Contacts between a spherocylinder primitive and a wall (SPEC section 2,
+/* Contacts between a spherocylinder primitive and a wall (docs/references.md, Contacts,
  * "Walls").  Device-safe header: C11 and OpenCL C 1.2 (see segseg.h).
  *
  * CONVENTION.  A wall contact is a pair contact in which the PARTICLE is
@@ -68,7 +68,7 @@ CD_DEVICE_BEGIN
  * plane with unit normal nrm: cd_parallel_weight of the squared sine of
  * the angle between them, dot(b - a, nrm)^2 / |b - a|^2 (1 within the
  * cut-off angle, 0 beyond twice it); 0 for a zero-length segment
- * (SPEC 2, parallel rule). */
+ * (docs/references.md, Contacts, parallel rule). */
 CD_INLINE cd_real cd_wall_parallel_weight(cd_vec3 a, cd_vec3 b, cd_vec3 nrm, cd_real sin_parallel, cd_int blend)
 {
     cd_vec3 ab = cd_v3_sub(b, a);
@@ -77,7 +77,7 @@ CD_INLINE cd_real cd_wall_parallel_weight(cd_vec3 a, cd_vec3 b, cd_vec3 nrm, cd_
     return l2 > CD_R(0) ? cd_parallel_weight(un * un, l2, sin_parallel, blend) : CD_R(0);
 }
 
-/* Plane wall (SPEC 2, walls): w->point on the plane, w->normal unit, into the
+/* Plane wall (docs/references.md, Contacts, walls): w->point on the plane, w->normal unit, into the
  * domain.  Segment a-b [m], radius r [m]; fills *g as described at the top
  * of this file. */
 CD_INLINE void cd_wall_plane_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r, cd_real sin_parallel,
@@ -105,7 +105,7 @@ CD_INLINE void cd_wall_plane_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_
 
 /* Outward radial vector of x [m] from the wall's axis (cylinder, axis
  * through w->point along unit w->normal) or centre (sphere, w->point)
- * (SPEC 2, walls). */
+ * (docs/references.md, Contacts, walls). */
 CD_INLINE cd_vec3 cd_wall_radial(const cd_wall *w, cd_vec3 x)
 {
     cd_vec3 rel = cd_v3_sub(x, w->point);
@@ -115,7 +115,7 @@ CD_INLINE cd_vec3 cd_wall_radial(const cd_wall *w, cd_vec3 x)
 
 /* Inside of a cylinder (radius w->radius about the axis through w->point
  * along unit w->normal) or of a sphere (radius w->radius, centre w->point)
- * (SPEC 2, walls).  Segment a-b [m], radius r [m]; fills *g as described at
+ * (docs/references.md, Contacts, walls).  Segment a-b [m], radius r [m]; fills *g as described at
  * the top of this file.  The radial distance rho is convex along the
  * segment, so its maximum is at an end point; D = R - rho_max,
  * overlap = r + rho_max - R.  A point on the axis / at the centre (rho = 0)
@@ -187,7 +187,7 @@ CD_INLINE int cd_wall_clearly_apart(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_r
 }
 
 /* Contact geometry of a spherocylinder primitive (axis ends a, b [m],
- * radius r [m]) with wall *w (SPEC 2, walls).  sin_parallel [1]: sine of the
+ * radius r [m]) with wall *w (docs/references.md, Contacts, walls).  sin_parallel [1]: sine of the
  * parallel cut-off angle, <= 0 disables the parallel rule; blend 1: its
  * continuous form (cd_parallel_weight).  The particle is body i, the wall
  * body j: g->normal points from the particle towards the wall (see the top
@@ -216,7 +216,7 @@ CD_INLINE void cd_wall_contact(const cd_wall *w, cd_vec3 a, cd_vec3 b, cd_real r
 }
 
 /* Velocity of the wall's surface material at a contact point [m/s]
- * (SPEC 2, walls: moving planes, sphere of variable radius).  Plane and
+ * (docs/references.md, Contacts, walls: moving planes, sphere of variable radius).  Plane and
  * cylinder: the wall's translational velocity w->velocity.  Sphere:
  * w->velocity + w->radial_velocity e, e the outward radial unit vector at
  * the point (just w->velocity at the centre). */

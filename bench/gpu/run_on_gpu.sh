@@ -163,25 +163,34 @@ fi
 VARIANTS=$(cd "$BIN" && ls)
 has() { [ -x "$BIN/$1/capdem" ]; }
 
-# OpenCL: the NVIDIA ICD, or one made from the driver's library when the
-# machine has the library but no /etc/OpenCL/vendors entry.
+# OpenCL: where the driver's libnvidia-opencl.so.1 is there but no ICD
+# names it (the first GPU machine had only PoCL's ICD in
+# /etc/OpenCL/vendors: no NVIDIA platform), a folder with an ICD for it
+# alone (PoCL loads its own libLLVM, which crashed next to libomptarget's
+# libLLVM-16 in one process).  ocl-icd (the bundle's libOpenCL.so.1) reads
+# every *.icd of the folder OCL_ICD_VENDORS names.
 ICD=
-if [ -n "${OCL_ICD_VENDORS:-}" ] || ls /etc/OpenCL/vendors/*.icd >/dev/null 2>&1; then
-    ICD=$(cat "${OCL_ICD_VENDORS:-/etc/OpenCL/vendors}"/*.icd 2>/dev/null | tr '\n' ' ')
-elif lib=$({ "$LDCONFIG" -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1 / {print $NF}'
-    ls /usr/local/nvidia/lib64/libnvidia-opencl.so.1 /usr/lib/x86_64-linux-gnu/libnvidia-opencl.so.1 2>/dev/null; } | head -1) && [ -n "$lib" ]; then
-    mkdir -p "$W/vendors" && echo "$lib" >"$W/vendors/nvidia.icd"
+VENDORS=${OCL_ICD_VENDORS:-/etc/OpenCL/vendors}
+NVCL=$({ "$LDCONFIG" -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1 / {print $NF}'
+    ls /usr/local/nvidia/lib64/libnvidia-opencl.so.1 /usr/lib/x86_64-linux-gnu/libnvidia-opencl.so.1 2>/dev/null; } | head -1)
+if [ -n "$NVCL" ] && ! cat "$VENDORS"/*.icd 2>/dev/null | grep -q nvidia; then
+    mkdir -p "$W/vendors"
+    echo "$NVCL" >"$W/vendors/nvidia.icd"
     export OCL_ICD_VENDORS=$W/vendors
-    ICD="$lib (made: no /etc/OpenCL/vendors)"
+    VENDORS=$W/vendors
 fi
-[ "$HOST" = 1 ] || [ -z "$ICD" ] || export CAPDEM_OPENCL_PLATFORM=${CAPDEM_OPENCL_PLATFORM:-NVIDIA}
+ls "$VENDORS"/*.icd >/dev/null 2>&1 && ICD=$(cat "$VENDORS"/*.icd 2>/dev/null | tr '\n' ' ')
+# The NVIDIA platform on a GPU machine when its ICD is there (else the
+# OpenCL parts run on whatever platform is, and say which).
+if [ "$HOST" != 1 ] && echo "$ICD" | grep -q nvidia; then export CAPDEM_OPENCL_PLATFORM=${CAPDEM_OPENCL_PLATFORM:-NVIDIA}; fi
 
 # ---------------------------------------------------------------- parts
 part_info() {
     {
         echo "== bundle"; sed -n '1,/^$/p' "$B/MANIFEST.txt"
         echo "== machine"; date -u; uname -a; ldd --version 2>&1 | head -1; nproc
-        echo "C++ runtime used: $CXXNOTE"; echo "OpenCL ICD: ${ICD:-none}"
+        echo "C++ runtime used: $CXXNOTE"; echo "OpenCL ICDs ($VENDORS): ${ICD:-none}; libnvidia-opencl: ${NVCL:-not found}"
+        echo "compute-sanitizer: $(command -v compute-sanitizer || ls /usr/local/cuda/bin/compute-sanitizer 2>/dev/null || echo none)"
         echo "nsys: $(command -v nsys || echo none); ncu: $(command -v ncu || echo none)"
         echo "== nvidia-smi"; nvidia-smi 2>&1 || echo "nvidia-smi: not available"
         nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.max.sm,clocks.max.mem --format=csv 2>&1
@@ -277,7 +286,9 @@ part_opencl() {
     { echo "== OpenCL (ICD: $ICD; CAPDEM_OPENCL_PLATFORM=${CAPDEM_OPENCL_PLATFORM:-})"; cat "$LOGS/opencl_version.log"; } >>"$INFO"
     # test_parity: omp against OpenCL; with the omp side on the host first
     # (the documented bitwise parity), then with it on the GPU.
-    step parity_omp_host 300 env OMP_TARGET_OFFLOAD=DISABLED bash -c "mkdir -p '$W/parity-host' && cd '$W/parity-host' && '$BIN/$v/test_parity'"
+    # (one host thread: LLVM 16's host fallback with several aborts, see
+    # CAPDEM_BUNDLE_HOST above; the first GPU machine's 16 threads did)
+    step parity_omp_host 300 env OMP_TARGET_OFFLOAD=DISABLED OMP_NUM_THREADS=1 bash -c "mkdir -p '$W/parity-host' && cd '$W/parity-host' && '$BIN/$v/test_parity'"
     [ "$HOST" = 1 ] || step parity_omp_gpu 300 bash -c "mkdir -p '$W/parity-gpu' && cd '$W/parity-gpu' && '$BIN/$v/test_parity'"
     # shellcheck disable=SC2046
     run_tests "$v" opencl "opencl-$v" $(printf '%s\n' $ALL_TESTS | grep -E '^test_(binary_collision|conservation|coulomb_sliding|plane2d|rest|determinism|neighbors)$')
@@ -327,6 +338,7 @@ part_profile() {
     local hex args tile
     hex=$(cd "$INPUTS" && ls hexapods_a3_n*.h5 | head -1)
     case $hex in *_n1000.h5) tile=40,25 ;; *) tile=10,10 ;; esac # 1e6 particles
+    tile=${CAPDEM_BUNDLE_PROFILE_TILE:-$tile}
     args=(--load-settled "$INPUTS/$hex" --tile $tile --relax-steps 10 --steps 40 --repeat 1 --device gpu)
     # libomptarget's own trace (Chrome trace JSON), always there: LLVM 16
     # keeps per-call events only above 500 us (so 1e6 particles, where a
@@ -334,7 +346,7 @@ part_profile() {
     # line, and a "Total" per runtime call (count, time) for all.
     step profile_omptarget 120 env LIBOMPTARGET_PROFILE="$W/omptarget_profile.json" "$BIN/clang/capdem-bench" "${args[@]}"
     {
-        echo "== LIBOMPTARGET_PROFILE, clang, 1e6 hexapods (tile $tile), 10+40 steps (host-side spans: total, count, mean)"
+        echo "== LIBOMPTARGET_PROFILE, clang, hexapods tiled $tile, 10+40 steps (host-side spans: total, count, mean)"
         python3 - "$W/omptarget_profile.json" <<'EOF' 2>&1
 import json, sys, collections
 ev = json.load(open(sys.argv[1]))
@@ -353,14 +365,50 @@ EOF
         step profile_nsys 200 nsys profile --force-overwrite true -o "$W/capdem" --stats=true "$BIN/clang/capdem-bench" "${args[@]}"
         { echo "== nsys --stats (clang, 1e6)"; grep -v '^{' "$LOGS/profile_nsys.log" | head -300; } >>"$PROFILE"
     elif command -v ncu >/dev/null; then
-        # Kernel time and DRAM bytes of 24 launches after the warm-up: the
-        # bytes moved per particle-step against the bandwidth bound.
+        # Every kernel's time over the first launches (--launch-count), summed
+        # per kernel (source line), then DRAM bytes of 24 launches after the
+        # warm-up: where a step's time goes, and the bytes moved per
+        # particle-step against the bandwidth bound.
+        step profile_ncu_time 200 ncu --launch-count "${CAPDEM_BUNDLE_NCU_LAUNCHES:-1500}" --metrics gpu__time_duration.sum --csv \
+            "$BIN/clang/capdem-bench" "${args[@]}"
+        {
+            echo "== ncu kernel time (clang, tile $tile; first ${CAPDEM_BUNDLE_NCU_LAUNCHES:-1500} launches), summed per kernel"
+            python3 - "$LOGS/profile_ncu_time.log" <<'EOF' 2>&1
+import csv, sys, collections
+rows = [l for l in open(sys.argv[1], errors="replace") if l.startswith('"')]
+tot = collections.defaultdict(lambda: [0.0, 0])
+for r in csv.DictReader(rows):
+    if r.get("Metric Name") != "gpu__time_duration.sum": continue
+    v = float(r["Metric Value"].replace(",", "")) * {"nsecond": 1e-3, "ns": 1e-3, "usecond": 1, "us": 1, "msecond": 1e3, "ms": 1e3, "second": 1e6, "s": 1e6}.get(r["Metric Unit"], 1)
+    k = r["Kernel Name"][:90]
+    tot[k][0] += v; tot[k][1] += 1
+all_us = sum(t for t, n in tot.values())
+print(f"{all_us/1e3:.1f} ms in {sum(n for t, n in tot.values())} launches")
+for k, (t, n) in sorted(tot.items(), key=lambda kv: -kv[1][0])[:40]:
+    print(f"{t/1e3:10.2f} ms {n:6d} {t/n:10.1f} us  {k}")
+EOF
+        } >>"$PROFILE"
         step profile_ncu 200 ncu --launch-skip 200 --launch-count 24 --metrics gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum \
             "$BIN/clang/capdem-bench" "${args[@]}"
-        { echo "== ncu (clang, 1e6; 24 launches after 200)"; grep -v '^{' "$LOGS/profile_ncu.log" | head -400; } >>"$PROFILE"
+        { echo "== ncu (clang, tile $tile; 24 launches after 200)"; grep -v '^{' "$LOGS/profile_ncu.log" | head -400; } >>"$PROFILE"
     else
         note "SKIP profile_nsys: neither nsys nor ncu on PATH"
     fi
+}
+
+# compute-sanitizer's memcheck on a few steps of the Clang build (the first
+# GPU run met an illegal address at 1e6 hexapods, reorder.c, the cell keys):
+# the faulting kernel, source line and address.
+part_sanitize() {
+    has clang || { note "SKIP sanitize: no clang build"; return 0; }
+    local cs hex tile
+    cs=$(command -v compute-sanitizer || ls /usr/local/cuda/bin/compute-sanitizer 2>/dev/null | head -1)
+    [ -n "$cs" ] || { note "SKIP sanitize: no compute-sanitizer"; return 0; }
+    hex=$(cd "$INPUTS" && ls hexapods_a3_n*.h5 | head -1)
+    tile=${CAPDEM_BUNDLE_SANITIZE_TILE:-40,25}
+    step sanitize_memcheck "${CAPDEM_BUNDLE_SANITIZE_CAP:-240}" "$cs" --tool memcheck --print-limit 20 --error-exitcode 99 \
+        "$BIN/clang/capdem-bench" --load-settled "$INPUTS/$hex" --tile "$tile" --relax-steps 2 --steps 2 --repeat 1 --device gpu
+    { echo "== compute-sanitizer memcheck (clang, hexapods tiled $tile)"; grep -v '^{' "$LOGS/sanitize_memcheck.log" | head -150; } >>"$PROFILE"
 }
 
 # ------------------------------------------------------------------ main
@@ -374,8 +422,8 @@ for p in "$@"; do
     quick) PARTS+=(info tests-clang ladder) ;;
     tests) PARTS+=(tests-clang) ;;
     ladder) PARTS+=(ladder-clang) ;;
-    info | tests-clang | tests-gcc | opencl | ladder-clang | ladder-gcc | profile) PARTS+=("$p") ;;
-    *) echo "run_on_gpu.sh: unknown part '$p' (info tests tests-gcc opencl ladder ladder-gcc profile all quick)" >&2; exit 2 ;;
+    info | tests-clang | tests-gcc | opencl | ladder-clang | ladder-gcc | profile | sanitize) PARTS+=("$p") ;;
+    *) echo "run_on_gpu.sh: unknown part '$p' (info tests tests-gcc opencl ladder ladder-gcc profile sanitize all quick)" >&2; exit 2 ;;
     esac
 done
 note "capdem GPU bundle: parts ${PARTS[*]}; OMP_TARGET_OFFLOAD=$OMP_TARGET_OFFLOAD; budget ${BUDGET}s; $(nvidia-smi -L 2>/dev/null | head -1 || true)"
@@ -388,6 +436,7 @@ for p in "${PARTS[@]}"; do
     ladder-clang) part_ladder clang ;;
     ladder-gcc) part_ladder gcc ;;
     profile) part_profile ;;
+    sanitize) part_sanitize ;;
     esac
 done
 

@@ -67,7 +67,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "liggghts"))
 import liggghts_bench  # noqa: E402
 import liggghts_law  # noqa: E402
 
-MATERIAL = dict(kn=1e5, kt=5e4, eta_n=0.2, eta_t=0.2, mu=0.5)  # SPEC 3; walls frictionless
+MATERIAL = dict(kn=1e5, kt=5e4, eta_n=0.2, eta_t=0.2, mu=0.5)  # docs/references.md, Contact law; walls frictionless
 SETTLE = {"spheres": 30000, "hexapods_a3": 15000, "hexapods_a9": 15000}
 # A tiled packing has lost its tangential springs (bench_tile.c): it slips and
 # springs back, and needs about 20 ms to find its contacts again (spheres: Z

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """capdem's contact law written in LAMMPS's `pair_style granular` terms.
 
-capdem (SPEC 3, kernels/contact_law.h), per contact between bodies of
+capdem (docs/references.md, Contact law, kernels/contact_law.h), per contact between bodies of
 effective mass m = m_i m_j / (m_i + m_j):
 
     F_n = max(0, (k_n/2) delta_n - eta_n sqrt(2 m k_n) v_n)

@@ -6,7 +6,7 @@ initial states and their packings are compared.
         [--settle 30000] [--threads 2] [--work build/bench-work/parity] [--json parity.json]
 
 For each seed capdem-bench writes the initial lattice deposit of N spheres
-(SPEC 3 material, d = 5 mm +- 20 %, friction limit mu F_n as in LAMMPS) and
+(default material of docs/references.md, Contact law; d = 5 mm +- 20 %, friction limit mu F_n as in LAMMPS) and
 settles it for --settle steps under 50 g in its box (the weight of the
 column compresses the packing); LAMMPS settles the very same initial state
 (positions, sizes, masses, velocities) with the equivalent law
@@ -15,7 +15,7 @@ contacts (particle pairs that overlap) and normal forces go through one
 estimator, here:
 
   Z  = 2 N_c / N*, N* the particles with at least one particle contact
-       (rattlers with none excluded; SPEC 7);
+       (rattlers with none excluded; docs/references.md, Analysis);
   k  = tail exponent of P(f), f = F_n / <F_n>, for f > 1: maximum-likelihood
        fit of P(f) ~ exp(-k f) on f > 1, k = 1 / mean(f - 1).
 

@@ -2,7 +2,7 @@
 """capdem's contact law in LIGGGHTS 3.8 terms (`pair_style gran model
 hooke/stiffness tangential history`), and the files LIGGGHTS reads.
 
-capdem (SPEC 3, kernels/contact_law.h), per contact of effective mass
+capdem (docs/references.md, Contact law, kernels/contact_law.h), per contact of effective mass
 m = m_i m_j / (m_i + m_j) (m = m_i against a wall):
 
     F_n = max(0, (k_n/2) delta_n - eta_n sqrt(2 m k_n) v_n)
@@ -46,7 +46,7 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-MATERIAL = dict(kn=1e5, kt=5e4, eta_n=0.2, eta_t=0.2, mu=0.5)  # SPEC 3; walls frictionless
+MATERIAL = dict(kn=1e5, kt=5e4, eta_n=0.2, eta_t=0.2, mu=0.5)  # docs/references.md, Contact law; walls frictionless
 N_TYPES = 24  # mass bins; the damping error bound is r^(1/4) - 1, r = (m_max/m_min)^(1/K)
 
 

@@ -1,4 +1,4 @@
-/* Host-side analysis of packings (SPEC section 7): `capdem analyze RUN.h5`.
+/* Host-side analysis of packings (docs/references.md, Analysis): `capdem analyze RUN.h5`.
  *
  * One snapshot of a run file is read into a cd_an_snapshot, the container
  * and its core region (away from the walls) are worked out into a
@@ -170,7 +170,7 @@ typedef struct {
     char note[256];                 /* why there is no container or no core, "" otherwise */
 } cd_an_geometry;
 
-/* Margins in units of L; negative: the defaults of SPEC 7 (10 L from every
+/* Margins in units of L; negative: the defaults of docs/references.md, Analysis (10 L from every
  * wall in 2D and pseudo-2D; 3 L from side walls and 10 L from floor and top
  * in 3D; 3 L from the ball).  Returns 0 (a missing container is recorded in
  * g->note, volume 0). */
@@ -239,7 +239,7 @@ typedef struct {
     int snapshot;                      /* index, < 0 from the end (-1: last) */
     unsigned measures;                 /* CD_AN_* bits */
     int strict;                        /* 1: a measure that cannot be computed fails the run (exit 2) */
-    double margin_side, margin_end;    /* core margins [L], < 0: SPEC defaults */
+    double margin_side, margin_end;    /* core margins [L], < 0: defaults of docs/references.md, Analysis */
     double rdf_max, rdf_bin;           /* G(r) range and bin [L], <= 0: defaults */
     long mc_points;                    /* Monte Carlo points for the core packing fraction */
     int write;                         /* 1: write /analysis into the run file */
@@ -329,7 +329,7 @@ void cd_an_put_fit(cd_an_group *g, const char *const *names, const cd_an_nlfit *
 int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double width, double total, double beta_guess,
                     cd_an_nlfit *out);
 
-/* Cascade model (seed 001, eq. 12-13) with the force normalised to mean 1. */
+/* Cascade model (Tran et al. 2024, eq. 12-13) with the force normalised to mean 1. */
 double cd_an_cascade_beta(double gamma);
 double cd_an_cascade_pdf(double f, double gamma);
 typedef struct {

@@ -1,5 +1,5 @@
 /* `capdem analyze RUN.h5 [options]`: reads one snapshot, runs the measures
- * of SPEC 7 on it and on the run's time series, writes the results into the
+ * of docs/references.md, Analysis on it and on the run's time series, writes the results into the
  * run file (/analysis) and prints a summary or one JSON object.  Usage and
  * output keys: docs/analysis.md. */
 #include "analysis/analyze.h"

@@ -1,12 +1,12 @@
-/* Fits of the analysis (SPEC 7), all with GSL:
+/* Fits of the analysis (docs/references.md, Analysis), all with GSL:
  *  - exponential tail of P(f) above f = 1: maximum likelihood on the
  *    samples with the exact chi-square interval (primary), and weighted
  *    least squares on log P of the histogram (as papers usually do);
  *  - Mueth's form a (1 - b e^{-f^2}) e^{-beta f}: weighted nonlinear least
  *    squares on the histogram;
- *  - cascade model of seed 001 (eq. 12-13): maximum likelihood of gamma,
+ *  - cascade model of Tran et al. 2024 (eq. 12-13): maximum likelihood of gamma,
  *    profile-likelihood interval;
- *  - (Z - Z_c) ~ (Phi - Phi_c)^(1/2) above jamming (seed 002, eq. 17):
+ *  - (Z - Z_c) ~ (Phi - Phi_c)^(1/2) above jamming (Nezamabadi et al. 2022, eq. 17):
  *    nonlinear least squares. */
 #include "analysis/analyze.h"
 #include <gsl/gsl_blas.h>
@@ -228,7 +228,7 @@ int cd_an_fit_mueth(const double *centre, const double *counts, int nb, double w
 /* ---- cascade model ----------------------------------------------------- */
 
 /* beta = (1 + gamma) ln((1 + gamma) / gamma): the value that makes the
- * mean of P_f equal to 1 (seed 001, eq. 13; checked: int_0^inf f P df =
+ * mean of P_f equal to 1 (Tran et al. 2024, eq. 13; checked: int_0^inf f P df =
  * (1 + gamma) ln((1 + gamma)/gamma) / beta). */
 double cd_an_cascade_beta(double gamma) { return (1 + gamma) * log1p(1 / gamma); }
 

@@ -1,14 +1,14 @@
-/* Force distributions (SPEC 7).
+/* Force distributions (docs/references.md, Analysis).
  *
  * Normal contact forces f = F_n / <F_n> over every contact of the snapshot:
  * P(f) in 50 bins of 0.2 on [0, 10], normalised as a density over all the
  * contacts (the fraction beyond 10 is reported, not renormalised away), the
- * exponential tail above f = 1 and Mueth's form (seed 000, eq. 1-2).
+ * exponential tail above f = 1 and Mueth's form (Conzelmann et al., eq. 1-2).
  *
- * Bond forces (seed 001, 3.4): the vector sum of the contact forces, normal
+ * Bond forces (Tran et al. 2024, section 3.4): the vector sum of the contact forces, normal
  * and tangential, between two particles.  Their PDF is given normalised by
- * <F_n> (SPEC), and normalised by their own mean <F_b> for the cascade
- * model, whose P_f has mean 1 by construction (seed 001: "the force f is
+ * <F_n> (docs/references.md, Analysis), and normalised by their own mean <F_b> for the cascade
+ * model, whose P_f has mean 1 by construction (Tran et al. 2024: "the force f is
  * assumed to be normalized by the mean force so that int f P_f df = 1");
  * fitting it to forces in units of <F_n>, whose mean is <F_b>/<F_n> ~ the
  * valence, would be inconsistent. */

@@ -1,4 +1,4 @@
-/* The container of a snapshot and its core region (SPEC 7): which domain
+/* The container of a snapshot and its core region (docs/references.md, Analysis): which domain
  * it is (2D, pseudo-2D or 3D box, cylinder, ball), where its walls are at
  * that snapshot (a piston or a shrinking ball moves), its volume up to the
  * highest particle or the piston, and the region far enough from the walls
@@ -60,7 +60,7 @@ static cd_an_kind container_kind(const cd_an_snapshot *s, const cd_an_geometry *
     if (s->cfg_ok ? d == CD_DOMAIN_BALL : sph > 0) return sph ? CD_AN_BALL : CD_AN_FREE;
     if (!box) return CD_AN_FREE;
     if (s->cfg.dimension == 2) return CD_AN_BOX2D;
-    /* SPEC 5: pseudo-2D boxes are T = L or 2L thick; 3 L separates them
+    /* docs/references.md, Domains and walls: pseudo-2D boxes are T = L or 2L thick; 3 L separates them
      * from boxes thick enough to be 3D packings. */
     return g->hi[2] - g->lo[2] <= 3 * g->L ? CD_AN_PSEUDO2D : CD_AN_BOX3D;
 }
@@ -106,7 +106,7 @@ int cd_an_geometry_setup(const cd_an_snapshot *s, double margin_side_L, double m
     g->top_wall = g->hi[1];
     g->kind = container_kind(s, g);
     double L = g->L;
-    double ms = 3 * L, me = 10 * L; /* SPEC 7 margins in 3D [m] */
+    double ms = 3 * L, me = 10 * L; /* docs/references.md, Analysis margins in 3D [m] */
     if (g->kind == CD_AN_BOX2D || g->kind == CD_AN_PSEUDO2D) ms = me = 10 * L;
     if (margin_side_L >= 0) ms = margin_side_L * L;
     if (margin_end_L >= 0) me = margin_end_L * L;

@@ -1,8 +1,8 @@
-/* Bonds and connectivity (seed 001, section 3.3).  A bond is a pair of
+/* Bonds and connectivity (Tran et al. 2024, section 3.3).  A bond is a pair of
  * particles with at least one contact; its valence k is its number of
  * contacts.  Over the N_p* particles with at least one particle contact
  * (rattlers excluded; wall contacts are not neighbours):
- *   Z_c = 2 N_c / N_p*   contacts per particle      (seed 001, eq. 9)
+ *   Z_c = 2 N_c / N_p*   contacts per particle      (Tran et al. 2024, eq. 9)
  *   Z   = 2 N_b / N_p*   contact neighbours per particle
  *   valence = Z_c / Z = N_c / N_b = sum_k k P_k
  *   P_c  fraction of those particles with exactly c contacts (Z_c = sum c P_c)
@@ -163,7 +163,7 @@ int cd_an_network(const cd_an_input *in, cd_an_report *r, char *err, size_t errl
     cd_an_put(g, "valence", Nc / Nb, "1");
     /* Isostatic value for frictionless rigid particles with all 6 (3 in
      * 2D) degrees of freedom and the rigid-body soft modes of a free
-     * aggregate (seed 001, eq. 11): 12 - 12/N_p* in 3D. */
+     * aggregate (Tran et al. 2024, eq. 11): 12 - 12/N_p* in 3D. */
     double dof = in->g->dim == 2 ? 3 : 6;
     cd_an_put(g, "Z_c_isostatic", 2 * dof - 2 * dof / Np, "1");
 
@@ -184,7 +184,7 @@ int cd_an_network(const cd_an_input *in, cd_an_report *r, char *err, size_t errl
             pb[2 * (nb[p] - 1) + 1] += 1 / Np;
         }
     /* F_k: mean magnitude of the bond force of valence-k bonds over the
-     * mean normal contact force (seed 001, Fig. 15). */
+     * mean normal contact force (Tran et al. 2024, Fig. 15). */
     for (int k = 0; k < kmax; k++) pk[4 * k] = k + 1;
     for (size_t q = 0; q < b->n; q++) {
         double *row = pk + 4 * (b->k[q] - 1);

@@ -1,5 +1,5 @@
 /* Packing fraction, contact density and the effective-medium bulk modulus
- * (SPEC 7; seed 001, 3.1, Fig. 3b and eq. 15).
+ * (docs/references.md, Analysis; Tran et al. 2024, section 3.1, Fig. 3b and eq. 15).
  *
  * Container: sum of particle volumes (shape volume x scale^3) over the
  * container volume (box or cylinder up to the lid, piston or highest
@@ -16,10 +16,10 @@
  * reported beside it; its error is of order the boundary layer, L x core
  * surface / core volume, and it double counts contact overlaps).
  *
- * K_t = n_c k <l^2> / 9 (3D; seed 001, eq. 15): n_c contacts per unit
+ * K_t = n_c k <l^2> / 9 (3D; Tran et al. 2024, eq. 15): n_c contacts per unit
  * volume, <l^2> the mean square branch length per contact, k the stiffness
  * of one contact, which in capdem is k_n / 2 (two particle springs in series,
- * SPEC 3; seed 001's k_n is the contact stiffness).  In 2D the affine
+ * docs/references.md, Contact law; Tran et al. 2024's k_n is the contact stiffness).  In 2D the affine
  * estimate reads n_c k <l^2> / 4 with n_c per unit area (a modulus in N/m). */
 #include "analysis/analyze.h"
 #include "core/rng.h"
@@ -319,7 +319,7 @@ int cd_an_modulus(const cd_an_input *in, cd_an_report *r, char *err, size_t errl
         cd_an_put(grp, "core_contact_density", ncc, g->dim == 2 ? "1/m^2" : "1/m^3");
         cd_an_put(grp, "K_t_core", ncc * kc * (sl2_core / (double)ncore) / d2, unit);
     }
-    /* The measured K of a bulk-modulus run, beside K_t (SPEC 7): the
+    /* The measured K of a bulk-modulus run, beside K_t (docs/references.md, Analysis): the
      * protocol keeps K of each probe in /walls/control slots 16.. and the
      * number of probes in slot 9; probe k has strain strain_min 10^k
      * (docs/protocols.md).  All probes are the linear response (K agrees

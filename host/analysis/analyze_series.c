@@ -1,5 +1,5 @@
 /* Time series of the whole run (/observables): the compaction curve and the
- * fit (Z - Z_c) ~ (Phi - Phi_c)^(1/2) above jamming (seed 002, eq. 17).
+ * fit (Z - Z_c) ~ (Phi - Phi_c)^(1/2) above jamming (Nezamabadi et al. 2022, eq. 17).
  *
  * The compaction curve gathers, per time-series row: time, contacts,
  * energies, and where the walls say it: the piston (the plane wall facing
@@ -13,10 +13,14 @@
 #include <hdf5.h>
 #include "io/io_h5_check.h"
 #include "io/io_h5_layout.h"
+#include "core/observables.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The name of observable id of kernels/observables.def. */
+#define OBS_NAME(id) (cd_observable_table[CD_OBSERVABLE_##id].name)
 
 typedef struct {
     char name[64];
@@ -178,7 +182,7 @@ int cd_an_compaction(const char *path, const cd_an_snapshot *snap, const cd_an_g
     series_set set;
     int rc = series_read(path, &set, err, errlen);
     if (rc) return rc;
-    const series *master = series_find(&set, "contacts");
+    const series *master = series_find(&set, OBS_NAME(NC));
     if (!master) master = set.n ? &set.s[0] : NULL;
     if (!master || master->rows == 0) {
         series_free(&set);
@@ -195,17 +199,18 @@ int cd_an_compaction(const char *path, const cd_an_snapshot *snap, const cd_an_g
     double *t = ADD("time", "s");
     for (size_t i = 0; i < R; i++) t[i] = master->time[i];
     /* the protocol's own series (docs/protocols.md) when the run has them */
-    const char *plain[][2] = {{"contacts", "1"},     {"elastic_energy", "J"}, {"packing_fraction", "1"},
-                              {"coordination", "1"}, {"phase", "1"},          {"wall_load", "N"},
-                              {"pressure", "Pa"}};
+    static const int plain[] = {CD_OBSERVABLE_NC,    CD_OBSERVABLE_EL,   CD_OBSERVABLE_PHI,     CD_OBSERVABLE_Z,
+                                CD_OBSERVABLE_PHASE, CD_OBSERVABLE_LOAD, CD_OBSERVABLE_PRESSURE};
     for (size_t k = 0; k < sizeof plain / sizeof plain[0]; k++) {
-        const series *s = series_find(&set, plain[k][0]);
-        if (s && s->ncomp == 1) align(master, s, 0, ADD(plain[k][0], plain[k][1]));
+        const cd_observable_desc *d = &cd_observable_table[plain[k]];
+        const series *s = series_find(&set, d->name);
+        if (s && s->ncomp == 1) align(master, s, 0, ADD(d->name, d->unit));
     }
-    const series *kt = series_find(&set, "kinetic_energy_translational");
-    const series *kr = series_find(&set, "kinetic_energy_rotational");
+    const series *kt = series_find(&set, OBS_NAME(KT));
+    const series *kr = series_find(&set, OBS_NAME(KR));
     if (kt && kr && kt->ncomp == 1 && kr->ncomp == 1) {
-        double *ke = ADD("kinetic_energy", "J"), *tmp = malloc(R * sizeof(double));
+        double *ke = ADD("kinetic_energy", cd_observable_table[CD_OBSERVABLE_KT].unit),
+               *tmp = malloc(R * sizeof(double));
         align(master, kt, 0, ke);
         if (tmp) {
             align(master, kr, 0, tmp);
@@ -217,8 +222,8 @@ int cd_an_compaction(const char *path, const cd_an_snapshot *snap, const cd_an_g
      * divides. */
     double solid = 0;
     for (size_t p = 0; p < snap->n; p++) solid += cd_an_particle_volume(snap, p);
-    const series *wf = series_find(&set, "wall_force"), *wp = series_find(&set, "wall_position");
-    const series *wr = series_find(&set, "wall_radius");
+    const series *wf = series_find(&set, OBS_NAME(WALL)), *wp = series_find(&set, OBS_NAME(WALL_POSITION));
+    const series *wr = series_find(&set, OBS_NAME(WALL_RADIUS));
     int W = snap->n_walls;
     cd_an_group *grp = cd_an_group_get(r, "compaction");
     if (g->dim == 3 && wf && wp && wf->ncomp == 3 * W && wp->ncomp == 3 * W &&
@@ -293,14 +298,16 @@ int cd_an_jamming(const char *path, const cd_an_options *opt, cd_an_report *r, c
     series_set set;
     int rc = series_read(path, &set, err, errlen);
     if (rc) return rc;
-    const char *phin[] = {"packing_fraction", "phi"}, *zn[] = {"coordination", "coordination_number", "Z", "z"};
+    const char *phin[] = {OBS_NAME(PHI), "phi"}, *zn[] = {OBS_NAME(Z), "coordination_number", "Z", "z"};
     const series *ph = NULL, *z = NULL;
     if (opt->phi_series) ph = series_find(&set, opt->phi_series);
     for (int k = 0; !opt->phi_series && !ph && k < 2; k++) ph = series_find(&set, phin[k]);
     if (opt->z_series) z = series_find(&set, opt->z_series);
     for (int k = 0; !opt->z_series && !z && k < 4; k++) z = series_find(&set, zn[k]);
     if (!ph || !z || ph->ncomp != 1 || z->ncomp != 1) {
-        char have[512] = "";
+        char have[512] = "", phis[128], zs[160];
+        snprintf(phis, sizeof phis, "%s or %s", phin[0], phin[1]);
+        snprintf(zs, sizeof zs, "%s, %s, %s or %s", zn[0], zn[1], zn[2], zn[3]);
         for (int k = 0; k < set.n; k++) {
             strncat(have, k ? ", " : "", sizeof have - strlen(have) - 1);
             strncat(have, set.s[k].name, sizeof have - strlen(have) - 1);
@@ -309,8 +316,8 @@ int cd_an_jamming(const char *path, const cd_an_options *opt, cd_an_report *r, c
                  "%s: no (Phi, Z) time series for the jamming fit: /observables holds %s; expected a packing "
                  "fraction (%s) and a coordination number (%s) series of one component each (--phi-series, "
                  "--z-series name others)",
-                 path, set.n ? have : "nothing", opt->phi_series ? opt->phi_series : "packing_fraction or phi",
-                 opt->z_series ? opt->z_series : "coordination, coordination_number, Z or z");
+                 path, set.n ? have : "nothing", opt->phi_series ? opt->phi_series : phis,
+                 opt->z_series ? opt->z_series : zs);
         series_free(&set);
         return 2;
     }
@@ -327,7 +334,7 @@ int cd_an_jamming(const char *path, const cd_an_options *opt, cd_an_report *r, c
      * fraction of the volume below it says nothing about the packing. */
     /* Likewise a piston that does not touch the packing yet (wall_load 0)
      * bounds empty space. */
-    const series *phase = series_find(&set, "phase"), *load = series_find(&set, "wall_load");
+    const series *phase = series_find(&set, OBS_NAME(PHASE)), *load = series_find(&set, OBS_NAME(LOAD));
     size_t used = ph->rows;
     if (phase && phase->ncomp == 1) {
         double *pv = malloc((ph->rows ? ph->rows : 1) * 2 * sizeof(double));

@@ -1,4 +1,4 @@
-/* Particle stresses (seed 000, eq. 8; SPEC 7):
+/* Particle stresses (Conzelmann et al., eq. 8; docs/references.md, Analysis):
  *   sigma_p = (1/V_p) sum_c F_c (x) r_c,   (F (x) r)_ab = F_a r_b,
  * F_c the force on particle p at contact c (normal + tangential, wall
  * contacts included), r_c from the centre of p to the contact point, V_p

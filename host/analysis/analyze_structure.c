@@ -1,4 +1,4 @@
-/* Structure of the packing (SPEC 7).
+/* Structure of the packing (docs/references.md, Analysis).
  *
  * G(r): reference particles are those in the core region (away from the
  * walls, analyze_geometry.c); every particle counts as a neighbour.  With
@@ -7,15 +7,16 @@
  * dV the exact shell volume (3D: 4/3 pi ((r+dr)^3 - r^3); 2D: pi ((r+dr)^2
  * - r^2) with the area density; pseudo-2D: the part of the shell inside a
  * slab of the centres' thickness, below), so that G -> 1 for an ideal gas.
- * Seed 000 prints 4 r^2 dr without the pi; SPEC asks for the pi.  r_max
+ * Conzelmann et al. print 4 r^2 dr without the pi; capdem keeps it
+ * (docs/references.md, Analysis).  r_max
  * does not exceed the smallest margin, so no shell around a reference
  * particle reaches a wall.  Pairs are found with a cell list (cells of
  * r_max / 4, only the cells within reach of the sphere), never all pairs.
  *
- * rho(r) = N(r) / N_inf (seed 001, eq. 8): N(r) the mean number of centres
+ * rho(r) = N(r) / N_inf (Tran et al. 2024, eq. 8): N(r) the mean number of centres
  * within r of a reference particle, N_inf = N(r_max).
  *
- * Branch vectors (seed 001, 3.2): centre-to-centre vectors of the bonds
+ * Branch vectors (Tran et al. 2024, section 3.2): centre-to-centre vectors of the bonds
  * (touching particle pairs); PDF of l / L and interlocking
  * lambda = 1 - <l> / L, L the tip-to-tip length of the largest shape. */
 #include "analysis/analyze.h"

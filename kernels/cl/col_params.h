@@ -5,6 +5,6 @@
  * the host binds columns by their index in cd_fields[] (no include guard:
  * it expands at each use). */
 #include "../field_groups.h"
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(__global ctype *name, )
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(__global ctype *name CD_COMMA)
 #include "../fields.def"
 #undef CD_FIELD

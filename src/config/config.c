@@ -320,7 +320,7 @@ static int check_whole(reader *r, cd_config *c, yaml_node_t *root)
         cd_species_config *sp = &c->species[i];
         yaml_node_t *item = yaml_document_get_node(r->doc, plist->data.sequence.items.start[i]);
         yaml_node_t *a = lookup(r->doc, item, "aspect", NULL);
-        if (strcmp(sp->shape, "sphere") == 0 && sp->aspect != 1.0) {
+        if (sp->shape == CD_SHAPE_SPHERE && sp->aspect != 1.0) {
             char val[VALLEN];
             cd_cfg_render(r->doc, a, val, sizeof val, 0);
             return cd_cfg_fail(r, line_of(a), "particles[%d].aspect = %s: expected 1 for shape sphere (aspect ratio)",

@@ -15,8 +15,11 @@
 /* neighbor.reorder: the memory order of the particles (src/backend/omp/reorder.c). */
 enum { CD_REORDER_CELLS = 0, CD_REORDER_NONE = 1 };
 
+/* particles[].shape, stored as the index of its choice (config_schema.c). */
+enum cd_shape_kind { CD_SHAPE_SPHERE, CD_SHAPE_ROD, CD_SHAPE_CROSS, CD_SHAPE_HEXAPOD, CD_SHAPE_SEGMENTS };
+
 typedef struct {
-    char shape[32];                                      /* sphere | rod | cross | hexapod | segments */
+    int shape;                                           /* enum cd_shape_kind */
     double aspect;                                       /* alpha = L / d_p [1] (named shapes) */
     double diameter;                                     /* arm diameter d_p [m] (named shapes) */
     int n_segments;                                      /* shape: segments */
@@ -51,14 +54,15 @@ typedef struct {
     double max_overlap;         /* stop when an overlap exceeds this fraction of the arm diameter [1] */
 
     /* physics */
-    int dimension;             /* 3, or 2 (x-y plane motion only) */
-    double gravity[3];         /* [m/s^2] */
-    double density;            /* rho [kg/m^3] */
-    double kn, kt;             /* particle stiffness [N/m] */
-    double eta_n, eta_t;       /* damping ratios [1] */
-    double friction;           /* mu between particles [1] */
-    double wall_friction;      /* mu_w [1] */
-    int friction_limit_total;  /* 0: mu F_n,elastic ((kn/2) delta_n, seed 000); 1: mu F_n (seed 001, LAMMPS) */
+    int dimension;        /* 3, or 2 (x-y plane motion only) */
+    double gravity[3];    /* [m/s^2] */
+    double density;       /* rho [kg/m^3] */
+    double kn, kt;        /* particle stiffness [N/m] */
+    double eta_n, eta_t;  /* damping ratios [1] */
+    double friction;      /* mu between particles [1] */
+    double wall_friction; /* mu_w [1] */
+    /* 0: mu F_n,elastic ((kn/2) delta_n, Conzelmann et al.); 1: mu F_n (Tran et al. 2024, LAMMPS) */
+    int friction_limit_total;
     int law;                   /* material.law: CD_LAW_LINEAR | CD_LAW_HERTZ_MINDLIN (kernels/contact_law.h) */
     double young_modulus;      /* hertz_mindlin: E [Pa] */
     double poisson_ratio;      /* hertz_mindlin: nu [1] */
@@ -96,7 +100,7 @@ typedef struct {
     int mpi_decomposition; /* 0: cartesian */
     double mpi_grid[3];    /* sub-domains along x, y, z; [0, 0, 0]: chosen from the ranks and the domain */
 
-    /* protocol (SPEC section 6; src/protocols/protocol.c) */
+    /* protocol (docs/references.md, Protocols; src/protocols/protocol.c) */
     char protocol[24];                   /* none | deposit_compress | radial_compaction | bulk_modulus */
     enum cd_protocol_kind protocol_kind; /* protocol as a selector, set at load */
     double settle_time;                  /* deposit: settling time [s] (0 = 3 sqrt(2 h / g)) */

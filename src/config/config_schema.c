@@ -28,6 +28,9 @@
 #define MPM_PACKING   2u
 
 _Static_assert(CD_WALL_PLANE == 0, "domain.walls[].type stores the index of \"plane\" in its choices");
+_Static_assert(CD_SHAPE_SPHERE == 0 && CD_SHAPE_ROD == 1 && CD_SHAPE_CROSS == 2 && CD_SHAPE_HEXAPOD == 3 &&
+                   CD_SHAPE_SEGMENTS == 4,
+               "particles[].shape stores the index of its choice");
 _Static_assert(CD_LAW_LINEAR == 0 && CD_LAW_HERTZ_MINDLIN == 1, "material.law stores the index of its choice");
 
 #define CFG(f)       .target = CD_TGT_CONFIG, .offset = offsetof(cd_config, f)
@@ -112,20 +115,21 @@ const cd_key cd_config_keys[] = {
      .meaning = "Coulomb coefficient mu_w between particles and every wall"},
     {"material.friction_limit", CD_KT_ENUM, "-", "elastic", CFG(friction_limit_total), .choices = "elastic|total",
      .label = "Coulomb limit",
-     .meaning = "elastic: mu times the elastic part of F_n, (k_n/2) delta_n when linear (seed 000); total: mu F_n "
-                "(seed 001, LAMMPS)"},
+     .meaning =
+         "elastic: mu times the elastic part of F_n, (k_n/2) delta_n when linear (Conzelmann et al.); total: mu F_n "
+         "(Tran et al. 2024, LAMMPS)"},
     {"material.parallel_angle", CD_KT_REAL, "deg", "2", CFG(parallel_angle_deg), GE(0), LT(45),
      .label = "parallel-contact angle", .meaning = "arms closer than this to parallel use the parallel-contact rule"},
     {"material.parallel_blend", CD_KT_BOOL, "-", "false", CFG(parallel_blend), .label = "continuous parallel rule",
      .meaning = "true: from the cut-off to twice its sine the contact point slides from the parallel point to the "
-                "closest points instead of jumping (docs/contacts.md); false: seed 000's rule"},
+                "closest points instead of jumping (docs/contacts.md); false: Conzelmann et al.'s rule"},
 
     /* particles */
     {"particles", CD_KT_LIST, "-", NULL, CFG(species), ALWAYS, .applies = SOLVER_DEM, .min_items = 1,
      .max_items = CD_MAX_SPECIES, .item_target = CD_TGT_SPECIES, .count_offset = offsetof(cd_config, n_species),
      .item_size = sizeof(cd_species_config), .label = "particle species",
      .meaning = "one mapping per kind of particle (keys particles[].*)"},
-    {"particles[].shape", CD_KT_ENUM, "-", NULL, SPC_SIZED(shape), ALWAYS, .flags = CD_KF_SELECTOR,
+    {"particles[].shape", CD_KT_ENUM, "-", NULL, SPC(shape), ALWAYS, .flags = CD_KF_SELECTOR,
      .choices = "sphere|rod|cross|hexapod|segments", .label = "particle shape",
      .meaning = "named shape, or segments for arms given one by one"},
     {"particles[].aspect", CD_KT_REAL, "1", "1", SPC(aspect), GE(1), .applies = S_NAMED,
@@ -151,7 +155,7 @@ const cd_key cd_config_keys[] = {
      .label = "box thickness", .meaning = "box extent in z"},
     {"domain.height", CD_KT_REAL, "m", "lattice fit", CFG(box_height), GT(0), .applies = D_BOX, .flags = CD_KF_DERIVED,
      .label = "box height",
-     .meaning = "box extent in y (up); omitted: just high enough for the init lattice (seed 000)"},
+     .meaning = "box extent in y (up); omitted: just high enough for the init lattice (Conzelmann et al.)"},
     {"domain.diameter", CD_KT_REAL, "m", NULL, CFG(cyl_diameter), GT(0), .applies = D_CYLINDER, .required = D_CYLINDER,
      .label = "cylinder diameter", .meaning = "diameter of the vertical cylinder"},
     {"domain.height", CD_KT_REAL, "m", "lattice fit", CFG(cyl_height), GT(0), .applies = D_CYLINDER,
@@ -181,7 +185,7 @@ const cd_key cd_config_keys[] = {
     {"init.clearance", CD_KT_REAL, "1", "1.5", CFG(clearance), GE(1), .conflicts = "gap", .label = "lattice clearance",
      .meaning = "lattice spacing over particle size"},
     {"init.gap", CD_KT_REAL, "m", NULL, CFG(lattice_gap), GT(0), .conflicts = "clearance", .label = "lattice gap",
-     .meaning = "instead of init.clearance: lattice spacing = particle size + this gap (seed 000: 1.5 d_p)"},
+     .meaning = "instead of init.clearance: lattice spacing = particle size + this gap (Conzelmann et al.: 1.5 d_p)"},
     {"init.speed", CD_KT_REAL, "m/s", "0.25", CFG(init_speed), GE(0), .label = "initial speed",
      .meaning = "each velocity component is uniform in (-v, v)"},
 
@@ -203,7 +207,8 @@ const cd_key cd_config_keys[] = {
     /* protocol */
     {"protocol.type", CD_KT_ENUM, "-", "none", CFG_SIZED(protocol), .flags = CD_KF_SELECTOR,
      .choices = "none|deposit_compress|radial_compaction|bulk_modulus", .label = "protocol",
-     .meaning = "none: run.steps of plain dynamics; else the SPEC 6 procedure (docs/protocols.md)"},
+     .meaning =
+         "none: run.steps of plain dynamics; else a procedure of docs/references.md, Protocols (docs/protocols.md)"},
     {"protocol.settle_time", CD_KT_REAL, "s", "0", CFG(settle_time), GE(0), .applies = P_DEPOSIT,
      .label = "settling time", .meaning = "deposit: settling before the piston moves; 0: 3 sqrt(2 h / g)"},
     {"protocol.piston_speed", CD_KT_REAL, "m/s", "0.25", CFG(piston_speed), GT(0), .applies = P_DEPOSIT,
@@ -222,7 +227,7 @@ const cd_key cd_config_keys[] = {
      .label = "piston mass", .meaning = "deposit: inertia of the load-controlled piston; 0: total particle mass"},
     {"protocol.fill_ratio", CD_KT_REAL, "1", "0", CFG(fill_ratio), GE(0), .applies = P_DEPOSIT, .label = "fill ratio",
      .meaning = "deposit: with particles[].count omitted, the count fills the container to fill_ratio x its width "
-                "(seed 000: 2)"},
+                "(Conzelmann et al.: 2)"},
     {"protocol.fill_fraction", CD_KT_REAL, "1", NULL, CFG(fill_fraction), GT(0), LT(1), .applies = P_DEPOSIT,
      .label = "expected packing fraction",
      .meaning = "deposit: packing fraction (time-series definition) the compressed packing is expected to reach; "
@@ -230,7 +235,7 @@ const cd_key cd_config_keys[] = {
     {"protocol.pressure", CD_KT_REAL, "Pa", "0", CFG(pressure), GE(0), .applies = P_RADIAL | P_BULK,
      .label = "pressure", .meaning = "ball: pressure on the ball; 0: pressure_ratio x kn / L"},
     {"protocol.pressure_ratio", CD_KT_REAL, "1", "1e-5", CFG(pressure_ratio), GT(0), .applies = P_RADIAL | P_BULK,
-     .label = "pressure ratio", .meaning = "ball: p L / kn when protocol.pressure is 0 (seed 001)"},
+     .label = "pressure ratio", .meaning = "ball: p L / kn when protocol.pressure is 0 (Tran et al. 2024)"},
     {"protocol.relax_ratio", CD_KT_REAL, "1", "1e-6", CFG(relax_ratio), GT(0), .applies = P_ANY,
      .flags = CD_KF_RESUMABLE, .label = "relaxation ratio",
      .meaning = "relaxed when kinetic energy < relax_ratio x elastic energy"},

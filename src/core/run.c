@@ -12,61 +12,12 @@
 #include <sys/stat.h>
 #include "core/run.h"
 #include "core/sim.h"
+#include "core/observables.h"
 #include "io/io_h5.h"
 #include "protocols/protocol.h"
 #include "rigid.h"
 #include "mpm/mpm_run.h"
 #include "mpi/mpi_decomp.h"
-
-enum { OBS_KT, OBS_KR, OBS_KC, OBS_EL, OBS_PE, OBS_NC, OBS_NW, OBS_MOM, OBS_WF, OBS_WP, OBS_WR, OBS_COUNT };
-
-static int observable_table(const cd_sim *sim, cd_observable_info *info)
-{
-    int W = (int)sim->s.n_walls;
-    cd_observable_info t[OBS_COUNT] = {
-        {"kinetic_energy_translational", "J", 1},
-        {"kinetic_energy_rotational", "J", 1},
-        {"kinetic_energy_in_contact", "J", 1},
-        {"elastic_energy", "J", 1},
-        {"potential_energy", "J", 1},
-        {"contacts", "1", 1},
-        {"wall_contacts", "1", 1},
-        {"momentum", "kg m/s", 3},
-        {"wall_force", "N", 3 * W},
-        {"wall_position", "m", 3 * W},
-        {"wall_radius", "m", W},
-    };
-    int n = 0;
-    for (int k = 0; k < OBS_COUNT; k++)
-        if (t[k].ncomp > 0) info[n++] = t[k];
-    const char *names[CD_PROTOCOL_OBSERVABLES], *units[CD_PROTOCOL_OBSERVABLES];
-    cd_protocol_observable_info(names, units);
-    for (int k = 0; k < CD_PROTOCOL_OBSERVABLES; k++) info[n++] = (cd_observable_info){names[k], units[k], 1};
-    return n;
-}
-
-/* One time-series row in the order of observable_table. */
-static void observable_row(const cd_sim *sim, const cd_observables *o, double *row)
-{
-    int n = 0;
-    row[n++] = o->kinetic_translational;
-    row[n++] = o->kinetic_rotational;
-    row[n++] = o->kinetic_in_contact;
-    row[n++] = o->elastic;
-    row[n++] = o->potential;
-    row[n++] = o->n_contacts;
-    row[n++] = o->n_wall_contacts;
-    for (int c = 0; c < 3; c++) row[n++] = o->momentum[c];
-    for (size_t w = 0; w < sim->s.n_walls; w++)
-        for (int c = 0; c < 3; c++) row[n++] = o->wall_force[w][c];
-    for (size_t w = 0; w < sim->s.n_walls; w++) {
-        row[n++] = sim->s.walls[w].point.x;
-        row[n++] = sim->s.walls[w].point.y;
-        row[n++] = sim->s.walls[w].point.z;
-    }
-    for (size_t w = 0; w < sim->s.n_walls; w++) row[n++] = sim->s.walls[w].radius;
-    cd_protocol_observables(sim, o, row + n);
-}
 
 static double now_seconds(void)
 {
@@ -194,7 +145,7 @@ static void write_failed(const cd_run_options *opt, const cd_config *cfg, long l
  * stop together. */
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
 {
-    if (out) observable_row(sim, o, row);
+    if (out) cd_observable_row(sim, o, row);
     return cd_mpi_agree(out ? cd_output_thermo(out, sim->s.step, sim->s.time, row) : 0);
 }
 
@@ -350,9 +301,9 @@ static int run(const cd_run_options *opt)
         cd_config_free(&cfg);
         return 2;
     }
-    cd_observable_info info[OBS_COUNT + CD_PROTOCOL_OBSERVABLES];
-    int n_obs = observable_table(&sim, info);
-    double row[16 + 7 * CD_MAX_WALLS + CD_PROTOCOL_OBSERVABLES];
+    cd_observable_info info[CD_OBSERVABLE_COUNT]; /* the time series, kernels/observables.def */
+    int n_obs = cd_observable_series(&sim, info);
+    double row[CD_OBS_ROW_MAX];
     cd_output *out = NULL;
     int status = 0;
     if (opt->resume_path) {

@@ -1,4 +1,5 @@
-/* Builds a simulation from a validated config (SPEC sections 1, 3, 5, 6):
+/* Builds a simulation from a validated config (docs/references.md,
+ * Particles, Contact law, Domains and walls, Protocols):
  * the shapes, the particles with their polydisperse scale factors, random
  * orientations and velocities, their placement, the walls of the domain and
  * the time-step check against the collision time. */
@@ -309,7 +310,7 @@ static double largest_bounding_radius(const cd_sim *sim)
     return rmax * (1 + pmax);
 }
 
-/* protocol.fill_ratio (seed 000): as many particles as fill the container
+/* protocol.fill_ratio (Conzelmann et al.): as many particles as fill the container
  * to fill_ratio x its width (box) or diameter (cylinder) at the expected
  * packing fraction, i.e. N = fill_ratio W A phi / <v>, with A the cross
  * section and <v> = v (1 + p^2) the mean particle volume when the length
@@ -329,14 +330,14 @@ static void resolve_fill_count(cd_sim *sim)
 }
 
 /* Lattice spacing [m] for particles of largest bounding radius R [m]:
- * init.gap (seed 000's "space of 1.5 d_p between each particle") or
+ * init.gap (Conzelmann et al.'s "space of 1.5 d_p between each particle") or
  * init.clearance x the particle size. */
 static double lattice_spacing(const cd_config *c, double R)
 {
     return c->lattice_gap > 0 ? 2 * R + c->lattice_gap : c->clearance * 2 * R;
 }
 
-/* domain.height omitted (seed 000): the lowest box or cylinder whose
+/* domain.height omitted (Conzelmann et al.): the lowest box or cylinder whose
  * lattice of spacing a holds every particle, i.e. rows x a with rows =
  * ceil(N / sites per row).  Rows are centred, so a height of exactly
  * rows x a puts the first row at a/2 >= R above the floor. */

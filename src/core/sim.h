@@ -182,17 +182,21 @@ int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen);
  * set-up work: world axis ends and angular velocities from the poses. */
 void cd_sim_refresh(cd_sim *sim);
 
-/* Observables (deterministic sums). */
+/* Observables (deterministic sums): one member per SUM or MAX row of
+ * kernels/observables.def, which gives its unit and meaning. */
+#define CD_OBS_DIMS_ONE
+#define CD_OBS_DIMS_VEC3              [3]
+#define CD_OBS_DIMS_WALL1             [CD_MAX_WALLS]
+#define CD_OBS_DIMS_WALL3             [CD_MAX_WALLS][3]
+#define CD_OBS_MEMBER_(member, count) double member CD_OBS_DIMS_##count;
+#define CD_OBS_MEMBER_NONE_(member, count)
+#define CD_OBS_MEMBER_SUM      CD_OBS_MEMBER_
+#define CD_OBS_MEMBER_MAX      CD_OBS_MEMBER_
+#define CD_OBS_MEMBER_WALLS    CD_OBS_MEMBER_NONE_
+#define CD_OBS_MEMBER_PROTOCOL CD_OBS_MEMBER_NONE_
 typedef struct {
-    double kinetic_translational, kinetic_rotational; /* [J] */
-    double kinetic_in_contact;                        /* kinetic energy of the particles that touch something [J] */
-    double elastic;                                   /* energy stored in contact springs [J] */
-    double potential;                                 /* gravitational potential energy -m g.x [J] */
-    double n_contacts;                                /* active particle-particle contacts */
-    double n_wall_contacts;                           /* active particle-wall contacts */
-    double momentum[3];                               /* total linear momentum [kg m/s] */
-    double wall_force[CD_MAX_WALLS][3];               /* force of the particles on each wall [N] */
-    double max_overlap_ratio;                         /* largest overlap / arm diameter [1] */
+#define CD_OBSERVABLE(id, name, unit, count, source, member, meaning) CD_OBS_MEMBER_##source(member, count)
+#include "observables.def"
 } cd_observables;
 /* From the host columns (current after a sync). */
 void cd_sim_observe(const cd_sim *sim, cd_observables *o);

@@ -1,10 +1,11 @@
-/* Protocols of SPEC section 6 (see protocol.h and docs/protocols.md): the
+/* Protocols of docs/references.md, Protocols (see protocol.h and docs/protocols.md): the
  * driver shared by all of them -- phases, the relaxation test, resume
  * checks, the protocol observables -- and the table of their operations
  * (protocol_internal.h), selected by protocol.type. */
 #include <math.h>
 #include <string.h>
 #include "protocols/protocol_internal.h"
+#include "core/observables.h"
 
 /* By cd_protocol_kind; none has no operations. */
 static const cd_protocol_ops *const protocol_table[] = {
@@ -130,17 +131,6 @@ int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen)
     return cd_proto_phase(sim) == CD_PHASE_DONE;
 }
 
-void cd_protocol_observable_info(const char **names, const char **units)
-{
-    static const char *const n[CD_PROTOCOL_OBSERVABLES] = {"packing_fraction", "coordination", "phase", "wall_load",
-                                                           "pressure"};
-    static const char *const u[CD_PROTOCOL_OBSERVABLES] = {"1", "1", "1", "N", "Pa"};
-    for (int k = 0; k < CD_PROTOCOL_OBSERVABLES; k++) {
-        names[k] = n[k];
-        units[k] = u[k];
-    }
-}
-
 /* Container volume [m^3] (0 when there is none): up to the piston for the
  * deposit protocol, the ball for the ball protocols. */
 static double container_volume(const cd_sim *sim)
@@ -161,11 +151,12 @@ void cd_protocol_observables(const cd_sim *sim, const cd_observables *o, double 
 {
     const cd_state *s = &sim->s;
     double V = container_volume(sim);
-    v[0] = V > 0 ? sim->solid_volume / V : 0;
-    v[1] = s->n_particles ? 2 * o->n_contacts / (double)s->n_particles : 0;
-    v[2] = s->control[CTL_PHASE];
-    v[3] = s->control[CTL_LOAD];
+    v[CD_POBS_PHI] = V > 0 ? sim->solid_volume / V : 0;
+    v[CD_POBS_Z] = s->n_particles ? 2 * o->n_contacts / (double)s->n_particles : 0;
+    v[CD_POBS_PHASE] = s->control[CTL_PHASE];
+    v[CD_POBS_LOAD] = s->control[CTL_LOAD];
     int w = (int)s->control[CTL_WALL];
     double R = s->n_walls ? s->walls[w].radius : 0;
-    v[4] = sim->cfg.domain_kind == CD_DOMAIN_BALL && R > 0 ? s->control[CTL_LOAD] / (4 * CD_PI * R * R) : 0;
+    v[CD_POBS_PRESSURE] =
+        sim->cfg.domain_kind == CD_DOMAIN_BALL && R > 0 ? s->control[CTL_LOAD] / (4 * CD_PI * R * R) : 0;
 }

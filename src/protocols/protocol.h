@@ -1,6 +1,6 @@
-/* The procedures of SPEC section 6 that a run file selects with
- * protocol.type: deposit and compress (seed 000), radial compaction in a
- * pressure-driven ball and the bulk-modulus probe (seed 001).  A protocol
+/* The procedures of docs/references.md, Protocols that a run file selects with
+ * protocol.type: deposit and compress (Conzelmann et al.), radial compaction in a
+ * pressure-driven ball and the bulk-modulus probe (Tran et al. 2024).  A protocol
  * moves the walls between steps and decides when the run is done; all its
  * state lives in sim->s.control, so it resumes from any snapshot. */
 #ifndef CD_PROTOCOL_H
@@ -39,10 +39,9 @@ long long cd_protocol_steps_until_control(const cd_sim *sim);
  * 0 to go on, -1 on error (message in err). */
 int cd_protocol_control(cd_sim *sim, FILE *log, char *err, size_t errlen);
 
-/* Extra time-series columns: packing fraction, coordination, phase,
- * pressure / load on the driven wall. */
-#define CD_PROTOCOL_OBSERVABLES 5
-void cd_protocol_observable_info(const char **names, const char **units);
+/* The PROTOCOL observables of kernels/observables.def (packing fraction,
+ * coordination, phase, load on the driven wall, ball pressure):
+ * values[CD_POBS_<id>] (src/core/observables.h). */
 void cd_protocol_observables(const cd_sim *sim, const cd_observables *o, double *values);
 
 /* Results of the bulk probe, appended as rows: strain, pressure change, K. */

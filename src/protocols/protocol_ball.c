@@ -1,4 +1,4 @@
-/* Radial compaction (SPEC section 6, docs/protocols.md): particles in a
+/* Radial compaction (docs/references.md, Protocols, docs/protocols.md): particles in a
  * ball whose radius is driven by the applied pressure, m_w R'' = sum f_i -
  * p 4 pi R^2, until the packing has relaxed.  The bulk probe
  * (protocol_bulk.c) starts with the same compaction. */
@@ -16,7 +16,7 @@ int cd_proto_ball_check(const cd_config *c, char *err, size_t errlen)
     return 0;
 }
 
-/* Pressure on the ball [Pa]: given, or p L / kn = pressure_ratio (seed 001). */
+/* Pressure on the ball [Pa]: given, or p L / kn = pressure_ratio (Tran et al. 2024). */
 static double ball_pressure(const cd_sim *sim)
 {
     if (sim->cfg.pressure > 0) return sim->cfg.pressure;

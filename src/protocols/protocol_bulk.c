@@ -1,4 +1,4 @@
-/* Bulk-modulus probe (SPEC section 6, docs/protocols.md): the radial
+/* Bulk-modulus probe (docs/references.md, Protocols, docs/protocols.md): the radial
  * compaction of protocol_ball.c, then the relaxed base state kept at rest,
  * then windows of probe_steps steps from that state, the reference
  * unstrained and the others at volumetric strains strain_min, 10 x, ...

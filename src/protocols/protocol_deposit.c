@@ -1,4 +1,4 @@
-/* Deposit and compress (SPEC section 6, docs/protocols.md): the particles
+/* Deposit and compress (docs/references.md, Protocols, docs/protocols.md): the particles
  * settle under gravity in a box or cylinder, a piston comes down at
  * protocol.piston_speed until it carries protocol.piston_force, then holds
  * that load (or its position) until the packing has relaxed. */
@@ -74,7 +74,7 @@ static long long steps_until_control(const cd_sim *sim, int phase)
 /* Deposit, protocol.piston_start = packing: moves the parked piston down
  * to one particle size (the largest bounding diameter, polydispersity
  * included) above the highest
- * point of any particle.  Seed 000 starts the piston at the top of the
+ * point of any particle.  Conzelmann et al. start the piston at the top of the
  * domain, but the domain is as high as the initial lattice, several times
  * the settled packing: the piston would cross metres of empty space at
  * 0.25 m/s (millions of steps) before touching anything.  Starting just
@@ -96,7 +96,7 @@ static int lower_piston(cd_sim *sim, int w, char *err, size_t errlen)
 }
 
 /* Deposit: the compressed packing's height (the piston's) against the
- * container width, which seed 000 wants to be at least 2. */
+ * container width, which Conzelmann et al. want to be at least 2. */
 static void report_fill(const cd_sim *sim, FILE *log)
 {
     const cd_config *c = &sim->cfg;

@@ -1,6 +1,6 @@
 /* Shape catalogue: named clusters of spherocylinders (sphere, rod, cross,
  * hexapod) and general segment lists, with the mass properties of the union
- * of their arms (SPEC section 1, docs/shapes.md).
+ * of their arms (docs/references.md, Particles, docs/shapes.md).
  *
  * Closed forms are used wherever the union decomposes into known pieces:
  * the sphere, one capsule, and crosses / hexapods with aspect >= 2, where
@@ -103,18 +103,28 @@ static int check_positive(const char *what, const char *name, double x, const ch
 
 /* ---- named shapes ------------------------------------------------------ */
 
+/* The names of enum cd_shape_kind, in its order. */
+static const char *const shape_kind_names[] = {"sphere", "rod", "cross", "hexapod", "segments"};
+
 int cd_shape_make_named(const char *kind, double aspect, double diameter, double density, cd_shape *out, char *err,
                         size_t errlen)
 {
-    static const char *const names[] = {"sphere", "rod", "cross", "hexapod"};
-    int n_arms = -1;
-    for (int k = 0; k < 4; k++)
-        if (kind && strcmp(kind, names[k]) == 0) n_arms = k == 0 ? 1 : k;
-    if (n_arms < 0)
-        return fail(err, errlen, "shape kind '%s' unknown, expected sphere, rod, cross or hexapod%s",
-                    kind ? kind : "(null)",
-                    kind && strcmp(kind, "segments") == 0 ? " (a segment list needs its segments)" : "");
-    const int is_sphere = strcmp(kind, "sphere") == 0;
+    for (int k = CD_SHAPE_SPHERE; k <= CD_SHAPE_HEXAPOD; k++)
+        if (kind && strcmp(kind, shape_kind_names[k]) == 0)
+            return cd_shape_make_kind(k, aspect, diameter, density, out, err, errlen);
+    return fail(err, errlen, "shape kind '%s' unknown, expected sphere, rod, cross or hexapod%s",
+                kind ? kind : "(null)",
+                kind && strcmp(kind, "segments") == 0 ? " (a segment list needs its segments)" : "");
+}
+
+int cd_shape_make_kind(int shape_kind, double aspect, double diameter, double density, cd_shape *out, char *err,
+                       size_t errlen)
+{
+    if (shape_kind < CD_SHAPE_SPHERE || shape_kind > CD_SHAPE_HEXAPOD)
+        return fail(err, errlen, "shape kind %d is not a named shape (sphere, rod, cross or hexapod)", shape_kind);
+    const char *kind = shape_kind_names[shape_kind];
+    const int n_arms = shape_kind == CD_SHAPE_SPHERE ? 1 : shape_kind; /* rod 1, cross 2, hexapod 3 */
+    const int is_sphere = shape_kind == CD_SHAPE_SPHERE;
     if (!isfinite(aspect) || aspect < 1.0)
         return fail(err, errlen, "%s: aspect = %g, expected a number >= 1 (tip-to-tip length L over arm diameter d_p)",
                     kind, aspect);
@@ -328,10 +338,10 @@ int cd_shape_make_segments(int n, const double (*a)[3], const double (*b)[3], co
 
 int cd_shape_from_species(const cd_species_config *sp, double density, cd_shape *out, char *err, size_t errlen)
 {
-    if (strcmp(sp->shape, "segments") == 0)
+    if (sp->shape == CD_SHAPE_SEGMENTS)
         return cd_shape_make_segments(sp->n_segments, (const double(*)[3])sp->seg_a, (const double(*)[3])sp->seg_b,
                                       sp->seg_radius, density, out, err, errlen);
-    return cd_shape_make_named(sp->shape, sp->aspect, sp->diameter, density, out, err, errlen);
+    return cd_shape_make_kind(sp->shape, sp->aspect, sp->diameter, density, out, err, errlen);
 }
 
 /* ---- JSON -------------------------------------------------------------- */

@@ -1,5 +1,5 @@
 /* Shape catalogue: rigid clusters of spherocylinders sharing one centre,
- * with the mass properties of the union of their arms (SPEC section 1). */
+ * with the mass properties of the union of their arms (docs/references.md, Particles). */
 #ifndef CD_SHAPES_H
 #define CD_SHAPES_H
 #include <stddef.h>
@@ -31,6 +31,10 @@ typedef struct {
  * aspect must be 1.  Returns 0, or -1 with a message in err. */
 int cd_shape_make_named(const char *kind, double aspect, double diameter, double density, cd_shape *out, char *err,
                         size_t errlen);
+/* The same for a kind of enum cd_shape_kind (sphere to hexapod): what a
+ * config's particles[].shape holds after loading. */
+int cd_shape_make_kind(int shape_kind, double aspect, double diameter, double density, cd_shape *out, char *err,
+                       size_t errlen);
 
 /* General cluster: n axis segments (a_i, b_i) with radii r_i in some body
  * frame.  The result is translated to its centre of mass and rotated to its

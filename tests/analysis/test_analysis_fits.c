@@ -1,6 +1,6 @@
 /* Fits of the analysis (host/analysis/analyze_fit.c) on synthetic samples with known
- * answers: the exponential tail, Mueth's form, the cascade model of seed
- * 001, the jamming law of seed 002, and P(f) through the whole forces
+ * answers: the exponential tail, Mueth's form, the cascade model of Tran et al.
+ * 2024, the jamming law of Nezamabadi et al. 2022, and P(f) through the whole forces
  * measure.  Random numbers come from capdem's seeded generator, so every
  * run sees the same samples. */
 #include <stdarg.h>
@@ -122,7 +122,7 @@ static void test_mueth_recovers_parameters(void **state)
     free(f);
 }
 
-/* Seed 001, eq. 12-13: P_f integrates to 1 and has mean 1 for every gamma
+/* Tran et al. 2024, eq. 12-13: P_f integrates to 1 and has mean 1 for every gamma
  * (this is what fixes beta); P(0) = gamma ln((1 + gamma)/gamma). */
 static void test_cascade_normalisation(void **state)
 {

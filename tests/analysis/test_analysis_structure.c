@@ -139,7 +139,7 @@ static void test_rdf_ideal_gas_2d(void **state)
     sync_prims(&s);
     cd_an_report rep;
     cd_an_geometry g;
-    run_rdf(&s, -1, -1, 5, 0.1, &rep, &g); /* SPEC margins: 10 L */
+    run_rdf(&s, -1, -1, 5, 0.1, &rep, &g); /* default margins: 10 L */
     assert_int_equal(g.kind, CD_AN_BOX2D);
     assert_true(fabs(g.margin_side - 10) < 1e-12);
     check_ideal(&rep, 0.5);

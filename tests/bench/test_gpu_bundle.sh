@@ -33,6 +33,7 @@ done
 if [ -e "$S/lib/libgomp.so.1" ] && p=$(ls /usr/lib/x86_64-linux-gnu/libgomp-plugin-nvptx.so.1 2>/dev/null); then cp -L "$p" "$S/lib/"; fi
 [ -e "$S/lib/libyaml-0.so.2" ] || { echo "libyaml-0.so.2 is not among the libraries ldd found"; exit 1; }
 cp -r "$src/configs" "$src/kernels" "$B/src/"
+mkdir -p "$B/src/host" && cp "$src/host/capdem_h5.py" "$B/src/host/"
 "$bench" --case hexapods_a3 --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/hexapods_a3_n40.h5" >/dev/null 2>&1
 "$bench" --case spheres --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/spheres_n40.h5" >/dev/null 2>&1
 tar -C "$S" -cf - lib lib.cxx | xz -0 -T2 >"$B/payload-lib.tar.xz"

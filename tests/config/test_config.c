@@ -168,12 +168,12 @@ static void test_full_config_gives_every_value(void **state)
     assert_int_equal(c.friction_limit_total, 1);
     assert_close(c.parallel_angle_deg, 5, 0);
     assert_int_equal(c.n_species, 2);
-    assert_string_equal(c.species[0].shape, "cross");
+    assert_int_equal(c.species[0].shape, CD_SHAPE_CROSS);
     assert_close(c.species[0].aspect, 8, 0);
     assert_close(c.species[0].diameter, 0.004, 0);
     assert_int_equal(c.species[0].count, 500);
     assert_close(c.species[0].polydispersity, 0.1, 0);
-    assert_string_equal(c.species[1].shape, "sphere");
+    assert_int_equal(c.species[1].shape, CD_SHAPE_SPHERE);
     assert_close(c.species[1].aspect, 1, 0);         /* sphere default */
     assert_close(c.species[1].polydispersity, 0, 0); /* default */
     assert_int_equal(c.species[1].count, 3);

@@ -1,4 +1,4 @@
-/* Head-on collision of two equal spheres (SPEC section 3): the coefficient
+/* Head-on collision of two equal spheres (docs/references.md, Contact law): the coefficient
  * of restitution and the contact duration against the damped linear
  * oscillator. */
 #include "test_util.h"
@@ -90,7 +90,7 @@ static double clipped_restitution(double eta)
     return -exp(-zw * t) * (cos(wd * t) - zw / wd * sin(wd * t));
 }
 
-/* SPEC section 3 clips F_n at zero: the rebound is faster than the textbook
+/* docs/references.md, Contact law clips F_n at zero: the rebound is faster than the textbook
  * e (0.572 instead of 0.527 for eta = 0.2).  Checked against the exact
  * clipped solution with the same budget of 2 dt/t_col (measured 5.9e-4). */
 static void test_restitution_with_clipped_normal_force(void **state)

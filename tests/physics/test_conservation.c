@@ -1,4 +1,4 @@
-/* Conservation laws of the step (SPEC sections 3-4): energy without damping
+/* Conservation laws of the step (docs/references.md, Contact law, Motion): energy without damping
  * or friction, linear and angular momentum in free collisions. */
 #include "test_util.h"
 #include <math.h>

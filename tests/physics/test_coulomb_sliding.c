@@ -1,4 +1,4 @@
-/* Coulomb friction (SPEC section 3) on a sphere and a floor, against the
+/* Coulomb friction (docs/references.md, Contact law) on a sphere and a floor, against the
  * closed-form motion of a rigid ball. */
 #include "test_util.h"
 #include <math.h>

@@ -28,7 +28,7 @@ static void test_disc_thicker_than_the_slab_touches_only_the_floor(void **state)
     cd_observables o;
     cd_sim_observe(&sim, &o);
     assert_true(o.n_wall_contacts == 1);
-    /* the floor spring alone: the law's normal spring is kn/2 (SPEC 3), so
+    /* the floor spring alone: the law's normal spring is kn/2 (docs/references.md, Contact law), so
      * 1/4 kn delta^2 = 2.5e-6 J; with front and back walls the disc (1.5 mm
      * into each) would add 0.11 J */
     double e = 0.25 * kn * delta * delta; /* [J] */

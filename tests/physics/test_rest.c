@@ -1,4 +1,4 @@
-/* Bodies on a floor come to rest (SPEC sections 2 and 4). */
+/* Bodies on a floor come to rest (docs/references.md, Contacts, Motion). */
 #include "test_util.h"
 #include <math.h>
 

@@ -1,4 +1,4 @@
-/* Order of accuracy of the free rotation (SPEC section 4; docs/motion.md,
+/* Order of accuracy of the free rotation (docs/references.md, Motion; docs/motion.md,
  * "Rigid bodies"; issue 21 item 1): a torque-free asymmetric top goes
  * through the whole step of the backend under test (kick with zero torque,
  * drift) with dt, dt/2, dt/4 and is compared at the same time T with a

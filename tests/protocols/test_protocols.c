@@ -1,4 +1,4 @@
-/* The SPEC 6 protocols on their CI-size presets (configs/protocols/ci). */
+/* The protocols (docs/references.md, Protocols) on their CI-size presets (configs/protocols/ci). */
 #include "test_util.h"
 #include <fnmatch.h>
 #include <float.h>
@@ -223,12 +223,12 @@ static void test_deposit_resumed_equals_uninterrupted(void **state)
     unlink("proto_dep2d_part.h5");
 }
 
-/* protocol.fill_ratio with the count left out (seed 000's rule): N =
+/* protocol.fill_ratio with the count left out (Conzelmann et al.'s rule): N =
  * ceil(2 W (W T) phi / <v>) with <v> = (pi d^3 / 6)(1 + p^2), the mean
  * volume of spheres whose diameter is uniform in [(1 - p) d, (1 + p) d];
  * and domain.height left out: rows x a for a lattice of spacing a,
  * floor(W / a) x floor(T / a) sites per row.  The spacing is
- * init.clearance x the largest diameter, or with init.gap (seed 000's
+ * init.clearance x the largest diameter, or with init.gap (Conzelmann et al.'s
  * "space of 1.5 d_p between each particle") the largest diameter + gap.
  * Both computed here from the closed forms. */
 static void check_fill_and_height(const char *init_key, double init_value, double a_expected)
@@ -318,7 +318,7 @@ static void test_random_shape_exclusion_places_dense_without_overlap(void **stat
 /* run.steps_per_collision: dt = t_col / n with t_col the collision time
  * of the lightest pair, here two equal spheres of mass m = rho pi d^3 / 6:
  * t_col = pi / sqrt((kn/2)/(m/2) (1 - eta^2)), the damped oscillator of
- * SPEC 3, computed here from the closed form. */
+ * docs/references.md, Contact law, computed here from the closed form. */
 static void test_steps_per_collision_sets_dt(void **state)
 {
     (void)state;

@@ -1,4 +1,4 @@
-/* Same backend, same input, same bits (SPEC; brief "Determinism"): for two
+/* Same backend, same input, same bits (docs/architecture.md, "Determinism and resume"): for two
  * runs, for 1 and 2 threads, across a forced neighbour rebuild, and for a
  * run checkpointed and resumed. */
 #include "test_util.h"

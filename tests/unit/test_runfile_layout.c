@@ -10,14 +10,21 @@
  * - a file the writer wrote: every group the table says a file has, every
  *   dataset with its type and unit attribute, every column of fields.def
  *   where the table puts it, the members of the /walls/value compound, and
- *   the commit journal beside the file while it is open. */
+ *   the commit journal beside the file while it is open, and the time
+ *   series of kernels/observables.def with their units and components.
+ * - docs/output.md: its table of the time series, between its GENERATED
+ *   markers, is what this program writes from kernels/observables.def
+ *   (`--write docs/output.md` rewrites it). */
 #include "test_util.h"
 #include <unistd.h>
 #include "io/io_h5.h"
 #include "io/io_h5_layout.h"
+#include "core/observables.h"
 
-#define BEGIN_MARK "# ---- BEGIN GENERATED"
-#define END_MARK   "# ---- END GENERATED"
+#define BEGIN_MARK     "# ---- BEGIN GENERATED"
+#define END_MARK       "# ---- END GENERATED"
+#define DOC_BEGIN_MARK "<!-- BEGIN GENERATED"
+#define DOC_END_MARK   "<!-- END GENERATED -->"
 
 static const char *store_name(enum cdh5_store st)
 {
@@ -31,13 +38,22 @@ static void lower(char *dst, const char *id, size_t len)
     dst[i] = 0;
 }
 
+/* Components of observable k in a row: "1", "3", "W" or "3 W" (W walls). */
+static const char *components(const cd_observable_desc *d)
+{
+    static char s[16];
+    if (d->per_wall) snprintf(s, sizeof s, d->ncomp > 1 ? "%d W" : "W", d->ncomp);
+    else snprintf(s, sizeof s, "%d", d->ncomp);
+    return s;
+}
+
 /* The generated block of host/capdem_h5.py, markers included. */
 static void write_block(FILE *o)
 {
     static const char *const group_names[CD_GROUP_COUNT] = {"particle", "prim", "pair", "wallc", "pair_out"};
     char key[64];
     fprintf(o,
-            "%s from kernels/runfile.def and kernels/fields.def by tests/unit/test_runfile_layout.c\n"
+            "%s from kernels/runfile.def, fields.def and observables.def by tests/unit/test_runfile_layout.c\n"
             "# (build/tests/test_runfile_layout --write host/capdem_h5.py); edit the tables, not this block.\n",
             BEGIN_MARK);
     fprintf(o, "# groups and datasets that are not columns: key -> absolute path\nPATH = {\n");
@@ -70,7 +86,28 @@ static void write_block(FILE *o)
     fprintf(o, "WALL_KIND_NAME = {\n");
 #define CD_H5_WALL_KIND(id, value, name) fprintf(o, "    %d: \"%s\",\n", value, name);
 #include "../kernels/runfile.def"
+    fprintf(o, "}\n# time series of a DEM run, /observables/<name>: name -> (unit, components per row, meaning);\n"
+               "# W: the number of walls\nOBSERVABLES = {\n");
+    for (int k = 0; k < CD_OBSERVABLE_COUNT; k++) {
+        const cd_observable_desc *d = &cd_observable_table[k];
+        if (*d->name)
+            fprintf(o, "    \"%s\": (\"%s\", \"%s\", \"%s\"),\n", d->name, d->unit, components(d), d->meaning);
+    }
     fprintf(o, "}\n%s\n", END_MARK);
+}
+
+/* The generated table of docs/output.md, markers included. */
+static void write_doc_block(FILE *o)
+{
+    fprintf(o,
+            "%s from kernels/observables.def by tests/unit/test_runfile_layout.c (--write docs/output.md) -->\n"
+            "| name | unit | components | meaning |\n|---|---|---|---|\n",
+            DOC_BEGIN_MARK);
+    for (int k = 0; k < CD_OBSERVABLE_COUNT; k++) {
+        const cd_observable_desc *d = &cd_observable_table[k];
+        if (*d->name) fprintf(o, "| `%s` | %s | %s | %s |\n", d->name, d->unit, components(d), d->meaning);
+    }
+    fprintf(o, "%s\n", DOC_END_MARK);
 }
 
 static char *slurp(const char *path, size_t *len)
@@ -97,11 +134,11 @@ static char *slurp(const char *path, size_t *len)
 
 /* The module's text with the block between (and including) the markers
  * replaced by block; NULL when the markers are missing. */
-static char *with_block(const char *text, const char *block)
+static char *with_block(const char *text, const char *block, const char *begin, const char *end)
 {
-    const char *b = strstr(text, BEGIN_MARK), *e = b ? strstr(b, END_MARK) : NULL;
+    const char *b = strstr(text, begin), *e = b ? strstr(b, end) : NULL;
     if (!b || !e) return NULL;
-    e += strlen(END_MARK);
+    e += strlen(end);
     if (*e == '\n') e++;
     size_t nb = (size_t)(b - text), nblock = strlen(block), ne = strlen(e);
     char *out = malloc(nb + nblock + ne + 1);
@@ -112,39 +149,52 @@ static char *with_block(const char *text, const char *block)
     return out;
 }
 
-static char *block_text(void)
+static char *block_text(void (*write)(FILE *))
 {
     char *buf = NULL;
     size_t len = 0;
     FILE *m = open_memstream(&buf, &len);
     assert_non_null(m);
-    write_block(m);
+    write(m);
     fclose(m);
     return buf;
+}
+
+/* A file of the source folder whose block between begin and end must be
+ * what write gives. */
+static void check_generated(const char *file, void (*write)(FILE *), const char *begin, const char *end)
+{
+    const char *src = getenv("CAPDEM_SOURCE_DIR");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", src ? src : CAPDEM_SOURCE_DIR, file);
+    size_t n;
+    char *text = slurp(path, &n), *block = block_text(write);
+    if (!text) fail_msg("cannot read %s", path);
+    char *want = with_block(text, block, begin, end);
+    if (!want) fail_msg("%s: no '%s' ... '%s' block", path, begin, end);
+    if (strcmp(want, text)) {
+        const char *a = text, *b = want;
+        int line = 1;
+        for (; *a && *a == *b; a++, b++) line += *a == '\n';
+        fail_msg("%s differs from the tables in kernels/ from line %d: regenerate it with "
+                 "build/tests/test_runfile_layout --write %s",
+                 path, line, file);
+    }
+    free(want);
+    free(block);
+    free(text);
 }
 
 static void test_python_module_is_generated(void **state)
 {
     (void)state;
-    const char *src = getenv("CAPDEM_SOURCE_DIR");
-    char path[4096];
-    snprintf(path, sizeof path, "%s/host/capdem_h5.py", src ? src : CAPDEM_SOURCE_DIR);
-    size_t n;
-    char *text = slurp(path, &n), *block = block_text();
-    if (!text) fail_msg("cannot read %s", path);
-    char *want = with_block(text, block);
-    if (!want) fail_msg("%s: no '%s' ... '%s' block", path, BEGIN_MARK, END_MARK);
-    if (strcmp(want, text)) {
-        const char *a = text, *b = want;
-        int line = 1;
-        for (; *a && *a == *b; a++, b++) line += *a == '\n';
-        fail_msg("%s differs from kernels/runfile.def + fields.def from line %d: regenerate it with "
-                 "build/tests/test_runfile_layout --write host/capdem_h5.py",
-                 path, line);
-    }
-    free(want);
-    free(block);
-    free(text);
+    check_generated("host/capdem_h5.py", write_block, BEGIN_MARK, END_MARK);
+}
+
+static void test_docs_table_is_generated(void **state)
+{
+    (void)state;
+    check_generated("docs/output.md", write_doc_block, DOC_BEGIN_MARK, DOC_END_MARK);
 }
 
 /* ---- the table against a written file ------------------------------------ */
@@ -197,8 +247,16 @@ static void test_written_file_matches_table(void **state)
     const char *path = "test_runfile_layout.h5";
     cdt_setup(&sim, &cfg, small_run);
     cdt_step(&sim, 10);
-    cd_output *o = cd_output_create(path, &cfg, sim.shapes, sim.n_shapes, NULL, 0, err, sizeof err);
+    /* the time series `capdem run` writes, one row */
+    cd_observable_info info[CD_OBSERVABLE_COUNT];
+    int n_obs = cd_observable_series(&sim, info);
+    double row[CD_OBS_ROW_MAX];
+    cd_observables obs;
+    cd_sim_observe(&sim, &obs);
+    cd_observable_row(&sim, &obs, row);
+    cd_output *o = cd_output_create(path, &cfg, sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
     if (!o) fail_msg("%s", err);
+    assert_int_equal(cd_output_thermo(o, sim.s.step, sim.s.time, row), 0);
     assert_int_equal(cd_output_snapshot(o, &sim.s), 0);
     /* the commit journal beside the file, under the table's name, while the file is open */
     char journal[CDH5_PATH_LEN];
@@ -253,6 +311,28 @@ static void test_written_file_matches_table(void **state)
     assert_int_equal(w.type, CD_WALL_PLANE);
     H5Dclose(d);
     H5Tclose(t);
+    /* every named observable of kernels/observables.def: one row, its unit,
+     * its components for the run's walls (here one plane) */
+    int named = 0;
+    for (int k = 0; k < CD_OBSERVABLE_COUNT; k++) {
+        const cd_observable_desc *od = &cd_observable_table[k];
+        if (!*od->name) continue;
+        char p[CDH5_PATH_LEN];
+        snprintf(p, sizeof p, "%s/%s/%s", CDH5_PATH(OBSERVABLES), od->name, CDH5_NAME(VALUE));
+        hid_t v = cdh5_exists(f, p) ? H5Dopen2(f, p, H5P_DEFAULT) : -1;
+        if (v < 0) fail_msg("time series %s (%s) is missing", p, od->id);
+        check_unit(v, p, od->unit);
+        hsize_t dims[2] = {0, 1};
+        hid_t sp = H5Dget_space(v);
+        int rank = H5Sget_simple_extent_dims(sp, dims, NULL);
+        H5Sclose(sp);
+        H5Dclose(v);
+        int want = cd_observable_ncomp(k, sim.s.n_walls);
+        if (dims[0] != 1 || rank != (want > 1 ? 2 : 1) || (int)dims[1] != want)
+            fail_msg("%s: %d rows of %d components, expected 1 of %d", p, (int)dims[0], (int)dims[1], want);
+        named++;
+    }
+    assert_int_equal(named, n_obs);
     /* the commit record */
     assert_int_equal(cdh5_committed(f, path, err, sizeof err), 1);
     H5Fclose(f);
@@ -264,9 +344,11 @@ static void test_written_file_matches_table(void **state)
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--write")) {
-        size_t n;
-        char *text = slurp(argv[2], &n), *block = block_text();
-        char *out = text ? with_block(text, block) : NULL;
+        size_t n, len = strlen(argv[2]);
+        int doc = len > 3 && !strcmp(argv[2] + len - 3, ".md"); /* docs/output.md, else host/capdem_h5.py */
+        char *text = slurp(argv[2], &n), *block = block_text(doc ? write_doc_block : write_block);
+        char *out =
+            text ? with_block(text, block, doc ? DOC_BEGIN_MARK : BEGIN_MARK, doc ? DOC_END_MARK : END_MARK) : NULL;
         FILE *f = out ? fopen(argv[2], "wb") : NULL;
         if (!f || fputs(out, f) < 0 || fclose(f)) {
             fprintf(stderr, "test_runfile_layout: cannot rewrite the generated block of %s\n", argv[2]);
@@ -277,6 +359,7 @@ int main(int argc, char **argv)
     }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_python_module_is_generated),
+        cmocka_unit_test(test_docs_table_is_generated),
         cmocka_unit_test(test_written_file_matches_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

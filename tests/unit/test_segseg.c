@@ -1,5 +1,5 @@
 /* Unit tests of the segment-segment narrow phase (kernels/segseg.h,
- * SPEC section 2) and an OpenCL C 1.2 syntax check of the geometry headers. */
+ * docs/references.md, Contacts) and an OpenCL C 1.2 syntax check of the geometry headers. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>

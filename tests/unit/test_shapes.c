@@ -1,5 +1,5 @@
 /* Shape catalogue: closed forms, the numerical union method, the principal
- * frame of general segment lists, Table S1 of seed 000, errors and JSON. */
+ * frame of general segment lists, Table S1 of Conzelmann et al., errors and JSON. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -271,7 +271,7 @@ static void test_irregular_cluster_area_and_volume_are_consistent(void **state)
     check_abs(p.volume, box * f, 4 * box * sqrt(f * (1 - f) / N), "irregular cluster volume (Monte Carlo, 4 sigma)");
 }
 
-/* ---- Table S1 of seed 000 --------------------------------------------- */
+/* ---- Table S1 of Conzelmann et al. --------------------------------------------- */
 
 /* Sphericity of crosses and stars against Table S1 (3 decimals).  Where the
  * exact value differs, the row says what this code gives (docs/shapes.md):
@@ -539,7 +539,7 @@ static void test_species_dispatch_on_shape(void **state)
     (void)state;
     cd_species_config sp;
     memset(&sp, 0, sizeof sp);
-    snprintf(sp.shape, sizeof sp.shape, "cross");
+    sp.shape = CD_SHAPE_CROSS;
     sp.aspect = 2.5;
     sp.diameter = 0.004;
     cd_shape s1, s2;
@@ -548,7 +548,7 @@ static void test_species_dispatch_on_shape(void **state)
     assert_int_equal(cd_shape_make_named("cross", 2.5, 0.004, 900, &s2, err, sizeof err), 0);
     assert_true(s1.volume == s2.volume && s1.principal[2] == s2.principal[2]);
 
-    snprintf(sp.shape, sizeof sp.shape, "segments");
+    sp.shape = CD_SHAPE_SEGMENTS;
     sp.n_segments = 2;
     const double a[2][3] = {{-0.01, 0, 0}, {0, -0.006, 0.002}}, b[2][3] = {{0.01, 0, 0}, {0, 0.006, 0.002}};
     for (int k = 0; k < 2; k++)

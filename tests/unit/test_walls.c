@@ -1,4 +1,4 @@
-/* Unit tests of the wall contacts (kernels/walls.h, SPEC section 2 "Walls")
+/* Unit tests of the wall contacts (kernels/walls.h, docs/references.md, Contacts "Walls")
  * against hand-computed overlaps, points and normals. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -58,7 +58,7 @@ static void test_plane_tilted_segment_touches_with_lower_end(void **state)
     cd_wall_contact(&w, cd_v3(0, 0, 0.4), cd_v3(2 * cos(5 * DEG), 0, 0.4 + 2 * sin(5 * DEG)), 0.5, SIN2DEG, &g);
     assert_int_equal(g.parallel, 0);
     assert_true(dist(g.point, cd_v3(0, 0, -0.05)) < 1e-15);
-    /* 3 degrees, above the cut-off: seed 000's rule takes the end point;
+    /* 3 degrees, above the cut-off: Conzelmann et al.'s rule takes the end point;
      * with material.parallel_blend (between the cut-off and twice it) the
      * end point's contact point (0, 0, -0.05) is mixed with the middle's, the
      * foot of the middle (cos 3, 0, 0) pushed overlap/2 = 0.05 into the

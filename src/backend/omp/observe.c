@@ -24,20 +24,18 @@ static obs_blocks count_blocks(const cd_state *s)
     return n;
 }
 
-static void unpack(const cd_state *s, const double *t, cd_observables *o)
+/* The merged slots into cd_observables: one member per SUM or MAX row of
+ * kernels/observables.def, all of its slots (those of walls a run does not
+ * have hold 0). */
+static void unpack(const double *t, cd_observables *o)
 {
-    memset(o, 0, sizeof(*o));
-    o->kinetic_translational = t[CD_OBS_KT];
-    o->kinetic_rotational = t[CD_OBS_KR];
-    o->kinetic_in_contact = t[CD_OBS_KC];
-    o->elastic = t[CD_OBS_EL];
-    o->potential = t[CD_OBS_PE];
-    o->n_contacts = t[CD_OBS_NC];
-    o->n_wall_contacts = t[CD_OBS_NW];
-    for (int k = 0; k < 3; k++) o->momentum[k] = t[CD_OBS_PX + k];
-    for (size_t w = 0; w < s->n_walls; w++)
-        for (int k = 0; k < 3; k++) o->wall_force[w][k] = t[CD_OBS_WALL + 3 * w + k];
-    o->max_overlap_ratio = t[CD_OBS_MAXOV];
+#define CD_OBS_UNPACK_(id, member)    memcpy(&o->member, &t[CD_OBS_##id], sizeof o->member);
+#define CD_OBS_UNPACK_SUM(id, member) CD_OBS_UNPACK_(id, member)
+#define CD_OBS_UNPACK_MAX(id, member) CD_OBS_UNPACK_(id, member)
+#define CD_OBS_UNPACK_WALLS(id, member)
+#define CD_OBS_UNPACK_PROTOCOL(id, member)
+#define CD_OBSERVABLE(id, name, unit, count, source, member, meaning) CD_OBS_UNPACK_##source(id, member)
+#include "observables.def"
 }
 
 void cd_observables_slots(const cd_sim *sim, double *total)
@@ -80,7 +78,7 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o)
 {
     double total[CD_OBS_SLOTS];
     cd_observables_slots(sim, total);
-    unpack(&sim->s, total, o);
+    unpack(total, o);
 }
 
 #if CD_OFFLOAD
@@ -142,7 +140,7 @@ int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen
     if (sim->backend && sim->backend->observe) {
         double t[CD_OBS_SLOTS];
         if (sim->backend->observe(sim, t, err, errlen)) return -1;
-        unpack(&sim->s, t, o);
+        unpack(t, o);
         return 0;
     }
     if (cd_sim_sync(sim, err, errlen)) return -1;

@@ -51,7 +51,7 @@ enum cd_cl_kernel {
  * cd_fields[] and of the kernels' column parameters; the device columns
  * only, which come first in cd_fields[] (kernels/field_groups.h). */
 enum {
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_CL_F_##name, )
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_CL_F_##name CD_COMMA)
 #include "fields.def"
 #undef CD_FIELD
     CD_CL_N_FIELDS
@@ -129,6 +129,11 @@ extern const int cd_cl_n_sources;
 int cd_cl_open(cd_cl *cl, const char *device_request, char *err, size_t errlen);
 void cd_cl_close(cd_cl *cl);
 const char *cd_cl_error_name(cl_int code);
+/* The program text cd_cl_open builds: the kernels of kernels/cl/ with
+ * their includes expanded (malloc'd; the caller frees it), or NULL with
+ * err.  tests/backend/test_cl_strict.sh compiles it with Clang's strict
+ * OpenCL C 1.2 (what NVIDIA's compiler refuses, PoCL may accept). */
+char *cd_cl_program_source(char *err, size_t errlen);
 /* Records the first failure; returns nonzero once any call has failed. */
 int cd_cl_check(cd_cl *cl, cl_int rc, const char *what);
 /* Formats the recorded failure into err. */

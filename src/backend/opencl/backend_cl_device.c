@@ -376,25 +376,32 @@ static int choose_device(cd_cl *cl, const char *request, char *err, size_t errle
     return -1;
 }
 
-static int build_program(cd_cl *cl, char *err, size_t errlen)
+/* The whole program text the OpenCL backend builds (backend_cl.h). */
+char *cd_cl_program_source(char *err, size_t errlen)
 {
     strbuf src = {0};
     for (int i = 0; i < cd_cl_n_sources; i++) {
         if (!cd_cl_sources[i].program) continue;
         if (expand(&src, cd_cl_sources[i].name, 0, err, errlen)) {
             free(src.p);
-            return -1;
+            return NULL;
         }
     }
     if (src.oom || !src.p) {
         free(src.p);
         snprintf(err, errlen, "OpenCL: out of memory assembling the kernel sources");
-        return -1;
+        return NULL;
     }
-    const char *text = src.p;
+    return src.p;
+}
+
+static int build_program(cd_cl *cl, char *err, size_t errlen)
+{
+    char *text = cd_cl_program_source(err, errlen);
+    if (!text) return -1;
     cl_int rc;
-    cl->program = clCreateProgramWithSource(cl->ctx, 1, &text, NULL, &rc);
-    free(src.p);
+    cl->program = clCreateProgramWithSource(cl->ctx, 1, (const char **)&text, NULL, &rc);
+    free(text);
     if (rc != CL_SUCCESS) {
         snprintf(err, errlen, "OpenCL: creating the program failed with %s (%d)", cd_cl_error_name(rc), (int)rc);
         return -1;
