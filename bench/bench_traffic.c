@@ -46,10 +46,10 @@ void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS])
     /* gather and second kick (cd_item_gather, cd_item_kick): per particle
      * m, x, its two CSR starts (40) and v, L, q, I (104); per wall
      * candidate its entry and flag (8), per active wall row force and torque
-     * (48); per pair row two entries and two flag reads (16); per active
-     * row force and point from each side (2 x 48); writes F, T, v, L,
-     * omega. */
-    out[3] = (cd_traffic){"gather_kick", N * 144 + C * 8 + Aw * 48 + R * 16 + A * 96, N * 120};
+     * (48); per pair row two entries (8) and, active or not (an inactive
+     * row adds its zero force: no branch), its force and point from each
+     * side (2 x 48); writes F, T, v, L, omega. */
+    out[3] = (cd_traffic){"gather_kick", N * 144 + C * 8 + Aw * 48 + R * 8 + R * 96, N * 120};
     /* the blow-up check at the end of cd_sim_step (x, v, L), amortised
      * over the steps of one call: counted once per step as an upper bound */
     out[4] = (cd_traffic){"finite_check", N * 72, 0};

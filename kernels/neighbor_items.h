@@ -213,7 +213,9 @@ CD_INLINE void cd_nb_item_place(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_int 
 
 /* Pass 8: history of new row k: the old row with the same key keeps its
  * activity and tangential spring [m]; a pair new to the list starts
- * without history.  prim_src: the memory slot each primitive had when the
+ * without history.  Force and point start at zero in every row: the
+ * gather adds every row's force, and a row that is not active must add a
+ * zero (cd_item_pair_force keeps it so).  prim_src: the memory slot each primitive had when the
  * old rows were made (null: the same; src/backend/omp/reorder.c), so that the key is
  * looked up as the old rows wrote it. */
 CD_INLINE void cd_nb_item_carry(cd_cols c, cd_long k, const CD_GLOBAL cd_ulong *keys,
@@ -225,6 +227,8 @@ CD_INLINE void cd_nb_item_carry(cd_cols c, cd_long k, const CD_GLOBAL cd_ulong *
     cd_long o = cd_bp_find_key(old_keys, n_old, key);
     c.pair_active[k] = o >= 0 ? old_active[o] : 0;
     c.pair_shear[k] = o >= 0 ? old_shear[o] : cd_v3_zero();
+    c.pair_force[k] = cd_v3_zero();
+    c.pair_point[k] = cd_v3_zero();
 }
 
 /* Pass 9a: row k counts once in each of its two particles' lists. */

@@ -50,12 +50,71 @@ CD_INLINE cd_wall cd_wall_advanced(cd_wall w, cd_real dt)
     return w;
 }
 
+/* Are both body-frame ends a, b the body origin (every component a zero
+ * of either sign)?  One test of a sum of magnitudes, which is zero only
+ * when every term is (a sum of non-negative numbers does not underflow to
+ * zero): fewer instructions than six compared components. */
+CD_INLINE int cd_ends_at_origin(cd_vec3 a, cd_vec3 b)
+{
+    return fabs(a.x) + fabs(a.y) + fabs(a.z) + fabs(b.x) + fabs(b.y) + fabs(b.z) == CD_R(0);
+}
+
+/* World axis ends *a, *b of primitive i for its particle's pose (centre x
+ * [m], orientation o).  A primitive whose body-frame ends are both the
+ * body origin (a sphere's ball) has both ends at x: the rotation of a zero
+ * vector is a zero, and x plus a zero is x (but for the sign of a zero
+ * coordinate of x), so the two rotations are skipped (docs/performance.md,
+ * "The sphere step"). */
+CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd_vec3 *a, cd_vec3 *b)
+{
+    cd_vec3 a_body = c.prim_a_body[i], b_body = c.prim_b_body[i];
+    if (cd_ends_at_origin(a_body, b_body)) {
+        *a = x;
+        *b = x;
+        return;
+    }
+    *a = cd_rigid_to_world(x, o, a_body);
+    *b = cd_rigid_to_world(x, o, b_body);
+}
+
 /* World axis ends of primitive i from its particle's pose. */
 CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
 {
     cd_particle_id p = c.prim_particle[i];
-    c.prim_a[i] = cd_rigid_to_world(c.position[p], c.orientation[p], c.prim_a_body[i]);
-    c.prim_b[i] = cd_rigid_to_world(c.position[p], c.orientation[p], c.prim_b_body[i]);
+    cd_vec3 a, b;
+    cd_prim_ends_at(c, i, c.position[p], c.orientation[p], &a, &b);
+    c.prim_a[i] = a;
+    c.prim_b[i] = b;
+}
+
+/* cd_item_advance for particle q whose velocity v [m/s], angular momentum
+ * L [kg m^2/s], force F [N], torque T [N m] and mass m [kg] the caller has
+ * already read (or just computed): the state is read once and written
+ * once, in locals between, which the compiler cannot do across the
+ * columns' stores (any column may alias any other for it).  The kick's own
+ * angular velocity is not formed: the drift's replaces it. */
+CD_INLINE int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_vec3 L, cd_vec3 F, cd_vec3 T, cd_real m,
+                              cd_real dt, cd_real limit2)
+{
+    cd_vec3 x = c.position[q], w;
+    cd_quat o = c.orientation[q];
+    cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
+    cd_rigid_drift_angvel(&x, &o, &w, v, L, c.inertia[q], dt);
+    c.velocity[q] = v;
+    c.angmom[q] = L;
+    c.position[q] = x;
+    c.orientation[q] = o;
+    c.angvel[q] = w;
+    int moved = 0;
+    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
+    for (cd_int i = first; i < last; i++) {
+        cd_vec3 a, b;
+        cd_prim_ends_at(c, i, x, o, &a, &b);
+        c.prim_a[i] = a;
+        c.prim_b[i] = b;
+        moved |= cd_bp_moved(a, c.prim_a_ref[i], b, c.prim_b_ref[i], limit2);
+    }
+    return moved;
 }
 
 /* Steps 1-4 of particle q in one pass over its data: the first half kick
@@ -67,15 +126,7 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
  * (docs/performance.md, "Bytes per step"). */
 CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real limit2)
 {
-    cd_item_kick(c, q, CD_R(0.5) * dt);
-    cd_item_drift(c, q, dt);
-    int moved = 0;
-    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
-    for (cd_int i = first; i < last; i++) {
-        cd_item_prim_ends(c, i);
-        moved |= cd_bp_moved(c.prim_a[i], c.prim_a_ref[i], c.prim_b[i], c.prim_b_ref[i], limit2);
-    }
-    return moved;
+    return cd_advance_from(c, q, c.velocity[q], c.angmom[q], c.force[q], c.torque[q], c.mass[q], dt, limit2);
 }
 
 /* Contact geometry of pair row k (docs/references.md, Contacts): closest points of the two axes
@@ -127,13 +178,15 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
         if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, &g);
     }
     if (apart || !(g.overlap > 0)) {
-        /* Separated: the contact and its history end.  An inactive row is
-         * read by nobody but its own next step and the history carry-over
-         * (every reader checks pair_active), so it is written only when it
-         * changes, to spare the bandwidth. */
+        /* Separated: the contact and its history end.  An inactive row
+         * holds a zero force (the gather adds it) and a finite point, and
+         * is otherwise read by nobody but its own next step and the history
+         * carry-over, so it is written only when it changes, to spare the
+         * bandwidth. */
         if (c.pair_active[k]) {
             c.pair_active[k] = 0;
             c.pair_shear[k] = cd_v3_zero();
+            c.pair_force[k] = cd_v3_zero();
             c.pair_fn[k] = 0;
             c.pair_overlap[k] = 0;
         }
@@ -222,7 +275,8 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
     return n;
 }
 
-/* Total force and torque of particle q: gravity [m/s^2] times its mass,
+/* Total force *F_out [N] and torque *T_out [N m] of particle q (mass m
+ * [kg], centre x [m]): gravity [m/s^2] times its mass,
  * then its wall contacts (its candidate rows wall_rows[wall_start[q] ..
  * wall_start[q+1]), ascending, i.e. primitive by primitive and wall by
  * wall), then its pair rows in ascending row order, so the sum has one
@@ -231,11 +285,12 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
  * pair row k: side 1 when q owns the row's primitive j (it gets +F_j), 0
  * when it owns primitive i (it gets -F_j), so the gather reads only the
  * row's force and point.  dimension 2 keeps the motion in the x-y plane. */
-CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
-                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                              const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension)
+CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, const CD_GLOBAL cd_int *gather_start,
+                             const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
+                             const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_vec3 *F_out,
+                             cd_vec3 *T_out)
 {
-    cd_vec3 F = cd_v3_scale(gravity, c.mass[q]);
+    cd_vec3 F = cd_v3_scale(gravity, m);
     cd_vec3 T = cd_v3_zero();
     for (cd_int r = wall_start[q]; r < wall_start[q + 1]; r++) {
         cd_int row = wall_rows[r];
@@ -243,18 +298,19 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
         F = cd_v3_add(F, c.wallc_force[row]);
         T = cd_v3_add(T, c.wallc_torque[row]);
     }
-    cd_vec3 x = c.position[q];
     for (cd_int r = gather_start[q]; r < gather_start[q + 1]; r++) {
         cd_pair_id e = gather_rows[r], k = e >> 1;
-        if (!c.pair_active[k]) continue;
-        cd_vec3 fj = c.pair_force[k];
-        if (e & 1) {
-            F = cd_v3_add(F, fj);
-            T = cd_v3_add(T, cd_contact_torque(c.pair_point[k], x, fj));
-        } else {
-            F = cd_v3_sub(F, fj);
-            T = cd_v3_add(T, cd_contact_torque(c.pair_point[k], x, cd_v3_neg(fj)));
-        }
+        /* Every row, without a branch: an inactive row adds a zero force
+         * (cd_nb_item_carry, cd_item_pair_force) and a zero torque, which
+         * leave F and T as they are (F + 0 is F, but for a sum that is -0,
+         * which only a gravity component written as -0 starts; T starts at
+         * +0 and never becomes -0).  +F_j or -F_j by a factor +-1 (exact:
+         * F + (-f) is F - f).  Branches on the row's activity and side
+         * follow no pattern: they were mispredicted about three times per
+         * particle-step (callgrind --branch-sim, 10,000 spheres). */
+        cd_vec3 f = cd_v3_scale(c.pair_force[k], (cd_real)(2 * (e & 1) - 1));
+        F = cd_v3_add(F, f);
+        T = cd_v3_add(T, cd_contact_torque(c.pair_point[k], x, f));
     }
     if (dimension == 2) {
         /* Crosses in the x-y plane: no out-of-plane force or tilt. */
@@ -262,8 +318,42 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
         T.x = 0;
         T.y = 0;
     }
+    *F_out = F;
+    *T_out = T;
+}
+
+/* cd_gather_sum for particle q, stored as its force and torque. */
+CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
+                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
+                              const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension)
+{
+    cd_vec3 F, T;
+    cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_rows, gravity, dimension,
+                  &F, &T);
     c.force[q] = F;
     c.torque[q] = T;
+}
+
+/* cd_item_gather, then the second half kick over dt/2 (cd_item_kick) and,
+ * with next = 1, the next step's cd_item_advance (returns its skin test),
+ * all on particle q's state read once (cd_advance_from): the same
+ * arithmetic in the same order as the three items one after the other. */
+CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
+                                          const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
+                                          const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension,
+                                          cd_real dt, cd_real limit2, int next)
+{
+    cd_real m = c.mass[q];
+    cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
+    cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_rows, gravity, dimension, &F, &T);
+    c.force[q] = F;
+    c.torque[q] = T;
+    cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
+    if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2);
+    c.velocity[q] = v;
+    c.angmom[q] = L;
+    c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, c.inertia[q]);
+    return 0;
 }
 
 /* Primitives per chunk of a wall-load sum: the load of a wall is the sum,

@@ -3,7 +3,7 @@
 
     /usr/bin/python3 bench/lammps/compare.py [--build build] [--cases spheres:1000,hexapods_a3:1000:100]
         [--peers lammps,liggghts] [--threads 2] [--steps 1000] [--repeat 3] [--peer-warm 200]
-        [--relax-steps 200] [--work build/bench-work] [--reuse]
+        [--relax-steps 200] [--work build/bench-work] [--reuse] [--baseline OTHER_BUILD]
 
 For each case:N[:PEER_STEPS][@KXxKZ], in one invocation (PEER_STEPS: the
 length of the peers' timed segments, default --steps; shorter ones for the
@@ -42,6 +42,10 @@ LAMMPS: loop time x "% CPU use" x ranks; LIGGGHTS: rank 0's CPU time
 around the timed run, cpu_stamp.sh, x ranks), which other jobs on a shared
 machine disturb much less; with 2 ranks LAMMPS's CPU time includes MPI's
 busy waiting, so that ratio is clean with --threads 1 only.
+
+--baseline OTHER_BUILD times that build's capdem-bench too, right after
+capdem in every round on the same packing (a change measured against the
+build before it, beside the peers; the table's last row per case).
 
 Installs LAMMPS (Debian package `lammps`) with apt-get if `lmp` is missing,
 and LIGGGHTS (`liggghts`) if `liggghts` is missing and a sphere case asks for it.
@@ -87,8 +91,8 @@ def lammps_version():
     return m.group(1).strip() if m else "unknown"
 
 
-def capdem_bench(args, extra):
-    cmd = [os.path.join(args.build, "capdem-bench"), "--threads", str(args.threads)] + extra
+def capdem_bench(args, extra, build=None):
+    cmd = [os.path.join(build or args.build, "capdem-bench"), "--threads", str(args.threads)] + extra
     env = dict(os.environ, OMP_WAIT_POLICY="PASSIVE")
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode:
@@ -170,10 +174,18 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
     nwarm = args.peer_warm  # a data file keeps no tangential history: let the springs build up again
     peers = [p for p in args.peers.split(",") if p and (p == "lammps" or case == "spheres")]
     lig_meta = liggghts_bench.convert(capdem_to_lammps.read_run(settled), w + "_liggghts") if "liggghts" in peers else None
+    base_rates, base_ratios, base_cpu = [], [], []
     capdem, rates, ratios, builds, cpu_ratios, lig_cpu, z = [], {p: [] for p in peers}, {p: [] for p in peers}, {p: [] for p in peers}, [], [], {}
     for r in range(args.repeat):
         c = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps), "--repeat", "1"])[0]
         capdem.append(c)
+        if args.baseline:
+            # another capdem build, timed in the same round on the same packing (capdem now / baseline)
+            b0 = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps),
+                                     "--repeat", "1"], build=args.baseline)[0]
+            base_rates.append(b0["particle_steps_per_s"])
+            base_ratios.append(c["particle_steps_per_s"] / b0["particle_steps_per_s"])
+            base_cpu.append(b0["cpu_s"] / c["cpu_s"])
         for peer in peers:
             if peer == "lammps":
                 timed, z[peer] = run_lammps(args, data, meta, w + ".lammps.log", 0, nwarm, nsteps=lammps_steps, nrepeat=1)
@@ -199,6 +211,11 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
         "packing": ("LAMMPS: its own, settled from capdem's initial lattice; LIGGGHTS: capdem's" if case == "spheres" and not tiled
                     else "capdem's settled packing" + (", tiled and relaxed" if tiled else "")),
     }
+    if args.baseline:
+        out.update(baseline_build=args.baseline, baseline_particle_steps_per_s=statistics.median(base_rates),
+                   baseline_repeats=base_rates, ratio_capdem_over_baseline=statistics.median(base_ratios),
+                   ratios_baseline=base_ratios, cpu_ratio_capdem_over_baseline=statistics.median(base_cpu),
+                   cpu_ratios_baseline=base_cpu)
     for peer in peers:
         out.update({
             peer + "_particle_steps_per_s": statistics.median(rates[peer]), peer + "_repeats": rates[peer],
@@ -230,6 +247,8 @@ def main():
                     help="steps a tiled packing relaxes (capdem) before timing (default: 20 ms, RELAX)")
     ap.add_argument("--peer-warm", type=int, default=200, help="untimed steps of a peer before each timed segment")
     ap.add_argument("--seed", type=int, default=5)
+    ap.add_argument("--baseline", default=None,
+                    help="another build folder whose capdem-bench is timed after capdem in every round (same packing)")
     ap.add_argument("--work", default="build/bench-work")
     ap.add_argument("--reuse", action="store_true", help="time capdem on a settled packing left by an earlier run")
     args = ap.parse_args()
@@ -269,6 +288,12 @@ def main():
                 r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], peer, r[peer + "_particle_steps_per_s"],
                 r["ratio_capdem_over_" + peer], min(q), max(q), r["cpu_ratio_capdem_over_" + peer], min(qc), max(qc),
                 r["capdem_neighbor_builds"], r[peer + "_neighbor_builds"]))
+        if "ratios_baseline" in r:
+            q, qc = r["ratios_baseline"], r["cpu_ratios_baseline"]
+            print("| %s | %d | %d | %.3g | capdem %s | %.3g | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) | |" % (
+                r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], r["baseline_build"],
+                r["baseline_particle_steps_per_s"], r["ratio_capdem_over_baseline"], min(q), max(q),
+                r["cpu_ratio_capdem_over_baseline"], min(qc), max(qc)))
     return 0
 
 

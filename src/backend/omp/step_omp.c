@@ -346,11 +346,9 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 {
     int moved = 0;
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
-    for (size_t q = 0; q < n; q++) {
-        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
-        cd_item_kick(c, (cd_particle_id)q, CD_R(0.5) * dt);
-        if (next) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
-    }
+    for (size_t q = 0; q < n; q++)
+        moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
+                                             d.wall_rows, g, dim, dt, limit2, next);
     return moved;
 }
 #endif
