@@ -75,7 +75,8 @@ typedef struct {
     double box_h0; /* distance of walls 0 and 1 at start [m] */
 
     cd_mpm_material mat;
-    double dt, time; /* [s] */
+    double pic_fraction; /* PIC share of the points' velocity update, the rest FLIP [1] (docs/mpm.md) */
+    double dt, time;     /* [s] */
     long long step;
 } cd_mpm;
 
