@@ -139,18 +139,19 @@ static double *read_rows(hid_t f, const char *path, const char *name, size_t row
 
 /* Everything the measures read from the run file. */
 typedef struct {
-    size_t rows, n, snaps;                    /* series rows, points, committed snapshots */
-    double *step, *phi, *sigma, *strain, *z;  /* series */
-    double *wall0;                            /* series row 0's wall positions (walls x 2) [m] */
-    int *particle;                            /* (n) */
-    double *sstep, *pos, *vol, *eps_p, *defg; /* snapshots: step, (S, n, 2), (S, n), (S, n), (S, n, 4) */
-    double *swall;                            /* snapshots' wall positions (S, 4, 2) [m] */
+    size_t rows, n, snaps;                   /* series rows, points, committed snapshots */
+    double *step, *phi, *sigma, *strain, *z; /* series */
+    double *wall0;                           /* series row 0's wall positions (walls x 2) [m] */
+    int *particle;                           /* (n) */
+    double *sstep, *stime;                   /* snapshots: step, time [s] */
+    double *pos, *vol, *eps_p, *defg;        /* snapshots: (S, n, 2) [m], (S, n) [m^3/m], (S, n), (S, n, 4) */
+    double *swall;                           /* snapshots' wall positions (S, 4, 2) [m] */
 } mpm_data;
 
 static void data_free(mpm_data *d)
 {
-    void *p[] = {d->step,  d->phi, d->sigma, d->strain, d->z,    d->wall0,
-                 d->sstep, d->pos, d->vol,   d->eps_p,  d->defg, d->swall};
+    void *p[] = {d->step,  d->phi, d->sigma, d->strain, d->z,    d->wall0, d->sstep,
+                 d->stime, d->pos, d->vol,   d->eps_p,  d->defg, d->swall};
     for (size_t i = 0; i < sizeof p / sizeof p[0]; i++) free(p[i]);
     free(d->particle);
     memset(d, 0, sizeof(*d));
@@ -207,6 +208,7 @@ static int data_read(const char *path, mpm_data *d, char *err, size_t errlen)
         !(d->z = read_rows(f, path, "/mpm/series/coordination", R, 1, err, errlen)) ||
         !(d->wall0 = read_rows(f, path, "/mpm/series/wall_position", 1, 8, err, errlen)) ||
         !(d->sstep = read_rows(f, path, "/mpm/snapshots/step", S, 1, err, errlen)) ||
+        !(d->stime = read_rows(f, path, "/mpm/snapshots/time", S, 1, err, errlen)) ||
         !(d->pos = read_rows(f, path, "/mpm/snapshots/position", S, 2 * n, err, errlen)) ||
         !(d->vol = read_rows(f, path, "/mpm/snapshots/volume", S, n, err, errlen)) ||
         !(d->eps_p = read_rows(f, path, "/mpm/snapshots/plastic_strain", S, n, err, errlen)) ||
@@ -309,7 +311,7 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
     r->snapshot = k;
     r->n_snapshots = (int)d.snaps;
     r->step = (long long)d.sstep[k];
-    r->time = NAN;
+    r->time = d.stime[k];
     cd_an_group *g = cd_an_group_get(r, "mpm");
     cd_an_put(g, "n_points", (double)d.n, "1");
     cd_an_put(g, "n_particles", (double)(d.particle[d.n - 1] + 1), "1");

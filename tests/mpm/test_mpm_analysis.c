@@ -134,13 +134,14 @@ static void write_run(const char *path)
     put(f, "/mpm/series/stress", H5T_NATIVE_DOUBLE, 1, dr, sig);
     put(f, "/mpm/series/wall_position", H5T_NATIVE_DOUBLE, 3, dr, wall);
     static int particle[n];
-    static double sstep[S], pos[S][n][2], vol[S][n], ep[S][n], F[S][n][4], swall[S][8];
+    static double sstep[S], stime[S], pos[S][n][2], vol[S][n], ep[S][n], F[S][n][4], swall[S][8];
     const int plastic[S] = {0, 30, 60, 120};
     for (int s = 0; s < S; s++) {
         double ph = pc * exp(plastic[s] / (double)n / 2.5), h = area / (W * ph);
         double w[8] = {0, 0, 0, h, 0, 0, W, 0};
         memcpy(swall[s], w, sizeof w);
         sstep[s] = 100.0 * s;
+        stime[s] = 1e-4 * s;
         for (int p = 0; p < n; p++) {
             int b = p / 100, q = p % 100;
             particle[p] = b;
@@ -155,6 +156,7 @@ static void write_run(const char *path)
     hsize_t dp[3] = {n, 1, 1}, dsn[3] = {S, n, 2}, ds4[3] = {S, n, 4}, dsw[3] = {S, 4, 2};
     put(f, "/mpm/points/particle", H5T_NATIVE_INT, 1, dp, particle);
     put(f, "/mpm/snapshots/step", H5T_NATIVE_DOUBLE, 1, dsn, sstep);
+    put(f, "/mpm/snapshots/time", H5T_NATIVE_DOUBLE, 1, dsn, stime);
     put(f, "/mpm/snapshots/position", H5T_NATIVE_DOUBLE, 3, dsn, pos);
     put(f, "/mpm/snapshots/volume", H5T_NATIVE_DOUBLE, 2, dsn, vol);
     put(f, "/mpm/snapshots/plastic_strain", H5T_NATIVE_DOUBLE, 2, dsn, ep);
@@ -177,6 +179,7 @@ static void test_synthetic_run(void **state)
     if (rc) fprintf(stderr, "%s\n", err);
     assert_int_equal(rc, 0);
     assert_int_equal(rep.snapshot, 3);
+    assert_true(rep.step == 300 && fabs(rep.time - 3e-4) < 1e-18);
     /* the last series row and snapshot */
     assert_true(fabs(cd_an_value(&rep, "mpm", "phi") - 0.95) < 1e-12);
     assert_true(fabs(cd_an_value(&rep, "mpm", "z") - (3 + 10 * sqrt(0.15))) < 1e-12);
