@@ -248,6 +248,7 @@ typedef struct {
     int quiet;                         /* 1: no text summary, no warnings on stderr */
     int timings;                       /* 1: wall-clock time of each phase on stderr */
     const char *phi_series, *z_series; /* observables for the jamming fit (NULL: known names) */
+    double phi_c;                      /* mpm: Phi_c of the fits of eqs. (5), (11); 0: eq. (17)'s */
 } cd_an_options;
 
 void cd_an_options_defaults(cd_an_options *o);

@@ -83,7 +83,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: capdem analyze RUN.h5 [--snapshot last|N] [--json] [--measures LIST] [--no-write]\n"
             "                      [--margins SIDE,END] [--rdf-max R] [--rdf-bin DR] [--mc-points M]\n"
-            "                      [--phi-series NAME] [--z-series NAME] [--quiet] [--timings]\n"
+            "                      [--phi-series NAME] [--z-series NAME] [--phi-c PHI] [--quiet] [--timings]\n"
             "  --snapshot N     snapshot index (0 first, -1 or last: the last; default last)\n"
             "  --json           print one JSON object on stdout (keys: docs/analysis.md)\n"
             "  --measures LIST  comma-separated subset, each of which must succeed (else exit 2), of\n"
@@ -96,6 +96,7 @@ static void usage(FILE *f)
             "  --rdf-bin DR     G(r) bin width in L (default 0.02)\n"
             "  --mc-points M    Monte Carlo points for the core packing fraction (default 1e6)\n"
             "  --phi-series, --z-series  observables for the jamming fit\n"
+            "  --phi-c PHI      mpm run files: Phi_c of the fits of eqs. (5) and (11) (default: eq. (17)'s)\n"
             "  --quiet          no summary and no warnings;  --timings  time of each phase on stderr\n"
             "exit status: 0 done, 2 bad input (missing file or data), 1 other failure\n",
             measure_list(names, sizeof names));
@@ -312,6 +313,12 @@ int cd_cmd_analyze(int argc, char **argv)
             if (!strcmp(a, "--rdf-max")) opt.rdf_max = v;
             else if (!strcmp(a, "--rdf-bin")) opt.rdf_bin = v;
             else opt.mc_points = (long)v;
+        } else if (!strcmp(a, "--phi-c") && more) {
+            if (parse_num(a, argv[++i], &v) || !(v > 0 && v < 1)) {
+                fprintf(stderr, "capdem analyze: --phi-c: expected a packing fraction in (0, 1)\n");
+                return 2;
+            }
+            opt.phi_c = v;
         } else if (!strcmp(a, "--phi-series") && more) {
             opt.phi_series = argv[++i];
         } else if (!strcmp(a, "--z-series") && more) {

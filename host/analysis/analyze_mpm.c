@@ -365,26 +365,29 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
         cd_an_put(g17, "n_points", (double)jf.n, "1");
         cd_an_put(g17, "rms_residual", sqrt(jf.chi2 / (double)jf.n), "1");
     }
-    /* eq. (5): sigma - sigma_c = M_eff (strain - strain_c) on the rows at or beyond Phi_c (eq. 17's) */
+    /* Phi_c of eqs. (5) and (11): --phi-c, else eq. (17)'s */
+    double pc = opt->phi_c > 0 ? opt->phi_c : fr ? NAN : jf.p[0];
+    const char *no_pc = "no Phi_c: eq. (17) did not fit (give it with --phi-c)";
+    /* eq. (5): sigma - sigma_c = M_eff (strain - strain_c) on the rows at or beyond Phi_c */
     cd_an_group *g5 = cd_an_group_get(r, "mpm_eq5");
     double sc = NAN, ec = NAN;
-    if (fr) cd_an_put_text(g5, "skipped", "no Phi_c: eq. (17) did not fit");
-    else if (at_phi(&d, jf.p[0], &sc, &ec))
-        cd_an_put_text(g5, "skipped", "the series does not reach Phi_c = %.4g", jf.p[0]);
+    if (!(pc > 0)) cd_an_put_text(g5, "skipped", "%s", no_pc);
+    else if (at_phi(&d, pc, &sc, &ec)) cd_an_put_text(g5, "skipped", "the series does not reach Phi_c = %.4g", pc);
     else {
         double *x = malloc(2 * d.rows * sizeof(double)), *y = x ? x + d.rows : NULL;
         size_t m = 0;
         for (size_t i = 1; x && i < d.rows; i++)
-            if (d.phi[i] >= jf.p[0]) {
+            if (d.phi[i] >= pc) {
                 x[m] = d.strain[i] - ec;
                 y[m] = d.sigma[i] - sc;
                 m++;
             }
         cd_an_linfit lf;
         if (!x || cd_an_fit_line(x, y, m, &lf))
-            cd_an_put_text(g5, "skipped", "fewer than 3 rows beyond Phi_c = %.4g", jf.p[0]);
+            cd_an_put_text(g5, "skipped", "fewer than 3 rows beyond Phi_c = %.4g", pc);
         else {
-            cd_an_put(g5, "phi_c", jf.p[0], "1");
+            cd_an_put_text(g5, "phi_c_from", "%s", opt->phi_c > 0 ? "--phi-c" : "eq. (17)");
+            cd_an_put(g5, "phi_c", pc, "1");
             cd_an_put(g5, "sigma_c", sc, "Pa");
             cd_an_put(g5, "strain_c", ec, "1");
             cd_an_put(g5, "m_eff", lf.slope, "Pa");
@@ -399,24 +402,24 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
     cd_an_group *g11 = cd_an_group_get(r, "mpm_eq11");
     double sxy = 0, sxx = 0, any = 0;
     size_t m = 0;
-    for (size_t s = 0; !fr && s < d.snaps; s++)
-        if (sphi[s] > jf.p[0]) {
-            double u = log(sphi[s] / jf.p[0]);
+    for (size_t s = 0; pc > 0 && s < d.snaps; s++)
+        if (sphi[s] > pc) {
+            double u = log(sphi[s] / pc);
             sxy += u * sfp[s];
             sxx += u * u;
             any += sfp[s];
             m++;
         }
-    if (fr || m < 2 || !(any > 0))
+    if (!(pc > 0) || m < 2 || !(any > 0))
         cd_an_put_text(g11, "skipped", "%s",
-                       fr      ? "no Phi_c: eq. (17) did not fit"
-                       : m < 2 ? "fewer than 2 snapshots beyond Phi_c"
-                               : "no plastic point (an elastic material)");
+                       !(pc > 0) ? no_pc
+                       : m < 2   ? "fewer than 2 snapshots beyond Phi_c"
+                                 : "no plastic point (an elastic material)");
     else {
         double alpha = sxy / sxx, ss = 0;
         for (size_t s = 0; s < d.snaps; s++)
-            if (sphi[s] > jf.p[0]) {
-                double e = sfp[s] - alpha * log(sphi[s] / jf.p[0]);
+            if (sphi[s] > pc) {
+                double e = sfp[s] - alpha * log(sphi[s] / pc);
                 ss += e * e;
             }
         double se = sqrt(ss / (double)(m - 1) / sxx), t = gsl_cdf_tdist_Pinv(0.975, (double)(m - 1));

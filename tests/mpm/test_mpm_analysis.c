@@ -200,6 +200,15 @@ static void test_synthetic_run(void **state)
     assert_true(cd_an_value(&rep, "mpm_eq5", "m_eff_lo") <= cd_an_value(&rep, "mpm_eq5", "m_eff"));
     /* eq. (11): alpha = 2.5 */
     assert_true(fabs(cd_an_value(&rep, "mpm_eq11", "alpha") / 2.5 - 1) < 1e-4);
+    /* Phi_c given (--phi-c): eqs. (5) and (11) use it, sigma_c and strain_c exact at 0.8 */
+    cd_an_report_free(&rep);
+    memset(&rep, 0, sizeof rep);
+    opt.phi_c = 0.8;
+    assert_int_equal(cd_an_mpm(path, &opt, &rep, err, sizeof err), 0);
+    assert_true(cd_an_value(&rep, "mpm_eq5", "phi_c") == 0.8);
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq5", "strain_c") - 0.1) < 1e-12);
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq5", "m_eff") / 2e6 - 1) < 1e-9);
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq11", "alpha") / 2.5 - 1) < 1e-9);
     /* a snapshot out of range is refused (exit 2) */
     cd_an_report_free(&rep);
     memset(&rep, 0, sizeof rep);

@@ -67,6 +67,11 @@ awk -v a="$(val z)" -v b="$(tail -1 z)" 'BEGIN { exit !(a != "" && (a - b)^2 < 1
 awk -v k="$(val kappa_d)" 'BEGIN { exit !(k >= 2 && k < 20) }' && ok || bad "analyze: kappa_d = $(val kappa_d)"
 h5ls -r an.h5 | grep -q "^/analysis/snapshot_[0-9]*/mpm/snapshots *Dataset" && ok \
   || bad "analyze wrote no /analysis/snapshot_*/mpm/snapshots into the run file"
+# eq. (5) with Phi_c given: a positive modulus M_eff inside its interval
+"$capdem" analyze an.h5 --no-write --phi-c 0.7 > out 2> err && awk '$1 == "m_eff" { m = $2 } $1 == "m_eff_lo" { lo = $2 }
+    $1 == "m_eff_hi" { hi = $2 } END { exit !(m > 0 && lo < m && m < hi) }' out && ok || bad "analyze --phi-c 0.7: no M_eff"
+"$capdem" analyze an.h5 --no-write --phi-c 1.5 > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q -- "--phi-c" err && ok || bad "analyze --phi-c 1.5: exit status $rc, expected 2"
 "$capdem" analyze deposit_disks_ci.h5 --measures mpm > out 2> err; rc=$?
 [ $rc = 2 ] && grep -q "not a run file of solver mpm" err && ok || bad "analyze --measures mpm of a DEM run: exit $rc"
 
