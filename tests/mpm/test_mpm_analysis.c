@@ -126,13 +126,6 @@ static void write_run(const char *path)
         double w[8] = {0, 0, 0, h, 0, 0, W, 0}; /* bottom, top, left, right */
         memcpy(wall[i], w, sizeof w);
     }
-    hsize_t dr[3] = {R, 4, 2};
-    put(f, "/mpm/series/step", H5T_NATIVE_DOUBLE, 1, dr, step);
-    put(f, "/mpm/series/packing_fraction", H5T_NATIVE_DOUBLE, 1, dr, phi);
-    put(f, "/mpm/series/strain", H5T_NATIVE_DOUBLE, 1, dr, eps);
-    put(f, "/mpm/series/coordination", H5T_NATIVE_DOUBLE, 1, dr, z);
-    put(f, "/mpm/series/stress", H5T_NATIVE_DOUBLE, 1, dr, sig);
-    put(f, "/mpm/series/wall_position", H5T_NATIVE_DOUBLE, 3, dr, wall);
     static int particle[n];
     static double sstep[S], stime[S], pos[S][n][2], vol[S][n], ep[S][n], F[S][n][4], swall[S][8];
     const int plastic[S] = {0, 30, 60, 120};
@@ -153,15 +146,31 @@ static void write_run(const char *path)
             F[s][p][1] = F[s][p][2] = 0;
         }
     }
-    hsize_t dp[3] = {n, 1, 1}, dsn[3] = {S, n, 2}, ds4[3] = {S, n, 4}, dsw[3] = {S, 4, 2};
+    hsize_t dp[3] = {n, 1, 1}, dr[3] = {R, 4, 2}, dsn[3] = {S, n, 2}, ds4[3] = {S, n, 4}, dsw[3] = {S, 4, 2};
     put(f, "/mpm/points/particle", H5T_NATIVE_INT, 1, dp, particle);
-    put(f, "/mpm/snapshots/step", H5T_NATIVE_DOUBLE, 1, dsn, sstep);
-    put(f, "/mpm/snapshots/time", H5T_NATIVE_DOUBLE, 1, dsn, stime);
-    put(f, "/mpm/snapshots/position", H5T_NATIVE_DOUBLE, 3, dsn, pos);
-    put(f, "/mpm/snapshots/volume", H5T_NATIVE_DOUBLE, 2, dsn, vol);
-    put(f, "/mpm/snapshots/plastic_strain", H5T_NATIVE_DOUBLE, 2, dsn, ep);
-    put(f, "/mpm/snapshots/deformation_gradient", H5T_NATIVE_DOUBLE, 3, ds4, F);
-    put(f, "/mpm/snapshots/wall_position", H5T_NATIVE_DOUBLE, 3, dsw, swall);
+    const struct {
+        const char *name;
+        int rank;
+        const hsize_t *dims;
+        const void *data;
+    } cols[] = {{"series/step", 1, dr, step},
+                {"series/packing_fraction", 1, dr, phi},
+                {"series/strain", 1, dr, eps},
+                {"series/coordination", 1, dr, z},
+                {"series/stress", 1, dr, sig},
+                {"series/wall_position", 3, dr, wall},
+                {"snapshots/step", 1, dsn, sstep},
+                {"snapshots/time", 1, dsn, stime},
+                {"snapshots/position", 3, dsn, pos},
+                {"snapshots/volume", 2, dsn, vol},
+                {"snapshots/plastic_strain", 2, dsn, ep},
+                {"snapshots/deformation_gradient", 3, ds4, F},
+                {"snapshots/wall_position", 3, dsw, swall}};
+    for (size_t k = 0; k < sizeof cols / sizeof cols[0]; k++) {
+        char name[96];
+        snprintf(name, sizeof name, "/mpm/%s", cols[k].name);
+        put(f, name, H5T_NATIVE_DOUBLE, cols[k].rank, cols[k].dims, cols[k].data);
+    }
     H5Fclose(f);
 }
 
