@@ -349,10 +349,10 @@ int cd_an_fit_cascade(const double *f, size_t n, cd_an_cascade_fit *out);
 int cd_an_fit_jamming(const double *phi, const double *z, size_t n, cd_an_nlfit *out);
 
 /* Ordinary least squares y = intercept + slope x: the slope's standard
- * error and 95% interval (Student's t, n - 2 degrees of freedom).  0, or -1
- * with fewer than 3 points or all x equal. */
+ * error and 95% interval, the intercept's 95% interval (Student's t, n - 2
+ * degrees of freedom).  0, or -1 with fewer than 3 points or all x equal. */
 typedef struct {
-    double slope, intercept, se, lo, hi;
+    double slope, intercept, se, lo, hi, intercept_lo, intercept_hi;
     size_t n;
     int dof;
 } cd_an_linfit;

@@ -48,6 +48,9 @@ int cd_an_fit_line(const double *x, const double *y, size_t n, cd_an_linfit *out
     double t = gsl_cdf_tdist_Pinv(0.975, out->dof);
     out->lo = out->slope - t * out->se;
     out->hi = out->slope + t * out->se;
+    double se0 = sqrt(ss / out->dof * (1.0 / (double)n + mx * mx / sxx)); /* the intercept's */
+    out->intercept_lo = out->intercept - t * se0;
+    out->intercept_hi = out->intercept + t * se0;
     return 0;
 }
 
@@ -350,11 +353,38 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
             cd_an_put(g, "kappa_d", kd, "1");
         }
     }
-    /* eq. (17): Z - Z_c = A sqrt(Phi - Phi_c), A = (Z_1 - Z_c) / sqrt(Phi_1 - Phi_c) */
+    /* eq. (17): Z - Z_c = A sqrt(Phi - Phi_c), A = (Z_1 - Z_c) / sqrt(Phi_1 - Phi_c); Phi_c fitted, or
+     * given (--phi-c): then a line in sqrt(Phi - Phi_c) */
     cd_an_nlfit jf;
-    int fr = cd_an_fit_jamming(d.phi, d.z, d.rows, &jf);
+    int fr = opt->phi_c > 0 ? 0 : cd_an_fit_jamming(d.phi, d.z, d.rows, &jf);
     cd_an_group *g17 = cd_an_group_get(r, "mpm_eq17");
-    if (fr) {
+    if (opt->phi_c > 0) {
+        double *x = malloc(2 * d.rows * sizeof(double)), *y = x ? x + d.rows : NULL;
+        size_t m = 0;
+        for (size_t i = 0; x && i < d.rows; i++)
+            if (d.phi[i] > opt->phi_c && d.z[i] > 0) {
+                x[m] = sqrt(d.phi[i] - opt->phi_c);
+                y[m++] = d.z[i];
+            }
+        cd_an_linfit lf;
+        if (!x || cd_an_fit_line(x, y, m, &lf))
+            cd_an_put_text(g17, "skipped", "fewer than 3 rows with Z > 0 beyond Phi_c = %.4g", opt->phi_c);
+        else {
+            double ss = 0;
+            for (size_t i = 0; i < m; i++) ss += pow(y[i] - lf.intercept - lf.slope * x[i], 2);
+            cd_an_put_text(g17, "phi_c_from", "--phi-c");
+            cd_an_put(g17, "phi_c", opt->phi_c, "1");
+            cd_an_put(g17, "z_c", lf.intercept, "1");
+            cd_an_put(g17, "z_c_lo", lf.intercept_lo, "1");
+            cd_an_put(g17, "z_c_hi", lf.intercept_hi, "1");
+            cd_an_put(g17, "amplitude", lf.slope, "1");
+            cd_an_put(g17, "amplitude_lo", lf.lo, "1");
+            cd_an_put(g17, "amplitude_hi", lf.hi, "1");
+            cd_an_put(g17, "n_points", (double)m, "1");
+            cd_an_put(g17, "rms_residual", sqrt(ss / (double)m), "1");
+        }
+        free(x);
+    } else if (fr) {
         cd_an_put_text(g17, "skipped", "%s",
                        fr == -1   ? "fewer than 5 states with Z > 0"
                        : fr == -2 ? "no convergence"

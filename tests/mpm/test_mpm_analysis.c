@@ -21,8 +21,9 @@
 static const double PI = 3.14159265358979323846;
 
 /* y = 3 + 2.5e5 x + uniform noise of +-1e3, 400 seeded draws of 200
- * points: the slope's 95% interval holds the truth in 92-98 % of them
- * (binomial: 95 % +- 3 x 1.1 %; measured 383 of 400), and the standard
+ * points: the slope's and the intercept's 95% intervals hold the truth in
+ * 92-98 % of them (binomial: 95 % +- 3 x 1.1 %; measured 383 and 383 of
+ * 400), and the slope's standard
  * error is the noise's sd (577 Pa) over sqrt(sum (x - mean)^2) within 15 %
  * on average (measured 0.996); exact data give the slope to round-off. */
 static void test_fit_line(void **state)
@@ -34,16 +35,18 @@ static void test_fit_line(void **state)
     for (int i = 0; i < n; i++) sxx += pow(x[i] - 0.0995, 2);
     cd_rng r;
     cd_rng_seed(&r, 5);
-    int cover = 0;
+    int cover = 0, cover0 = 0;
     double se = 0;
     cd_an_linfit f;
     for (int d = 0; d < draws; d++) {
         for (int i = 0; i < n; i++) y[i] = 3 + 2.5e5 * x[i] + 2e3 * (cd_rng_uniform(&r) - 0.5);
         assert_int_equal(cd_an_fit_line(x, y, n, &f), 0);
         cover += f.lo <= 2.5e5 && 2.5e5 <= f.hi;
+        cover0 += f.intercept_lo <= 3 && 3 <= f.intercept_hi;
         se += f.se / draws;
     }
     assert_true(cover >= 0.92 * draws && cover <= 0.98 * draws);
+    assert_true(cover0 >= 0.92 * draws && cover0 <= 0.98 * draws);
     assert_true(fabs(se / (577.35 / sqrt(sxx)) - 1) < 0.15);
     for (int i = 0; i < n; i++) y[i] = 3 + 2.5e5 * x[i];
     assert_int_equal(cd_an_fit_line(x, y, n, &f), 0);
@@ -218,6 +221,11 @@ static void test_synthetic_run(void **state)
     assert_true(fabs(cd_an_value(&rep, "mpm_eq5", "strain_c") - 0.1) < 1e-12);
     assert_true(fabs(cd_an_value(&rep, "mpm_eq5", "m_eff") / 2e6 - 1) < 1e-9);
     assert_true(fabs(cd_an_value(&rep, "mpm_eq11", "alpha") / 2.5 - 1) < 1e-9);
+    /* and eq. (17) is a line in sqrt(Phi - 0.8): Z_c and A exact, their intervals around them */
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq17", "z_c") - 3) < 1e-9);
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq17", "amplitude") - 10) < 1e-9);
+    assert_true(cd_an_value(&rep, "mpm_eq17", "z_c_lo") <= 3 + 1e-9 &&
+                cd_an_value(&rep, "mpm_eq17", "z_c_hi") >= 3 - 1e-9);
     /* a snapshot out of range is refused (exit 2) */
     cd_an_report_free(&rep);
     memset(&rep, 0, sizeof rep);
