@@ -367,6 +367,10 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
         m->y[p] += dt * uy;
     }
     remap_velocity(m);
+    double mesh_kinetic = 0; /* [J/m], summed in body-node order: the same bits for any thread count */
+    for (size_t t = 0; t < m->n_bnodes; t++)
+        mesh_kinetic += 0.5 * m->gm[t] * (m->gvx[t] * m->gvx[t] + m->gvy[t] * m->gvy[t]);
+    m->mesh_kinetic = mesh_kinetic;
     if (m->n_bodies > 1 && cd_mpm_contact_correct(m, 1, err, errlen)) return -1;
     /* points: velocity gradient, stress, deformation gradient and volume */
     long long bad = -1;
