@@ -374,12 +374,10 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
             for (size_t i = 0; i < m; i++) ss += pow(y[i] - lf.intercept - lf.slope * x[i], 2);
             cd_an_put_text(g17, "phi_c_from", "--phi-c");
             cd_an_put(g17, "phi_c", opt->phi_c, "1");
-            cd_an_put(g17, "z_c", lf.intercept, "1");
-            cd_an_put(g17, "z_c_lo", lf.intercept_lo, "1");
-            cd_an_put(g17, "z_c_hi", lf.intercept_hi, "1");
-            cd_an_put(g17, "amplitude", lf.slope, "1");
-            cd_an_put(g17, "amplitude_lo", lf.lo, "1");
-            cd_an_put(g17, "amplitude_hi", lf.hi, "1");
+            static const char *const names[2] = {"z_c", "amplitude"};
+            cd_an_nlfit two = {
+                .np = 2, .p = {lf.intercept, lf.slope}, .lo = {lf.intercept_lo, lf.lo}, .hi = {lf.intercept_hi, lf.hi}};
+            cd_an_put_fit(g17, names, &two);
             cd_an_put(g17, "n_points", (double)m, "1");
             cd_an_put(g17, "rms_residual", sqrt(ss / (double)m), "1");
         }
