@@ -232,7 +232,8 @@ enum {
     CD_AN_MODULUS = 1u << 7,    /* effective-medium K_t */
     CD_AN_COMPACTION = 1u << 8, /* time series: compaction curve */
     CD_AN_JAMMING = 1u << 9,    /* (Z - Z_c) ~ (Phi - Phi_c)^(1/2) fit */
-    CD_AN_ALL = (1u << 10) - 1
+    CD_AN_ALL = (1u << 10) - 1,
+    CD_AN_MPM = 1u << 10 /* run files of solver mpm (their only measure; not in CD_AN_ALL) */
 };
 
 typedef struct {
@@ -247,6 +248,7 @@ typedef struct {
     int quiet;                         /* 1: no text summary, no warnings on stderr */
     int timings;                       /* 1: wall-clock time of each phase on stderr */
     const char *phi_series, *z_series; /* observables for the jamming fit (NULL: known names) */
+    double phi_c;                      /* mpm: Phi_c of the fits of eqs. (5), (11); 0: eq. (17)'s */
 } cd_an_options;
 
 void cd_an_options_defaults(cd_an_options *o);
@@ -345,5 +347,27 @@ int cd_an_fit_cascade(const double *f, size_t n, cd_an_cascade_fit *out);
  * 5 jammed points; -2 no convergence; -3 the data do not resolve the law
  * (A <= 0, or Phi_c above the data or more than their range below). */
 int cd_an_fit_jamming(const double *phi, const double *z, size_t n, cd_an_nlfit *out);
+
+/* Ordinary least squares y = intercept + slope x: the slope's standard
+ * error and 95% interval, the intercept's 95% interval (Student's t, n - 2
+ * degrees of freedom).  0, or -1 with fewer than 3 points or all x equal. */
+typedef struct {
+    double slope, intercept, se, lo, hi, intercept_lo, intercept_hi;
+    size_t n;
+    int dof;
+} cd_an_linfit;
+int cd_an_fit_line(const double *x, const double *y, size_t n, cd_an_linfit *out);
+
+/* The material point method (host/analysis/analyze_mpm.c, docs/mpm.md
+ * "Analysis").  The largest curvature [1/m] of the convex hull of the n
+ * points xy (x, y pairs, reordered) at the scale `scale` [m]: the largest
+ * turning of its tangent over an arc of 2 scale, over 2 scale (a circle:
+ * 1/R; a corner of angle theta alone in the arc: (pi - theta) / (2 scale));
+ * NAN with fewer than 3 points or a perimeter under 4 scale. */
+double cd_an_max_boundary_curvature(double *xy, size_t n, double scale);
+/* The measures and fits of an mpm packing run file (every committed
+ * snapshot; opt->snapshot picks the one reported alone).  0, 2 when the
+ * file lacks what they need (reason in err), 1 on other failures. */
+int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char *err, size_t errlen);
 
 #endif

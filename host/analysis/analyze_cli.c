@@ -4,6 +4,7 @@
  * output keys: docs/analysis.md. */
 #include "analysis/analyze.h"
 #include "config/config.h"
+#include "mpm/mpm_output.h" /* cd_mpm_is_run_file */
 #include <gsl/gsl_errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -27,18 +28,25 @@ static int jamming(const cd_an_input *in, cd_an_report *rep, char *msg, size_t l
 /* Every measure, once, in the order they run and report: its --measures
  * name, its bit (analyze.h), whether it needs the snapshot's particle
  * contacts, and the function (docs/architecture.md, "How to add a
- * measure"). */
+ * measure"); mpm, the measure of run files of solver mpm, has its own
+ * reader (analyze_file, host/analysis/analyze_mpm.c). */
 static const struct {
     const char *name;
     unsigned bit;
     int needs_contacts;
     measure_fn fn;
 } measures[] = {
-    {"forces", CD_AN_FORCES, 1, cd_an_forces},       {"bonds", CD_AN_BONDS, 1, cd_an_bond_forces},
-    {"stress", CD_AN_STRESS, 1, cd_an_stress},       {"rdf", CD_AN_RDF, 0, cd_an_rdf},
-    {"branch", CD_AN_BRANCH, 1, cd_an_branch},       {"network", CD_AN_NETWORK, 1, cd_an_network},
-    {"packing", CD_AN_PACKING, 0, cd_an_packing},    {"modulus", CD_AN_MODULUS, 1, cd_an_modulus},
-    {"compaction", CD_AN_COMPACTION, 0, compaction}, {"jamming", CD_AN_JAMMING, 0, jamming},
+    {"forces", CD_AN_FORCES, 1, cd_an_forces},
+    {"bonds", CD_AN_BONDS, 1, cd_an_bond_forces},
+    {"stress", CD_AN_STRESS, 1, cd_an_stress},
+    {"rdf", CD_AN_RDF, 0, cd_an_rdf},
+    {"branch", CD_AN_BRANCH, 1, cd_an_branch},
+    {"network", CD_AN_NETWORK, 1, cd_an_network},
+    {"packing", CD_AN_PACKING, 0, cd_an_packing},
+    {"modulus", CD_AN_MODULUS, 1, cd_an_modulus},
+    {"compaction", CD_AN_COMPACTION, 0, compaction},
+    {"jamming", CD_AN_JAMMING, 0, jamming},
+    {"mpm", CD_AN_MPM, 0, NULL},
 };
 #define N_MEASURES (sizeof measures / sizeof measures[0])
 
@@ -75,7 +83,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: capdem analyze RUN.h5 [--snapshot last|N] [--json] [--measures LIST] [--no-write]\n"
             "                      [--margins SIDE,END] [--rdf-max R] [--rdf-bin DR] [--mc-points M]\n"
-            "                      [--phi-series NAME] [--z-series NAME] [--quiet] [--timings]\n"
+            "                      [--phi-series NAME] [--z-series NAME] [--phi-c PHI] [--quiet] [--timings]\n"
             "  --snapshot N     snapshot index (0 first, -1 or last: the last; default last)\n"
             "  --json           print one JSON object on stdout (keys: docs/analysis.md)\n"
             "  --measures LIST  comma-separated subset, each of which must succeed (else exit 2), of\n"
@@ -88,6 +96,7 @@ static void usage(FILE *f)
             "  --rdf-bin DR     G(r) bin width in L (default 0.02)\n"
             "  --mc-points M    Monte Carlo points for the core packing fraction (default 1e6)\n"
             "  --phi-series, --z-series  observables for the jamming fit\n"
+            "  --phi-c PHI      mpm run files: Phi_c of the fits of eqs. (5) and (11) (default: eq. (17)'s)\n"
             "  --quiet          no summary and no warnings;  --timings  time of each phase on stderr\n"
             "exit status: 0 done, 2 bad input (missing file or data), 1 other failure\n",
             measure_list(names, sizeof names));
@@ -132,6 +141,16 @@ static int run_measure(unsigned bit, int rc, const char *msg, const cd_an_option
 
 static int analyze_file(const char *path, const cd_an_options *opt, cd_an_report *rep, char *err, size_t errlen)
 {
+    int mpm = cd_mpm_is_run_file(path);
+    if (mpm && opt->measures != CD_AN_ALL && opt->measures != CD_AN_MPM) {
+        snprintf(err, errlen, "%s: a run file of solver mpm: its only measure is mpm (--measures mpm)", path);
+        return 2;
+    }
+    if (!mpm && (opt->measures & CD_AN_MPM)) {
+        snprintf(err, errlen, "%s: measure mpm: not a run file of solver mpm", path);
+        return 2;
+    }
+    if (mpm) return cd_an_mpm(path, opt, rep, err, errlen);
     cd_an_snapshot s;
     double t0 = now();
     int rc = cd_an_read_snapshot(path, opt->snapshot, &s, err, errlen);
@@ -179,7 +198,7 @@ static int analyze_file(const char *path, const cd_an_options *opt, cd_an_report
     if (g.note[0]) cd_an_put_text(info, "container_note", "%s", g.note);
 
     for (size_t k = 0; k < N_MEASURES && rc == 0; k++) {
-        if (!(opt->measures & measures[k].bit)) continue;
+        if (!(opt->measures & measures[k].bit) || !measures[k].fn) continue;
         char msg[1024] = "";
         rc = run_measure(measures[k].bit, measures[k].fn(&in, rep, msg, sizeof msg), msg, opt, rep);
         if (rc) snprintf(err, errlen, "%s", msg);
@@ -294,6 +313,12 @@ int cd_cmd_analyze(int argc, char **argv)
             if (!strcmp(a, "--rdf-max")) opt.rdf_max = v;
             else if (!strcmp(a, "--rdf-bin")) opt.rdf_bin = v;
             else opt.mc_points = (long)v;
+        } else if (!strcmp(a, "--phi-c") && more) {
+            if (parse_num(a, argv[++i], &v) || !(v > 0 && v < 1)) {
+                fprintf(stderr, "capdem analyze: --phi-c: expected a packing fraction in (0, 1)\n");
+                return 2;
+            }
+            opt.phi_c = v;
         } else if (!strcmp(a, "--phi-series") && more) {
             opt.phi_series = argv[++i];
         } else if (!strcmp(a, "--z-series") && more) {

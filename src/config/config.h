@@ -131,6 +131,7 @@ typedef struct {
     double mpm_wall_speed;         /* speed of the top wall towards the bottom one [m/s] */
     double mpm_wall_stiffness;     /* wall penalty k / E [1] */
     double mpm_contact_gap;        /* gap from which particles' contact acts, in cells [1] */
+    double mpm_pic_fraction;       /* PIC share of the points' velocity update, the rest FLIP [1] */
     int mpm_model;                 /* 0 elastic, 1 von_mises */
     double mpm_density;            /* rho [kg/m^3] */
     double mpm_young;              /* E [Pa] */

@@ -284,6 +284,10 @@ const cd_key cd_config_keys[] = {
     {"mpm.contact_gap", CD_KT_REAL, "1", "0.25", CFG(mpm_contact_gap), GE(0), LE(2), .label = "contact gap, cells",
      .meaning = "two particles' contact acts from this gap between them on, in cells (docs/mpm.md: less "
                 "interpenetration, earlier contact)"},
+    {"mpm.pic_fraction", CD_KT_REAL, "1", "0.01", CFG(mpm_pic_fraction), GE(0), LE(1), .label = "PIC share",
+     .meaning = "share of PIC (the new node velocities) in each step's point velocity update, the rest FLIP (the "
+                "node accelerations); damps the point velocities the mesh does not see (docs/mpm.md: 0, pure "
+                "FLIP, lets them grow in the packings' compaction)"},
     {"mpm.material.model", CD_KT_ENUM, "-", "elastic", CFG(mpm_model), .flags = CD_KF_SELECTOR,
      .choices = "elastic|von_mises", .label = "MPM material",
      .meaning = "elastic: linear isotropic; von_mises: plus von Mises plasticity, linear isotropic hardening"},

@@ -343,7 +343,11 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
         cd_mpm_contact_nodes(m);
         if (cd_mpm_contact_correct(m, 0, err, errlen)) return -1;
     }
-    /* points: velocity from the node accelerations (FLIP), position from the new node velocities */
+    /* points: velocity from the node accelerations (FLIP) blended with the new node velocities
+     * (PIC, a share pic_fraction: damps the velocity modes the mesh does not see, which FLIP
+     * keeps and the compaction feeds; docs/mpm.md "FLIP's noise"); position from the new node
+     * velocities */
+    double pic = m->pic_fraction; /* [1] */
 #pragma omp parallel for schedule(static) if (CD_PARALLEL(m->n))
     for (size_t p = 0; p < m->n; p++) {
         double ax = 0, ay = 0, ux = 0, uy = 0;
@@ -357,12 +361,16 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
                 ux += N * m->gvx[node];
                 uy += N * m->gvy[node];
             }
-        m->vx[p] += dt * ax;
-        m->vy[p] += dt * ay;
+        m->vx[p] = (1 - pic) * (m->vx[p] + dt * ax) + pic * ux;
+        m->vy[p] = (1 - pic) * (m->vy[p] + dt * ay) + pic * uy;
         m->x[p] += dt * ux;
         m->y[p] += dt * uy;
     }
     remap_velocity(m);
+    double mesh_kinetic = 0; /* [J/m], summed in body-node order: the same bits for any thread count */
+    for (size_t t = 0; t < m->n_bnodes; t++)
+        mesh_kinetic += 0.5 * m->gm[t] * (m->gvx[t] * m->gvx[t] + m->gvy[t] * m->gvy[t]);
+    m->mesh_kinetic = mesh_kinetic;
     if (m->n_bodies > 1 && cd_mpm_contact_correct(m, 1, err, errlen)) return -1;
     /* points: velocity gradient, stress, deformation gradient and volume */
     long long bad = -1;

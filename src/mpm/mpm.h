@@ -75,7 +75,10 @@ typedef struct {
     double box_h0; /* distance of walls 0 and 1 at start [m] */
 
     cd_mpm_material mat;
-    double dt, time; /* [s] */
+    double pic_fraction; /* PIC share of the points' velocity update, the rest FLIP [1] (docs/mpm.md) */
+    double mesh_kinetic; /* sum m_i v_i^2 / 2 of the node velocities after the last step's remap [J/m]: the
+                          * points' kinetic energy the mesh sees (docs/mpm.md "FLIP's noise") */
+    double dt, time;     /* [s] */
     long long step;
 } cd_mpm;
 

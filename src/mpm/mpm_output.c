@@ -188,6 +188,7 @@ cd_mpm_output *cd_mpm_output_create(const char *path, int replace, const cd_conf
     rc |= make_growing(o->file, "/mpm/series/wall_position", H5T_IEEE_F64LE, 3, tw, 1024, "m");
     rc |= make_growing(o->file, "/mpm/series/wall_force", H5T_IEEE_F64LE, 3, tw, 1024, "N/m");
     rc |= make_growing(o->file, "/mpm/series/kinetic_energy", H5T_IEEE_F64LE, 1, NULL, 1024, "J/m");
+    rc |= make_growing(o->file, "/mpm/series/kinetic_energy_mesh", H5T_IEEE_F64LE, 1, NULL, 1024, "J/m");
     for (int k = 0; o->packing && k < PACKING_SERIES; k++)
         rc |= make_growing(o->file, packing_series[k].name, H5T_IEEE_F64LE, 1, NULL, 1024, packing_series[k].unit);
     if (rc) {
@@ -266,6 +267,7 @@ int cd_mpm_output_series(cd_mpm_output *o, const cd_mpm *m, double kinetic, char
     rc |= append(f, "/mpm/series/wall_position", D, at, pos);
     rc |= append(f, "/mpm/series/wall_force", D, at, force);
     rc |= append(f, "/mpm/series/kinetic_energy", D, at, &kinetic);
+    rc |= append(f, "/mpm/series/kinetic_energy_mesh", D, at, &m->mesh_kinetic);
     if (o->packing) {
         double v[PACKING_SERIES];
         cd_mpm_packing_measures(m, &v[0], &v[1], &v[2], &v[3]);
@@ -449,7 +451,8 @@ cd_mpm_output *cd_mpm_output_reopen(const char *path, const cd_config *cfg, cons
             const char *snaps[] = {"step",          "time",      "position",       "velocity",
                                    "volume",        "stress",    "plastic_strain", "deformation_gradient",
                                    "wall_position", "wall_force"};
-            const char *series[] = {"step", "time", "wall_position", "wall_force", "kinetic_energy"};
+            const char *series[] = {"step",       "time",           "wall_position",
+                                    "wall_force", "kinetic_energy", "kinetic_energy_mesh"};
             char p[96];
             for (size_t k = 0; rc == 0 && k < sizeof snaps / sizeof snaps[0]; k++) {
                 snprintf(p, sizeof p, "/mpm/snapshots/%s", snaps[k]);

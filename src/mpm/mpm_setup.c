@@ -179,6 +179,7 @@ int cd_mpm_setup(cd_mpm *m, const cd_config *c, char *err, size_t errlen)
                                   c->mpm_model == 1 ? c->mpm_hardening : 0);
     m->wall_k = c->mpm_wall_stiffness * c->mpm_young;
     m->contact_gap = c->mpm_contact_gap * m->h;
+    m->pic_fraction = c->mpm_pic_fraction;
     m->dt = c->dt;
     double lim = cd_mpm_dt_limit(m);
     if (c->dt > lim && !c->force_dt) {

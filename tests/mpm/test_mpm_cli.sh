@@ -65,11 +65,15 @@ awk -v f="$fy" 'BEGIN { exit !(f > 0) }' && ok || bad "good run: top wall force 
 "$capdem" run good.yaml --resume half.h5 --steps 60 --quiet > out 2> err; rc=$?
 [ $rc = 2 ] && grep -q "at step 100 already" err && ok || bad "--resume --steps 60: exit status $rc, expected 2"
 
-# analyze and export do not read mpm run files yet: refused by name, not misread
-for c in analyze export; do
-  "$capdem" $c good.h5 > out 2> err; rc=$?
-  [ $rc = 2 ] && grep -q "solver mpm" err && ok || bad "$c of an mpm run file: exit status $rc, expected 2 naming solver mpm"
-done
+# export does not read mpm run files yet, analyze only those of set-up packing (test_mpm_packing):
+# refused by name, not misread
+"$capdem" export good.h5 > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q "solver mpm" err && ok || bad "export of an mpm run file: exit status $rc, expected 2 naming solver mpm"
+"$capdem" analyze good.h5 > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q "not a packing run of solver mpm" err && ok \
+  || bad "analyze of a diametral mpm run: exit status $rc, expected 2 naming the set-up"
+"$capdem" analyze good.h5 --measures forces > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q "its only measure is mpm" err && ok || bad "analyze --measures forces of an mpm run: exit $rc"
 
 echo "test_mpm_cli: $pass passed, $fails failed"
 [ $fails = 0 ]

@@ -52,6 +52,29 @@ for d in packing_fraction:1 stress:Pa strain:1 coordination:1 penetration:m; do
   h5dump -a "/mpm/series/$name/unit" run.h5 2> /dev/null | grep -qF "\"$unit\"" && ok || bad "/mpm/series/$name has no unit $unit"
 done
 
+# capdem analyze (docs/mpm.md "Analysis"): Phi, sigma, strain and Z of the series' last row; an elastic
+# material has no plastic point; the disks' kappa <d> is at least 2 (a convex outline's largest turning
+# over an arc is at least its mean, 2 pi / perimeter); the report goes into the run file; the DEM
+# deposit is refused for measure mpm
+cp run.h5 an.h5
+if "$capdem" analyze an.h5 > out 2> err; then ok; else bad "analyze of the packing run: exit status $?"; fi
+val() { awk -v k="$1" '$1 == k { print $2; exit }' out; }
+awk -v a="$(val phi)" -v b="$(tail -1 phi)" 'BEGIN { exit !(a != "" && (a - b)^2 < 1e-10) }' && ok \
+  || bad "analyze: phi $(val phi), the series ends at $(tail -1 phi)"
+awk -v a="$(val z)" -v b="$(tail -1 z)" 'BEGIN { exit !(a != "" && (a - b)^2 < 1e-10) }' && ok \
+  || bad "analyze: z $(val z), the series ends at $(tail -1 z)"
+[ "$(val f_p)" = 0 ] && ok || bad "analyze: f_p = $(val f_p) for an elastic material, expected 0"
+awk -v k="$(val kappa_d)" 'BEGIN { exit !(k >= 2 && k < 20) }' && ok || bad "analyze: kappa_d = $(val kappa_d)"
+h5ls -r an.h5 | grep -q "^/analysis/snapshot_[0-9]*/mpm/snapshots *Dataset" && ok \
+  || bad "analyze wrote no /analysis/snapshot_*/mpm/snapshots into the run file"
+# eq. (5) with Phi_c given: a positive modulus M_eff inside its interval
+"$capdem" analyze an.h5 --no-write --phi-c 0.7 > out 2> err && awk '$1 == "m_eff" { m = $2 } $1 == "m_eff_lo" { lo = $2 }
+    $1 == "m_eff_hi" { hi = $2 } END { exit !(m > 0 && lo < m && m < hi) }' out && ok || bad "analyze --phi-c 0.7: no M_eff"
+"$capdem" analyze an.h5 --no-write --phi-c 1.5 > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q -- "--phi-c" err && ok || bad "analyze --phi-c 1.5: exit status $rc, expected 2"
+"$capdem" analyze deposit_disks_ci.h5 --measures mpm > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q "not a run file of solver mpm" err && ok || bad "analyze --measures mpm of a DEM run: exit $rc"
+
 # resume, bit for bit: 400 steps, then on to 900, against the run above
 "$capdem" run "$cfg/packing_elastic.yaml" --steps 400 --output part.h5 --quiet > out 2> err &&
   "$capdem" run "$cfg/packing_elastic.yaml" --steps 900 --resume part.h5 --quiet > out 2> err && ok \
