@@ -470,7 +470,8 @@ int cd_cmd_export(int argc, char **argv)
     if (x->viz >= 0) H5Gclose(x->viz);
     if (x->status && x->f >= 0) cdh5_drop_on_close(x->f); /* a failed export adds nothing to the run file */
     if (x->vf >= 0 && x->vf != x->f) H5Fclose(x->vf);
-    if (x->f >= 0) H5Fclose(x->f);
+    if (x->f >= 0 && H5Fclose(x->f) < 0 && !x->status) /* (the run file then keeps its last commit) */
+        cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot close the run file after adding the helpers", run);
     cdh5_guard_end();
     H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
 
