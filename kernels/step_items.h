@@ -218,9 +218,12 @@ CD_INLINE void cd_wall_row_clear(cd_cols c, cd_long row)
 /* Wall-contact row `row` = i n_walls + w: primitive i against wall w
  * (docs/references.md, Contacts (walls), Contact law).  The step runs it for the candidate rows of the last
  * neighbour-list build only (cd_item_wall_candidates).  wall_law: the
- * particle-wall law (its mu is replaced by the wall's friction). */
-CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall *walls, cd_int n_walls,
-                                cd_law_params wall_law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend)
+ * particle-wall law (its mu is replaced by the wall's friction).  *torque:
+ * the candidate's torque slot (kernels/fields.def, WALLC_OUT), written
+ * while in contact. */
+CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_vec3 *torque, const CD_GLOBAL cd_wall *walls,
+                                cd_int n_walls, cd_law_params wall_law, cd_real dt, cd_real sin_parallel,
+                                cd_int parallel_blend)
 {
     cd_prim_id i = (cd_prim_id)(row / n_walls);
     cd_particle_id pi = c.prim_particle[i];
@@ -247,7 +250,7 @@ CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall 
     c.wallc_overlap[row] = g.overlap;
     c.wallc_fn[row] = f.fn;
     c.wallc_force[row] = fi;
-    c.wallc_torque[row] = cd_contact_torque(g.point, c.position[pi], fi);
+    *torque = cd_contact_torque(g.point, c.position[pi], fi);
 }
 
 /* Wall candidates of particle q at a neighbour-list build: the rows
@@ -279,16 +282,16 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
  * [kg], centre x [m]): gravity [m/s^2] times its mass,
  * then its wall contacts (its candidate rows wall_rows[wall_start[q] ..
  * wall_start[q+1]), ascending, i.e. primitive by primitive and wall by
- * wall), then its pair rows in ascending row order, so the sum has one
- * fixed order on every backend.
+ * wall; wall_torque[e]: the torque of candidate e), then its pair rows in
+ * ascending row order, so the sum has one fixed order on every backend.
  * gather_rows[gather_start[q] .. gather_start[q+1]) hold 2 k + side for
  * pair row k: side 1 when q owns the row's primitive j (it gets +F_j), 0
  * when it owns primitive i (it gets -F_j), so the gather reads only the
  * row's force and point.  dimension 2 keeps the motion in the x-y plane. */
 CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, const CD_GLOBAL cd_int *gather_start,
                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                             const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_vec3 *F_out,
-                             cd_vec3 *T_out)
+                             const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_vec3 *wall_torque, cd_vec3 gravity,
+                             cd_int dimension, cd_vec3 *F_out, cd_vec3 *T_out)
 {
     cd_vec3 F = cd_v3_scale(gravity, m);
     cd_vec3 T = cd_v3_zero();
@@ -296,7 +299,7 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
         cd_int row = wall_rows[r];
         if (!c.wallc_active[row]) continue;
         F = cd_v3_add(F, c.wallc_force[row]);
-        T = cd_v3_add(T, c.wallc_torque[row]);
+        T = cd_v3_add(T, wall_torque[r]);
     }
     for (cd_int r = gather_start[q]; r < gather_start[q + 1]; r++) {
         cd_pair_id e = gather_rows[r], k = e >> 1;
@@ -325,11 +328,12 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
 /* cd_gather_sum for particle q, stored as its force and torque. */
 CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                               const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                              const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension)
+                              const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_vec3 *wall_torque, cd_vec3 gravity,
+                              cd_int dimension)
 {
     cd_vec3 F, T;
-    cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_rows, gravity, dimension,
-                  &F, &T);
+    cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_rows, wall_torque,
+                  gravity, dimension, &F, &T);
     c.force[q] = F;
     c.torque[q] = T;
 }
@@ -340,12 +344,13 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
  * arithmetic in the same order as the three items one after the other. */
 CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                                           const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                                          const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension,
-                                          cd_real dt, cd_real limit2, int next)
+                                          const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_vec3 *wall_torque,
+                                          cd_vec3 gravity, cd_int dimension, cd_real dt, cd_real limit2, int next)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
-    cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_rows, gravity, dimension, &F, &T);
+    cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_rows, wall_torque, gravity,
+                  dimension, &F, &T);
     c.force[q] = F;
     c.torque[q] = T;
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);

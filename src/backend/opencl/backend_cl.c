@@ -32,7 +32,6 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 2, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 3, sizeof p->sin_parallel, &p->sin_parallel);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 4, sizeof p->parallel_blend, &p->parallel_blend);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 2, sizeof cl->walls, &cl->walls);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 3, sizeof W, &W);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 4, sizeof p->wall_law, &p->wall_law);
@@ -42,7 +41,6 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 1, sizeof cl->gather_start, &cl->gather_start);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof cl->wall_start, &cl->wall_start);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->gravity, &p->gravity);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof p->dimension, &p->dimension);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
@@ -59,6 +57,11 @@ static void set_list_args(cd_cl *cl)
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F, sizeof n, &n);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F, sizeof cl->n_wall_rows, &cl->n_wall_rows);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 2, sizeof cl->gather_rows, &cl->gather_rows);
+    /* the wall candidates' lists, sized by the last build */
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 8, sizeof cl->wall_torque, &cl->wall_torque);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 9, sizeof cl->wall_torque, &cl->wall_torque);
 }
 
 /* Rebuild of the list, then steps 5-8 (forces, gather, second kick). */
@@ -71,6 +74,7 @@ static int forces(cd_cl *cl, cd_sim *sim, int rebuild)
     }
     cd_cl_run(cl, CD_CLK_PAIR_FORCES, cl->n_pairs);
     if (cl->n_wall_rows) cd_cl_run(cl, CD_CLK_WALL_FORCES, (size_t)cl->n_wall_rows);
+    cl->wall_out = 1;
     return cd_cl_run(cl, CD_CLK_GATHER_KICK, s->n_particles);
 }
 

@@ -107,9 +107,12 @@ typedef struct cd_cl {
     cl_mem gather_count, gather_start, gather_cursor, gather_rows;
     size_t gather_cap;
     /* wall candidates of the last build (cd_item_wall_candidates): counts
-     * per particle, CSR offsets, rows (at most n_prims n_walls) */
+     * per particle, CSR offsets, rows (sized by the build's count) */
     cl_mem wall_count, wall_start, wall_rows;
+    cl_mem wall_torque; /* per candidate: torque of its wall contact [N m] (fields.def, WALLC_OUT) */
     cd_int n_wall_rows;
+    size_t cap_wall_rows;             /* entries wall_rows and wall_torque hold */
+    int wall_out;                     /* 1: wall_torque holds the step's torques (forces computed since start) */
     cd_wall host_walls[CD_MAX_WALLS]; /* the walls as the device moves them, for the rebuild test */
     int cols_dirty;                   /* a column buffer changed: rebind the column arguments */
 } cd_cl;
@@ -153,6 +156,8 @@ void cd_cl_buffers_release(cd_cl *cl);
  * hold at least n rows (with headroom).  Contents are kept only where no
  * buffer had to grow. */
 int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which);
+/* Room for n wall candidates in wall_rows and wall_torque (contents dropped). */
+int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n);
 /* The buffer bound as column f (the current history set for pair_active
  * and pair_shear). */
 cl_mem cd_cl_col(const cd_cl *cl, int f);
