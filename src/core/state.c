@@ -116,9 +116,19 @@ int cd_state_copy(cd_state *dst, const cd_state *src)
     return 0;
 }
 
-void cd_state_expand_wall_torque(cd_state *s, const cd_int *rows, const cd_vec3 *torque, size_t n)
+void cd_state_expand_wall_out(cd_state *s, const cd_int *rows, const cd_wall_out *out, size_t n)
 {
-    memset(s->wallc_torque, 0, s->n_prims * s->n_walls * sizeof *s->wallc_torque);
-    for (size_t e = 0; e < n; e++)
-        if (s->wallc_active[rows[e]]) s->wallc_torque[rows[e]] = torque[e];
+    size_t R = s->n_prims * s->n_walls;
+    memset(s->wallc_force, 0, R * sizeof *s->wallc_force);
+    memset(s->wallc_torque, 0, R * sizeof *s->wallc_torque);
+    memset(s->wallc_overlap, 0, R * sizeof *s->wallc_overlap);
+    memset(s->wallc_fn, 0, R * sizeof *s->wallc_fn);
+    for (size_t e = 0; e < n; e++) {
+        size_t r = (size_t)rows[e];
+        if (!s->wallc_active[r]) continue;
+        s->wallc_force[r] = out[e].force;
+        s->wallc_torque[r] = out[e].torque;
+        s->wallc_overlap[r] = out[e].overlap;
+        s->wallc_fn[r] = out[e].fn;
+    }
 }

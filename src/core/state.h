@@ -67,9 +67,9 @@ void cd_state_free(cd_state *s);
  * allocated for the same particles, primitives and walls (its pair columns
  * grow as needed).  Returns 0, or -1 (out of memory, or other sizes). */
 int cd_state_copy(cd_state *dst, const cd_state *src);
-/* The host column wallc_torque (fields.def, WALLC_OUT) from the torques
- * the step keeps per wall candidate: torque[e] for the candidate row
- * rows[e] (e < n) while it is in contact (wallc_active), 0 elsewhere. */
-void cd_state_expand_wall_torque(cd_state *s, const cd_int *rows, const cd_vec3 *torque, size_t n);
+/* The host's wall-contact outputs (fields.def, WALLC_OUT) from those the
+ * step keeps per wall candidate: out[e] for the candidate row rows[e]
+ * (e < n) while it is in contact (wallc_active), 0 elsewhere. */
+void cd_state_expand_wall_out(cd_state *s, const cd_int *rows, const cd_wall_out *out, size_t n);
 
 #endif

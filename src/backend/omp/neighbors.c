@@ -40,12 +40,12 @@ void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder)
 void cd_neighbors_free(cd_neighbors *nb)
 {
     cd_nb_lists *d = &nb->d;
-    void *all[] = {d->wall_torque, d->gather_start, d->gather_rows, d->wall_start, d->wall_rows,  d->grid,
-                   d->part_bound,  d->partial,      d->part_cell,   d->cell_count, d->cell_start, d->cell_parts,
-                   d->pair_count,  d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active,
-                   d->old_shear,   d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,
-                   d->prim_at,     d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
-                   d->sort_keys,   d->sort_vals,    d->hist,        d->move};
+    void *all[] = {d->wall_out,   d->gather_start, d->gather_rows, d->wall_start, d->wall_rows,  d->grid,
+                   d->part_bound, d->partial,      d->part_cell,   d->cell_count, d->cell_start, d->cell_parts,
+                   d->pair_count, d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active,
+                   d->old_shear,  d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,
+                   d->prim_at,    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
+                   d->sort_keys,  d->sort_vals,    d->hist,        d->move};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -196,14 +196,14 @@ static int keep_history(cd_sim *sim, cd_cols c)
     return 0;
 }
 
-/* Room for n wall candidates (their rows and torques), with a quarter to
+/* Room for n wall candidates (their rows and outputs), with a quarter to
  * spare: sized by the candidates, not by primitives x walls. */
 static int reserve_wall_rows(cd_neighbors *nb, size_t n)
 {
     if (n <= nb->cap_wall_rows && nb->d.wall_rows) return 0;
     size_t cap = n + n / 4 + 16;
     if (realloc_dev((void **)&nb->d.wall_rows, cap, sizeof(cd_int)) ||
-        realloc_dev((void **)&nb->d.wall_torque, cap, sizeof(cd_vec3)))
+        realloc_dev((void **)&nb->d.wall_out, cap, sizeof(cd_wall_out)))
         return -1;
     nb->cap_wall_rows = cap;
     return 0;
@@ -213,16 +213,18 @@ int cd_neighbors_wall_out_to_host(cd_sim *sim)
 {
     cd_neighbors *nb = &sim->nb;
     size_t n = nb->n_wall_rows;
-    if (!nb->wall_out || !sim->s.n_walls) return 0;
+    if (!nb->wall_out_pending || !sim->s.n_walls) return 0;
     cd_int *rows = malloc((n + 1) * sizeof *rows);
-    cd_vec3 *torque = malloc((n + 1) * sizeof *torque);
-    int rc = rows && torque ? 0 : -1;
+    cd_wall_out *out = malloc((n + 1) * sizeof *out);
+    int rc = rows && out ? 0 : -1;
     if (!rc && n)
-        rc = cd_dev_get(rows, nb->d.wall_rows, n * sizeof *rows) ||
-             cd_dev_get(torque, nb->d.wall_torque, n * sizeof *torque);
-    if (!rc) cd_state_expand_wall_torque(&sim->s, rows, torque, n);
+        rc = cd_dev_get(rows, nb->d.wall_rows, n * sizeof *rows) || cd_dev_get(out, nb->d.wall_out, n * sizeof *out);
+    if (!rc) {
+        cd_state_expand_wall_out(&sim->s, rows, out, n);
+        nb->wall_out_pending = 0;
+    }
     free(rows);
-    free(torque);
+    free(out);
     return rc ? -1 : 0;
 }
 

@@ -109,10 +109,11 @@ typedef struct cd_cl {
     /* wall candidates of the last build (cd_item_wall_candidates): counts
      * per particle, CSR offsets, rows (sized by the build's count) */
     cl_mem wall_count, wall_start, wall_rows;
-    cl_mem wall_torque; /* per candidate: torque of its wall contact [N m] (fields.def, WALLC_OUT) */
+    cl_mem wall_out; /* cd_wall_out per candidate: outputs of its wall contact (fields.def, WALLC_OUT) */
     cd_int n_wall_rows;
-    size_t cap_wall_rows;             /* entries wall_rows and wall_torque hold */
-    int wall_out;                     /* 1: wall_torque holds the step's torques (forces computed since start) */
+    size_t cap_wall_rows;             /* entries wall_rows and wall_out hold */
+    int wall_out_valid;               /* wall_out holds the step's wall-contact outputs (forces since start) */
+    int wall_out_pending;             /* ... newer than the host's columns (expanded at sync) */
     cd_wall host_walls[CD_MAX_WALLS]; /* the walls as the device moves them, for the rebuild test */
     int cols_dirty;                   /* a column buffer changed: rebind the column arguments */
 } cd_cl;
@@ -156,7 +157,7 @@ void cd_cl_buffers_release(cd_cl *cl);
  * hold at least n rows (with headroom).  Contents are kept only where no
  * buffer had to grow. */
 int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which);
-/* Room for n wall candidates in wall_rows and wall_torque (contents dropped). */
+/* Room for n wall candidates in wall_rows and wall_out (contents dropped). */
 int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n);
 /* The buffer bound as column f (the current history set for pair_active
  * and pair_shear). */
