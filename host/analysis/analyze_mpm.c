@@ -1,7 +1,7 @@
 /* `capdem analyze` of a run file of the material point method (solver mpm,
  * docs/mpm.md "Analysis"): the compaction measures of Nezamabadi et al.
  * 2022 (the paper) from the run's series and snapshots, and the fits of its
- * eqs. (5), (11) and (17).
+ * eqs. (5), (11) and (17); those of eqs. (6)-(16) in analyze_mpm_models.c.
  *
  * Series (every thermo_every steps): packing fraction Phi, applied stress
  * sigma [Pa], strain ln(h_i/h) (compression positive: the paper's
@@ -12,6 +12,8 @@
 #include "analysis/analyze.h"
 #include <hdf5.h>
 #include "io/io_h5_layout.h"
+#include "io/io_h5.h"
+#include "config/config.h"
 #include <gsl/gsl_cdf.h>
 #include <math.h>
 #include <stdio.h>
@@ -149,6 +151,8 @@ typedef struct {
     double *sstep, *stime;                   /* snapshots: step, time [s] */
     double *pos, *vol, *eps_p, *defg;        /* snapshots: (S, n, 2) [m], (S, n) [m^3/m], (S, n), (S, n, 4) */
     double *swall;                           /* snapshots' wall positions (S, 4, 2) [m] */
+    int material_ok, plastic;                /* the echoed config parsed; its model von_mises */
+    cd_an_mpm_model material;                /* E, nu, sigma_y, H of the config */
 } mpm_data;
 
 static void data_free(mpm_data *d)
@@ -222,6 +226,22 @@ static int data_read(const char *path, mpm_data *d, char *err, size_t errlen)
 done:
     if (f >= 0) H5Fclose(f);
     cdh5_quiet_end(&q);
+    if (rc == 0) { /* the material, from the config echoed in the file (the models of eqs. (6)-(16)) */
+        char cerr[512];
+        char *text = cd_h5_read_config_text(path, cerr, sizeof cerr);
+        cd_config c;
+        cd_config_defaults(&c);
+        if (text && cd_config_parse(text, path, &c, cerr, sizeof cerr) == 0 && c.solver == 1) { /* mpm */
+            d->material_ok = 1;
+            d->plastic = c.mpm_model == 1;
+            d->material.E = c.mpm_young;
+            d->material.nu = c.mpm_poisson;
+            d->material.sigma_y = d->plastic ? c.mpm_yield : 0;
+            d->material.H = d->plastic ? c.mpm_hardening : 0;
+        }
+        cd_config_free(&c);
+        free(text);
+    }
     return rc;
 }
 
@@ -359,7 +379,7 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
     int fr = opt->phi_c > 0 ? 0 : cd_an_fit_jamming(d.phi, d.z, d.rows, &jf);
     cd_an_group *g17 = cd_an_group_get(r, "mpm_eq17");
     if (opt->phi_c > 0) {
-        double *x = malloc(2 * d.rows * sizeof(double)), *y = x ? x + d.rows : NULL;
+        double *x = calloc(2 * d.rows, sizeof(double)), *y = x ? x + d.rows : NULL;
         size_t m = 0;
         for (size_t i = 0; x && i < d.rows; i++)
             if (d.phi[i] > opt->phi_c && d.z[i] > 0) {
@@ -402,7 +422,7 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
     if (!(pc > 0)) cd_an_put_text(g5, "skipped", "%s", no_pc);
     else if (at_phi(&d, pc, &sc, &ec)) cd_an_put_text(g5, "skipped", "the series does not reach Phi_c = %.4g", pc);
     else {
-        double *x = malloc(2 * d.rows * sizeof(double)), *y = x ? x + d.rows : NULL;
+        double *x = calloc(2 * d.rows, sizeof(double)), *y = x ? x + d.rows : NULL;
         size_t m = 0;
         for (size_t i = 1; x && i < d.rows; i++)
             if (d.phi[i] >= pc) {
@@ -455,6 +475,14 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
         cd_an_put(g11, "alpha_lo", alpha - t * se, "1");
         cd_an_put(g11, "alpha_hi", alpha + t * se, "1");
         cd_an_put(g11, "n_points", (double)m, "1");
+    }
+    /* eqs. (6)-(16): the porous-medium law and the plastic mixture */
+    if (d.material_ok)
+        cd_an_mpm_models(r, &d.material, d.plastic, opt->elastic_model_set ? opt->elastic_model : NULL, pc, d.phi, d.z,
+                         d.sigma, d.strain, d.rows);
+    else {
+        cd_an_put_text(cd_an_group_get(r, "mpm_eq6"), "skipped", "the echoed config does not parse: no material");
+        cd_an_put_text(cd_an_group_get(r, "mpm_eq10"), "skipped", "the echoed config does not parse: no material");
     }
     free(sphi);
     data_free(&d);
