@@ -372,6 +372,18 @@ double cd_an_max_boundary_curvature(double *xy, size_t n, double scale);
  * file lacks what they need (reason in err), 1 on other failures. */
 int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char *err, size_t errlen);
 
+/* Reads rows [0, rows) of dataset name (rank 1..3, doubles) of the open
+ * file f (path: for messages) into a new buffer of `per_row` values a
+ * row; NULL with a message when it is missing or shaped otherwise.  (An
+ * hid_t is an int64_t.) */
+double *cd_an_mpm_read_rows(int64_t f, const char *path, const char *name, size_t rows, size_t per_row, char *err,
+                            size_t errlen);
+/* A diametral run (set-up diametral: two walls, no packing series)? */
+int cd_an_mpm_is_disk(const char *path);
+/* The paper's Fig. 1 measures of a diametral run (analyze_mpm_disk.c):
+ * the group mpm_disk.  0, 2 (reason in err), 1. */
+int cd_an_mpm_disk(const char *path, const cd_an_options *opt, cd_an_report *r, char *err, size_t errlen);
+
 /* The paper's compaction models beyond jamming (analyze_mpm_models.c):
  * the particle material and the models' parameters. */
 typedef struct {

@@ -239,6 +239,13 @@ static void test_synthetic_run(void **state)
     assert_true(fabs(cd_an_value(&rep, "mpm", "snapshot_strain") - log(ph3 / 0.75)) < 1e-12);
     assert_true(fabs(cd_an_value(&rep, "mpm", "f_p") - 0.4) < 1e-12);
     assert_true(fabs(cd_an_value(&rep, "mpm", "kappa_d") / (2 * PI) - 1) < 1e-9);
+    /* the tables for the figures: the whole series, and each snapshot's applied stress, that of the
+     * series row of its step (steps 0, 100, 200, 300: rows 0, 5, 10, 15) */
+    const cd_an_curve *ser = cd_an_curve_find(&rep, "mpm", "series"), *sn = cd_an_curve_find(&rep, "mpm", "snapshots");
+    assert_true(ser && ser->rows == 100 && ser->cols == 5 && !strcmp(ser->columns, "step,strain,phi,sigma,z"));
+    assert_true(sn && sn->rows == 4 && sn->cols == 6 && !strcmp(sn->columns, "step,strain,phi,f_p,kappa_d,sigma"));
+    assert_true(ser->data[5 * 99 + 2] == 0.95 && ser->data[5 * 99 + 3] > 0);
+    for (int k = 0; k < 4; k++) assert_true(sn->data[6 * k + 5] == ser->data[5 * (5 * k) + 3]);
     /* eq. (17): exact data, the fit recovers them */
     assert_true(fabs(cd_an_value(&rep, "mpm_eq17", "phi_c") - 0.8) < 1e-5);
     assert_true(fabs(cd_an_value(&rep, "mpm_eq17", "z_c") - 3) < 1e-3);
