@@ -367,6 +367,15 @@ def mpm_fig5(runs, outdir, made):
     save_mpm(fig, outdir, "fig5", data, made)
 
 
+def report(made, notes):
+    """The figures made on stdout, the skipped ones on stderr; the exit status."""
+    for p in made:
+        print(p)
+    for n in notes:
+        print(f"plot_run.py: skipped: {n}", file=sys.stderr)
+    return 0 if made else 2
+
+
 def main_mpm(paths, outdir):
     runs = mpm_runs(paths)
     made, notes = [], []
@@ -374,11 +383,7 @@ def main_mpm(paths, outdir):
         note = job(runs, outdir, made)
         if note:
             notes.append(note)
-    for p in made:
-        print(p)
-    for n in notes:
-        print(f"plot_run.py: skipped: {n}", file=sys.stderr)
-    return 0 if made else 2
+    return report(made, notes)
 
 
 def is_mpm(path):
@@ -436,11 +441,7 @@ def main(argv=None):
         note = plot_compaction(root, outdir, made)
         if note:
             notes.append(note)
-    for p in made:
-        print(p)
-    for n in notes:
-        print(f"plot_run.py: skipped: {n}", file=sys.stderr)
-    return 0 if made else 2
+    return report(made, notes)
 
 
 if __name__ == "__main__":

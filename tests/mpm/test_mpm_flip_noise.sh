@@ -25,7 +25,7 @@ capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 cfg=$src/configs/mpm/ci
 
-series() { h5dump -w 0 -A 0 -m %.17g -d "/mpm/series/$1" "$2" | sed -n 's/^ *([0-9,]*): *//p' | tr ',' '\n' | sed '/^ *$/d'; }
+. "$src/tests/mpm/mpm_series.sh"
 # growth FILE: mean kinetic energy of steps 2400-3000 over that of steps 400-1200
 growth() {
   paste <(series step "$1") <(series kinetic_energy "$1") | awk '

@@ -25,7 +25,7 @@ capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 cfg=$src/configs/mpm/ci
 
-series() { h5dump -w 0 -A 0 -m %.17g -d "/mpm/series/$1" "$2" | sed -n 's/^ *([0-9,]*): *//p' | tr ',' '\n' | sed '/^ *$/d'; }
+. "$src/tests/mpm/mpm_series.sh"
 # last NAME FILE COLUMNS: the last snapshot of /mpm/snapshots/NAME, one point a line
 last() {
   local n points

@@ -13,8 +13,7 @@ capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 cfg=$src/configs/mpm/ci
 
-# series NAME FILE: the rows of /mpm/series/NAME, one a line
-series() { h5dump -w 0 -A 0 -m %.17g -d "/mpm/series/$1" "$2" | sed -n 's/^ *([0-9,]*): *//p' | tr ',' '\n' | sed '/^ *$/d'; }
+. "$src/tests/mpm/mpm_series.sh"
 
 "$capdem" run "$cfg/deposit_disks.yaml" --quiet > out 2> err && [ -f deposit_disks_ci.h5 ] && ok \
   || { bad "the DEM deposit did not run"; echo "test_mpm_packing: $pass passed, $fails failed"; exit 1; }
