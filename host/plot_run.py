@@ -2,6 +2,7 @@
 """Draws the figures of `capdem analyze` from a run file's /analysis group.
 
 usage: host/plot_run.py RUN.h5 [-o DIR] [--step STEP]
+       host/plot_run.py MPM_RUN.h5 [MPM_RUN.h5 ...] [-o DIR]
 
 Reads /analysis/snapshot_<step> (the latest analysed snapshot unless --step
 is given), /analysis/compaction and /analysis/jamming, and writes PNGs into
@@ -18,12 +19,29 @@ DIR (default: next to the run file, in <run>_plots/):
   compaction.png    the time series: stress or load, coordination, packing
                     fraction; and Z against Phi with the jamming fit
 
+Run files of solver mpm (docs/mpm.md), one or several, each analysed by
+`capdem analyze` first: the paper's figures (Nezamabadi et al. 2022), one
+curve per run, labelled by its material; each PNG with a JSON of the
+numbers drawn beside it (fig1.json, ...), taken from the analyses as they
+are (DIR default: next to the first run file, in <run>_plots/):
+
+  fig1.png  diametral runs: F/D against eps_yy (mpm_disk/curve)
+  fig3.png  packing runs: kappa <d> against sigma at the snapshots
+            (mpm/snapshots), Phi against sigma (mpm/series)
+  fig4.png  sigma - sigma_c against Phi, with eq. (6) or (10) fitted and
+            with the paper's parameters (mpm_eq6/curve, mpm_eq10/curve),
+            and against eps - eps_c with eq. (5) (mpm_eq5, mpm/series)
+  fig5.png  Z - Z_c against Phi - Phi_c (mpm/series, mpm_eq17), log-log,
+            with the slope 1/2 of eq. (17)
+
 Figures whose data the file lacks are skipped with a note.  Needs Debian's
 python3-matplotlib, python3-h5py and python3-numpy.  The layout of
 /analysis is in docs/analysis.md.
 """
 import argparse
+import json
 import os
+import re
 import sys
 
 import capdem_h5
@@ -207,14 +225,191 @@ def plot_compaction(root, outdir, made):
     save(fig, outdir, "compaction.png", made)
 
 
+# ---- the material point method (docs/mpm.md): the paper's Figs. 1, 3, 4, 5 ----
+
+def mpm_label(f):
+    """The run's material from its echoed config: 'elastic' or 'H = x MPa'."""
+    text = f["/parameters/config"][()] if "/parameters/config" in f else b""
+    text = text.decode() if isinstance(text, bytes) else str(text)
+    if re.search(r"model:\s*von_mises", text):
+        h = re.search(r"hardening:\s*([-+0-9.eE]+)", text)
+        return "H = %g MPa" % (float(h.group(1)) / 1e6 if h else 0)
+    return "elastic"
+
+
+def mpm_runs(paths):
+    """Each run's label and the groups of its latest analysed snapshot, as dicts of arrays and
+    numbers: {group: {"attrs": {...}, table name: {column: array}}}."""
+    prefix = capdem_h5.NAME["analysis_snapshot"]
+    runs = []
+    for path in paths:
+        with capdem_h5.open_run(path) as f:
+            root = capdem_h5.analysis(f)
+            steps = sorted(int(k[len(prefix):]) for k in root if k.startswith(prefix)) if root is not None else []
+            if not steps:
+                raise SystemExit(f"plot_run.py: {path} has no analysed snapshot: run `capdem analyze {path}` first")
+            snap = root[f"{prefix}{steps[-1]}"]
+            groups = {}
+            for name, g in snap.items():
+                d = {"attrs": {k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
+                               for k, v in g.attrs.items()}}
+                for t in g:
+                    d[t] = table(g, t)
+                groups[name] = d
+            runs.append({"path": path, "label": mpm_label(f), "groups": groups})
+    return runs
+
+
+def save_mpm(fig, outdir, name, data, made):
+    """The figure and, beside it, the numbers drawn (name.json)."""
+    save(fig, outdir, name + ".png", made)
+    with open(os.path.join(outdir, name + ".json"), "w") as out:
+        json.dump(data, out, indent=1, allow_nan=True,
+                  default=lambda a: [None if not np.isfinite(x) else float(x) for x in a])
+
+
+def mpm_fig1(runs, outdir, made):
+    disks = [r for r in runs if "mpm_disk" in r["groups"]]
+    if not disks:
+        return "fig1: no diametral run"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    data = {}
+    for r in disks:
+        c = r["groups"]["mpm_disk"]["curve"]
+        ax.plot(c["strain"], c["f_over_d"] / 1e6, "-", label=r["label"])
+        data[r["label"]] = {"strain": c["strain"], "f_over_d": c["f_over_d"]}
+    ax.set_xlabel("eps_yy = (D - gap) / D")
+    ax.set_ylabel("F / D [MPa]")
+    ax.legend(fontsize=8)
+    save_mpm(fig, outdir, "fig1", data, made)
+
+
+def mpm_packings(runs):
+    return [r for r in runs if "mpm" in r["groups"] and "series" in r["groups"]["mpm"]]
+
+
+def mpm_fig3(runs, outdir, made):
+    packs = mpm_packings(runs)
+    if not packs:
+        return "fig3: no packing run"
+    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 4))
+    data = {}
+    for r in packs:
+        sn, se = r["groups"]["mpm"]["snapshots"], r["groups"]["mpm"]["series"]
+        a.plot(sn["sigma"] / 1e6, sn["kappa_d"], "o-", ms=4, label=r["label"])
+        b.plot(se["sigma"] / 1e6, se["phi"], "-", label=r["label"])
+        data[r["label"]] = {"snapshot_sigma": sn["sigma"], "kappa_d": sn["kappa_d"], "sigma": se["sigma"],
+                            "phi": se["phi"]}
+    a.set_xlabel("sigma [MPa]")
+    a.set_ylabel("kappa <d>")
+    b.set_xlabel("sigma [MPa]")
+    b.set_ylabel("Phi")
+    a.legend(fontsize=8)
+    save_mpm(fig, outdir, "fig3", data, made)
+
+
+def mpm_fig4(runs, outdir, made):
+    packs = [r for r in mpm_packings(runs) if "mpm_eq5" in r["groups"] and "sigma_c" in r["groups"]["mpm_eq5"]["attrs"]]
+    if not packs:
+        return "fig4: no packing run with eq. (5) fitted (give --phi-c to capdem analyze)"
+    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 4))
+    data = {}
+    for k, r in enumerate(packs):
+        g5 = r["groups"]["mpm_eq5"]["attrs"]
+        sc, ec, pc = g5["sigma_c"], g5["strain_c"], g5["phi_c"]
+        model = "mpm_eq10" if "curve" in r["groups"].get("mpm_eq10", {}) else "mpm_eq6"
+        d = {"sigma_c": sc, "strain_c": ec, "phi_c": pc, "model": model}
+        col = f"C{k}"
+        c = r["groups"].get(model, {}).get("curve")
+        if c is not None:
+            a.plot(c["phi"], (c["sigma"] - sc) / 1e6, ".", ms=2, color=col, label=r["label"])
+            a.plot(c["phi"], (c["sigma_fit"] - sc) / 1e6, "-", color=col)
+            a.plot(c["phi"], (c["sigma_paper"] - sc) / 1e6, "--", color=col, lw=0.8)
+            d.update(phi=c["phi"], sigma=c["sigma"], sigma_fit=c["sigma_fit"], sigma_paper=c["sigma_paper"])
+        se = r["groups"]["mpm"]["series"]
+        keep = se["phi"] >= pc
+        x = se["strain"][keep] - ec
+        b.plot(x, (se["sigma"][keep] - sc) / 1e6, ".", ms=2, color=col, label=r["label"])
+        line = g5["offset"] + g5["m_eff"] * x
+        b.plot(x, line / 1e6, "-", color=col, label=f"M_eff = {g5['m_eff'] / 1e6:.2f} MPa")
+        d.update(excess_strain=x, excess_sigma=se["sigma"][keep] - sc, eq5_line=line)
+        data[r["label"]] = d
+    a.set_xlabel("Phi")
+    a.set_ylabel("sigma - sigma_c [MPa]")
+    a.set_title("points: runs; -: eq. (6)/(10) fitted; --: the paper's parameters", fontsize=7)
+    b.set_xlabel("eps - eps_c (ln(h_i/h))")
+    b.set_ylabel("sigma - sigma_c [MPa]")
+    a.legend(fontsize=7)
+    b.legend(fontsize=7)
+    save_mpm(fig, outdir, "fig4", data, made)
+
+
+def mpm_fig5(runs, outdir, made):
+    packs = [r for r in mpm_packings(runs) if "z_c" in r["groups"].get("mpm_eq17", {}).get("attrs", {})]
+    if not packs:
+        return "fig5: no packing run with eq. (17) fitted (give --phi-c to capdem analyze)"
+    fig, ax = plt.subplots(figsize=(5, 4))
+    data = {}
+    for r in packs:
+        g = r["groups"]["mpm_eq17"]["attrs"]
+        se = r["groups"]["mpm"]["series"]
+        x, y = se["phi"] - g["phi_c"], se["z"] - g["z_c"]
+        keep = (x > 0) & (y > 0)
+        ax.loglog(x[keep], y[keep], ".", ms=3, label=f"{r['label']}: Z_c = {g['z_c']:.2f}")
+        data[r["label"]] = {"phi_c": g["phi_c"], "z_c": g["z_c"], "amplitude": g["amplitude"],
+                            "excess_phi": x[keep], "excess_z": y[keep]}
+    xs = np.logspace(-3, 0, 50)
+    a0 = np.median([data[k]["amplitude"] for k in data])
+    ax.loglog(xs, a0 * np.sqrt(xs), "k-", lw=0.8, label=f"{a0:.2f} (Phi - Phi_c)^1/2")
+    ax.set_xlabel("Phi - Phi_c")
+    ax.set_ylabel("Z - Z_c")
+    ax.legend(fontsize=7)
+    save_mpm(fig, outdir, "fig5", data, made)
+
+
+def report(made, notes):
+    """The figures made on stdout, the skipped ones on stderr; the exit status."""
+    for p in made:
+        print(p)
+    for n in notes:
+        print(f"plot_run.py: skipped: {n}", file=sys.stderr)
+    return 0 if made else 2
+
+
+def main_mpm(paths, outdir):
+    runs = mpm_runs(paths)
+    made, notes = [], []
+    for job in (mpm_fig1, mpm_fig3, mpm_fig4, mpm_fig5):
+        note = job(runs, outdir, made)
+        if note:
+            notes.append(note)
+    return report(made, notes)
+
+
+def is_mpm(path):
+    with capdem_h5.open_run(path) as f:
+        s = f.attrs.get("solver", b"")
+        return (s.decode() if isinstance(s, bytes) else str(s)) == "mpm"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description="Figures of capdem analyze from RUN.h5/analysis")
-    ap.add_argument("run")
+    ap.add_argument("runs", nargs="+", metavar="run", help="a run file; several: mpm run files")
     ap.add_argument("-o", "--outdir", default=None)
     ap.add_argument("--step", type=int, default=None, help="analysed snapshot step (default: the latest)")
     a = ap.parse_args(argv)
+    a.run = a.runs[0]
     outdir = a.outdir or os.path.splitext(a.run)[0] + "_plots"
     os.makedirs(outdir, exist_ok=True)
+    mpm = [is_mpm(p) for p in a.runs]
+    if any(mpm):
+        if not all(mpm):
+            print("plot_run.py: mpm and dem run files mixed", file=sys.stderr)
+            return 2
+        return main_mpm(a.runs, outdir)
+    if len(a.runs) > 1:
+        print("plot_run.py: several run files are for solver mpm only", file=sys.stderr)
+        return 2
     made, notes = [], []
     prefix = capdem_h5.NAME["analysis_snapshot"]
     with capdem_h5.open_run(a.run) as f:
@@ -246,11 +441,7 @@ def main(argv=None):
         note = plot_compaction(root, outdir, made)
         if note:
             notes.append(note)
-    for p in made:
-        print(p)
-    for n in notes:
-        print(f"plot_run.py: skipped: {n}", file=sys.stderr)
-    return 0 if made else 2
+    return report(made, notes)
 
 
 if __name__ == "__main__":

@@ -249,6 +249,8 @@ typedef struct {
     int timings;                       /* 1: wall-clock time of each phase on stderr */
     const char *phi_series, *z_series; /* observables for the jamming fit (NULL: known names) */
     double phi_c;                      /* mpm: Phi_c of the fits of eqs. (5), (11); 0: eq. (17)'s */
+    int elastic_model_set;             /* mpm: 1: elastic_model given (--elastic-model) */
+    double elastic_model[3];           /* mpm: f_E, f_G, c1 of eq. (10)'s elastic part (default: the paper's) */
 } cd_an_options;
 
 void cd_an_options_defaults(cd_an_options *o);
@@ -369,5 +371,49 @@ double cd_an_max_boundary_curvature(double *xy, size_t n, double scale);
  * snapshot; opt->snapshot picks the one reported alone).  0, 2 when the
  * file lacks what they need (reason in err), 1 on other failures. */
 int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char *err, size_t errlen);
+
+/* Reads rows [0, rows) of dataset name (rank 1..3, doubles) of the open
+ * file f (path: for messages) into a new buffer of `per_row` values a
+ * row; NULL with a message when it is missing or shaped otherwise.  (An
+ * hid_t is an int64_t.) */
+double *cd_an_mpm_read_rows(int64_t f, const char *path, const char *name, size_t rows, size_t per_row, char *err,
+                            size_t errlen);
+/* A diametral run (set-up diametral: two walls, no packing series)? */
+int cd_an_mpm_is_disk(const char *path);
+/* The paper's Fig. 1 measures of a diametral run (analyze_mpm_disk.c):
+ * the group mpm_disk.  0, 2 (reason in err), 1. */
+int cd_an_mpm_disk(const char *path, const cd_an_options *opt, cd_an_report *r, char *err, size_t errlen);
+
+/* The paper's compaction models beyond jamming (analyze_mpm_models.c):
+ * the particle material and the models' parameters. */
+typedef struct {
+    double E, nu, sigma_y, H; /* Young's modulus [Pa], Poisson's ratio [1], yield stress and hardening [Pa] */
+    double f_E, f_G, p_c;     /* eqs. (8), (9) (and (15), (16): the plastic ones equal, as in the paper) [1] */
+    double c1, c2;            /* eqs. (6), (13) [1] */
+    double alpha, phi_c;      /* eq. (11) [1] */
+} cd_an_mpm_model;
+/* Eqs. (7)-(9): M_eff [Pa] of a material (E [Pa], nu) at packing fraction
+ * phi; 0 at or below Phi = 1 - p_c. */
+double cd_an_mpm_m_eff(double E, double nu, double f_E, double f_G, double p_c, double phi);
+/* Eq. (6), elastic [Pa], compression positive, at (Phi, Z). */
+double cd_an_mpm_sigma_elastic(const cd_an_mpm_model *m, double phi, double z);
+/* Eqs. (10), (11), (13)-(16), plastic [Pa]: E_p = E H / (E + H). */
+double cd_an_mpm_sigma_plastic(const cd_an_mpm_model *m, double phi, double z);
+/* Fits m's f_E, f_G, c1 (from m's values) of eq. (6) to n states (phi,
+ * z, sigma [Pa]); out->p = {f_E, f_G, c1}, intervals from Student's t.
+ * 0, or -1 (too few states, no convergence, a singular M_eff). */
+int cd_an_mpm_fit_eq6(const double *phi, const double *z, const double *sigma, size_t n, cd_an_mpm_model *m,
+                      cd_an_nlfit *out);
+/* Fits m's alpha of eq. (10) (sigma linear in alpha), the rest of m fixed;
+ * its 95 % interval.  0, or -1. */
+int cd_an_mpm_fit_eq10(const double *phi, const double *z, const double *sigma, size_t n, cd_an_mpm_model *m,
+                       double *alpha_lo, double *alpha_hi);
+/* The groups mpm_eq6 (elastic material: f_E, f_G, c1 fitted, p_c = 1 -
+ * Phi_c, c2 = -ln Phi_c) and mpm_eq10 (plastic: alpha fitted, the elastic
+ * parameters from `elastic` = {f_E, f_G, c1} or else the paper's), each
+ * with its curve against the series rows beyond Phi_c = pc and the paper's
+ * parameters' curve; material: E, nu, sigma_y, H. */
+void cd_an_mpm_models(cd_an_report *r, const cd_an_mpm_model *material, int plastic, const double *elastic, double pc,
+                      const double *phi, const double *z, const double *sigma, const double *strain, size_t rows);
 
 #endif

@@ -84,7 +84,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: capdem analyze RUN.h5 [--snapshot last|N] [--json] [--measures LIST] [--no-write]\n"
             "                      [--margins SIDE,END] [--rdf-max R] [--rdf-bin DR] [--mc-points M]\n"
-            "                      [--phi-series NAME] [--z-series NAME] [--phi-c PHI] [--quiet] [--timings]\n"
+            "                      [--phi-series NAME] [--z-series NAME] [--phi-c PHI] [--elastic-model F_E,F_G,C1]\n"
+            "                      [--quiet] [--timings]\n"
             "  --snapshot N     snapshot index (0 first, -1 or last: the last; default last)\n"
             "  --json           print one JSON object on stdout (keys: docs/analysis.md)\n"
             "  --measures LIST  comma-separated subset, each of which must succeed (else exit 2), of\n"
@@ -97,7 +98,8 @@ static void usage(FILE *f)
             "  --rdf-bin DR     G(r) bin width in L (default 0.02)\n"
             "  --mc-points M    Monte Carlo points for the core packing fraction (default 1e6)\n"
             "  --phi-series, --z-series  observables for the jamming fit\n"
-            "  --phi-c PHI      mpm run files: Phi_c of the fits of eqs. (5) and (11) (default: eq. (17)'s)\n"
+            "  --phi-c PHI      mpm run files: Phi_c of the fits of eqs. (5), (6), (10), (11) (default: eq. (17)'s)\n"
+            "  --elastic-model F_E,F_G,C1  mpm, plastic: eq. (10)'s elastic part (default the paper's 1.2,0.2,1)\n"
             "  --quiet          no summary and no warnings;  --timings  time of each phase on stderr\n"
             "exit status: 0 done, 2 bad input (missing file or data), 1 other failure\n",
             measure_list(names, sizeof names));
@@ -322,6 +324,18 @@ int cd_cmd_analyze(int argc, char **argv)
                 return 2;
             }
             opt.phi_c = v;
+        } else if (!strcmp(a, "--elastic-model") && more) {
+            const char *t = argv[++i];
+            char *end;
+            double *e = opt.elastic_model;
+            e[0] = strtod(t, &end);
+            e[1] = *end == ',' ? strtod(end + 1, &end) : NAN;
+            e[2] = *end == ',' ? strtod(end + 1, &end) : NAN;
+            if (*end || !isfinite(e[0]) || !isfinite(e[1]) || !(e[2] > 0 && isfinite(e[2]))) {
+                fprintf(stderr, "capdem analyze: --elastic-model %s: expected F_E,F_G,C1, three numbers, C1 > 0\n", t);
+                return 2;
+            }
+            opt.elastic_model_set = 1;
         } else if (!strcmp(a, "--phi-series") && more) {
             opt.phi_series = argv[++i];
         } else if (!strcmp(a, "--z-series") && more) {

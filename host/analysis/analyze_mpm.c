@@ -1,7 +1,7 @@
 /* `capdem analyze` of a run file of the material point method (solver mpm,
  * docs/mpm.md "Analysis"): the compaction measures of Nezamabadi et al.
  * 2022 (the paper) from the run's series and snapshots, and the fits of its
- * eqs. (5), (11) and (17).
+ * eqs. (5), (11) and (17); those of eqs. (6)-(16) in analyze_mpm_models.c.
  *
  * Series (every thermo_every steps): packing fraction Phi, applied stress
  * sigma [Pa], strain ln(h_i/h) (compression positive: the paper's
@@ -12,6 +12,8 @@
 #include "analysis/analyze.h"
 #include <hdf5.h>
 #include "io/io_h5_layout.h"
+#include "io/io_h5.h"
+#include "config/config.h"
 #include <gsl/gsl_cdf.h>
 #include <math.h>
 #include <stdio.h>
@@ -118,11 +120,8 @@ double cd_an_max_boundary_curvature(double *xy, size_t n, double scale)
     return kmax;
 }
 
-/* Reads rows [0, rows) of dataset name (rank 1..3, doubles) into a new
- * buffer of `per_row` values a row; NULL with a message when it is missing
- * or shaped otherwise. */
-static double *read_rows(hid_t f, const char *path, const char *name, size_t rows, size_t per_row, char *err,
-                         size_t errlen)
+double *cd_an_mpm_read_rows(hid_t f, const char *path, const char *name, size_t rows, size_t per_row, char *err,
+                            size_t errlen)
 {
     hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
     hsize_t dims[3] = {1, 1, 1};
@@ -149,6 +148,8 @@ typedef struct {
     double *sstep, *stime;                   /* snapshots: step, time [s] */
     double *pos, *vol, *eps_p, *defg;        /* snapshots: (S, n, 2) [m], (S, n) [m^3/m], (S, n), (S, n, 4) */
     double *swall;                           /* snapshots' wall positions (S, 4, 2) [m] */
+    int material_ok, plastic;                /* the echoed config parsed; its model von_mises */
+    cd_an_mpm_model material;                /* E, nu, sigma_y, H of the config */
 } mpm_data;
 
 static void data_free(mpm_data *d)
@@ -204,24 +205,40 @@ static int data_read(const char *path, mpm_data *d, char *err, size_t errlen)
     }
     d->snaps = (size_t)snaps;
     size_t R = d->rows, S = d->snaps, n = d->n;
-    if (!(d->step = read_rows(f, path, "/mpm/series/step", R, 1, err, errlen)) ||
-        !(d->phi = read_rows(f, path, "/mpm/series/packing_fraction", R, 1, err, errlen)) ||
-        !(d->sigma = read_rows(f, path, "/mpm/series/stress", R, 1, err, errlen)) ||
-        !(d->strain = read_rows(f, path, "/mpm/series/strain", R, 1, err, errlen)) ||
-        !(d->z = read_rows(f, path, "/mpm/series/coordination", R, 1, err, errlen)) ||
-        !(d->wall0 = read_rows(f, path, "/mpm/series/wall_position", 1, 8, err, errlen)) ||
-        !(d->sstep = read_rows(f, path, "/mpm/snapshots/step", S, 1, err, errlen)) ||
-        !(d->stime = read_rows(f, path, "/mpm/snapshots/time", S, 1, err, errlen)) ||
-        !(d->pos = read_rows(f, path, "/mpm/snapshots/position", S, 2 * n, err, errlen)) ||
-        !(d->vol = read_rows(f, path, "/mpm/snapshots/volume", S, n, err, errlen)) ||
-        !(d->eps_p = read_rows(f, path, "/mpm/snapshots/plastic_strain", S, n, err, errlen)) ||
-        !(d->defg = read_rows(f, path, "/mpm/snapshots/deformation_gradient", S, 4 * n, err, errlen)) ||
-        !(d->swall = read_rows(f, path, "/mpm/snapshots/wall_position", S, 8, err, errlen)))
+    if (!(d->step = cd_an_mpm_read_rows(f, path, "/mpm/series/step", R, 1, err, errlen)) ||
+        !(d->phi = cd_an_mpm_read_rows(f, path, "/mpm/series/packing_fraction", R, 1, err, errlen)) ||
+        !(d->sigma = cd_an_mpm_read_rows(f, path, "/mpm/series/stress", R, 1, err, errlen)) ||
+        !(d->strain = cd_an_mpm_read_rows(f, path, "/mpm/series/strain", R, 1, err, errlen)) ||
+        !(d->z = cd_an_mpm_read_rows(f, path, "/mpm/series/coordination", R, 1, err, errlen)) ||
+        !(d->wall0 = cd_an_mpm_read_rows(f, path, "/mpm/series/wall_position", 1, 8, err, errlen)) ||
+        !(d->sstep = cd_an_mpm_read_rows(f, path, "/mpm/snapshots/step", S, 1, err, errlen)) ||
+        !(d->stime = cd_an_mpm_read_rows(f, path, "/mpm/snapshots/time", S, 1, err, errlen)) ||
+        !(d->pos = cd_an_mpm_read_rows(f, path, "/mpm/snapshots/position", S, 2 * n, err, errlen)) ||
+        !(d->vol = cd_an_mpm_read_rows(f, path, "/mpm/snapshots/volume", S, n, err, errlen)) ||
+        !(d->eps_p = cd_an_mpm_read_rows(f, path, "/mpm/snapshots/plastic_strain", S, n, err, errlen)) ||
+        !(d->defg = cd_an_mpm_read_rows(f, path, "/mpm/snapshots/deformation_gradient", S, 4 * n, err, errlen)) ||
+        !(d->swall = cd_an_mpm_read_rows(f, path, "/mpm/snapshots/wall_position", S, 8, err, errlen)))
         goto done;
     rc = 0;
 done:
     if (f >= 0) H5Fclose(f);
     cdh5_quiet_end(&q);
+    if (rc == 0) { /* the material, from the config echoed in the file (the models of eqs. (6)-(16)) */
+        char cerr[512];
+        char *text = cd_h5_read_config_text(path, cerr, sizeof cerr);
+        cd_config c;
+        cd_config_defaults(&c);
+        if (text && cd_config_parse(text, path, &c, cerr, sizeof cerr) == 0 && c.solver == 1) { /* mpm */
+            d->material_ok = 1;
+            d->plastic = c.mpm_model == 1;
+            d->material.E = c.mpm_young;
+            d->material.nu = c.mpm_poisson;
+            d->material.sigma_y = d->plastic ? c.mpm_yield : 0;
+            d->material.H = d->plastic ? c.mpm_hardening : 0;
+        }
+        cd_config_free(&c);
+        free(text);
+    }
     return rc;
 }
 
@@ -277,6 +294,19 @@ static int snapshot_measures(const mpm_data *d, size_t k, double *phi, double *s
     return 0;
 }
 
+/* The applied stress of the series at a step [Pa]: interpolated between the rows around it (the
+ * snapshots' steps need not be series rows); NAN outside the series. */
+static double series_at(const mpm_data *d, double step)
+{
+    for (size_t i = 0; i < d->rows; i++) {
+        if (d->step[i] == step) return d->sigma[i];
+        if (i > 0 && d->step[i - 1] < step && step < d->step[i])
+            return d->sigma[i - 1] +
+                   (step - d->step[i - 1]) / (d->step[i] - d->step[i - 1]) * (d->sigma[i] - d->sigma[i - 1]);
+    }
+    return NAN;
+}
+
 /* The first crossing of Phi = phi_c in the series: sigma and strain there
  * by linear interpolation; -1 when the series never reaches phi_c. */
 static int at_phi(const mpm_data *d, double phi_c, double *sigma_c, double *strain_c)
@@ -298,6 +328,7 @@ static int at_phi(const mpm_data *d, double phi_c, double *sigma_c, double *stra
 
 int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char *err, size_t errlen)
 {
+    if (cd_an_mpm_is_disk(path)) return cd_an_mpm_disk(path, opt, r, err, errlen);
     mpm_data d;
     int rc = data_read(path, &d, err, errlen);
     if (rc) {
@@ -326,7 +357,13 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
     cd_an_put(g, "strain", d.strain[L], "1");
     cd_an_put(g, "z", d.z[L], "1");
     /* every snapshot, and the chosen one's values */
-    double *c = cd_an_put_curve(g, "snapshots", d.snaps, "step,strain,phi,f_p,kappa_d", "1,1,1,1,1");
+    /* the whole series, for the figures (host/plot_run.py: the paper's Figs. 3-5) */
+    double *ser = cd_an_put_curve(g, "series", d.rows, "step,strain,phi,sigma,z", "1,1,1,Pa,1");
+    for (size_t i = 0; ser && i < d.rows; i++) {
+        double row[5] = {d.step[i], d.strain[i], d.phi[i], d.sigma[i], d.z[i]};
+        memcpy(ser + 5 * i, row, sizeof row);
+    }
+    double *c = cd_an_put_curve(g, "snapshots", d.snaps, "step,strain,phi,f_p,kappa_d,sigma", "1,1,1,1,1,Pa");
     double *sphi = malloc(d.snaps * 2 * sizeof(double)), *sfp = sphi ? sphi + d.snaps : NULL;
     if (!c || !sphi) {
         snprintf(err, errlen, "out of memory");
@@ -342,8 +379,8 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
             data_free(&d);
             return 1;
         }
-        double row[5] = {d.sstep[s], strain, phi, fp, kd};
-        memcpy(c + 5 * s, row, sizeof row);
+        double row[6] = {d.sstep[s], strain, phi, fp, kd, series_at(&d, d.sstep[s])};
+        memcpy(c + 6 * s, row, sizeof row);
         sphi[s] = phi;
         sfp[s] = fp;
         if ((int)s == k) {
@@ -359,7 +396,7 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
     int fr = opt->phi_c > 0 ? 0 : cd_an_fit_jamming(d.phi, d.z, d.rows, &jf);
     cd_an_group *g17 = cd_an_group_get(r, "mpm_eq17");
     if (opt->phi_c > 0) {
-        double *x = malloc(2 * d.rows * sizeof(double)), *y = x ? x + d.rows : NULL;
+        double *x = calloc(2 * d.rows, sizeof(double)), *y = x ? x + d.rows : NULL;
         size_t m = 0;
         for (size_t i = 0; x && i < d.rows; i++)
             if (d.phi[i] > opt->phi_c && d.z[i] > 0) {
@@ -402,7 +439,7 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
     if (!(pc > 0)) cd_an_put_text(g5, "skipped", "%s", no_pc);
     else if (at_phi(&d, pc, &sc, &ec)) cd_an_put_text(g5, "skipped", "the series does not reach Phi_c = %.4g", pc);
     else {
-        double *x = malloc(2 * d.rows * sizeof(double)), *y = x ? x + d.rows : NULL;
+        double *x = calloc(2 * d.rows, sizeof(double)), *y = x ? x + d.rows : NULL;
         size_t m = 0;
         for (size_t i = 1; x && i < d.rows; i++)
             if (d.phi[i] >= pc) {
@@ -455,6 +492,14 @@ int cd_an_mpm(const char *path, const cd_an_options *opt, cd_an_report *r, char 
         cd_an_put(g11, "alpha_lo", alpha - t * se, "1");
         cd_an_put(g11, "alpha_hi", alpha + t * se, "1");
         cd_an_put(g11, "n_points", (double)m, "1");
+    }
+    /* eqs. (6)-(16): the porous-medium law and the plastic mixture */
+    if (d.material_ok)
+        cd_an_mpm_models(r, &d.material, d.plastic, opt->elastic_model_set ? opt->elastic_model : NULL, pc, d.phi, d.z,
+                         d.sigma, d.strain, d.rows);
+    else {
+        cd_an_put_text(cd_an_group_get(r, "mpm_eq6"), "skipped", "the echoed config does not parse: no material");
+        cd_an_put_text(cd_an_group_get(r, "mpm_eq10"), "skipped", "the echoed config does not parse: no material");
     }
     free(sphi);
     data_free(&d);

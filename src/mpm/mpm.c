@@ -341,7 +341,7 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
     }
     if (m->n_bodies > 1) {
         cd_mpm_contact_nodes(m);
-        if (cd_mpm_contact_correct(m, 0, err, errlen)) return -1;
+        if (cd_mpm_contact_correct(m, err, errlen)) return -1;
     }
     /* points: velocity from the node accelerations (FLIP) blended with the new node velocities
      * (PIC, a share pic_fraction: damps the velocity modes the mesh does not see, which FLIP
@@ -371,7 +371,9 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
     for (size_t t = 0; t < m->n_bnodes; t++)
         mesh_kinetic += 0.5 * m->gm[t] * (m->gvx[t] * m->gvx[t] + m->gvy[t] * m->gvy[t]);
     m->mesh_kinetic = mesh_kinetic;
-    if (m->n_bodies > 1 && cd_mpm_contact_correct(m, 1, err, errlen)) return -1;
+    /* no second contact correction of the remapped velocities: the strain follows each body's own
+     * remapped field, the motion its points made; re-imposing the contact there, on the contact's
+     * widened nodes, made strain the points' motion did not have and fed energy (docs/mpm.md) */
     /* points: velocity gradient, stress, deformation gradient and volume */
     long long bad = -1;
 #pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(m->n))

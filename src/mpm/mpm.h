@@ -121,14 +121,13 @@ double cd_mpm_strain_energy(const cd_mpm *m);
 void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double *strain, double *z);
 
 /* Contact (src/mpm/mpm_contact.c, docs/mpm.md "Contact"): lists the common
- * nodes two or more bodies share; corrects the bodies' node velocities
- * there (phase 0: after the forces, detects the contacts, sets the
- * accelerations to match and counts the body pairs; phase 1: the MUSL
- * remap).  -1 with a message when more bodies than CD_MPM_NODE_BODIES
- * meet at a node. */
+ * nodes two or more bodies share; after the forces, detects the contacts
+ * there, corrects the bodies' node velocities, sets the accelerations to
+ * match and counts the body pairs.  -1 with a message when more bodies
+ * than CD_MPM_NODE_BODIES meet at a node. */
 #define CD_MPM_NODE_BODIES 8
 void cd_mpm_contact_nodes(cd_mpm *m);
-int cd_mpm_contact_correct(cd_mpm *m, int phase, char *err, size_t errlen);
+int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen);
 /* The common-mesh coordinates (i, j) of body-node t. */
 static inline void cd_mpm_bnode_ij(const cd_mpm *m, size_t t, int *i, int *j)
 {

@@ -99,8 +99,26 @@ static void put(hid_t f, const char *name, hid_t type, int rank, const hsize_t *
  * and 3 + 10 sqrt(Phi - 0.8) above; sigma = 1e5 (Phi / 0.8)^4 below and
  * sigma_c + 2e6 (strain - strain_c) above.  Snapshots at Phi = 0.8
  * e^(f_p / 2.5) with f_p = 0, 0.1, 0.2, 0.4 (the first 0, 30, 60, 120 of
- * the 300 equal points plastic): alpha = 2.5. */
-static void write_run(const char *path)
+ * the 300 equal points plastic): alpha = 2.5.  law 1 and 2: sigma above
+ * Phi_c from eq. (6) (an elastic material, E = 10 MPa, nu = 0.45, f_E =
+ * 1.0, f_G = 0.3, c1 = 0.7, p_c = 0.2, c2 = -ln 0.8) or eq. (10) (von Mises,
+ * sigma_y = 0.4 MPa, H = 1 MPa, alpha = 2.5, the elastic part with the
+ * paper's f_E = 1.2, f_G = 0.2, c1 = 1 and p_c = 0.2, c2 = -ln 0.8), the
+ * material in the echoed config. */
+enum { LAW_EQ5, LAW_EQ6, LAW_EQ10 };
+static const cd_an_mpm_model law6 = {.E = 1e7, .nu = 0.45, .f_E = 1.0, .f_G = 0.3, .p_c = 0.2, .c1 = 0.7, .phi_c = 0.8};
+static const cd_an_mpm_model law10 = {.E = 1e7,
+                                      .nu = 0.45,
+                                      .sigma_y = 4e5,
+                                      .H = 1e6,
+                                      .f_E = 1.2,
+                                      .f_G = 0.2,
+                                      .p_c = 0.2,
+                                      .c1 = 1,
+                                      .alpha = 2.5,
+                                      .phi_c = 0.8};
+
+static void write_run(const char *path, int law)
 {
     enum { R = 100, S = 4, n = 300 };
     const double l = 1e-4, W = 4e-3, area = n * l * l; /* [m], [m], [m^2/m] */
@@ -124,7 +142,12 @@ static void write_run(const char *path)
         phi[i] = 0.75 + 0.2 * i / (R - 1);
         eps[i] = 2 * (phi[i] - 0.75);
         z[i] = phi[i] > pc ? 3 + 10 * sqrt(phi[i] - pc) : 1;
-        sig[i] = phi[i] > pc ? sc + 2e6 * (eps[i] - ec) : sc * pow(phi[i] / pc, 4);
+        cd_an_mpm_model m6 = law6, m10 = law10;
+        m6.c2 = m10.c2 = -log(pc);
+        sig[i] = phi[i] <= pc     ? sc * pow(phi[i] / pc, 4)
+                 : law == LAW_EQ5 ? sc + 2e6 * (eps[i] - ec)
+                 : law == LAW_EQ6 ? cd_an_mpm_sigma_elastic(&m6, phi[i], z[i])
+                                  : cd_an_mpm_sigma_plastic(&m10, phi[i], z[i]);
         double h = area / (W * phi[i]);
         double w[8] = {0, 0, 0, h, 0, 0, W, 0}; /* bottom, top, left, right */
         memcpy(wall[i], w, sizeof w);
@@ -174,6 +197,22 @@ static void write_run(const char *path)
         snprintf(name, sizeof name, "/mpm/%s", cols[k].name);
         put(f, name, H5T_NATIVE_DOUBLE, cols[k].rank, cols[k].dims, cols[k].data);
     }
+    char config[1024];
+    snprintf(config, sizeof config,
+             "solver: mpm\nrun:\n  name: synthetic\n  dt: 1.0e-7\n  steps: 10\nmpm:\n  setup: packing\n"
+             "  packing: none.h5\n  cells_per_diameter: 6\n  wall_speed: 2\n  material:\n    model: %s\n"
+             "    density: 1000\n    young_modulus: 1.0e7\n    poisson_ratio: 0.45\n%s",
+             law == LAW_EQ10 ? "von_mises" : "elastic",
+             law == LAW_EQ10 ? "    yield_stress: 4.0e5\n    hardening: 1.0e6\n" : "");
+    hid_t ct = H5Tcopy(H5T_C_S1);
+    H5Tset_size(ct, strlen(config) + 1);
+    hid_t cs = H5Screate(H5S_SCALAR), g = H5Gcreate2(f, "/parameters", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t cd = H5Dcreate2(f, "/parameters/config", ct, cs, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    assert_true(cd >= 0 && H5Dwrite(cd, ct, H5S_ALL, H5S_ALL, H5P_DEFAULT, config) >= 0);
+    H5Dclose(cd);
+    H5Gclose(g);
+    H5Sclose(cs);
+    H5Tclose(ct);
     H5Fclose(f);
 }
 
@@ -181,7 +220,7 @@ static void test_synthetic_run(void **state)
 {
     (void)state;
     const char *path = "test_mpm_analysis.h5";
-    write_run(path);
+    write_run(path, LAW_EQ5);
     cd_an_options opt;
     cd_an_options_defaults(&opt);
     cd_an_report rep;
@@ -200,6 +239,13 @@ static void test_synthetic_run(void **state)
     assert_true(fabs(cd_an_value(&rep, "mpm", "snapshot_strain") - log(ph3 / 0.75)) < 1e-12);
     assert_true(fabs(cd_an_value(&rep, "mpm", "f_p") - 0.4) < 1e-12);
     assert_true(fabs(cd_an_value(&rep, "mpm", "kappa_d") / (2 * PI) - 1) < 1e-9);
+    /* the tables for the figures: the whole series, and each snapshot's applied stress, that of the
+     * series row of its step (steps 0, 100, 200, 300: rows 0, 5, 10, 15) */
+    const cd_an_curve *ser = cd_an_curve_find(&rep, "mpm", "series"), *sn = cd_an_curve_find(&rep, "mpm", "snapshots");
+    assert_true(ser && ser->rows == 100 && ser->cols == 5 && !strcmp(ser->columns, "step,strain,phi,sigma,z"));
+    assert_true(sn && sn->rows == 4 && sn->cols == 6 && !strcmp(sn->columns, "step,strain,phi,f_p,kappa_d,sigma"));
+    assert_true(ser->data[5 * 99 + 2] == 0.95 && ser->data[5 * 99 + 3] > 0);
+    for (int k = 0; k < 4; k++) assert_true(sn->data[6 * k + 5] == ser->data[5 * (5 * k) + 3]);
     /* eq. (17): exact data, the fit recovers them */
     assert_true(fabs(cd_an_value(&rep, "mpm_eq17", "phi_c") - 0.8) < 1e-5);
     assert_true(fabs(cd_an_value(&rep, "mpm_eq17", "z_c") - 3) < 1e-3);
@@ -236,12 +282,104 @@ static void test_synthetic_run(void **state)
     remove(path);
 }
 
+/* Eqs. (6)-(16) (host/analysis/analyze_mpm_models.c): known values of the
+ * formulas, and the synthetic runs of law 1 and 2 give their parameters
+ * back with Phi_c given (--phi-c 0.8). */
+/* A text of a report group, "" when absent. */
+static const char *text_of(const cd_an_report *r, const char *group, const char *name)
+{
+    const cd_an_group *g = cd_an_group_find(r, group);
+    for (int k = 0; g && k < g->n_texts; k++)
+        if (!strcmp(g->texts[k].name, name)) return g->texts[k].text;
+    return "";
+}
+
+static void test_models(void **state)
+{
+    (void)state;
+    /* eq. (7) at Phi = 1 (no porosity): the P-wave modulus lambda + 2 mu = 2 G (1 - nu) / (1 - 2 nu) */
+    double G = 1e7 / 2.9, M1 = 2 * G * 0.55 / 0.1;
+    assert_true(fabs(cd_an_mpm_m_eff(1e7, 0.45, 1.2, 0.2, 0.201, 1.0) / M1 - 1) < 1e-12);
+    /* (1 - p/p_c)^f: at p = p_c / 2, E_eff = E / 2^f_E, G_eff = G / 2^f_G, eq. (7) of those */
+    double Ee = 1e7 / pow(2, 1.2), Ge = G / pow(2, 0.2);
+    assert_true(fabs(cd_an_mpm_m_eff(1e7, 0.45, 1.2, 0.2, 0.2, 0.9) / (Ge * (4 * Ge - Ee) / (3 * Ge - Ee)) - 1) <
+                1e-12);
+    assert_true(cd_an_mpm_m_eff(1e7, 0.45, 1.2, 0.2, 0.2, 0.79) == 0); /* below 1 - p_c: none */
+    cd_an_mpm_model m = law10;
+    m.c2 = -log(0.8);
+    /* eq. (6) vanishes at Phi_c = exp(-c2); eq. (6) by hand at Phi = 0.9, Z = 4 (K = lambda + mu) */
+    assert_true(fabs(cd_an_mpm_sigma_elastic(&m, 0.8, 4)) < 1e-6);
+    double M = cd_an_mpm_m_eff(1e7, 0.45, 1.2, 0.2, 0.2, 0.9), K = 1e7 / (2 * 1.45 * 0.1);
+    assert_true(fabs(cd_an_mpm_sigma_elastic(&m, 0.9, 4) / (M / (1 + M / (K * 4 * 0.9)) * log(0.9 / 0.8)) - 1) < 1e-12);
+    /* eq. (10): alpha = 0 is the elastic law; H = 0 makes sigma_p = sigma_y */
+    m.alpha = 0;
+    assert_true(cd_an_mpm_sigma_plastic(&m, 0.9, 4) == cd_an_mpm_sigma_elastic(&m, 0.9, 4));
+    m.alpha = 2.5;
+    m.H = 0;
+    double fp = 2.5 * log(0.9 / 0.8);
+    assert_true(
+        fabs(cd_an_mpm_sigma_plastic(&m, 0.9, 4) - ((1 - fp) * cd_an_mpm_sigma_elastic(&m, 0.9, 4) + fp * 4e5)) < 1e-6);
+
+    const char *path = "test_mpm_models.h5";
+    cd_an_options opt;
+    cd_an_options_defaults(&opt);
+    opt.phi_c = 0.8;
+    cd_an_report rep;
+    char err[512] = "";
+    /* eq. (6): f_E, f_G, c1 back from exact data (from the paper's 1.2, 0.2, 1), their intervals hold them */
+    write_run(path, LAW_EQ6);
+    memset(&rep, 0, sizeof rep);
+    assert_int_equal(cd_an_mpm(path, &opt, &rep, err, sizeof err), 0);
+    const char *names[3] = {"f_e", "f_g", "c1"};
+    const double truth[3] = {law6.f_E, law6.f_G, law6.c1};
+    for (int k = 0; k < 3; k++) {
+        char lo[16], hi[16];
+        snprintf(lo, sizeof lo, "%s_lo", names[k]);
+        snprintf(hi, sizeof hi, "%s_hi", names[k]);
+        double v = cd_an_value(&rep, "mpm_eq6", names[k]);
+        print_message("eq. (6): %s = %.9g (truth %g)\n", names[k], v, truth[k]);
+        assert_true(fabs(v / truth[k] - 1) < 1e-6);
+        assert_true(cd_an_value(&rep, "mpm_eq6", lo) <= truth[k] + 1e-6 &&
+                    cd_an_value(&rep, "mpm_eq6", hi) >= truth[k] - 1e-6);
+    }
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq6", "p_c") - 0.2) < 1e-12);
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq6", "c2") + log(0.8)) < 1e-12);
+    assert_true(cd_an_value(&rep, "mpm_eq6", "rms_residual") < 1e-3);      /* Pa, of stresses up to ~1 MPa */
+    assert_true(cd_an_value(&rep, "mpm_eq6", "rms_residual_paper") > 1e3); /* other parameters, other curve */
+    assert_true(cd_an_value(&rep, "mpm_eq6", "n_points") == 75);           /* the rows with Phi > 0.8: 25..99 */
+    assert_non_null(strstr(text_of(&rep, "mpm_eq10", "skipped"), "elastic material"));
+    cd_an_report_free(&rep);
+    /* eq. (10): alpha = 2.5 back (sigma is linear in it), the elastic part the paper's by default */
+    write_run(path, LAW_EQ10);
+    memset(&rep, 0, sizeof rep);
+    assert_int_equal(cd_an_mpm(path, &opt, &rep, err, sizeof err), 0);
+    print_message("eq. (10): alpha = %.12g\n", cd_an_value(&rep, "mpm_eq10", "alpha"));
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq10", "alpha") / 2.5 - 1) < 1e-9);
+    assert_true(cd_an_value(&rep, "mpm_eq10", "rms_residual") < 1e-3);
+    assert_true(cd_an_value(&rep, "mpm_eq10", "f_e") == 1.2 && cd_an_value(&rep, "mpm_eq10", "c1") == 1);
+    assert_non_null(strstr(text_of(&rep, "mpm_eq6", "skipped"), "plastic material"));
+    cd_an_report_free(&rep);
+    /* another elastic part (--elastic-model): used, and then the data do not fit exactly */
+    opt.elastic_model_set = 1;
+    opt.elastic_model[0] = 1.0;
+    opt.elastic_model[1] = 0.3;
+    opt.elastic_model[2] = 0.7;
+    memset(&rep, 0, sizeof rep);
+    assert_int_equal(cd_an_mpm(path, &opt, &rep, err, sizeof err), 0);
+    assert_true(cd_an_value(&rep, "mpm_eq10", "f_e") == 1.0 && cd_an_value(&rep, "mpm_eq10", "c1") == 0.7);
+    assert_true(fabs(cd_an_value(&rep, "mpm_eq10", "alpha") / 2.5 - 1) > 1e-3);
+    assert_true(cd_an_value(&rep, "mpm_eq10", "rms_residual") > 1);
+    cd_an_report_free(&rep);
+    remove(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fit_line),
         cmocka_unit_test(test_curvature),
         cmocka_unit_test(test_synthetic_run),
+        cmocka_unit_test(test_models),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

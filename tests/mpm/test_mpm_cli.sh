@@ -65,13 +65,23 @@ awk -v f="$fy" 'BEGIN { exit !(f > 0) }' && ok || bad "good run: top wall force 
 "$capdem" run good.yaml --resume half.h5 --steps 60 --quiet > out 2> err; rc=$?
 [ $rc = 2 ] && grep -q "at step 100 already" err && ok || bad "--resume --steps 60: exit status $rc, expected 2"
 
-# export does not read mpm run files yet, analyze only those of set-up packing (test_mpm_packing):
-# refused by name, not misread
+# export does not read mpm run files yet: refused by name, not misread
 "$capdem" export good.h5 > out 2> err; rc=$?
 [ $rc = 2 ] && grep -q "solver mpm" err && ok || bad "export of an mpm run file: exit status $rc, expected 2 naming solver mpm"
-"$capdem" analyze good.h5 > out 2> err; rc=$?
-[ $rc = 2 ] && grep -q "not a packing run of solver mpm" err && ok \
-  || bad "analyze of a diametral mpm run: exit status $rc, expected 2 naming the set-up"
+# analyze of a diametral run (docs/mpm.md "Analysis"): the strain (D - gap)/D and F/D, the mean of the two
+# walls' forces over D, of the series' last row (wall_position and wall_force rows: x0,y0,x1,y1), to the
+# 6 digits of the text report
+if "$capdem" analyze good.h5 --no-write > out 2> err; then ok; else bad "analyze of a diametral run: exit status $?"; fi
+last_row() { h5dump -w 0 -A 0 -m %.17g -d "/mpm/series/$1" good.h5 | sed -n 's/^ *([0-9,]*): *//p' | tr -d ' ' |
+  tr ',' '\n' | sed '/^$/d' | paste -d, - - - - | sed -n "\$p"; }
+first_row() { h5dump -w 0 -A 0 -m %.17g -d /mpm/series/wall_position good.h5 | sed -n 's/^ *([0-9,]*): *//p' |
+  tr -d ' ' | tr ',' '\n' | sed '/^$/d' | paste -d, - - - - | head -1; }
+awk -F, -v p0="$(first_row)" -v p="$(last_row wall_position)" -v f="$(last_row wall_force)" \
+  -v e="$(awk '$1 == "strain" { print $2 }' out)" -v s="$(awk '$1 == "f_over_d" { print $2 }' out)" 'BEGIN {
+    split(p0, a, ","); split(p, b, ","); split(f, c, ","); D = a[4] - a[2]
+    es = (D - (b[4] - b[2])) / D; fs = (-c[2] + c[4]) / 2 / D
+    exit !(D > 0 && e != "" && s > 0 && ((e - es) / es)^2 < 1e-11 && ((s - fs) / fs)^2 < 1e-11) }' && ok \
+  || bad "analyze of a diametral run: strain/F/D not those of the series: $(cat out)"
 "$capdem" analyze good.h5 --measures forces > out 2> err; rc=$?
 [ $rc = 2 ] && grep -q "its only measure is mpm" err && ok || bad "analyze --measures forces of an mpm run: exit $rc"
 

@@ -12,20 +12,20 @@
 # 400-1,200 (the ringing of the wall's start at 2 m/s, when the packing
 # first jams).  An undamped elastic compaction keeps its ringing but gains
 # no energy beyond the wall's work going into strain energy: the ratio
-# stays near or below 1.  Measured (one thread; any count gives the same bits): 0.76 with the
-# default, 1.76 with pure FLIP; the limit 1 lies between (geometric middle
-# 1.16), and the pure-FLIP run must exceed 1.4 so that the case still shows
-# the growth it guards against.  And what grows is the energy the mesh does
-# not see (kinetic_energy - kinetic_energy_mesh, same steps): measured 0.066
-# J/m with the default, 0.62 with pure FLIP; the default must stay under a
-# quarter of pure FLIP's.
+# stays near or below 1.  Measured (one thread; any count gives the same bits): 0.41 with the
+# default, 1.23 with pure FLIP; the limit 1 lies between, and the pure-FLIP run must exceed 1.1 so
+# that the case still shows the growth it guards against (1.76 before the contact's lines of
+# docs/mpm.md "Contact between particles": the contacts that crept into each other fed it more).
+# And what grows is the energy the mesh does not see (kinetic_energy - kinetic_energy_mesh, same
+# steps): measured 0.028 J/m with the default, 0.37 with pure FLIP (0.066 and 0.62 before the
+# contact's lines); the default must stay under a quarter of pure FLIP's.
 # usage: test_mpm_flip_noise.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 cfg=$src/configs/mpm/ci
 
-series() { h5dump -w 0 -A 0 -m %.17g -d "/mpm/series/$1" "$2" | sed -n 's/^ *([0-9,]*): *//p' | tr ',' '\n' | sed '/^ *$/d'; }
+. "$src/tests/mpm/mpm_series.sh"
 # growth FILE: mean kinetic energy of steps 2400-3000 over that of steps 400-1200
 growth() {
   paste <(series step "$1") <(series kinetic_energy "$1") | awk '
@@ -54,8 +54,8 @@ g_blend=$(growth blend.h5) g_flip=$(growth flip.h5)
 echo "kinetic energy, steps 2400-3000 over 400-1200: default $g_blend, pure FLIP $g_flip"
 awk -v g="$g_blend" 'BEGIN { exit !(g + 0 == g && g < 1) }' && ok \
   || bad "the default run's kinetic energy grows: ratio $g_blend, expected < 1"
-awk -v g="$g_flip" 'BEGIN { exit !(g + 0 == g && g > 1.4) }' && ok \
-  || bad "pure FLIP no longer shows the growth (ratio $g_flip, expected > 1.4): the case guards nothing"
+awk -v g="$g_flip" 'BEGIN { exit !(g + 0 == g && g > 1.1) }' && ok \
+  || bad "pure FLIP no longer shows the growth (ratio $g_flip, expected > 1.1): the case guards nothing"
 # what grows is the part the mesh does not see (docs/mpm.md "FLIP's noise")
 u_blend=$(unseen blend.h5) u_flip=$(unseen flip.h5)
 echo "kinetic energy the mesh does not see, steps 2400-3000: default $u_blend J/m, pure FLIP $u_flip J/m"

@@ -13,8 +13,7 @@ capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 cfg=$src/configs/mpm/ci
 
-# series NAME FILE: the rows of /mpm/series/NAME, one a line
-series() { h5dump -w 0 -A 0 -m %.17g -d "/mpm/series/$1" "$2" | sed -n 's/^ *([0-9,]*): *//p' | tr ',' '\n' | sed '/^ *$/d'; }
+. "$src/tests/mpm/mpm_series.sh"
 
 "$capdem" run "$cfg/deposit_disks.yaml" --quiet > out 2> err && [ -f deposit_disks_ci.h5 ] && ok \
   || { bad "the DEM deposit did not run"; echo "test_mpm_packing: $pass passed, $fails failed"; exit 1; }
@@ -70,6 +69,14 @@ h5ls -r an.h5 | grep -q "^/analysis/snapshot_[0-9]*/mpm/snapshots *Dataset" && o
 # eq. (5) with Phi_c given: a positive modulus M_eff inside its interval
 "$capdem" analyze an.h5 --no-write --phi-c 0.7 > out 2> err && awk '$1 == "m_eff" { m = $2 } $1 == "m_eff_lo" { lo = $2 }
     $1 == "m_eff_hi" { hi = $2 } END { exit !(m > 0 && lo < m && m < hi) }' out && ok || bad "analyze --phi-c 0.7: no M_eff"
+# eqs. (6)-(9) on an elastic material: the paper's curve against the series rows beyond Phi_c (the fit of
+# f_E, f_G, c1 needs more of the compaction than these 900 steps, Phi 0.70-0.75: it says so; the synthetic
+# runs of test_mpm_analysis check the fit)
+"$capdem" analyze an.h5 --no-write --phi-c 0.7 > out 2> err && awk '/^\[mpm_eq6\]/ { g = 1 } /^\[mpm_eq10\]/ { g = 0 }
+    g && $1 == "rms_residual_paper" { p = $2 } g && $1 == "curve" { c = 1 } g && ($1 == "f_e" || $1 == "fit") { f = 1 }
+    END { exit !(p > 0 && c && f) }' out && ok || bad "analyze --phi-c 0.7: no eq. (6) group: $(sed -n '/mpm_eq6/,$p' out)"
+"$capdem" analyze an.h5 --no-write --elastic-model 1.2,0.2 > out 2> err; rc=$?
+[ $rc = 2 ] && grep -q -- "--elastic-model" err && ok || bad "analyze --elastic-model 1.2,0.2: exit status $rc, expected 2"
 "$capdem" analyze an.h5 --no-write --phi-c 1.5 > out 2> err; rc=$?
 [ $rc = 2 ] && grep -q -- "--phi-c" err && ok || bad "analyze --phi-c 1.5: exit status $rc, expected 2"
 "$capdem" analyze deposit_disks_ci.h5 --measures mpm > out 2> err; rc=$?
