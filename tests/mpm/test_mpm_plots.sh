@@ -6,19 +6,19 @@
 # the four PNGs exist and are not trivial, and the numbers drawn (the JSON
 # beside each PNG) are those of the analyses (`capdem analyze --json`), to
 # 1e-14 relative: copied, to the 15 digits of analyze's JSON, or computed
-# (eq. (5)'s line offset + M_eff x, Z - Z_c) to round-off.  Needs python3
-# (or $PYTHON) with h5py, numpy and matplotlib (the README's python3-h5py,
-# python3-matplotlib): without them it reports itself skipped (exit 77,
-# CTest's SKIP_RETURN_CODE; CI fails on any skip).
+# (eq. (5)'s line offset + M_eff x, Z - Z_c) to round-off.  Needs
+# /usr/bin/python3 (or $PYTHON), the Python `capdem render` runs, with
+# h5py, numpy and matplotlib (the README's python3-h5py, python3-matplotlib):
+# without them it fails, as every test of a dependency the README lists.
 # usage: test_mpm_plots.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
 . "$src/tests/cli/common.sh"
 cfg=$src/configs/mpm/ci
-py=${PYTHON:-python3}
+py=${PYTHON:-/usr/bin/python3}
 
 "$py" -c 'import h5py, numpy, matplotlib' 2> err && ok \
-  || { echo "SKIP $py lacks h5py, numpy or matplotlib (python3-h5py, python3-matplotlib; or set PYTHON)"; exit 77; }
+  || { bad "$py cannot import h5py, numpy and matplotlib (apt-get install python3-h5py python3-matplotlib; or set PYTHON)"; exit 1; }
 
 printf '%s\n' 'solver: mpm' 'run: {dt: 2.0e-6, steps: 100, snapshot_every: 50, thermo_every: 10}' \
   'mpm: {cells_per_diameter: 8, wall_speed: 10, material: {model: von_mises, yield_stress: 4.0e5, hardening: 1.0e6}}' > disk.yaml
