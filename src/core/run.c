@@ -140,9 +140,9 @@ static void write_failed(const cd_run_options *opt, const cd_config *cfg, long l
                 cfg->output, last_snap, opt->config_path, cfg->output);
 }
 
-/* Under MPI (docs/mpi.md) rank 0 alone holds the output (out is NULL on
- * the others) and every rank learns whether a write failed, so that all
- * stop together. */
+/* Under MPI (docs/mpi.md) every rank holds the output and writes the rows
+ * of its particles (parallel HDF5), and every rank learns whether a write
+ * failed, so that all stop together. */
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
 {
     if (out) cd_observable_row(sim, o, row);
@@ -151,6 +151,7 @@ static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables 
 
 static int write_snapshot(cd_output *out, const cd_state *s)
 {
+    if (out) cd_output_set_owned(out, cd_mpi_owned_rows(s->n_particles));
     return cd_mpi_agree(out ? cd_output_snapshot(out, s) : 0);
 }
 
@@ -342,7 +343,7 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        out = cd_mpi_is_writer() ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err) : NULL;
+        out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
         if (out && cd_output_note_resume(out, sim.s.step, &cfg)) { /* (the writer says why) */
             cd_output_close(out);
             out = NULL;
@@ -360,12 +361,10 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        if (cd_mpi_is_writer())
-            out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg,
-                                        sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
+        out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg, sim.shapes,
+                                    sim.n_shapes, info, n_obs, err, sizeof err);
     }
-    if (cd_mpi_agree(cd_mpi_is_writer() &&
-                     !out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
+    if (cd_mpi_agree(!out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
         status = 1;
         goto done;
     }

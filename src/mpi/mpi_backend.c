@@ -15,6 +15,7 @@
 #include "mpi/mpi_halo.h"
 #include "broadphase.h"
 #include "observe_items.h"
+#include "io/io_h5.h"
 
 static int began_here; /* MPI_Init was called by cd_mpi_begin */
 /* The decomposition of this process's run (cd_mpi_wrap): it outlives the
@@ -88,6 +89,24 @@ int cd_mpi_is_writer(void)
     int rank;
     world(&rank);
     return rank == 0;
+}
+
+const unsigned char *cd_mpi_owned_rows(size_t n_particles)
+{
+    static unsigned char *mask;
+    static size_t cap;
+    const cd_mpi_ctx *x = the_ctx;
+    if (!x || !x->started) return NULL;
+    if (cap < n_particles) {
+        unsigned char *m = realloc(mask, n_particles);
+        if (!m) return NULL; /* (rank 0 then writes every row: the same file) */
+        mask = m;
+        cap = n_particles;
+    }
+    memset(mask, 0, n_particles);
+    for (size_t q = 0; q < x->loc.s.n_particles; q++)
+        if (x->owned[q] && (size_t)x->gid[q] < n_particles) mask[x->gid[q]] = 1;
+    return mask;
 }
 
 int cd_mpi_decomposed(void)
@@ -374,6 +393,12 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     MPI_Comm_size(x->comm, &x->size);
     const char *all = getenv("CAPDEM_MPI_ALL_RANKS"); /* the fallback path of a migration, for its test */
     x->all_ranks = all && !strcmp(all, "1");
+    /* one run file, every rank writing its particles' rows (docs/mpi.md, "One file") */
+    if (cd_output_use_mpi(&x->comm)) {
+        snprintf(err, errlen, "this build's HDF5 cannot write one file from several MPI ranks (docs/mpi.md)");
+        free(x);
+        return -1;
+    }
     x->inner = sim->backend ? sim->backend : &cd_backend_omp;
     sim->backend = &cd_backend_mpi;
     sim->backend_data = x;
