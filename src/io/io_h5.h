@@ -103,6 +103,9 @@ int cd_output_use_mpi(const void *comm);
  * and wall contacts, this rank writes at the next snapshots (NULL: rank 0
  * writes them all).  The array must stay valid until then. */
 void cd_output_set_owned(cd_output *o, const unsigned char *owned);
+/* Under cd_output_use_mpi: the bytes of data this rank has written into
+ * run files (its rows, and on rank 0 the rest), for the closing report. */
+unsigned long long cd_output_bytes_written(void);
 
 /* Number of snapshots in a run file, or -1 (message in err). */
 int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);

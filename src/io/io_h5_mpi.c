@@ -23,7 +23,10 @@ static struct {
     int on;
     MPI_Comm comm;
     int rank;
+    unsigned long long bytes; /* data bytes this rank wrote into run files */
 } par;
+
+unsigned long long cd_output_bytes_written(void) { return par.bytes; }
 
 int cd_output_use_mpi(const void *comm)
 {
@@ -144,6 +147,8 @@ herr_t cdh5_par_write(const cd_output *o, hid_t d, hid_t mtype, hid_t ms, hid_t 
     }
     /* collective: every rank calls, those with nothing to write with none selected */
     if (e >= 0) e = H5Dwrite(d, mtype, ms, fs, dxpl, buf);
+    hssize_t sel = e < 0 ? 0 : H5Sget_select_npoints(ms);
+    if (sel > 0) par.bytes += (unsigned long long)sel * H5Tget_size(mtype);
     free(conv);
     if (ftype >= 0) H5Tclose(ftype);
     if (dxpl >= 0) H5Pclose(dxpl);
@@ -158,6 +163,7 @@ int cd_output_use_mpi(const void *comm)
     return comm ? -1 : 0;
 }
 
+unsigned long long cd_output_bytes_written(void) { return 0; }
 int cdh5_par_on(void) { return 0; }
 int cdh5_par_root(void) { return 1; }
 hid_t cdh5_par_fapl(void) { return H5I_INVALID_HID; }

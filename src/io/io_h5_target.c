@@ -150,7 +150,8 @@ static int publish(cd_output *o)
         return FAIL("%s: cannot rename %s to it: %s; this run's file stays at %s", o->path, o->tmp_path,
                     strerror(errno), o->tmp_path);
     o->tmp_path[0] = 0;
-    if (cdh5_journal_follow(o->file, o->path, o->err, sizeof o->err)) return cdh5_report(o);
+    /* (MPI-IO has no journal; asking would be collective) */
+    if (!cdh5_par_on() && cdh5_journal_follow(o->file, o->path, o->err, sizeof o->err)) return cdh5_report(o);
     if (o->old_fd >= 0) close(o->old_fd);
     o->old_fd = -1;
     return 0;
@@ -235,6 +236,8 @@ int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what)
 {
     haddr_t eoa = 0;
     void *handle = NULL;
+    /* MPI-IO: no descriptor to reserve through (docs/mpi.md, "One file") */
+    if (cdh5_par_on()) return 0;
     if (cdh5_journal_eoa(o->file, &eoa) < 0 || H5Fget_vfd_handle(o->file, H5P_DEFAULT, &handle) < 0 || !handle) {
         H5Eclear2(H5E_DEFAULT);
         return 0; /* a driver without a plain descriptor: no reservation */

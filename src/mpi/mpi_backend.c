@@ -205,6 +205,9 @@ static void report(const cd_mpi_ctx *x)
            cmax[5], csum[5];
     MPI_Reduce(c, cmax, 5, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     MPI_Reduce(c, csum, 5, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    double wrote = (double)cd_output_bytes_written(), wmin, wmax; /* [bytes] into the run file */
+    MPI_Reduce(&wrote, &wmin, 1, MPI_DOUBLE, MPI_MIN, 0, x->comm);
+    MPI_Reduce(&wrote, &wmax, 1, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     if (x->rank == 0) {
         fprintf(stderr,
                 "capdem: MPI: %d ranks, %lld migrations (%lld through all ranks); per rank now %ld..%ld owned "
@@ -222,6 +225,8 @@ static void report(const cd_mpi_ctx *x)
             "migration %.4g, %.4g messages and %.6g, %.6g bytes, %.4g, %.4g particle records\n",
             csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
             cmax[3], csum[4] / x->size, cmax[4]);
+        fprintf(stderr, "capdem: MPI output: data bytes each rank wrote into the run file (MPI-IO): %.0f..%.0f\n", wmin,
+                wmax);
     }
 }
 
