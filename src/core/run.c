@@ -444,6 +444,13 @@ static int run(const cd_run_options *opt)
              * diameter) are taken for a numerical failure (dt too large,
              * stiffness too low) or a load the stiffness cannot carry. */
             char cause[768];
+            /* (under MPI the observables are reduced without the state: the
+             * diagnosis reads the gathered one) */
+            if (o.max_overlap_ratio > cfg.max_overlap && cd_mpi_decomposed() && cd_sim_sync(&sim, err, sizeof err)) {
+                fprintf(stderr, "\ncapdem: %s\n", err);
+                status = 1;
+                break;
+            }
             if (o.max_overlap_ratio > cfg.max_overlap && blowup_cause(&sim, cause, sizeof cause)) {
                 /* the overlap is a symptom: name the blow-up */
                 fprintf(stderr, "\ncapdem: run stopped: %s\n", cause);

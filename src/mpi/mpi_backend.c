@@ -205,6 +205,9 @@ static void report(const cd_mpi_ctx *x)
            cmax[5], csum[5];
     MPI_Reduce(c, cmax, 5, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     MPI_Reduce(c, csum, 5, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    double red = x->reduces > 0 ? (double)x->reduce_bytes / (double)x->reduces : 0, rsum, rmax;
+    MPI_Reduce(&red, &rsum, 1, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    MPI_Reduce(&red, &rmax, 1, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     double wrote = (double)cd_output_bytes_written(), wmin, wmax; /* [bytes] into the run file */
     MPI_Reduce(&wrote, &wmin, 1, MPI_DOUBLE, MPI_MIN, 0, x->comm);
     MPI_Reduce(&wrote, &wmax, 1, MPI_DOUBLE, MPI_MAX, 0, x->comm);
@@ -227,6 +230,10 @@ static void report(const cd_mpi_ctx *x)
             cmax[3], csum[4] / x->size, cmax[4]);
         fprintf(stderr, "capdem: MPI output: data bytes each rank wrote into the run file (MPI-IO): %.0f..%.0f\n", wmin,
                 wmax);
+        fprintf(stderr,
+                "capdem: MPI reductions (observables, wall loads): %lld, sent per rank and reduction (mean, max) "
+                "%.6g, %.6g bytes\n",
+                x->reduces, rsum / x->size, rmax);
     }
 }
 
@@ -345,9 +352,9 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
  * rank's. */
 static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
-    if (mpi_sync(sim, err, errlen)) return -1;
-    cd_observables_slots(sim, slots);
-    return 0;
+    cd_mpi_ctx *x = sim->backend_data;
+    if (agree_failure(x, x->inner->sync(&x->loc, err, errlen), err, errlen)) return -1;
+    return cd_mpi_observe_slots(x, sim, slots);
 }
 
 /* The load a protocol asks for at every control call: the nonzero wall
