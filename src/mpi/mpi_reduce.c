@@ -64,6 +64,15 @@ static int route(cd_mpi_ctx *x, const char *items, const int *dest, size_t n, si
     return rc;
 }
 
+/* qsort order of records that begin with their key (a long long). */
+static int by_key(const void *pa, const void *pb)
+{
+    long long a, b;
+    memcpy(&a, pa, sizeof a);
+    memcpy(&b, pb, sizeof b);
+    return a < b ? -1 : a > b;
+}
+
 /* ---- wall loads ------------------------------------------------------------ */
 
 typedef struct {
@@ -75,12 +84,6 @@ typedef struct {
     long long chunk;
     double sum; /* [N] */
 } chunk_sum;
-
-static int by_prim(const void *pa, const void *pb)
-{
-    const prim_load *a = pa, *b = pb;
-    return a->prim < b->prim ? -1 : a->prim > b->prim;
-}
 
 /* Rank 0 merges n_blocks partials (block index, then `width` doubles)
  * gathered from every rank with merge(), and every rank gets the `width`
@@ -113,19 +116,13 @@ static int gather_partials(cd_mpi_ctx *x, const char *mine, int bytes, size_t it
     return rc;
 }
 
-static int by_chunk(const void *pa, const void *pb)
-{
-    const chunk_sum *a = pa, *b = pb;
-    return a->chunk < b->chunk ? -1 : a->chunk > b->chunk;
-}
-
 /* kernels/step_items.h, CD_LOAD_CHUNK: the chunks' sums in chunk order
  * from +0; a chunk without a nonzero row sums to +0, and adding +0 to a sum
  * that starts at +0 changes no bit, so only the chunks with rows come. */
 static void merge_chunks(const char *all, size_t n, double *total)
 {
     chunk_sum *c = (chunk_sum *)all;
-    qsort(c, n, sizeof *c, by_chunk);
+    qsort(c, n, sizeof *c, by_key);
     double load = 0;
     for (size_t k = 0; k < n; k++) load += c[k].sum;
     *total = load;
@@ -152,7 +149,7 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
     /* this rank's chunks: each summed in primitive order */
     size_t m = len / sizeof(prim_load), nc = 0;
     prim_load *e = (prim_load *)got;
-    qsort(e, m, sizeof *e, by_prim);
+    qsort(e, m, sizeof *e, by_key);
     chunk_sum *sums = malloc((m + 1) * sizeof *sums);
     if (!sums) MPI_Abort(x->comm, 1);
     for (size_t k = 0; k < m;) {
@@ -228,24 +225,12 @@ static double *push(partials *v, long long block)
     return v->p[v->n++].acc;
 }
 
-static int by_block(const void *pa, const void *pb)
-{
-    const obs_partial *a = pa, *b = pb;
-    return a->block < b->block ? -1 : a->block > b->block;
-}
-
-static int by_prim_rows(const void *pa, const void *pb)
-{
-    const prim_rows *a = pa, *b = pb;
-    return a->prim < b->prim ? -1 : a->prim > b->prim;
-}
-
 /* Every block has one rank, so the n partials are all the blocks: merged
  * in order as the serial program merges them (cd_obs_merge). */
 static void merge_blocks(const char *all, size_t n, double *total)
 {
     obs_partial *p = (obs_partial *)all;
-    qsort(p, n, sizeof *p, by_block);
+    qsort(p, n, sizeof *p, by_key);
     double *flat = malloc((n + 1) * CD_OBS_SLOTS * sizeof *flat);
     if (!flat) {
         for (int k = 0; k < CD_OBS_SLOTS; k++) total[k] = 0.0 / 0.0; /* (NaN: nothing known) */
@@ -285,7 +270,7 @@ static int serial_rows(cd_mpi_ctx *x, const long long *rows, prim_rows **firsts,
     size_t m = len / sizeof(prim_rows);
     prim_rows *e = (prim_rows *)got;
     if (!rc) {
-        qsort(e, m, sizeof *e, by_prim_rows);
+        qsort(e, m, sizeof *e, by_key);
         for (size_t k = 0; k < m; k++) tot[e[k].prim / CD_OBS_BLOCK] += e[k].value;
         /* each entry from one rank, the others' zeros: an integer sum, exact */
         MPI_Allreduce(tot, start, (int)nb, MPI_LONG_LONG, MPI_SUM, x->comm);
@@ -315,7 +300,7 @@ static int serial_rows(cd_mpi_ctx *x, const long long *rows, prim_rows **firsts,
     if (!rc) {
         *firsts = (prim_rows *)back;
         *n_firsts = blen / sizeof(prim_rows);
-        qsort(*firsts, *n_firsts, sizeof **firsts, by_prim_rows);
+        qsort(*firsts, *n_firsts, sizeof **firsts, by_key);
     } else free(back);
     free(mine);
     free(dest);
