@@ -141,8 +141,9 @@ static void write_failed(const cd_run_options *opt, const cd_config *cfg, long l
 }
 
 /* Under MPI (docs/mpi.md) every rank holds the output and writes the rows
- * of its particles (parallel HDF5), and every rank learns whether a write
- * failed, so that all stop together. */
+ * of its particles (parallel HDF5; with mpi.output = rank0 rank 0 alone
+ * holds it, out is NULL on the others), and every rank learns whether a
+ * write failed, so that all stop together. */
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
 {
     if (out) cd_observable_row(sim, o, row);
@@ -343,7 +344,8 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        out = cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err);
+        out =
+            cd_mpi_opens_output() ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err) : NULL;
         if (out && cd_output_note_resume(out, sim.s.step, &cfg)) { /* (the writer says why) */
             cd_output_close(out);
             out = NULL;
@@ -361,10 +363,12 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg, sim.shapes,
-                                    sim.n_shapes, info, n_obs, err, sizeof err);
+        if (cd_mpi_opens_output())
+            out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg,
+                                        sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
     }
-    if (cd_mpi_agree(!out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
+    if (cd_mpi_agree(cd_mpi_opens_output() &&
+                     !out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
         status = 1;
         goto done;
     }

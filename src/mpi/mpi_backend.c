@@ -22,6 +22,7 @@ static int began_here; /* MPI_Init was called by cd_mpi_begin */
  * backend's stop, which a protocol calls to restart from a state it put
  * back (the bulk probe), and reports at cd_mpi_end. */
 static cd_mpi_ctx *the_ctx;
+static int parallel_output; /* every rank writes the run file (mpi.output = parallel) */
 static void report(const cd_mpi_ctx *x);
 
 static int world(int *rank)
@@ -108,6 +109,8 @@ const unsigned char *cd_mpi_owned_rows(size_t n_particles)
         if (x->owned[q] && (size_t)x->gid[q] < n_particles) mask[x->gid[q]] = 1;
     return mask;
 }
+
+int cd_mpi_opens_output(void) { return parallel_output || cd_mpi_is_writer(); }
 
 int cd_mpi_decomposed(void)
 {
@@ -228,8 +231,10 @@ static void report(const cd_mpi_ctx *x)
             "migration %.4g, %.4g messages and %.6g, %.6g bytes, %.4g, %.4g particle records\n",
             csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
             cmax[3], csum[4] / x->size, cmax[4]);
-        fprintf(stderr, "capdem: MPI output: data bytes each rank wrote into the run file (MPI-IO): %.0f..%.0f\n", wmin,
-                wmax);
+        if (parallel_output)
+            fprintf(stderr, "capdem: MPI output: data bytes each rank wrote into the run file (MPI-IO): %.0f..%.0f\n",
+                    wmin, wmax);
+        else fprintf(stderr, "capdem: MPI output: rank 0 wrote the run file (mpi.output = rank0)\n");
         fprintf(stderr,
                 "capdem: MPI reductions (observables, wall loads): %lld, sent per rank and reduction (mean, max) "
                 "%.6g, %.6g bytes\n",
@@ -405,8 +410,10 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     MPI_Comm_size(x->comm, &x->size);
     const char *all = getenv("CAPDEM_MPI_ALL_RANKS"); /* the fallback path of a migration, for its test */
     x->all_ranks = all && !strcmp(all, "1");
-    /* one run file, every rank writing its particles' rows (docs/mpi.md, "One file") */
-    if (cd_output_use_mpi(&x->comm)) {
+    /* one run file, every rank writing its particles' rows (docs/mpi.md,
+     * "One file"), or rank 0 writing it with the serial writer */
+    parallel_output = sim->cfg.mpi_output == 0;
+    if (cd_output_use_mpi(parallel_output ? &x->comm : NULL)) {
         snprintf(err, errlen, "this build's HDF5 cannot write one file from several MPI ranks (docs/mpi.md)");
         free(x);
         return -1;

@@ -2,7 +2,8 @@
 # One run file written by every MPI rank through parallel HDF5 (docs/mpi.md,
 # "One file"): each rank writes data into the file (the closing "MPI output"
 # line), and the file is the serial program's, value for value (h5diff) and
-# byte for byte (same_bytes.py); the output safety of docs/output.md holds
+# byte for byte (same_bytes.py), as is the file of mpi.output = rank0 (rank
+# 0 writes, journaled); the output safety of docs/output.md holds
 # under the MPI-IO driver: an existing output is refused and left as it
 # was, --overwrite replaces it (written aside, renamed, nothing left
 # beside it), a file an MPI run is writing is in use for another capdem
@@ -24,6 +25,14 @@ if mpi 3 run "$cfg" --output mpi3.h5 --quiet 2> err; then
 else
   bad "3 ranks: the run failed"
 fi
+
+# mpi.output = rank0: rank 0 alone writes, with the serial writer's
+# journaled commits; the same file
+{ printf 'mpi:\n  output: rank0\n'; cat "$cfg"; } > rank0.yaml
+"$capdem" run rank0.yaml --output serial0.h5 --quiet 2> err || bad "the serial run of rank0.yaml failed"
+if mpi 3 run rank0.yaml --output rank0.h5 --quiet 2> err && grep -q 'MPI output: rank 0 wrote the run file' err &&
+   same serial0.h5 rank0.h5; then ok
+else bad "mpi.output = rank0 on 3 ranks: expected rank 0's file, equal to the serial one"; cat diff.txt; fi
 
 # an existing output is refused (exit 2, once) and left byte for byte
 cp serial.h5 exists.h5 && cp serial.h5 exists.orig
