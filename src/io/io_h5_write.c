@@ -14,6 +14,13 @@
 
 int cdh5_commit_output(cd_output *o)
 {
+    /* MPI-IO: a collective flush, no journal (docs/mpi.md, "One file"; asking
+     * the driver which it is would duplicate the communicator each time) */
+    if (cdh5_par_on() && H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0) {
+        o->io_failed = 1;
+        return FAIL("%s: cannot flush", o->path);
+    }
+    if (cdh5_par_on()) return 0;
     if (cdh5_commit(o->file, o->path, o->err, sizeof o->err) == 0) return 0;
     o->io_failed = 1;
     /* the usual cause when the journal beside it cannot be made: the file and its folder were deleted */
