@@ -184,8 +184,8 @@ typedef struct {
 
 typedef struct {
     long long row; /* global primitive x walls + wall */
-    cd_vec3 shear, force;
-    double overlap;
+    cd_vec3 shear;
+    cd_wall_out out; /* the row's outputs (kernels/geom_types.h) */
     long long active;
 } obs_wall;
 
@@ -366,12 +366,15 @@ static int particle_blocks(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, pa
 }
 
 /* The wall-row blocks of this rank (first block first_block in merge
- * order), summed on the global state's wall columns: this rank's blocks
- * cleared, then the active rows written from the owners' records. */
+ * order), summed on the global state's wall columns (this rank's blocks
+ * cleared, then the active rows written from the owners' records) with
+ * the rows' outputs in the form of the step's candidate lists
+ * (kernels/step_items.h, cd_wall_out_place): per particle its rows in
+ * contact, ascending. */
 static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials *out)
 {
     cd_state *s = &x->loc.s, *gs = &g->s;
-    size_t W = s->n_walls, n = 0, rows = gs->n_prims * W;
+    size_t W = s->n_walls, n = 0, rows = gs->n_prims * W, N = gs->n_particles;
     obs_wall *mine = malloc((s->n_prims * W + 1) * sizeof *mine);
     int *dest = malloc((s->n_prims * W + 1) * sizeof *dest);
     if (!mine || !dest) return -1;
@@ -381,33 +384,44 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
                 size_t r = (size_t)i * W + w;
                 if (!s->wallc_active[r]) continue; /* (an inactive row adds nothing) */
                 long long row = x->gprim[i] * (long long)W + (long long)w;
-                mine[n] =
-                    (obs_wall){row, s->wallc_shear[r], s->wallc_force[r], s->wallc_overlap[r], s->wallc_active[r]};
+                cd_wall_out o = {s->wallc_force[r], s->wallc_torque[r], s->wallc_overlap[r], s->wallc_fn[r]};
+                mine[n] = (obs_wall){row, s->wallc_shear[r], o, s->wallc_active[r]};
                 dest[n++] = block_rank(x, row);
             }
     char *got = NULL;
-    size_t len = 0;
+    size_t len = 0, m = 0;
     int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
+    m = len / sizeof(obs_wall);
+    obs_wall *e = (obs_wall *)got;
+    cd_int *start = calloc(N + 2, sizeof *start), *wrows = malloc((m + 1) * sizeof *wrows);
+    cd_wall_out *outs = malloc((m + 1) * sizeof *outs);
+    if (!start || !wrows || !outs) rc = -1;
     cd_long nb = ((cd_long)rows + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
     for (cd_long b = x->rank; !rc && b < nb; b += x->size)
         for (cd_long r = b * CD_OBS_BLOCK; r < cd_obs_block_end(b, (cd_long)rows); r++) gs->wallc_active[r] = 0;
-    for (size_t k = 0; !rc && k < len / sizeof(obs_wall); k++) {
-        obs_wall r;
-        memcpy(&r, got + k * sizeof r, sizeof r);
-        gs->wallc_active[r.row] = (cd_int)r.active;
-        gs->wallc_shear[r.row] = r.shear;
-        gs->wallc_force[r.row] = r.force;
-        gs->wallc_overlap[r.row] = r.overlap;
+    if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: particles ascending */
+    for (size_t k = 0; !rc && k < m; k++) {
+        gs->wallc_active[e[k].row] = (cd_int)e[k].active;
+        gs->wallc_shear[e[k].row] = e[k].shear;
+        start[gs->prim_particle[e[k].row / (long long)W] + 1]++;
+        wrows[k] = (cd_int)e[k].row;
+        outs[k] = e[k].out;
     }
+    for (size_t q = 0; !rc && q < N; q++) start[q + 1] += start[q];
     cd_cols c = cd_sim_host_cols(gs);
     for (cd_long b = x->rank; !rc && b < nb; b += x->size) {
         double *acc = push(out, first_block + b);
         if (!acc) rc = -1;
-        else cd_obs_block_walls(c, b, (cd_long)rows, (cd_int)W, g->p.wall_law, acc, cd_order_identity());
+        else
+            cd_obs_block_walls(c, b, (cd_long)rows, (cd_int)W, g->p.wall_law, acc, cd_order_identity(), start, wrows,
+                               outs);
     }
     free(mine);
     free(dest);
     free(got);
+    free(start);
+    free(wrows);
+    free(outs);
     return rc;
 }
 
