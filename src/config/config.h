@@ -99,6 +99,7 @@ typedef struct {
     /* MPI domain decomposition (docs/mpi.md; read by the MPI build only) */
     int mpi_decomposition; /* CD_DECOMP_CARTESIAN (0) or CD_DECOMP_RCB (1), src/mpi/mpi_decomp.h */
     double mpi_grid[3];    /* sub-domains along x, y, z; [0, 0, 0]: chosen from the ranks and the domain */
+    int mpi_output;        /* 0 parallel: every rank writes its rows (MPI-IO); 1 rank0: rank 0 writes (journaled) */
 
     /* protocol (docs/references.md, Protocols; src/protocols/protocol.c) */
     char protocol[24];                   /* none | deposit_compress | radial_compaction | bulk_modulus */

@@ -205,6 +205,11 @@ const cd_key cd_config_keys[] = {
     {"mpi.grid", CD_KT_VEC3, "-", "[0, 0, 0]", CFG(mpi_grid), .flags = CD_KF_RESUMABLE, .label = "MPI grid",
      .meaning = "cartesian: sub-domains along x, y, z, their product the ranks; [0, 0, 0]: chosen from the ranks and "
                 "the domain (not with rcb)"},
+    {"mpi.output", CD_KT_ENUM, "-", "parallel", CFG(mpi_output), .flags = CD_KF_RESUMABLE, .choices = "parallel|rank0",
+     .label = "MPI output",
+     .meaning = "parallel: every rank writes its particles' rows of the run file through parallel HDF5 (commits "
+                "ordered, not journaled); rank0: rank 0 writes the gathered state with the serial writer's atomic "
+                "commits (docs/mpi.md)"},
 
     /* protocol */
     {"protocol.type", CD_KT_ENUM, "-", "none", CFG_SIZED(protocol), .flags = CD_KF_SELECTOR,

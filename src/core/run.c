@@ -141,9 +141,10 @@ static void write_failed(const cd_run_options *opt, const cd_config *cfg, long l
                 cfg->output, last_snap, opt->config_path, cfg->output);
 }
 
-/* Under MPI (docs/mpi.md) rank 0 alone holds the output (out is NULL on
- * the others) and every rank learns whether a write failed, so that all
- * stop together. */
+/* Under MPI (docs/mpi.md) every rank holds the output and writes the rows
+ * of its particles (parallel HDF5; with mpi.output = rank0 rank 0 alone
+ * holds it, out is NULL on the others), and every rank learns whether a
+ * write failed, so that all stop together. */
 static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables *o, double *row)
 {
     if (out) cd_observable_row(sim, o, row);
@@ -152,6 +153,7 @@ static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables 
 
 static int write_snapshot(cd_output *out, const cd_state *s)
 {
+    if (out) cd_output_set_owned(out, cd_mpi_owned_rows(s->n_particles));
     return cd_mpi_agree(out ? cd_output_snapshot(out, s) : 0);
 }
 
@@ -348,7 +350,8 @@ static int run(const cd_run_options *opt)
             goto done;
         }
         cdh5_guard_end();
-        out = cd_mpi_is_writer() ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err) : NULL;
+        out =
+            cd_mpi_opens_output() ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err) : NULL;
         if (out && cd_output_note_resume(out, sim.s.step, &cfg)) { /* (the writer says why) */
             cd_output_close(out);
             out = NULL;
@@ -366,11 +369,11 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        if (cd_mpi_is_writer())
+        if (cd_mpi_opens_output())
             out = cd_output_create_mode(cfg.output, opt->overwrite ? CD_OUTPUT_REPLACE : CD_OUTPUT_NEW, &cfg,
                                         sim.shapes, sim.n_shapes, info, n_obs, err, sizeof err);
     }
-    if (cd_mpi_agree(cd_mpi_is_writer() &&
+    if (cd_mpi_agree(cd_mpi_opens_output() &&
                      !out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
         status = 1;
         goto done;
@@ -451,6 +454,13 @@ static int run(const cd_run_options *opt)
              * diameter) are taken for a numerical failure (dt too large,
              * stiffness too low) or a load the stiffness cannot carry. */
             char cause[768];
+            /* (under MPI the observables are reduced without the state: the
+             * diagnosis reads the gathered one) */
+            if (o.max_overlap_ratio > cfg.max_overlap && cd_mpi_decomposed() && cd_sim_sync(&sim, err, sizeof err)) {
+                fprintf(stderr, "\ncapdem: %s\n", err);
+                status = 1;
+                break;
+            }
             if (o.max_overlap_ratio > cfg.max_overlap && blowup_cause(&sim, cause, sizeof cause)) {
                 /* the overlap is a symptom: name the blow-up */
                 fprintf(stderr, "\ncapdem: run stopped: %s\n", cause);

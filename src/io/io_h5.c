@@ -192,7 +192,7 @@ static void output_free(cd_output *o)
         H5Fclose(o->file);
     }
     /* CD_OUTPUT_REPLACE closed before its first snapshot: the old file stays */
-    if (o->tmp_path[0] && o->n_snap == 0) unlink(o->tmp_path);
+    if (o->tmp_path[0] && o->n_snap == 0 && cdh5_par_root()) unlink(o->tmp_path);
     if (o->old_fd >= 0) close(o->old_fd);
     if (o->own_lock >= 0) close(o->own_lock);
     free(o->obs);
@@ -208,12 +208,36 @@ static void output_free(cd_output *o)
  * checksum the metadata too, but it marks a file open for writing in its
  * superblock, so a killed run would leave a file that HDF5 refuses to open
  * (tests/unit/test_io_h5.c, killed writer). */
-static hid_t file_access(void) { return cdh5_fapl(); }
+static hid_t file_access(void) { return cdh5_par_on() ? cdh5_par_fapl() : cdh5_fapl(); }
+
+static int claim_target(cd_output *o, const char *path, enum cd_output_mode how);
 
 /* Opens the file that o will write: path itself, created exclusively, or
  * (CD_OUTPUT_REPLACE of an existing path) a file beside it, with the old
- * one locked until the first commit. */
+ * one locked until the first commit.  Parallel output: rank 0 claims it,
+ * every rank opens it. */
 static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
+{
+    int rc = cdh5_par_root() ? claim_target(o, path, how) : 0;
+    if (cdh5_par_max(rc != 0)) return -1; /* (rank 0 said why) */
+    cdh5_par_bcast(o->tmp_path, sizeof o->tmp_path);
+    const char *target = o->tmp_path[0] ? o->tmp_path : path;
+    hid_t fapl = file_access();
+    /* TRUNC only on the empty file made here (or by mkstemp) */
+    o->file = H5Fcreate(target, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    rc = o->file < 0 ? FAIL("%s: cannot create the output file", target) : 0; /* (before H5Pclose clears the stack) */
+    H5Pclose(fapl);
+    if (cdh5_par_max(rc != 0)) {
+        if (target == path && cdh5_par_root()) unlink(path); /* the empty file made by claim_target */
+        return -1;
+    }
+    cdh5_par_lock(o->own_lock);
+    return 0;
+}
+
+/* The file system side of create_file: the old file locked and a file
+ * beside it made (o->tmp_path), or path created exclusively and marked. */
+static int claim_target(cd_output *o, const char *path, enum cd_output_mode how)
 {
     const char *target = path;
     if (how == CD_OUTPUT_REPLACE) {
@@ -239,14 +263,7 @@ static int create_file(cd_output *o, const char *path, enum cd_output_mode how)
                                    : FAIL("%s: cannot create the output file: %s", path, strerror(errno));
         cdh5_mark(o->own_lock);
     }
-    hid_t fapl = file_access();
-    /* TRUNC only on the empty file made here (or by mkstemp) */
-    o->file = H5Fcreate(target, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    int rc =
-        o->file < 0 ? FAIL("%s: cannot create the output file", target) : 0; /* (before H5Pclose clears the stack) */
-    H5Pclose(fapl);
-    if (rc && target == path) unlink(path); /* the empty file made above */
-    return rc;
+    return 0;
 }
 
 cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
@@ -397,13 +414,22 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
         cdh5_quiet_end(&q);
         return NULL;
     }
-    hid_t fapl = file_access();
-    o->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
-    int rc = o->file < 0 ? FAIL("%s: cannot open the run file for appending", path) : 0;
-    H5Pclose(fapl);
-    if (!rc) {
+    int rc = 0;
+    /* parallel output: a journal a killed writer left (io_h5_journal.h) is
+     * replayed in place by rank 0 before the ranks open the file through
+     * MPI-IO (which knows no journal); the serial driver does it on open */
+    if (cdh5_par_on() && cdh5_par_max(cdh5_par_root() && cdh5_recover(path, o->err, sizeof o->err) < 0)) {
+        if (cdh5_par_root()) cdh5_report(o);
+        rc = -1;
+    }
+    hid_t fapl = rc ? H5I_INVALID_HID : file_access();
+    o->file = rc ? H5I_INVALID_HID : H5Fopen(path, H5F_ACC_RDWR, fapl);
+    if (!rc && cdh5_par_max(o->file < 0)) rc = FAIL("%s: cannot open the run file for appending", path);
+    if (fapl >= 0) H5Pclose(fapl);
+    if (!rc && cdh5_par_root()) {
         o->own_lock = open(path, O_RDONLY | O_NOCTTY | O_CLOEXEC);
         if (o->own_lock >= 0) cdh5_mark(o->own_lock);
+        cdh5_par_lock(o->own_lock);
     }
     if (!rc && (!cdh5_exists(o->file, CDH5_PATH(H5MD)) || !cdh5_exists(o->file, CDH5_PATH(OBSERVABLES))))
         rc = FAIL("%s: not a capdem run file (no %s or %s)", path, CDH5_PATH(H5MD), CDH5_PATH(OBSERVABLES));

@@ -90,6 +90,23 @@ int cd_output_close(cd_output *o);
  * as one does after a full disk.)  Every file is closed explicitly. */
 void cd_h5_no_atexit(void);
 
+/* MPI builds with parallel HDF5 (docs/mpi.md, "One file"): comm (a
+ * pointer to an MPI_Comm of more than one rank) shares the run files that
+ * cd_output_create_mode and cd_output_reopen open from now on: they go
+ * through HDF5's MPI-IO driver, every cd_output_* call on them is
+ * collective (every rank calls it with the same state), and a snapshot's
+ * rows are written by the ranks cd_output_set_owned names.  NULL: one
+ * writer again.  0, or -1 in a build without parallel HDF5. */
+int cd_output_use_mpi(const void *comm);
+/* Under cd_output_use_mpi: owned[p] != 0 for the particles (global ids)
+ * whose rows, with those of their primitives, contacts (as particle i)
+ * and wall contacts, this rank writes at the next snapshots (NULL: rank 0
+ * writes them all).  The array must stay valid until then. */
+void cd_output_set_owned(cd_output *o, const unsigned char *owned);
+/* Under cd_output_use_mpi: the bytes of data this rank has written into
+ * run files (its rows, and on rank 0 the rest), for the closing report. */
+unsigned long long cd_output_bytes_written(void);
+
 /* Number of snapshots in a run file, or -1 (message in err). */
 int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
 

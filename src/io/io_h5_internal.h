@@ -78,6 +78,12 @@ struct cd_output {
     int own_lock;  /* descriptor holding capdem's mark on the file (cdh5_mark), or -1 */
     int io_failed; /* a write failed or found no room: nothing more is written */
     int writing;   /* inside a snapshot, past its checks */
+    /* parallel output (io_h5_mpi.c): per particle, whether this rank
+     * writes its rows (cd_output_set_owned; NULL: rank 0 writes all); the
+     * rows of the write under way this rank writes: row_mask[r] for row r
+     * along dimension mask_dim of the block written (NULL: rank 0 all) */
+    const unsigned char *owned, *row_mask;
+    int mask_dim;
 };
 
 /* Makes sure bytes more can be written at the end of the file (the space
@@ -111,6 +117,28 @@ int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t
 /* After the first commit: renames tmp_path over path, unless path no
  * longer is the file locked at creation. */
 int cdh5_target_publish(cd_output *o);
+
+/* ---- parallel output: io_h5_mpi.c (MPI builds; else one writer) --------------- */
+
+/* The writer's file is shared by the ranks of cd_output_use_mpi's
+ * communicator: every cd_output_* call is collective. */
+int cdh5_par_on(void);
+/* Rank 0 of it, or the one writer when output is not parallel. */
+int cdh5_par_root(void);
+/* File access through HDF5's MPI-IO driver on that communicator. */
+hid_t cdh5_par_fapl(void);
+/* The largest v of the ranks (v alone when not parallel). */
+int cdh5_par_max(int v);
+/* bytes of buf from rank 0 to every rank (nothing when not parallel). */
+void cdh5_par_bcast(void *buf, size_t bytes);
+/* Rank 0: the exclusive flock HDF5's serial driver would hold on fd's file. */
+void cdh5_par_lock(int fd);
+/* The collective H5Dwrite of the block start..start+cnt (rank dims; the
+ * file selection fs, memory ms of shape cnt): this rank's rows of it
+ * (o->row_mask) or, with no mask, all of it on rank 0 and none on the
+ * others.  Not parallel: H5Dwrite as given. */
+herr_t cdh5_par_write(const cd_output *o, hid_t d, hid_t mtype, hid_t ms, hid_t fs, int rank, const hsize_t *start,
+                      const hsize_t *cnt, const void *buf);
 
 /* Every writer failure goes through FAIL: message into o->err (with the
  * HDF5 detail), printed to stderr, value -1. */

@@ -256,12 +256,40 @@ static int check_counts(cd_output *o, const cd_state *s)
     return 0;
 }
 
+/* The columns of write_contacts, at row `at`. */
+static int write_contact_rows(cd_output *o, const cd_state *s, enum cd_field_group g, const size_t *idx, size_t m,
+                              void *tmp, hsize_t at);
+
 /* Appends the active rows of one contact group (PAIR, with its PAIR_OUT
  * columns, or WALLC). */
 static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g, const size_t *idx, size_t m,
                           void *tmp)
 {
     hsize_t at = g == CD_GROUP_PAIR ? o->c_rows : o->w_rows;
+    /* parallel output: a row is written by the rank that owns its particle
+     * (a contact's particle i) */
+    const unsigned char *owned = cdh5_par_on() ? o->owned : NULL;
+    unsigned char *mine = owned ? malloc(m ? m : 1) : NULL;
+    if (owned && !mine) return FAIL("%s: out of memory", o->path);
+    for (size_t r = 0; mine && r < m; r++) {
+        long long prim = g == CD_GROUP_PAIR ? (long long)s->pair_prim_i[idx[r]] : (long long)(idx[r] / s->n_walls);
+        mine[r] = prim >= 0 && (size_t)prim < s->n_prims ? owned[s->prim_particle[prim]] : cdh5_par_root();
+    }
+    o->row_mask = mine;
+    o->mask_dim = 0;
+    int rc = write_contact_rows(o, s, g, idx, m, tmp, at);
+    o->row_mask = NULL;
+    free(mine);
+    if (rc) return -1;
+    long long end = (long long)(at + m);
+    hid_t off = g == CD_GROUP_PAIR ? o->c_offset : o->w_offset;
+    return cdh5_append(o, off, g == CD_GROUP_PAIR ? CDH5_C_OFFSET : CDH5_W_OFFSET, o->n_snap + 1, 1, H5T_NATIVE_LLONG,
+                       &end);
+}
+
+static int write_contact_rows(cd_output *o, const cd_state *s, enum cd_field_group g, const size_t *idx, size_t m,
+                              void *tmp, hsize_t at)
+{
     for (size_t k = 0; k < cd_n_fields; k++) {
         const cd_field_info *f = &cd_fields[k];
         if (f->group != g && !(g == CD_GROUP_PAIR && f->group == CD_GROUP_PAIR_OUT)) continue;
@@ -288,10 +316,7 @@ static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g
         for (size_t r = 0; r < m; r++) p[r] = (long long)idx[r];
         if (cdh5_append(o, o->w_index, CDH5_W_INDEX, at, m, H5T_NATIVE_LLONG, p)) return -1;
     }
-    long long end = (long long)(at + m);
-    hid_t off = g == CD_GROUP_PAIR ? o->c_offset : o->w_offset;
-    return cdh5_append(o, off, g == CD_GROUP_PAIR ? CDH5_C_OFFSET : CDH5_W_OFFSET, o->n_snap + 1, 1, H5T_NATIVE_LLONG,
-                       &end);
+    return 0;
 }
 
 /* An upper bound of the bytes a snapshot with m contact and wm wall-contact
@@ -351,6 +376,28 @@ static unsigned long long first_snapshot_bytes(const cd_output *o, const cd_stat
     return (b + 16 * 8192) / 4 * 5; /* and a quarter more: the first snapshot measured 0.97 of the bound without it */
 }
 
+/* The per-snapshot columns of particles and primitives, as row n; under
+ * parallel output each rank writes the rows of the particles it owns
+ * (o->owned) and of their primitives. */
+static int write_series(cd_output *o, const cd_state *s, hsize_t n)
+{
+    const unsigned char *owned = cdh5_par_on() ? o->owned : NULL;
+    unsigned char *prim_mine = owned ? malloc(s->n_prims ? s->n_prims : 1) : NULL;
+    if (owned && !prim_mine) return FAIL("%s: out of memory", o->path);
+    for (size_t p = 0; prim_mine && p < s->n_prims; p++) prim_mine[p] = owned[s->prim_particle[p]];
+    int rc = 0;
+    for (size_t k = 0; k < cd_n_fields && !rc; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        if (cdh5_store_of(f) != CDH5_SERIES) continue;
+        o->row_mask = f->group == CD_GROUP_PARTICLE ? owned : f->group == CD_GROUP_PRIM ? prim_mine : NULL;
+        o->mask_dim = 1; /* (snapshots, rows[, ncomp]) */
+        rc = cdh5_append(o, o->cols[k].dset, f->name, n, 1, cdh5_mem_type(f), *cd_field_ptr((cd_state *)s, f));
+    }
+    o->row_mask = NULL;
+    free(prim_mine);
+    return rc;
+}
+
 static int snapshot(cd_output *o, const cd_state *s)
 {
     if (o->have_layout && check_counts(o, s)) return -1;
@@ -370,12 +417,7 @@ static int snapshot(cd_output *o, const cd_state *s)
         return -1;
     o->writing = 1; /* from here on a failure leaves the file to its last commit */
     if (!o->have_layout && cdh5_layout_create(o, s)) return -1;
-    for (size_t k = 0; k < cd_n_fields; k++) {
-        const cd_field_info *f = &cd_fields[k];
-        if (cdh5_store_of(f) != CDH5_SERIES) continue;
-        if (cdh5_append(o, o->cols[k].dset, f->name, n, 1, cdh5_mem_type(f), *cd_field_ptr((cd_state *)s, f)))
-            return -1;
-    }
+    if (write_series(o, s, n)) return -1;
     size_t *idx = malloc(cap * sizeof *idx);
     void *tmp = malloc(cap * cdh5_max_row_bytes());
     int rc = idx && tmp ? 0 : FAIL("%s: out of memory", o->path);
@@ -399,7 +441,10 @@ static int snapshot(cd_output *o, const cd_state *s)
         cdh5_append(o, o->time, CDH5_SNAP_TIME, n, 1, H5T_NATIVE_DOUBLE, &s->time) ||
         cdh5_append(o, o->step, CDH5_SNAP_STEP, n, 1, H5T_NATIVE_LLONG, &s->step) || cdh5_obs_flush(o))
         return -1;
-    /* the snapshot and its count become the file's content in one atomic commit */
+    /* the snapshot and its count become the file's content in one atomic
+     * commit; through MPI-IO (no journal, docs/mpi.md) the rows are flushed
+     * before the count that names them is written */
+    if (cdh5_par_on() && cdh5_commit_output(o)) return -1;
     if (cdh5_write_commit(o, n + 1) || cdh5_commit_output(o)) return -1;
     o->n_snap = n + 1;
     o->c_rows += m;

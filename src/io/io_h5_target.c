@@ -128,7 +128,18 @@ int cdh5_target_aside(const char *path, char *tmp, size_t len, char *err, size_t
     return 0;
 }
 
+static int publish(cd_output *o);
+
+/* Parallel output: rank 0 renames, every rank learns how it went. */
 int cdh5_target_publish(cd_output *o)
+{
+    int rc = cdh5_par_root() ? publish(o) : 0;
+    if (cdh5_par_max(rc != 0)) return -1;
+    o->tmp_path[0] = 0;
+    return 0;
+}
+
+static int publish(cd_output *o)
 {
     struct stat now;
     if (stat(o->path, &now) == 0 &&
@@ -139,7 +150,8 @@ int cdh5_target_publish(cd_output *o)
         return FAIL("%s: cannot rename %s to it: %s; this run's file stays at %s", o->path, o->tmp_path,
                     strerror(errno), o->tmp_path);
     o->tmp_path[0] = 0;
-    if (cdh5_journal_follow(o->file, o->path, o->err, sizeof o->err)) return cdh5_report(o);
+    /* (MPI-IO has no journal; asking would be collective) */
+    if (!cdh5_par_on() && cdh5_journal_follow(o->file, o->path, o->err, sizeof o->err)) return cdh5_report(o);
     if (o->old_fd >= 0) close(o->old_fd);
     o->old_fd = -1;
     return 0;
@@ -224,6 +236,8 @@ int cdh5_reserve(cd_output *o, unsigned long long bytes, const char *what)
 {
     haddr_t eoa = 0;
     void *handle = NULL;
+    /* MPI-IO: no descriptor to reserve through (docs/mpi.md, "One file") */
+    if (cdh5_par_on()) return 0;
     if (cdh5_journal_eoa(o->file, &eoa) < 0 || H5Fget_vfd_handle(o->file, H5P_DEFAULT, &handle) < 0 || !handle) {
         H5Eclear2(H5E_DEFAULT);
         return 0; /* a driver without a plain descriptor: no reservation */
@@ -239,11 +253,15 @@ int cdh5_check_linked(cd_output *o)
 {
     void *handle = NULL;
     struct stat st;
-    if (H5Fget_vfd_handle(o->file, H5P_DEFAULT, &handle) < 0 || !handle || fstat(*(int *)handle, &st) < 0) {
+    if (cdh5_par_on()) { /* rank 0 looks at its descriptor of the file (MPI-IO's handle is no descriptor) */
+        int gone = cdh5_par_root() && o->own_lock >= 0 && fstat(o->own_lock, &st) == 0 && st.st_nlink == 0;
+        if (!cdh5_par_max(gone)) return 0;
+    } else if (H5Fget_vfd_handle(o->file, H5P_DEFAULT, &handle) < 0 || !handle || fstat(*(int *)handle, &st) < 0) {
         H5Eclear2(H5E_DEFAULT);
         return 0;
+    } else if (st.st_nlink > 0) {
+        return 0;
     }
-    if (st.st_nlink > 0) return 0;
     o->io_failed = 1;
     return FAIL("%s was deleted during the run (the file or its folder): the run stops, as what it writes could not "
                 "be read by anyone",

@@ -15,12 +15,14 @@
 #include "mpi/mpi_halo.h"
 #include "broadphase.h"
 #include "observe_items.h"
+#include "io/io_h5.h"
 
 static int began_here; /* MPI_Init was called by cd_mpi_begin */
 /* The decomposition of this process's run (cd_mpi_wrap): it outlives the
  * backend's stop, which a protocol calls to restart from a state it put
  * back (the bulk probe), and reports at cd_mpi_end. */
 static cd_mpi_ctx *the_ctx;
+static int parallel_output; /* every rank writes the run file (mpi.output = parallel) */
 static void report(const cd_mpi_ctx *x);
 
 static int world(int *rank)
@@ -89,6 +91,26 @@ int cd_mpi_is_writer(void)
     world(&rank);
     return rank == 0;
 }
+
+const unsigned char *cd_mpi_owned_rows(size_t n_particles)
+{
+    static unsigned char *mask;
+    static size_t cap;
+    const cd_mpi_ctx *x = the_ctx;
+    if (!x || !x->started) return NULL;
+    if (cap < n_particles) {
+        unsigned char *m = realloc(mask, n_particles);
+        if (!m) return NULL; /* (rank 0 then writes every row: the same file) */
+        mask = m;
+        cap = n_particles;
+    }
+    memset(mask, 0, n_particles);
+    for (size_t q = 0; q < x->loc.s.n_particles; q++)
+        if (x->owned[q] && (size_t)x->gid[q] < n_particles) mask[x->gid[q]] = 1;
+    return mask;
+}
+
+int cd_mpi_opens_output(void) { return parallel_output || cd_mpi_is_writer(); }
 
 int cd_mpi_decomposed(void)
 {
@@ -186,6 +208,12 @@ static void report(const cd_mpi_ctx *x)
            cmax[5], csum[5];
     MPI_Reduce(c, cmax, 5, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     MPI_Reduce(c, csum, 5, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    double red = x->reduces > 0 ? (double)x->reduce_bytes / (double)x->reduces : 0, rsum, rmax;
+    MPI_Reduce(&red, &rsum, 1, MPI_DOUBLE, MPI_SUM, 0, x->comm);
+    MPI_Reduce(&red, &rmax, 1, MPI_DOUBLE, MPI_MAX, 0, x->comm);
+    double wrote = (double)cd_output_bytes_written(), wmin, wmax; /* [bytes] into the run file */
+    MPI_Reduce(&wrote, &wmin, 1, MPI_DOUBLE, MPI_MIN, 0, x->comm);
+    MPI_Reduce(&wrote, &wmax, 1, MPI_DOUBLE, MPI_MAX, 0, x->comm);
     if (x->rank == 0) {
         fprintf(stderr,
                 "capdem: MPI: %d ranks, %lld migrations (%lld through all ranks); per rank now %ld..%ld owned "
@@ -203,6 +231,14 @@ static void report(const cd_mpi_ctx *x)
             "migration %.4g, %.4g messages and %.6g, %.6g bytes, %.4g, %.4g particle records\n",
             csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
             cmax[3], csum[4] / x->size, cmax[4]);
+        if (parallel_output)
+            fprintf(stderr, "capdem: MPI output: data bytes each rank wrote into the run file (MPI-IO): %.0f..%.0f\n",
+                    wmin, wmax);
+        else fprintf(stderr, "capdem: MPI output: rank 0 wrote the run file (mpi.output = rank0)\n");
+        fprintf(stderr,
+                "capdem: MPI reductions (observables, wall loads): %lld, sent per rank and reduction (mean, max) "
+                "%.6g, %.6g bytes\n",
+                x->reduces, rsum / x->size, rmax);
     }
 }
 
@@ -321,9 +357,9 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
  * rank's. */
 static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
-    if (mpi_sync(sim, err, errlen)) return -1;
-    cd_observables_slots(sim, slots);
-    return 0;
+    cd_mpi_ctx *x = sim->backend_data;
+    if (agree_failure(x, x->inner->sync(&x->loc, err, errlen), err, errlen)) return -1;
+    return cd_mpi_observe_slots(x, sim, slots);
 }
 
 /* The load a protocol asks for at every control call: the nonzero wall
@@ -378,6 +414,14 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     MPI_Comm_size(x->comm, &x->size);
     const char *all = getenv("CAPDEM_MPI_ALL_RANKS"); /* the fallback path of a migration, for its test */
     x->all_ranks = all && !strcmp(all, "1");
+    /* one run file, every rank writing its particles' rows (docs/mpi.md,
+     * "One file"), or rank 0 writing it with the serial writer */
+    parallel_output = sim->cfg.mpi_output == 0;
+    if (cd_output_use_mpi(parallel_output ? &x->comm : NULL)) {
+        snprintf(err, errlen, "this build's HDF5 cannot write one file from several MPI ranks (docs/mpi.md)");
+        free(x);
+        return -1;
+    }
     x->inner = sim->backend ? sim->backend : &cd_backend_omp;
     sim->backend = &cd_backend_mpi;
     sim->backend_data = x;

@@ -34,6 +34,15 @@ int cd_mpi_agree(int status);
 int cd_mpi_is_writer(void);
 /* More than one rank: the run is decomposed. */
 int cd_mpi_decomposed(void);
+/* Whether this process opens the run's output: every rank with parallel
+ * output (mpi.output = parallel, the default), else rank 0 (or the one
+ * process).  Valid after cd_mpi_wrap. */
+int cd_mpi_opens_output(void);
+/* Decomposed: per global particle (n_particles of them), 1 when this rank
+ * owns it (it writes the particle's rows of the run file, io_h5.h
+ * cd_output_set_owned); NULL when not decomposed.  Valid until the next
+ * call. */
+const unsigned char *cd_mpi_owned_rows(size_t n_particles);
 /* With more than one rank: checks that the config can run decomposed
  * (solver, protocol, backend) and puts cd_backend_mpi in front of the
  * chosen backend.  0, or -1 with a message naming the key (exit 2). */
@@ -44,6 +53,12 @@ static inline int cd_mpi_end(int status) { return status; }
 static inline int cd_mpi_agree(int status) { return status; }
 static inline int cd_mpi_is_writer(void) { return 1; }
 static inline int cd_mpi_decomposed(void) { return 0; }
+static inline int cd_mpi_opens_output(void) { return 1; }
+static inline const unsigned char *cd_mpi_owned_rows(size_t n_particles)
+{
+    (void)n_particles;
+    return NULL;
+}
 static inline int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err, size_t errlen)
 {
     (void)sim;

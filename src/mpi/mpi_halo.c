@@ -538,49 +538,6 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
     return rc;
 }
 
-/* A wall row's normal force with its global primitive. */
-typedef struct {
-    long long prim;
-    double fn; /* [N] */
-} prim_load;
-
-static int cmp_prim_load(const void *pa, const void *pb)
-{
-    const prim_load *a = pa, *b = pb;
-    return a->prim < b->prim ? -1 : a->prim > b->prim;
-}
-
-double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
-{
-    cd_state *s = &x->loc.s;
-    size_t W = s->n_walls, n = 0;
-    prim_load *mine = malloc((s->n_prims + 1) * sizeof *mine);
-    if (!mine) MPI_Abort(x->comm, 1);
-    for (size_t q = 0; q < s->n_particles; q++)
-        for (cd_int i = s->prim_first[q]; x->owned[q] && i < s->prim_first[q] + s->prim_count[q]; i++)
-            if (s->wallc_fn[(size_t)i * W + (size_t)w] != 0)
-                mine[n++] = (prim_load){x->gprim[i], s->wallc_fn[(size_t)i * W + (size_t)w]};
-    char *all;
-    size_t len;
-    allgather_bytes(x, mine, (int)(n * sizeof *mine), &all, &len);
-    size_t m = len / sizeof(prim_load);
-    prim_load *e = (prim_load *)all;
-    qsort(e, m, sizeof *e, cmp_prim_load);
-    /* kernels/step_items.h, CD_LOAD_CHUNK: per chunk of primitives the sum
-     * in primitive order, the chunks' sums in order.  The rows left out
-     * hold exact zeros: adding one changes no sum that starts at +0. */
-    double load = 0;
-    size_t k = 0;
-    for (size_t ch = 0; ch * CD_LOAD_CHUNK < n_prims_global; ch++) {
-        double acc = 0;
-        for (; k < m && (size_t)e[k].prim < (ch + 1) * CD_LOAD_CHUNK; k++) acc += e[k].fn;
-        load += acc;
-    }
-    free(mine);
-    free(all);
-    return load;
-}
-
 void cd_mpi_halo_free(cd_mpi_ctx *x)
 {
     free(x->gid);

@@ -43,6 +43,9 @@ typedef struct {
      * the migrations, with the particle records among them (the collectives that agree on decisions and statuses
      * not counted: one int each) */
     long long refreshes, refresh_msgs, refresh_bytes, migrate_msgs, migrate_bytes, migrate_records;
+    /* the reductions (observables, wall loads: src/mpi/mpi_reduce.c) and
+     * what this rank sent for them */
+    long long reduces, reduce_msgs, reduce_bytes;
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,
@@ -80,8 +83,17 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
 int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global);
 /* Normal load on wall w [N] with the serial program's bits (the sum of
  * kernels/step_items.h, CD_LOAD_CHUNK, over n_prims_global primitives),
- * from the nonzero rows alone: every rank's, on every rank.  Collective. */
+ * from the nonzero rows alone: each chunk summed on rank chunk % R, the
+ * chunks' sums merged in order on rank 0; the load on every rank
+ * (src/mpi/mpi_reduce.c).  Collective. */
 double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
+/* The observables' slots (kernels/observe_items.h) with the serial
+ * program's bits, without gathering the state: each block of rows summed
+ * by the serial block function on rank block % R from its rows' owners'
+ * records, the blocks merged in order on rank 0, the total on every rank
+ * (src/mpi/mpi_reduce.c).  Writes the moving columns of the blocks' rows
+ * into global (which is the gathered state between syncs).  Collective. */
+int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total);
 void cd_mpi_halo_free(cd_mpi_ctx *x);
 
 /* ---- records, shared by src/mpi/mpi_halo.c and src/mpi/mpi_migrate.c ------
