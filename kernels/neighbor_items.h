@@ -275,37 +275,80 @@ CD_INLINE void cd_nb_item_gather_sort(cd_cols c, cd_order o, cd_particle_id q, c
     }
 }
 
-/* The prefix sums of passes 4, 6, 9 and 10: out[0] = 0, out[k+1] = out[k] +
- * in[k] (out has n + 1 entries, out[n] the total), in three steps: each
- * chunk sums its inputs, one item scans the chunk sums, each chunk writes
- * its outputs.  Integer arithmetic: exact whatever the chunking. */
-CD_INLINE void cd_scan_item_sum(const CD_GLOBAL cd_int *in, cd_int n, cd_int chunk, cd_int g,
-                                CD_GLOBAL cd_int *chunk_sum)
+/* The prefix sums of passes 4, 6, 9 and 10 (and of the reorder's radix
+ * sort): out[0] = 0, out[k+1] = out[k] + in[k] (out has n + 1 entries,
+ * out[n] the total), as a tree of chunks of CD_SCAN_CHUNK entries, shaped
+ * for a GPU as much as for host threads (docs/performance.md, "GPU-shaped
+ * reductions"):
+ *
+ *   up      level l+1 holds the sums of the chunks of level l (level 0 is
+ *           in), while level l has more than one chunk: cd_scan_item_sum;
+ *   top     one item scans the last level (at most one chunk) in place,
+ *           or in into out when n fits one chunk: cd_scan_item_top;
+ *   down    each chunk of level l, from the top level down, rewrites its
+ *           entries as prefix sums starting at its chunk's entry one level
+ *           up; level 0 writes into out: cd_scan_item_fill.
+ *
+ * 2n additions in all, and short serial loops: a chunk of 64 entries is
+ * one item, so 1e6 entries give 15,625 items at level 0 (1,024-entry chunks
+ * gave a GPU under a thousand threads with long dependent loops).  Integer
+ * arithmetic: exact, so the result does not depend on the chunking. The
+ * levels above 0 live in one scratch array of cd_scan_scratch(n) entries,
+ * level after level, each with one entry more for its total. */
+#define CD_SCAN_CHUNK 64
+
+/* Entries of the scratch of a scan of n entries (all levels above 0, and
+ * their totals); at least 1. */
+CD_INLINE cd_long cd_scan_scratch(cd_long n)
 {
-    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n, s = 0;
-    for (cd_int i = g * chunk; i < end; i++) s += in[i];
-    chunk_sum[g] = s;
+    cd_long s = 1;
+    while (n > CD_SCAN_CHUNK) {
+        n = (n + CD_SCAN_CHUNK - 1) / CD_SCAN_CHUNK;
+        s += n + 1;
+    }
+    return s;
 }
 
-CD_INLINE void cd_scan_item_top(CD_GLOBAL cd_int *chunk_sum, cd_int n_chunks, CD_GLOBAL cd_int *out, cd_int n)
+CD_INLINE cd_long cd_scan_chunk_end(cd_long g, cd_long n)
+{
+    return (g + 1) * CD_SCAN_CHUNK < n ? (g + 1) * CD_SCAN_CHUNK : n;
+}
+
+/* Up: sums[g] = the sum of chunk g of the n entries of in. */
+CD_INLINE void cd_scan_item_sum(const CD_GLOBAL cd_int *in, cd_long n, cd_long g, CD_GLOBAL cd_int *sums)
+{
+    cd_int s = 0;
+    for (cd_long i = g * CD_SCAN_CHUNK; i < cd_scan_chunk_end(g, n); i++) s += in[i];
+    sums[g] = s;
+}
+
+/* Top (one item): out[k] = in[0] + ... + in[k-1] for k <= n; in and out
+ * may be the same array (then it holds n + 1 entries). */
+CD_INLINE void cd_scan_item_top(const CD_GLOBAL cd_int *in, cd_long n, CD_GLOBAL cd_int *out)
 {
     cd_int run = 0;
-    for (cd_int g = 0; g < n_chunks; g++) {
-        cd_int t = chunk_sum[g];
-        chunk_sum[g] = run;
+    for (cd_long i = 0; i < n; i++) {
+        cd_int t = in[i];
+        out[i] = run;
         run += t;
     }
     out[n] = run;
 }
 
-CD_INLINE void cd_scan_item_fill(const CD_GLOBAL cd_int *in, cd_int n, cd_int chunk, cd_int g,
-                                 const CD_GLOBAL cd_int *chunk_sum, CD_GLOBAL cd_int *out)
+/* Down: chunk g of the n entries of in as prefix sums into out, starting
+ * at starts[g] (the scanned level above); the last chunk writes the total
+ * out[n].  in and out may be the same array. */
+CD_INLINE void cd_scan_item_fill(const CD_GLOBAL cd_int *in, cd_long n, cd_long g, const CD_GLOBAL cd_int *starts,
+                                 CD_GLOBAL cd_int *out)
 {
-    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n, run = chunk_sum[g];
-    for (cd_int i = g * chunk; i < end; i++) {
+    cd_long end = cd_scan_chunk_end(g, n);
+    cd_int run = starts[g];
+    for (cd_long i = g * CD_SCAN_CHUNK; i < end; i++) {
+        cd_int t = in[i];
         out[i] = run;
-        run += in[i];
+        run += t;
     }
+    if (end == n) out[n] = run;
 }
 
 CD_DEVICE_END

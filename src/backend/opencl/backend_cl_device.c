@@ -128,8 +128,6 @@ int cd_cl_run(cd_cl *cl, enum cd_cl_kernel k, size_t n)
         global = local = 1; /* one work-item */
         break;
     case CD_CLK_BOUNDS:
-    case CD_CLK_SCAN_BLOCKS:
-    case CD_CLK_SCAN_FILL:
         lp = NULL; /* exactly n chunks, few: let the runtime group them */
         break;
     default:
