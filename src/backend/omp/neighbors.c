@@ -19,9 +19,6 @@
 #include "neighbor_items.h"
 #include "step_items.h"
 
-/* Particles per chunk of the bounds pass, entries per chunk of a prefix
- * sum: a few thousand items at 1e6 particles, enough for any device. */
-#define CD_NB_CHUNK 256
 /* Candidate slots per primitive at the first build (a hexapod arm in a
  * dense packing with a skin of 0.1 d has about 10); they double whenever a
  * primitive overflows its slot. */
@@ -73,7 +70,7 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
         size_t chunks = (size_t)cd_scan_scratch((cd_long)longest);
         if (realloc_dev((void **)&d->grid, 1, sizeof(cd_grid)) ||
             realloc_dev((void **)&d->part_bound, N + 1, sizeof(cd_real)) ||
-            realloc_dev((void **)&d->partial, 7 * (N / CD_NB_CHUNK + 1), sizeof(cd_real)) ||
+            realloc_dev((void **)&d->partial, 7 * (size_t)cd_nb_box_scratch((cd_long)N), sizeof(cd_real)) ||
             realloc_dev((void **)&d->part_cell, N + 1, sizeof(cd_int)) ||
             realloc_dev((void **)&d->cell_count, nb->cell_cap + 1, sizeof(cd_int)) ||
             realloc_dev((void **)&d->cell_start, nb->cell_cap + 1, sizeof(cd_int)) ||
@@ -149,18 +146,31 @@ static void zero_ints(cd_int *dst, size_t n)
     for (size_t k = 0; k < n; k++) dst[k] = 0;
 }
 
-/* Passes 1-2: bounds and grid.  Returns 1 when the grid says the run blew
- * up (cd_nb_item_grid; the grid comes back, 56 bytes), 0 otherwise. */
+/* Passes 1-2: bounds, the tree of boxes, and grid (2 + L loops for L
+ * levels of boxes: 3 up to 4,096 particles, 4 up to 262,144).  Returns 1
+ * when the grid says the run blew up (cd_nb_item_grid; the grid comes
+ * back, 56 bytes), 0 otherwise. */
 static int make_grid(cd_sim *sim, cd_cols c, cd_nb_lists d)
 {
-    cd_int N = (cd_int)sim->s.n_particles;
-    cd_int chunk = CD_NB_CHUNK, n_chunks = (N + chunk - 1) / chunk;
-    cd_real skin = sim->nb.skin; /* [m] */
+    cd_long N = (cd_long)sim->s.n_particles, n = (N + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK;
+    cd_real skin = sim->nb.skin, *boxes = d.partial; /* [m] */
     CD_WIDE_MIN
-    CD_STEP_FOR(n_chunks, firstprivate(c, d))
-    for (cd_int g = 0; g < n_chunks; g++) cd_nb_item_bounds(c, g, chunk, N, d.part_bound, d.partial);
-    CD_STEP_FOR(1, firstprivate(d))
-    for (int one = 0; one < 1; one++) cd_nb_item_grid(d.partial, n_chunks, skin, N, d.grid);
+    CD_STEP_FOR(N, firstprivate(c, d))
+    for (cd_long p = 0; p < N; p++) cd_nb_item_bound(c, p, d.part_bound);
+    CD_STEP_FOR(n, firstprivate(c, d))
+    for (cd_long g = 0; g < n; g++) cd_nb_item_box(c, g, N, d.part_bound, d.partial);
+    while (n > CD_BOX_CHUNK) {
+        cd_long m = (n + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK, n_in = n;
+        cd_real *up = boxes + 7 * n;
+        CD_STEP_FOR(m, CD_DEV(is_device_ptr(boxes, up)))
+        for (cd_long g = 0; g < m; g++) cd_nb_item_box_up(boxes, n_in, g, up);
+        boxes = up;
+        n = m;
+    }
+    cd_int n_top = (cd_int)n;
+    cd_grid *grid = d.grid;
+    CD_STEP_FOR(1, CD_DEV(is_device_ptr(boxes, grid)))
+    for (int one = 0; one < 1; one++) cd_nb_item_grid(boxes, n_top, skin, (cd_int)N, grid);
     cd_grid g;
     return cd_dev_get(&g, d.grid, sizeof g) == 0 && g.dim[0] < 0;
 }

@@ -153,7 +153,8 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->obs_touch = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the observables' sums");
     cl->obs_total = cd_cl_buffer(cl, CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
     cl->obs_cap_blocks = 0; /* obs_part: at the first sum (cl_observe) */
-    cl->partial = cd_cl_buffer(cl, 7 * CD_CL_MAX_BLOCKS * sizeof(cd_real), "allocating the neighbour list");
+    cl->partial =
+        cd_cl_buffer(cl, 7 * (size_t)cd_nb_box_scratch((cd_long)N) * sizeof(cd_real), "allocating the neighbour list");
     cl->grid = cd_cl_buffer(cl, sizeof(cd_grid), "allocating the neighbour list");
     /* The grid has at most 8 N + 64 <= 8 P + 64 cells (cd_grid_make), so
      * the cell arrays never grow and the host never needs the cell count. */
