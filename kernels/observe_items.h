@@ -1,8 +1,11 @@
 /* The observables of the state (energies, contact counts, momentum, wall
  * forces, largest overlap; their SUM and MAX rows of kernels/observables.def
- * give the slots) as fixed-order reductions: rows in blocks of
- * CD_OBS_BLOCK, each block summed in row order into its own slots, then
- * the blocks merged in order (particles, pairs, wall rows).  Rows are
+ * give the slots) as fixed-order reductions, a fixed tree: rows in blocks
+ * of CD_OBS_BLOCK, each block summed in row order into its own slots (the
+ * leaves: particles, then pairs, then wall rows), then the leaves merged
+ * in order CD_OBS_FANIN at a time, level by level, into the total (docs/
+ * performance.md, "GPU-shaped reductions": 4,096-row blocks gave a GPU a
+ * few dozen serial loops, 25 ms an observation at 1e5 hexapods).  Rows are
  * visited in user order (cd_order, kernels/reorder_items.h; the identity
  * when the memory order is the user's), so the sums do not depend on it.  src/backend/omp/observe.c
  * runs the items on host threads or, in the offload variant, on the device
@@ -16,7 +19,8 @@
 #include "contact_law.h"
 #include "reorder_items.h"
 
-#define CD_OBS_BLOCK 4096
+#define CD_OBS_BLOCK 64
+#define CD_OBS_FANIN 16
 
 /* Components of an observable (kernels/observables.def) in the slots:
  * every wall of CD_MAX_WALLS has its place, used or not. */
@@ -65,9 +69,33 @@ CD_INLINE void cd_obs_item_touch_wall(cd_cols c, cd_long row, cd_int n_walls, CD
     if (c.wallc_active[row]) cd_atomic_inc(&touch[c.prim_particle[row / n_walls]]);
 }
 
+/* Partial sums of the tree over n leaves: the leaves and the levels above
+ * them but the last (the total). */
+CD_INLINE cd_long cd_obs_tree_blocks(cd_long n)
+{
+    cd_long s = n;
+    while (n > CD_OBS_FANIN) {
+        n = (n + CD_OBS_FANIN - 1) / CD_OBS_FANIN;
+        s += n;
+    }
+    return s;
+}
+
 CD_INLINE void cd_obs_clear(CD_GLOBAL cd_real *acc)
 {
     for (int k = 0; k < CD_OBS_SLOTS; k++) acc[k] = 0;
+}
+
+/* A leaf's sums are kept in a private array (registers where the slot is
+ * known at compile time), written out once. */
+CD_INLINE void cd_obs_zero(CD_NOESCAPE cd_real *acc)
+{
+    for (int k = 0; k < CD_OBS_SLOTS; k++) acc[k] = 0;
+}
+
+CD_INLINE void cd_obs_store(CD_NOESCAPE const cd_real *acc, CD_GLOBAL cd_real *out)
+{
+    for (int k = 0; k < CD_OBS_SLOTS; k++) out[k] = acc[k];
 }
 
 CD_INLINE cd_long cd_obs_block_end(cd_long b, cd_long n)
@@ -78,9 +106,10 @@ CD_INLINE cd_long cd_obs_block_end(cd_long b, cd_long n)
 /* Block b of the particles: kinetic and potential energy in gravity
  * [m/s^2], momentum. */
 CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 gravity, const CD_GLOBAL cd_int *touch,
-                                      CD_GLOBAL cd_real *acc, cd_order o)
+                                      CD_GLOBAL cd_real *out, cd_order o)
 {
-    cd_obs_clear(acc);
+    cd_real acc[CD_OBS_SLOTS];
+    cd_obs_zero(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long q = cd_map(o.part_at, u);
         cd_vec3 v = c.velocity[q];
@@ -95,13 +124,15 @@ CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 g
         acc[CD_OBS_PX + 1] += m * v.y;
         acc[CD_OBS_PX + 2] += m * v.z;
     }
+    cd_obs_store(acc, out);
 }
 
 /* Block b of the pair rows: elastic energy, contacts, largest overlap. */
-CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc,
+CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *out,
                                   cd_order o)
 {
-    cd_obs_clear(acc);
+    cd_real acc[CD_OBS_SLOTS];
+    cd_obs_zero(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long k = cd_map(o.pair_at, u);
         if (!c.pair_active[k]) continue;
@@ -112,14 +143,16 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
         cd_real ratio = c.pair_overlap[k] / (2 * (ri < rj ? ri : rj));
         if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
     }
+    cd_obs_store(acc, out);
 }
 
 /* Block b of the primitive-wall rows (n_walls per primitive): elastic
  * energy, contacts, the particles' force on each wall, largest overlap. */
 CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
-                                  CD_GLOBAL cd_real *acc, cd_order o)
+                                  CD_GLOBAL cd_real *out, cd_order o)
 {
-    cd_obs_clear(acc);
+    cd_real acc[CD_OBS_SLOTS];
+    cd_obs_zero(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
         if (!c.wallc_active[r]) continue;
@@ -132,14 +165,19 @@ CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_wall
         cd_real ratio = c.wallc_overlap[r] / (2 * c.prim_radius[i]);
         if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
     }
+    cd_obs_store(acc, out);
 }
 
-/* One item: the n_blocks partial slots merged in order into total: the
- * SUM slots added, the MAX slots by maximum. */
-CD_INLINE void cd_obs_merge(const CD_GLOBAL cd_real *partial, cd_long n_blocks, CD_GLOBAL cd_real *total)
+/* Item g of a level of the tree: partial sums g FANIN .. (g + 1) FANIN - 1
+ * of the n at partial merged in order into out + g CD_OBS_SLOTS: the SUM
+ * slots added, the MAX slots by maximum.  The last level has one item,
+ * whose out is the total. */
+CD_INLINE void cd_obs_item_merge(const CD_GLOBAL cd_real *partial, cd_long n, cd_long g, CD_GLOBAL cd_real *out)
 {
+    CD_GLOBAL cd_real *total = out + g * CD_OBS_SLOTS;
     cd_obs_clear(total);
-    for (cd_long b = 0; b < n_blocks; b++) {
+    cd_long end = (g + 1) * CD_OBS_FANIN < n ? (g + 1) * CD_OBS_FANIN : n;
+    for (cd_long b = g * CD_OBS_FANIN; b < end; b++) {
         const CD_GLOBAL cd_real *p = partial + b * CD_OBS_SLOTS;
         for (int k = 0; k < CD_OBS_SUMS; k++) total[k] += p[k];
         for (int k = CD_OBS_SUMS; k < CD_OBS_SLOTS; k++)
