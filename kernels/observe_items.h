@@ -86,86 +86,90 @@ CD_INLINE void cd_obs_clear(CD_GLOBAL cd_real *acc)
     for (int k = 0; k < CD_OBS_SLOTS; k++) acc[k] = 0;
 }
 
-/* A leaf's sums are kept in a private array (registers where the slot is
- * known at compile time), written out once. */
-CD_INLINE void cd_obs_zero(CD_NOESCAPE cd_real *acc)
-{
-    for (int k = 0; k < CD_OBS_SLOTS; k++) acc[k] = 0;
-}
-
-CD_INLINE void cd_obs_store(CD_NOESCAPE const cd_real *acc, CD_GLOBAL cd_real *out)
-{
-    for (int k = 0; k < CD_OBS_SLOTS; k++) out[k] = acc[k];
-}
-
 CD_INLINE cd_long cd_obs_block_end(cd_long b, cd_long n)
 {
     return (b + 1) * CD_OBS_BLOCK < n ? (b + 1) * CD_OBS_BLOCK : n;
 }
 
+/* The leaves sum into scalars (registers on a GPU; a private array of
+ * the slots was kept in device heap by Clang's offload, remark OMP112),
+ * written out once; per slot the additions are those of a sum into the
+ * slots, in row order. */
+
 /* Block b of the particles: kinetic and potential energy in gravity
  * [m/s^2], momentum. */
 CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 gravity, const CD_GLOBAL cd_int *touch,
-                                      CD_GLOBAL cd_real *out, cd_order o)
+                                      CD_GLOBAL cd_real *acc, cd_order o)
 {
-    cd_real acc[CD_OBS_SLOTS];
-    cd_obs_zero(acc);
+    cd_real sum_kt = 0, sum_kr = 0, sum_kc = 0, sum_pe = 0; /* [J] */
+    cd_vec3 sum_p = cd_v3_zero();                           /* [kg m/s] */
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long q = cd_map(o.part_at, u);
         cd_vec3 v = c.velocity[q];
         cd_real m = c.mass[q];
         cd_real kt = CD_R(0.5) * m * cd_v3_norm2(v),
                 kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], c.inertia[q]);
-        acc[CD_OBS_KT] += kt;
-        acc[CD_OBS_KR] += kr;
-        if (touch[q]) acc[CD_OBS_KC] += kt + kr;
-        acc[CD_OBS_PE] -= m * cd_v3_dot(gravity, c.position[q]);
-        acc[CD_OBS_PX] += m * v.x;
-        acc[CD_OBS_PX + 1] += m * v.y;
-        acc[CD_OBS_PX + 2] += m * v.z;
+        sum_kt += kt;
+        sum_kr += kr;
+        if (touch[q]) sum_kc += kt + kr;
+        sum_pe -= m * cd_v3_dot(gravity, c.position[q]);
+        sum_p.x += m * v.x;
+        sum_p.y += m * v.y;
+        sum_p.z += m * v.z;
     }
-    cd_obs_store(acc, out);
+    cd_obs_clear(acc);
+    acc[CD_OBS_KT] = sum_kt;
+    acc[CD_OBS_KR] = sum_kr;
+    acc[CD_OBS_KC] = sum_kc;
+    acc[CD_OBS_PE] = sum_pe;
+    acc[CD_OBS_PX] = sum_p.x;
+    acc[CD_OBS_PX + 1] = sum_p.y;
+    acc[CD_OBS_PX + 2] = sum_p.z;
 }
 
 /* Block b of the pair rows: elastic energy, contacts, largest overlap. */
-CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *out,
+CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc,
                                   cd_order o)
 {
-    cd_real acc[CD_OBS_SLOTS];
-    cd_obs_zero(acc);
+    cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long k = cd_map(o.pair_at, u);
         if (!c.pair_active[k]) continue;
         cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
-        acc[CD_OBS_EL] +=
-            cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
-        acc[CD_OBS_NC] += 1;
+        el += cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
+        contacts += 1;
         cd_real ratio = c.pair_overlap[k] / (2 * (ri < rj ? ri : rj));
-        if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
+        if (ratio > most) most = ratio;
     }
-    cd_obs_store(acc, out);
+    cd_obs_clear(acc);
+    acc[CD_OBS_EL] = el;
+    acc[CD_OBS_NC] = contacts;
+    acc[CD_OBS_MAXOV] = most;
 }
 
 /* Block b of the primitive-wall rows (n_walls per primitive): elastic
- * energy, contacts, the particles' force on each wall, largest overlap. */
+ * energy, contacts, the particles' force on each wall [N] (summed in
+ * place: its slot depends on the row), largest overlap. */
 CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
-                                  CD_GLOBAL cd_real *out, cd_order o)
+                                  CD_GLOBAL cd_real *acc, cd_order o)
 {
-    cd_real acc[CD_OBS_SLOTS];
-    cd_obs_zero(acc);
+    cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
+    cd_obs_clear(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
         if (!c.wallc_active[r]) continue;
-        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.prim_radius[i], c.wallc_overlap[r], c.wallc_shear[r]);
-        acc[CD_OBS_NW] += 1;
+        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], c.wallc_overlap[r], c.wallc_shear[r]);
+        contacts += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
         acc[CD_OBS_WALL + 3 * w + 0] -= c.wallc_force[r].x;
         acc[CD_OBS_WALL + 3 * w + 1] -= c.wallc_force[r].y;
         acc[CD_OBS_WALL + 3 * w + 2] -= c.wallc_force[r].z;
         cd_real ratio = c.wallc_overlap[r] / (2 * c.prim_radius[i]);
-        if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
+        if (ratio > most) most = ratio;
     }
-    cd_obs_store(acc, out);
+    acc[CD_OBS_EL] = el;
+    acc[CD_OBS_NW] = contacts;
+    acc[CD_OBS_MAXOV] = most;
 }
 
 /* Item g of a level of the tree: partial sums g FANIN .. (g + 1) FANIN - 1
