@@ -41,7 +41,7 @@ void cd_neighbors_free(cd_neighbors *nb)
                    d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active, d->old_shear,
                    d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,   d->prim_at,
                    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,  d->sort_keys,
-                   d->sort_vals,    d->hist,        d->move};
+                   d->sort_vals,    d->hist,        d->move,       d->skin_flag};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
