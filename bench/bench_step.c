@@ -71,12 +71,14 @@ static size_t state_bytes(const cd_sim *sim)
 {
     size_t b = 0;
     for (size_t f = 0; f < cd_n_fields; f++) {
-        if (cd_fields[f].group == CD_GROUP_PAIR_OUT) continue; /* host-only output columns */
+        if (!cd_fields[f].on_device) continue; /* host-only output columns */
         size_t rows =
             cd_fields[f].group == CD_GROUP_PAIR ? sim->s.cap_pairs : cd_state_rows(&sim->s, cd_fields[f].group);
         b += rows * cd_fields[f].elem_size;
     }
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
+    /* the wall candidates: CSR starts, rows and their outputs (cd_wall_out) */
+    b += (sim->s.n_particles + 1) * sizeof(cd_int) + sim->nb.cap_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_out));
     return b;
 }
 

@@ -34,6 +34,19 @@ typedef struct {
     cd_real friction;        /* Coulomb coefficient mu_w [1] */
 } cd_wall;
 
+/* What the step keeps of a wall contact per wall candidate of the last
+ * neighbour-list build (not per primitive and wall): the outputs of the
+ * candidate's wall-contact row, valid while the row is in contact
+ * (wallc_active).  Sync expands them into the host's columns of the same
+ * names (kernels/fields.def, group WALLC_OUT).  Plain struct for an OpenCL
+ * buffer: 64 bytes on every backend. */
+typedef struct {
+    cd_vec3 force;   /* force of the wall on the primitive [N] */
+    cd_vec3 torque;  /* torque of that force about the particle centre [N m] */
+    cd_real overlap; /* normal overlap [m] */
+    cd_real fn;      /* normal force magnitude F_n [N] (pushes the wall outwards) */
+} cd_wall_out;
+
 /* Walls a simulation may have (the state's table, the observables' slots). */
 #define CD_MAX_WALLS 8
 

@@ -18,6 +18,7 @@
 #include "rigid.h"
 #include "contact_law.h"
 #include "reorder_items.h"
+#include "step_items.h"
 
 #define CD_OBS_BLOCK 64
 #define CD_OBS_FANIN 16
@@ -149,22 +150,27 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
 
 /* Block b of the primitive-wall rows (n_walls per primitive): elastic
  * energy, contacts, the particles' force on each wall [N] (summed in
- * place: its slot depends on the row), largest overlap. */
+ * place: its slot depends on the row), largest overlap.  The outputs of
+ * the rows in contact: wall_out per wall candidate (cd_wall_out_place). */
 CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
-                                  CD_GLOBAL cd_real *acc, cd_order o)
+                                  CD_GLOBAL cd_real *acc, cd_order o, const CD_GLOBAL cd_int *wall_start,
+                                  const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out)
 {
     cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
     cd_obs_clear(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
         if (!c.wallc_active[r]) continue;
-        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], c.wallc_overlap[r], c.wallc_shear[r]);
+        cd_long e = cd_wall_out_place(c, r, n_walls, wall_start, wall_rows);
+        if (e < 0) continue; /* (a row in contact is a candidate) */
+        cd_wall_out out = wall_out[e];
+        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], out.overlap, c.wallc_shear[r]);
         contacts += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
-        acc[CD_OBS_WALL + 3 * w + 0] -= c.wallc_force[r].x;
-        acc[CD_OBS_WALL + 3 * w + 1] -= c.wallc_force[r].y;
-        acc[CD_OBS_WALL + 3 * w + 2] -= c.wallc_force[r].z;
-        cd_real ratio = c.wallc_overlap[r] / (2 * c.prim_radius[i]);
+        acc[CD_OBS_WALL + 3 * w + 0] -= out.force.x;
+        acc[CD_OBS_WALL + 3 * w + 1] -= out.force.y;
+        acc[CD_OBS_WALL + 3 * w + 2] -= out.force.z;
+        cd_real ratio = out.overlap / (2 * c.prim_radius[i]);
         if (ratio > most) most = ratio;
     }
     acc[CD_OBS_EL] = el;

@@ -205,22 +205,34 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     c.pair_fn[k] = f.fn;
 }
 
-/* Ends the contact of wall-contact row `row`: an inactive row holds zeros
- * (the load sums read every row). */
+/* Ends the contact of wall-contact row `row`: no history.  (Its outputs,
+ * kept per candidate, are read only while a row is in contact.) */
 CD_INLINE void cd_wall_row_clear(cd_cols c, cd_long row)
 {
     c.wallc_active[row] = 0;
     c.wallc_shear[row] = cd_v3_zero();
-    c.wallc_overlap[row] = 0;
-    c.wallc_fn[row] = 0;
+}
+
+/* The place e of wall-contact row `row` (primitive i = row / n_walls)
+ * among the wall candidates of i's particle (wall_rows[wall_start[q] ..
+ * wall_start[q+1]), cd_item_wall_candidates), or -1 when it is none. */
+CD_INLINE cd_long cd_wall_out_place(cd_cols c, cd_long row, cd_int n_walls, const CD_GLOBAL cd_int *wall_start,
+                                    const CD_GLOBAL cd_int *wall_rows)
+{
+    cd_int q = c.prim_particle[row / n_walls];
+    for (cd_int e = wall_start[q]; e < wall_start[q + 1]; e++)
+        if (wall_rows[e] == row) return e;
+    return -1;
 }
 
 /* Wall-contact row `row` = i n_walls + w: primitive i against wall w
  * (docs/references.md, Contacts (walls), Contact law).  The step runs it for the candidate rows of the last
  * neighbour-list build only (cd_item_wall_candidates).  wall_law: the
- * particle-wall law (its mu is replaced by the wall's friction). */
-CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall *walls, cd_int n_walls,
-                                cd_law_params wall_law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend)
+ * particle-wall law (its mu is replaced by the wall's friction).  *out:
+ * the candidate's outputs (cd_wall_out), written while in contact. */
+CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_out *out, const CD_GLOBAL cd_wall *walls,
+                                cd_int n_walls, cd_law_params wall_law, cd_real dt, cd_real sin_parallel,
+                                cd_int parallel_blend)
 {
     cd_prim_id i = (cd_prim_id)(row / n_walls);
     cd_particle_id pi = c.prim_particle[i];
@@ -244,10 +256,10 @@ CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, const CD_GLOBAL cd_wall 
     cd_vec3 fi = cd_v3_neg(f.force_j);
     c.wallc_active[row] = 1;
     c.wallc_shear[row] = shear;
-    c.wallc_overlap[row] = g.overlap;
-    c.wallc_fn[row] = f.fn;
-    c.wallc_force[row] = fi;
-    c.wallc_torque[row] = cd_contact_torque(g.point, c.position[pi], fi);
+    out->force = fi;
+    out->torque = cd_contact_torque(g.point, c.position[pi], fi);
+    out->overlap = g.overlap;
+    out->fn = f.fn;
 }
 
 /* Wall candidates of particle q at a neighbour-list build: the rows
@@ -279,24 +291,24 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
  * [kg], centre x [m]): gravity [m/s^2] times its mass,
  * then its wall contacts (its candidate rows wall_rows[wall_start[q] ..
  * wall_start[q+1]), ascending, i.e. primitive by primitive and wall by
- * wall), then its pair rows in ascending row order, so the sum has one
- * fixed order on every backend.
+ * wall; wall_out[e]: the outputs of candidate e), then its pair rows in
+ * ascending row order, so the sum has one fixed order on every backend.
  * gather_rows[gather_start[q] .. gather_start[q+1]) hold 2 k + side for
  * pair row k: side 1 when q owns the row's primitive j (it gets +F_j), 0
  * when it owns primitive i (it gets -F_j), so the gather reads only the
  * row's force and point.  dimension 2 keeps the motion in the x-y plane. */
 CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, const CD_GLOBAL cd_int *gather_start,
                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                             const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_vec3 *F_out,
-                             cd_vec3 *T_out)
+                             const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out, cd_vec3 gravity,
+                             cd_int dimension, cd_vec3 *F_out, cd_vec3 *T_out)
 {
     cd_vec3 F = cd_v3_scale(gravity, m);
     cd_vec3 T = cd_v3_zero();
     for (cd_int r = wall_start[q]; r < wall_start[q + 1]; r++) {
         cd_int row = wall_rows[r];
         if (!c.wallc_active[row]) continue;
-        F = cd_v3_add(F, c.wallc_force[row]);
-        T = cd_v3_add(T, c.wallc_torque[row]);
+        F = cd_v3_add(F, wall_out[r].force);
+        T = cd_v3_add(T, wall_out[r].torque);
     }
     for (cd_int r = gather_start[q]; r < gather_start[q + 1]; r++) {
         cd_pair_id e = gather_rows[r], k = e >> 1;
@@ -325,11 +337,12 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
 /* cd_gather_sum for particle q, stored as its force and torque. */
 CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                               const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                              const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension)
+                              const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out, cd_vec3 gravity,
+                              cd_int dimension)
 {
     cd_vec3 F, T;
-    cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_rows, gravity, dimension,
-                  &F, &T);
+    cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity,
+                  dimension, &F, &T);
     c.force[q] = F;
     c.torque[q] = T;
 }
@@ -340,12 +353,13 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
  * arithmetic in the same order as the three items one after the other. */
 CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                                           const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                                          const CD_GLOBAL cd_int *wall_rows, cd_vec3 gravity, cd_int dimension,
-                                          cd_real dt, cd_real limit2, int next)
+                                          const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out,
+                                          cd_vec3 gravity, cd_int dimension, cd_real dt, cd_real limit2, int next)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
-    cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_rows, gravity, dimension, &F, &T);
+    cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity,
+                  dimension, &F, &T);
     c.force[q] = F;
     c.torque[q] = T;
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
@@ -365,13 +379,21 @@ CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_
 
 /* Sum of the normal forces F_n [N] that the primitives of chunk ch exert
  * on wall w, in user primitive order (prim_at: user id -> memory slot,
- * null for the identity; kernels/reorder_items.h). */
+ * null for the identity; kernels/reorder_items.h): the rows in contact,
+ * whose outputs wall_out holds per wall candidate (cd_wall_out_place; the
+ * rows not in contact have F_n = +0, which leaves a sum as it is). */
 CD_INLINE cd_real cd_item_wall_load_chunk(cd_cols c, cd_long ch, cd_long n_prims, cd_int n_walls, cd_int w,
-                                          const CD_GLOBAL cd_int *prim_at)
+                                          const CD_GLOBAL cd_int *prim_at, const CD_GLOBAL cd_int *wall_start,
+                                          const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out)
 {
     cd_long end = (ch + 1) * CD_LOAD_CHUNK < n_prims ? (ch + 1) * CD_LOAD_CHUNK : n_prims;
     cd_real acc = 0;
-    for (cd_long u = ch * CD_LOAD_CHUNK; u < end; u++) acc += c.wallc_fn[cd_map(prim_at, u) * n_walls + w];
+    for (cd_long u = ch * CD_LOAD_CHUNK; u < end; u++) {
+        cd_long row = cd_map(prim_at, u) * n_walls + w;
+        if (!c.wallc_active[row]) continue;
+        cd_long e = cd_wall_out_place(c, row, n_walls, wall_start, wall_rows);
+        if (e >= 0) acc += wall_out[e].fn;
+    }
     return acc;
 }
 

@@ -4,6 +4,7 @@
  * output keys: docs/analysis.md. */
 #include "analysis/analyze.h"
 #include "config/config.h"
+#include "io/io_h5_guard.h"
 #include "mpm/mpm_output.h" /* cd_mpm_is_run_file */
 #include <gsl/gsl_errno.h>
 #include <math.h>
@@ -215,7 +216,9 @@ int cd_analyze_file(const char *path, const cd_an_options *opt, cd_an_report *re
     /* GSL's default handler aborts the process; every GSL result is
      * checked where it is used instead. */
     gsl_error_handler_t *old = gsl_set_error_handler_off();
+    cdh5_guard_begin("analyze", path); /* (analyze_file only reads the file) */
     int rc = analyze_file(path, opt, rep, err, errlen);
+    cdh5_guard_end();
     gsl_set_error_handler(old);
     return rc;
 }

@@ -65,6 +65,8 @@ static int rd_rows(rd *r, const char *dpath, hsize_t start0, hsize_t count0, hsi
         rc = rd_fail(r, 2, "dataset %s is missing: is this a capdem run file?", dpath);
     } else if (rank < 0) {
         rc = rd_fail(r, 2, "dataset %s has more than 3 dimensions or cannot be read", dpath);
+    } else if (!cdh5_storage_fits(d, start0, count0)) {
+        rc = rd_fail(r, 2, "dataset %s is corrupted (its stored size does not match its type)", dpath);
     } else if (rank == 0) { /* scalar dataset: one value */
         if (start0 != 0 || count0 != 1 || inner != 1) rc = rd_fail(r, 2, "dataset %s is a scalar", dpath);
         else if (H5Dread(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)

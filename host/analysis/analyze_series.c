@@ -119,7 +119,7 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
             H5Tclose(t);
             H5Aclose(a);
         }
-        if (!s->value || !s->time || !s->step ||
+        if (!s->value || !s->time || !s->step || (s->rows && !cdh5_storage_fits(d, 0, HSIZE_UNDEF)) ||
             (s->rows && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->value) < 0)) {
             snprintf(err, errlen, "%s: cannot read %s", path, p);
             rc = 2;
@@ -140,7 +140,8 @@ static int series_read(const char *path, series_set *set, char *err, size_t errl
              cd_h5_check_dset(ds, path, ps, H5T_INTEGER, 1, exact, exact, NULL, err, errlen)))
             rc = 2;
         if (!rc && s->rows &&
-            (H5Dread(dt, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->time) < 0 ||
+            (!cdh5_storage_fits(dt, 0, HSIZE_UNDEF) || !cdh5_storage_fits(ds, 0, HSIZE_UNDEF) ||
+             H5Dread(dt, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->time) < 0 ||
              H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, s->step) < 0)) {
             snprintf(err, errlen, "%s: cannot read the clock of %s/%s", path, obs, s->name);
             rc = 2;

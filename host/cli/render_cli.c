@@ -9,6 +9,7 @@
  * the python3 first on PATH may be another interpreter without them. */
 #define _XOPEN_SOURCE 700
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -137,7 +138,11 @@ int cd_cmd_render(int argc, char **argv)
         }
     }
     if (WIFEXITED(st)) return WEXITSTATUS(st);
-    fprintf(stderr, "capdem render: %s %s was killed by signal %d\n", python, script,
-            WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+    int sig = WIFSIGNALED(st) ? WTERMSIG(st) : 0;
+    fprintf(stderr, "capdem render: %s %s was killed by signal %d (%s)%s\n", python, script, sig, strsignal(sig),
+            sig == SIGSEGV || sig == SIGFPE || sig == SIGBUS
+                ? "; a corrupted run file can make libhdf5 (under h5py) fault like this: `capdem analyze` "
+                  "checks the file and names what is wrong"
+                : "");
     return 1;
 }

@@ -202,10 +202,13 @@ int cd_export_read_run(cd_export_ctx *x)
 {
     cd_export_field *pos = &x->position, *pa = &x->prim_a, *pb = &x->prim_b;
     char ppos[CDH5_PATH_LEN], pa_path[CDH5_PATH_LEN], pb_path[CDH5_PATH_LEN];
-    if (cd_export_describe(x->f, cdh5_column_path("position", ppos), pos) || pos->rank != 3 || pos->dims[2] != 3 ||
-        cd_export_describe(x->f, cdh5_column_path("prim_a", pa_path), pa) || pa->rank != 3 || pa->dims[2] != 3 ||
-        cd_export_describe(x->f, cdh5_column_path("prim_b", pb_path), pb) || pb->rank != 3 || pb->dims[2] != 3 ||
-        pa->dims[1] != pb->dims[1])
+    /* (all three paths first: the message names them even when the first check fails) */
+    cdh5_column_path("position", ppos);
+    cdh5_column_path("prim_a", pa_path);
+    cdh5_column_path("prim_b", pb_path);
+    if (cd_export_describe(x->f, ppos, pos) || pos->rank != 3 || pos->dims[2] != 3 ||
+        cd_export_describe(x->f, pa_path, pa) || pa->rank != 3 || pa->dims[2] != 3 ||
+        cd_export_describe(x->f, pb_path, pb) || pb->rank != 3 || pb->dims[2] != 3 || pa->dims[1] != pb->dims[1])
         return cd_export_fail(x, CD_EXPORT_BAD_INPUT,
                               "%s: not a capdem run file (needs %s (S, N, 3) and %s, %s (S, P, 3))", x->path, ppos,
                               pa_path, pb_path);

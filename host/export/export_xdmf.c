@@ -58,6 +58,7 @@
 #include "io/io_h5_journal.h"
 #include "export/export.h"
 #include "io/io_h5.h"
+#include "io/io_h5_guard.h"
 #include "export/export_internal.h"
 
 /* Records the first failure (later ones are usually consequences). */
@@ -441,6 +442,8 @@ int cd_cmd_export(int argc, char **argv)
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
 
     char err[512];
+    /* (the run file is opened journaled: what export adds reaches it only at its commit) */
+    cdh5_guard_begin("export", run);
     htri_t is_h5 = H5Fis_hdf5(run);
     if (is_h5 <= 0) {
         cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: not an HDF5 file", run);
@@ -460,13 +463,16 @@ int cd_cmd_export(int argc, char **argv)
             cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot flush the helper datasets (HDF5: %s)", run,
                            cd_export_h5_reason(why));
         } else {
+            cdh5_guard_end(); /* the run file has been read */
             cd_export_write_xml(x, out);
         }
     }
     if (x->viz >= 0) H5Gclose(x->viz);
     if (x->status && x->f >= 0) cdh5_drop_on_close(x->f); /* a failed export adds nothing to the run file */
     if (x->vf >= 0 && x->vf != x->f) H5Fclose(x->vf);
-    if (x->f >= 0) H5Fclose(x->f);
+    if (x->f >= 0 && H5Fclose(x->f) < 0 && !x->status) /* (the run file then keeps its last commit) */
+        cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot close the run file after adding the helpers", run);
+    cdh5_guard_end();
     H5Eset_auto2(H5E_DEFAULT, old_func, old_data);
 
     int status = x->status;

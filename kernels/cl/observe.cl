@@ -45,12 +45,14 @@ __kernel void cd_cl_obs_pairs(
 
 __kernel void cd_cl_obs_walls(
 #include "col_params.h"
-    cd_long n, cd_int n_walls, cd_law_params wall_law, __global cd_real *part, cd_long first)
+    cd_long n, cd_int n_walls, cd_law_params wall_law, __global cd_real *part, cd_long first,
+    __global const cd_int *wall_start, __global const cd_int *wall_rows, __global const cd_wall_out *wall_out)
 {
 #include "col_bind.h"
     cd_long b = (cd_long)get_global_id(0);
     if (b * CD_OBS_BLOCK < n)
-        cd_obs_block_walls(c, b, n, n_walls, wall_law, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
+        cd_obs_block_walls(c, b, n, n_walls, wall_law, part + (first + b) * CD_OBS_SLOTS, cd_order_identity(),
+                           wall_start, wall_rows, wall_out);
 }
 
 /* One level of the tree: the n partial sums from block `at` of part merged

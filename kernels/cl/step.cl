@@ -30,15 +30,17 @@ __kernel void cd_cl_pair_forces(
     if (k < n_pairs) cd_item_pair_force(c, k, law, dt, sin_parallel, parallel_blend);
 }
 
-/* Step 6: wall candidate e of the last build (its wall-contact row). */
+/* Step 6: wall candidate e of the last build (its wall-contact row; its
+ * outputs in wall_out[e]). */
 __kernel void cd_cl_wall_forces(
 #include "col_params.h"
     cd_int n_rows, __global const cd_int *wall_rows, __global const cd_wall *walls, cd_int n_walls,
-    cd_law_params wall_law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend)
+    cd_law_params wall_law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend, __global cd_wall_out *wall_out)
 {
 #include "col_bind.h"
     cd_int e = (cd_int)get_global_id(0);
-    if (e < n_rows) cd_item_wall_row(c, wall_rows[e], walls, n_walls, wall_law, dt, sin_parallel, parallel_blend);
+    if (e < n_rows)
+        cd_item_wall_row(c, wall_rows[e], wall_out + e, walls, n_walls, wall_law, dt, sin_parallel, parallel_blend);
 }
 
 /* Steps 7-8: gather of particle q in fixed order, then (kick = 1) the
@@ -47,12 +49,12 @@ __kernel void cd_cl_gather_kick(
 #include "col_params.h"
     cd_int n_particles, __global const cd_int *gather_start, __global const cd_pair_id *gather_rows,
     __global const cd_int *wall_start, __global const cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_int kick,
-    cd_real dt)
+    cd_real dt, __global const cd_wall_out *wall_out)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
     if (q >= n_particles) return;
-    cd_item_gather(c, q, gather_start, gather_rows, wall_start, wall_rows, gravity, dimension);
+    cd_item_gather(c, q, gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity, dimension);
     if (kick) cd_item_kick(c, q, CD_R(0.5) * dt);
 }
 
@@ -68,14 +70,18 @@ __kernel void cd_cl_check_finite(
 }
 
 /* Sum of the normal forces of wall w's contacts [N], pass 1: one
- * work-item per chunk of primitives (cd_item_wall_load_chunk). */
+ * work-item per chunk of primitives (cd_item_wall_load_chunk), from the
+ * outputs of the wall candidates. */
 __kernel void cd_cl_wall_load(
 #include "col_params.h"
-    cd_int n_prims, cd_int n_walls, cd_int w, __global cd_real *part, cd_int n_chunks)
+    cd_int n_prims, cd_int n_walls, cd_int w, __global cd_real *part, cd_int n_chunks,
+    __global const cd_int *wall_start, __global const cd_int *wall_rows, __global const cd_wall_out *wall_out)
 {
 #include "col_bind.h"
     cd_int ch = (cd_int)get_global_id(0);
-    if (ch < n_chunks) part[ch] = cd_item_wall_load_chunk(c, ch, n_prims, n_walls, w, (__global const cd_int *)0);
+    if (ch < n_chunks)
+        part[ch] = cd_item_wall_load_chunk(c, ch, n_prims, n_walls, w, (__global const cd_int *)0, wall_start,
+                                           wall_rows, wall_out);
 }
 
 /* Pass 2, one work-item: the chunks' sums in chunk order, as every backend

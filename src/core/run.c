@@ -14,6 +14,7 @@
 #include "core/sim.h"
 #include "core/observables.h"
 #include "io/io_h5.h"
+#include "io/io_h5_guard.h"
 #include "protocols/protocol.h"
 #include "rigid.h"
 #include "mpm/mpm_run.h"
@@ -249,7 +250,9 @@ int cd_run(const cd_run_options *opt)
         fprintf(stderr, "capdem: MPI could not start\n");
         return 1;
     }
-    return cd_mpi_end(run(opt));
+    int status = run(opt);
+    cdh5_guard_end(); /* (when a refusal returned before the resume's reopen) */
+    return cd_mpi_end(status);
 }
 
 static int run(const cd_run_options *opt)
@@ -272,6 +275,8 @@ static int run(const cd_run_options *opt)
     if (opt->output_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->output_path);
     if (!cfg.output[0]) snprintf(cfg.output, sizeof cfg.output, "%s.h5", cfg.name);
     if (opt->resume_path) snprintf(cfg.output, sizeof cfg.output, "%s", opt->resume_path);
+    /* from here to the reopen for writing a resume only reads its file */
+    if (opt->resume_path) cdh5_guard_begin("run --resume", opt->resume_path);
     /* (under MPI rank 0 looks, before any rank writes) */
     if (cd_mpi_agree(cd_mpi_is_writer() ? check_files(opt, &cfg, &as_given) : 0)) {
         cd_config_free(&cfg);
@@ -342,6 +347,7 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
+        cdh5_guard_end();
         out = cd_mpi_is_writer() ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err) : NULL;
         if (out && cd_output_note_resume(out, sim.s.step, &cfg)) { /* (the writer says why) */
             cd_output_close(out);

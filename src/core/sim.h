@@ -43,8 +43,9 @@ typedef struct {
      * rows wall_rows[wall_start[p] .. wall_start[p+1]) that the steps until
      * the next build test (kernels/step_items.h, cd_item_wall_candidates),
      * ascending */
-    cd_int *wall_start; /* n_particles + 1 */
-    cd_int *wall_rows;  /* at most n_prims n_walls */
+    cd_int *wall_start;    /* n_particles + 1 */
+    cd_int *wall_rows;     /* wall_start[n_particles] (cap_wall_rows) */
+    cd_wall_out *wall_out; /* per candidate: outputs of its wall contact (fields.def, WALLC_OUT) */
     /* scratch of the build */
     cd_grid *grid;       /* 1 */
     cd_real *part_bound; /* bounding radius per particle [m] */
@@ -81,6 +82,9 @@ typedef struct {
     int force_rebuild;               /* 1: rebuild at the next step regardless of motion */
     cd_wall walls_ref[CD_MAX_WALLS]; /* the walls at the last build (cd_bp_wall_moved) */
     size_t n_wall_rows;              /* entries of d.wall_rows (wall_start[n_particles]) */
+    size_t cap_wall_rows;            /* entries d.wall_rows and d.wall_out hold */
+    int wall_out_valid;              /* d.wall_out holds the step's wall-contact outputs (forces since start) */
+    int wall_out_pending;            /* ... newer than the host's columns (expanded at sync) */
     cd_nb_lists d;                   /* lists and scratch, where the loops run */
     size_t cap_rows;                 /* rows that keys and gather_rows (twice) hold */
     size_t cap_old;                  /* rows that old_keys, old_active, old_shear hold */
@@ -223,6 +227,11 @@ int cd_neighbors_build(cd_sim *sim);
 /* The bounding radii [m] of the last build, copied to out (n_particles,
  * user order); 0, or -1 before the first build.  For tests. */
 int cd_neighbors_part_bounds(const cd_sim *sim, double *out);
+/* The host's wall-contact outputs (fields.def, WALLC_OUT) from the step's
+ * per-candidate ones, when these are newer (nb.wall_out_pending), in the
+ * memory order of the step's columns: call after the other columns came
+ * back and before they go to user order.  0 or -1 (out of memory). */
+int cd_neighbors_wall_out_to_host(cd_sim *sim);
 
 /* Memory order (src/backend/omp/reorder.c, docs/architecture.md "Memory order"). */
 /* The maps the step columns are in now (the identity when not reordered),

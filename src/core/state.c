@@ -1,4 +1,5 @@
 #include "core/state.h"
+#include "field_groups.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -7,12 +8,23 @@
 #define CD_GROUP_OF_PAIR     CD_GROUP_PAIR
 #define CD_GROUP_OF_WALLC    CD_GROUP_WALLC
 #define CD_GROUP_OF_PAIR_OUT CD_GROUP_PAIR_OUT
-#define CD_KIND_OF_REAL      CD_KIND_REAL
-#define CD_KIND_OF_INT       CD_KIND_INT
+/* WALLC_OUT: the rows of WALLC on the host (I/O, reorder, copies); only
+ * the devices leave it out (on_device below, kernels/field_groups.h). */
+#define CD_GROUP_OF_WALLC_OUT CD_GROUP_WALLC
+#define CD_KIND_OF_REAL       CD_KIND_REAL
+#define CD_KIND_OF_INT        CD_KIND_INT
 
 const cd_field_info cd_fields[] = {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning)                                                     \
-    {CD_GROUP_OF_##group, CD_KIND_OF_##h5type, ncomp, sizeof(ctype), offsetof(cd_state, name), #name, unit, meaning},
+    {CD_GROUP_OF_##group,                                                                                              \
+     CD_KIND_OF_##h5type,                                                                                              \
+     ncomp,                                                                                                            \
+     sizeof(ctype),                                                                                                    \
+     offsetof(cd_state, name),                                                                                         \
+     #name,                                                                                                            \
+     unit,                                                                                                             \
+     meaning,                                                                                                          \
+     CD_ON_DEVICE_##group(1) + 0},
 #include "fields.def"
 #undef CD_FIELD
 };
@@ -102,4 +114,21 @@ int cd_state_copy(cd_state *dst, const cd_state *src)
                cd_state_rows(src, cd_fields[k].group) * cd_fields[k].elem_size);
     }
     return 0;
+}
+
+void cd_state_expand_wall_out(cd_state *s, const cd_int *rows, const cd_wall_out *out, size_t n)
+{
+    size_t R = s->n_prims * s->n_walls;
+    memset(s->wallc_force, 0, R * sizeof *s->wallc_force);
+    memset(s->wallc_torque, 0, R * sizeof *s->wallc_torque);
+    memset(s->wallc_overlap, 0, R * sizeof *s->wallc_overlap);
+    memset(s->wallc_fn, 0, R * sizeof *s->wallc_fn);
+    for (size_t e = 0; e < n; e++) {
+        size_t r = (size_t)rows[e];
+        if (!s->wallc_active[r]) continue;
+        s->wallc_force[r] = out[e].force;
+        s->wallc_torque[r] = out[e].torque;
+        s->wallc_overlap[r] = out[e].overlap;
+        s->wallc_fn[r] = out[e].fn;
+    }
 }

@@ -46,6 +46,7 @@ typedef struct {
     size_t elem_size; /* bytes per row */
     size_t offset;    /* offset of the column pointer inside cd_state */
     const char *name, *unit, *meaning;
+    int on_device; /* 1: a column the step reads or writes (kernels/field_groups.h) */
 } cd_field_info;
 
 extern const cd_field_info cd_fields[];
@@ -66,5 +67,9 @@ void cd_state_free(cd_state *s);
  * allocated for the same particles, primitives and walls (its pair columns
  * grow as needed).  Returns 0, or -1 (out of memory, or other sizes). */
 int cd_state_copy(cd_state *dst, const cd_state *src);
+/* The host's wall-contact outputs (fields.def, WALLC_OUT) from those the
+ * step keeps per wall candidate: out[e] for the candidate row rows[e]
+ * (e < n) while it is in contact (wallc_active), 0 elsewhere. */
+void cd_state_expand_wall_out(cd_state *s, const cd_int *rows, const cd_wall_out *out, size_t n);
 
 #endif

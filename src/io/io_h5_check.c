@@ -118,44 +118,87 @@ typedef struct {
     int bad;
 } tail_check;
 
-/* Whether every chunk that holds row `row` of the chunked dataset d is
- * stored with the size its extent and type imply (chunk elements times
- * the type's size, plus 4 bytes of Fletcher-32 when it has that filter).
- * HDF5 1.10 trusts that size and reads past its buffer when a corrupted
- * datatype makes elements larger than the stored chunk (found by
- * fuzz_runfile: a 12-byte chunk of a dataset whose type claimed 32-byte
- * elements).  Files with another filter (h5repack'ed) are not checked. */
-static int chunks_fit(hid_t d, hid_t dcpl, hid_t ft, int rank, const hsize_t *dims, hsize_t row)
+/* Bytes one chunk of dcpl's layout must occupy on disk: its elements
+ * times elem, plus 4 bytes of Fletcher-32 when it has that filter; 0 when
+ * that cannot be known (another filter, e.g. an h5repack'ed file, whose
+ * output HDF5 sizes itself) and -1 when the layout is impossible. */
+static long long chunk_bytes(hid_t dcpl, int rank, size_t elem, hsize_t ch[8])
 {
-    hsize_t ch[8];
-    if (H5Pget_chunk(dcpl, rank, ch) != rank) return 0;
+    if (H5Pget_chunk(dcpl, rank, ch) != rank) return -1;
     int nf = H5Pget_nfilters(dcpl), fletcher = 0;
     for (int k = 0; k < nf; k++) {
         unsigned flags, conf;
         size_t nv = 0;
         H5Z_filter_t id = H5Pget_filter2(dcpl, (unsigned)k, &flags, &nv, NULL, 0, NULL, &conf);
-        if (id == H5Z_FILTER_FLETCHER32) fletcher = 1;
-        else return 1;
+        if (id != H5Z_FILTER_FLETCHER32) return 0;
+        fletcher = 1;
     }
-    size_t elem = H5Tget_size(ft), want = elem;
+    size_t want = elem;
     for (int r = 0; r < rank; r++)
-        if (!ch[r] || cd_h5_mul(&want, want, (size_t)ch[r], 1)) return 0;
-    want += fletcher ? 4 : 0;
-    hsize_t off[8];
-    off[0] = row - row % ch[0];
-    for (int r = 1; r < rank; r++) off[r] = 0;
-    for (;;) {
-        hsize_t bytes = 0;
-        if (H5Dget_chunk_storage_size(d, off, &bytes) < 0) return 0;
-        if (bytes != 0 && bytes != (hsize_t)want) return 0; /* 0: never written, read as fill values */
-        int r = rank - 1;
-        for (; r >= 1; r--) {
-            off[r] += ch[r];
-            if (off[r] < dims[r]) break;
-            off[r] = 0;
+        if (!ch[r] || cd_h5_mul(&want, want, (size_t)ch[r], 1) || want > ((size_t)1 << 40)) return -1;
+    return (long long)want + (fletcher ? 4 : 0);
+}
+
+/* Whether every chunk holding rows row0..row0+nrows-1 (all of every inner
+ * dimension) is stored with exactly chunk_bytes (0 bytes: never written,
+ * read as fill values). */
+static int chunks_fit(hid_t d, hid_t dcpl, int rank, size_t elem, const hsize_t *dims, hsize_t row0, hsize_t nrows)
+{
+    hsize_t ch[8], off[8];
+    long long want = chunk_bytes(dcpl, rank, elem, ch);
+    if (want <= 0) return want == 0;
+    if (rank == 0 || nrows == 0) return 1;
+    for (off[0] = row0 - row0 % ch[0]; off[0] < row0 + nrows; off[0] += ch[0]) {
+        for (int r = 1; r < rank; r++) off[r] = 0;
+        for (;;) {
+            hsize_t bytes = 0;
+            if (H5Dget_chunk_storage_size(d, off, &bytes) < 0) return 0;
+            if (bytes != 0 && bytes != (hsize_t)want) return 0;
+            int r = rank - 1;
+            for (; r >= 1; r--) {
+                off[r] += ch[r];
+                if (off[r] < dims[r]) break;
+                off[r] = 0;
+            }
+            if (r < 1) break;
         }
-        if (r < 1) return 1;
     }
+    return 1;
+}
+
+/* HDF5 1.10 trusts a dataset's type and layout messages when it reads and
+ * copies that many bytes from what is stored: a corrupted datatype that
+ * makes elements larger than a stored chunk (found by fuzz_runfile: a
+ * 12-byte chunk of a dataset whose type claimed 32-byte elements) is read
+ * past its buffer, by the resume's tail check and by every row reader.
+ * So every reader first compares what is stored with what the extent and
+ * type imply: each chunk it will touch (chunked), the whole buffer
+ * (compact), or at least the extent (contiguous, once allocated). */
+int cdh5_storage_fits(hid_t d, hsize_t row0, hsize_t nrows)
+{
+    hid_t dcpl = H5Dget_create_plist(d), sp = H5Dget_space(d), ft = H5Dget_type(d);
+    int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1, ok = 0;
+    hsize_t dims[8];
+    size_t elem = ft >= 0 ? H5Tget_size(ft) : 0, total = elem;
+    if (dcpl >= 0 && rank >= 0 && rank <= 8 && elem && H5Sget_simple_extent_dims(sp, dims, NULL) == rank) {
+        ok = 1;
+        for (int r = 0; r < rank && ok; r++) ok = !cd_h5_mul(&total, total, (size_t)dims[r], 1);
+        if (rank > 0) nrows = row0 > dims[0] ? 0 : (nrows < dims[0] - row0 ? nrows : dims[0] - row0);
+        H5D_layout_t layout = H5Pget_layout(dcpl);
+        hsize_t stored = H5Dget_storage_size(d);
+        if (!ok) {
+        } else if (layout == H5D_CHUNKED) {
+            ok = chunks_fit(d, dcpl, rank, elem, dims, row0, nrows);
+        } else if (layout == H5D_COMPACT) {
+            ok = stored == (hsize_t)total;
+        } else if (layout == H5D_CONTIGUOUS) {
+            ok = stored == 0 || stored >= (hsize_t)total;
+        }
+    }
+    if (ft >= 0) H5Tclose(ft);
+    if (sp >= 0) H5Sclose(sp);
+    if (dcpl >= 0) H5Pclose(dcpl);
+    return ok;
 }
 
 /* Reads the last row of dataset `name` when it is chunked, so that HDF5
@@ -186,7 +229,7 @@ static herr_t check_tail(hid_t loc, const char *name, const H5O_info_t *info, vo
         count[0] = 1;
         for (int r = 1; r < rank; r++) count[r] = dims[r];
         hid_t ms = H5Screate_simple(rank, count, NULL);
-        ok = buf && ms >= 0 && chunks_fit(d, dcpl, ft, rank, dims, start[0]) &&
+        ok = buf && ms >= 0 && cdh5_storage_fits(d, start[0], 1) &&
              H5Sselect_hyperslab(sp, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
              H5Dread(d, mt, ms, sp, H5P_DEFAULT, buf) >= 0;
         if (ms >= 0) H5Sclose(ms);

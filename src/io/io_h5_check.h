@@ -28,6 +28,12 @@ int cd_h5_check_string(hid_t obj, int attr, const char *file, const char *what, 
  * floating-point number; otherwise -1 and a message naming file and what. */
 int cd_h5_check_number_attr(hid_t a, const char *file, const char *what, char *err, size_t errlen);
 
+/* 1 when what dataset d stores covers rows row0..row0+nrows-1 (clipped to
+ * its extent; a scalar whole) as its extent and type imply, so HDF5 can
+ * read them without running past a stored buffer; 0 otherwise (a
+ * corrupted file).  Every reader calls it before H5Dread. */
+int cdh5_storage_fits(hid_t d, hsize_t row0, hsize_t nrows);
+
 /* *out = a * b * c; -1 (and *out 0) when the product overflows size_t. */
 int cd_h5_mul(size_t *out, size_t a, size_t b, size_t c);
 

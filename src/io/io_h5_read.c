@@ -178,6 +178,7 @@ herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype,
     hsize_t start[3] = {start0, 0, 0}, cnt[3] = {count0, dims[1], dims[2]};
     if (start0 + count0 > dims[0]) return -1;
     if (cnt[0] * cnt[1] * cnt[2] == 0) return 0;
+    if (!cdh5_storage_fits(dset, start0, count0)) return -1;
     hid_t fs = H5Dget_space(dset), ms = H5Screate_simple(rank, cnt, NULL);
     herr_t e = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL);
     if (e >= 0) e = H5Dread(dset, memtype, ms, fs, H5P_DEFAULT, buf);
@@ -425,7 +426,10 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
         if (r->ds[i] < 0 && is_pair_force(f) && r->legacy_force) continue; /* rebuilt below */
         switch (cdh5_store_of(f)) {
         case CDH5_FIXED:
-            if (cd_state_rows(s, f->group)) e = H5Dread(r->ds[i], mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, col);
+            if (cd_state_rows(s, f->group))
+                e = cdh5_storage_fits(r->ds[i], 0, HSIZE_UNDEF)
+                        ? H5Dread(r->ds[i], mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, col)
+                        : -1;
             break;
         case CDH5_SERIES:
             e = cdh5_read_rows(r->ds[i], (hsize_t)k, 1, mt, col);
@@ -575,6 +579,10 @@ char *cdh5_read_string(hid_t f, const char *path, const char *dpath, size_t max_
         goto done;
     }
     if (cd_h5_check_string(d, 0, path, dpath, max_bytes, err, errlen)) goto done;
+    if (!cdh5_storage_fits(d, 0, HSIZE_UNDEF)) {
+        cdh5_msg(err, errlen, "%s: %s is corrupted (its stored size does not match its type)", path, dpath);
+        goto done;
+    }
     t = H5Dget_type(d);
     mt = H5Tcopy(t);
     if (H5Tis_variable_str(t) > 0) {

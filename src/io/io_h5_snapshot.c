@@ -223,6 +223,9 @@ int cdh5_layout_open(cd_output *o)
                 return FAIL("%s: %s has %lld rows, too many to hold; the file is refused", o->path, p, n);
             c->fixed = malloc(c->fixed_bytes ? c->fixed_bytes : 1);
             if (!c->fixed) return FAIL("%s: out of memory", o->path);
+            if (n && !cdh5_storage_fits(c->dset, 0, HSIZE_UNDEF))
+                return FAIL("%s: %s is corrupted (its stored size does not match its type); the file is refused",
+                            o->path, p);
             if (n && H5Dread(c->dset, cdh5_mem_type(f), H5S_ALL, H5S_ALL, H5P_DEFAULT, c->fixed) < 0)
                 return FAIL("%s: cannot read %s", o->path, p);
         }

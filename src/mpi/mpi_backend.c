@@ -327,12 +327,16 @@ static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 }
 
 /* The load a protocol asks for at every control call: the nonzero wall
- * rows only, summed in the serial order (cd_mpi_wall_load). */
+ * rows only, summed in the serial order (cd_mpi_wall_load).  The local
+ * state's wall rows first from the inner backend (whose step keeps their
+ * F_n per wall candidate, kernels/fields.def WALLC_OUT); every rank calls
+ * it, so a failure stops all. */
 static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
-    (void)err;
-    (void)errlen;
-    *load = cd_mpi_wall_load(sim->backend_data, w, sim->s.n_prims);
+    cd_mpi_ctx *x = sim->backend_data;
+    int rc = x->inner->sync(&x->loc, err, errlen);
+    if (agree_failure(x, rc, err, errlen)) return -1;
+    *load = cd_mpi_wall_load(x, w, sim->s.n_prims);
     return 0;
 }
 

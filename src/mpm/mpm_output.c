@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "mpm/mpm_output.h"
+#include "io/io_h5_check.h"
 #include "io/io_h5_journal.h"
 #include "capdem_commit.h" /* CAPDEM_COMMIT (src/git_commit.cmake) */
 
@@ -303,7 +304,7 @@ static int read_row(hid_t file, const char *path, hid_t mtype, hsize_t at, size_
         for (int k = 1; k < rank; k++) row *= (size_t)(cnt[k] = dims[k]);
         if (at < dims[0] && row == count) {
             hid_t ms = H5Screate_simple(rank, cnt, NULL);
-            rc = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL) >= 0 &&
+            rc = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL) >= 0 && cdh5_storage_fits(d, at, 1) &&
                          H5Dread(d, mtype, ms, fs, H5P_DEFAULT, buf) >= 0
                      ? 0
                      : -1;
@@ -335,8 +336,8 @@ static int same_fixed(hid_t f, const char *path, hid_t mtype, size_t n, size_t s
     hsize_t dims[1] = {0};
     int same = H5Sget_simple_extent_ndims(fs) == 1 && (H5Sget_simple_extent_dims(fs, dims, NULL), dims[0] == n);
     void *buf = same ? malloc(n * size + 1) : NULL;
-    same =
-        same && buf && H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 && memcmp(buf, want, n * size) == 0;
+    same = same && buf && cdh5_storage_fits(d, 0, HSIZE_UNDEF) &&
+           H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 && memcmp(buf, want, n * size) == 0;
     free(buf);
     H5Sclose(fs);
     H5Dclose(d);
@@ -439,9 +440,11 @@ cd_mpm_output *cd_mpm_output_reopen(const char *path, const cd_config *cfg, cons
             hsize_t rows = 0;
             if (d >= 0) {
                 hid_t fs = H5Dget_space(d);
-                H5Sget_simple_extent_dims(fs, &rows, NULL);
+                if (H5Sget_simple_extent_ndims(fs) != 1 || !cdh5_storage_fits(d, 0, HSIZE_UNDEF))
+                    rows = (hsize_t)-1; /* refused below: not a series of steps */
+                else H5Sget_simple_extent_dims(fs, &rows, NULL);
                 H5Sclose(fs);
-                steps = malloc((rows + 1) * sizeof(long long));
+                steps = rows < ((hsize_t)1 << 40) ? malloc((rows + 1) * sizeof(long long)) : NULL;
                 if (steps && H5Dread(d, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps) >= 0) {
                     while (o->n_series < rows && steps[o->n_series] <= m->step) o->n_series++;
                     rc = 0;

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "io/io_h5_check.h"
 #include "io/io_h5_journal.h"
 #include "mpm/mpm_packing.h"
 
@@ -22,6 +23,7 @@ static int read_row3(hid_t f, const char *name, long long row, long long n, doub
     hsize_t start[3] = {(hsize_t)row, 0, 0}, count[3] = {1, (hsize_t)n, 3};
     hid_t ms = H5Screate_simple(3, count, NULL);
     int rc = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) >= 0 &&
+                     cdh5_storage_fits(d, (hsize_t)row, 1) &&
                      H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, buf) >= 0
                  ? 0
                  : -1;
@@ -46,7 +48,8 @@ static int read_all(hid_t f, const char *name, int rank, long long *dims, double
         dims[k] = (long long)got[k];
     }
     if (ok && (dbl || ints))
-        ok = H5Dread(d, dbl ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+        ok = cdh5_storage_fits(d, 0, HSIZE_UNDEF) &&
+             H5Dread(d, dbl ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT,
                      dbl ? (void *)dbl : (void *)ints) >= 0;
     H5Sclose(sp);
     H5Dclose(d);

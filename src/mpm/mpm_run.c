@@ -9,6 +9,7 @@
 #include "mpm/mpm_run.h"
 #include "mpm/mpm.h"
 #include "mpm/mpm_output.h"
+#include "io/io_h5_guard.h"
 
 static double now_seconds(void)
 {
@@ -74,6 +75,7 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
             cd_mpm_free(&m);
             return 2;
         }
+        cdh5_guard_end(); /* (armed by cd_run while the file is only read) */
         out = cd_mpm_output_reopen(opt->resume_path, cfg, &m, err, sizeof err);
     } else {
         out = cd_mpm_output_create(cfg->output, opt->overwrite, cfg, &m, err, sizeof err);

@@ -178,5 +178,16 @@ for i in 1 2; do
   fi
 done
 
+# Files on which libhdf5 itself divides by zero or reads a wild address
+# while opening a dataset (found by fuzz_runfile; tests/fuzz/hdf5_defects):
+# a refusal naming the signal (src/io/io_h5_guard.c), the file unchanged.
+for defect in chunk-layout-division-by-zero:SIGFPE group-btree-read-segv:SIGSEGV; do
+  name=${defect%%:*} sig=${defect##*:}
+  cp "$src/tests/fuzz/hdf5_defects/$name.h5" "$name.h5"
+  analyze "$name" "stopped by $sig" refuse
+  export_ "$name" "stopped by $sig" refuse
+  cmp -s "$name.h5" "$src/tests/fuzz/hdf5_defects/$name.h5" || bad "$name: the file was changed"
+done
+
 echo "$pass passed, $fails failed"
 [ $fails -eq 0 ]

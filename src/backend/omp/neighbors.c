@@ -36,12 +36,12 @@ void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder)
 void cd_neighbors_free(cd_neighbors *nb)
 {
     cd_nb_lists *d = &nb->d;
-    void *all[] = {d->gather_start, d->gather_rows, d->wall_start, d->wall_rows,  d->grid,       d->part_bound,
-                   d->partial,      d->part_cell,   d->cell_count, d->cell_start, d->cell_parts, d->pair_count,
-                   d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active, d->old_shear,
-                   d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,   d->prim_at,
-                   d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,  d->sort_keys,
-                   d->sort_vals,    d->hist,        d->move,       d->skin_flag};
+    void *all[] = {d->wall_out,   d->gather_start, d->gather_rows, d->wall_start, d->wall_rows,  d->grid,
+                   d->part_bound, d->partial,      d->part_cell,   d->cell_count, d->cell_start, d->cell_parts,
+                   d->pair_count, d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active,
+                   d->old_shear,  d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,
+                   d->prim_at,    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
+                   d->sort_keys,  d->sort_vals,    d->hist,        d->move,       d->skin_flag};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -81,8 +81,7 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
             realloc_dev((void **)&d->count, N + 1, sizeof(cd_int)) ||
             realloc_dev((void **)&d->chunk_sum, chunks, sizeof(cd_int)) ||
             realloc_dev((void **)&d->gather_start, N + 1, sizeof(cd_int)) ||
-            realloc_dev((void **)&d->wall_start, N + 1, sizeof(cd_int)) ||
-            realloc_dev((void **)&d->wall_rows, P * s->n_walls + 1, sizeof(cd_int)))
+            realloc_dev((void **)&d->wall_start, N + 1, sizeof(cd_int)))
             return -1;
     }
     if (rows > nb->cap_rows || !d->keys) {
@@ -234,8 +233,40 @@ static int keep_history(cd_sim *sim, cd_cols c)
     return 0;
 }
 
+/* Room for n wall candidates (their rows and outputs), with a quarter to
+ * spare: sized by the candidates, not by primitives x walls. */
+static int reserve_wall_rows(cd_neighbors *nb, size_t n)
+{
+    if (n <= nb->cap_wall_rows && nb->d.wall_rows) return 0;
+    size_t cap = n + n / 4 + 16;
+    if (realloc_dev((void **)&nb->d.wall_rows, cap, sizeof(cd_int)) ||
+        realloc_dev((void **)&nb->d.wall_out, cap, sizeof(cd_wall_out)))
+        return -1;
+    nb->cap_wall_rows = cap;
+    return 0;
+}
+
+int cd_neighbors_wall_out_to_host(cd_sim *sim)
+{
+    cd_neighbors *nb = &sim->nb;
+    size_t n = nb->n_wall_rows;
+    if (!nb->wall_out_pending || !sim->s.n_walls) return 0;
+    cd_int *rows = malloc((n + 1) * sizeof *rows);
+    cd_wall_out *out = malloc((n + 1) * sizeof *out);
+    int rc = rows && out ? 0 : -1;
+    if (!rc && n)
+        rc = cd_dev_get(rows, nb->d.wall_rows, n * sizeof *rows) || cd_dev_get(out, nb->d.wall_out, n * sizeof *out);
+    if (!rc) {
+        cd_state_expand_wall_out(&sim->s, rows, out, n);
+        nb->wall_out_pending = 0;
+    }
+    free(rows);
+    free(out);
+    return rc ? -1 : 0;
+}
+
 /* Passes 9 (gather lists) and 10 (wall candidates; their number comes
- * back). */
+ * back, to size their lists). */
 static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
 {
     cd_state *s = &sim->s;
@@ -258,10 +289,11 @@ static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
     CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
     for (cd_int q = 0; q < N; q++) d.count[q] = cd_item_wall_candidates(c, q, walls, W, skin, 0);
     cd_nb_scan(d.count, N, d.wall_start, d.chunk_sum);
+    cd_int n_rows = 0;
+    if (cd_dev_get(&n_rows, d.wall_start + N, sizeof n_rows) || reserve_wall_rows(&sim->nb, (size_t)n_rows)) return -1;
+    d = sim->nb.d; /* the candidate lists may have moved */
     CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
     for (cd_int q = 0; q < N; q++) cd_item_wall_candidates(c, q, walls, W, skin, d.wall_rows + d.wall_start[q]);
-    cd_int n_rows = 0;
-    if (cd_dev_get(&n_rows, d.wall_start + N, sizeof n_rows)) return -1;
     sim->nb.n_wall_rows = (size_t)n_rows;
     memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
     return 0;

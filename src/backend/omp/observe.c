@@ -63,6 +63,32 @@ static void unpack(const double *t, cd_observables *o)
 #include "observables.def"
 }
 
+/* The host's wall contacts in the form of the step's candidate lists
+ * (kernels/step_items.h, cd_wall_out_place): per particle the rows in
+ * contact of its primitives, ascending, with their outputs from the
+ * host's columns.  0, or -1 (out of memory). */
+static int host_wall_lists(const cd_state *s, cd_int **start, cd_int **rows, cd_wall_out **out)
+{
+    size_t N = s->n_particles, W = s->n_walls, n = 0;
+    for (size_t r = 0; r < s->n_prims * W; r++) n += s->wallc_active[r] != 0;
+    *start = malloc((N + 1) * sizeof **start);
+    *rows = malloc((n + 1) * sizeof **rows);
+    *out = malloc((n + 1) * sizeof **out);
+    if (!*start || !*rows || !*out) return -1;
+    cd_int e = 0;
+    for (size_t q = 0; q < N; q++) {
+        (*start)[q] = e;
+        size_t first = (size_t)s->prim_first[q], last = first + (size_t)s->prim_count[q];
+        for (size_t r = first * W; r < last * W; r++) {
+            if (!s->wallc_active[r]) continue;
+            (*rows)[e] = (cd_int)r;
+            (*out)[e++] = (cd_wall_out){s->wallc_force[r], s->wallc_torque[r], s->wallc_overlap[r], s->wallc_fn[r]};
+        }
+    }
+    (*start)[N] = e;
+    return 0;
+}
+
 void cd_observables_slots(const cd_sim *sim, double *total)
 {
     const cd_state *s = &sim->s;
@@ -75,9 +101,15 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     cd_order o = cd_sim_host_order(sim);
     cd_int *touch = calloc((size_t)N + 1, sizeof(cd_int));
     double *part = malloc((size_t)(cd_obs_tree_blocks(leaves(nb)) + 1) * CD_OBS_SLOTS * sizeof(double));
-    if (!touch || !part) { /* without memory: what is known is nothing */
+    cd_int *wall_start = NULL, *wall_rows = NULL;
+    cd_wall_out *out = NULL;
+    if (!touch || !part || host_wall_lists(s, &wall_start, &wall_rows, &out)) {
+        /* without memory: what is known is nothing */
         free(touch);
         free(part);
+        free(wall_start);
+        free(wall_rows);
+        free(out);
         for (int k = 0; k < CD_OBS_SLOTS; k++) total[k] = NAN;
         return;
     }
@@ -93,10 +125,14 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     CD_HOST_FOR(K, firstprivate(c, o))
     for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS, o);
     CD_HOST_FOR(R, firstprivate(c, o))
-    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS, o);
+    for (cd_long b = 0; b < nb.walls; b++)
+        cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS, o, wall_start, wall_rows, out);
     merge_tree(part, leaves(nb), total, 0);
     free(touch);
     free(part);
+    free(wall_start);
+    free(wall_rows);
+    free(out);
 }
 
 void cd_sim_observe(const cd_sim *sim, cd_observables *o)
@@ -113,7 +149,10 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o)
 int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     const cd_state *s = &sim->s;
-    if (!sim->backend_data) { /* not started: the host columns are current */
+    /* not started, or no forces since the start: the host columns are
+     * current (the wall contacts' outputs are on the device from the first
+     * forces on) */
+    if (!sim->backend_data || !sim->nb.wall_out_valid) {
         cd_observables_slots(sim, slots);
         return 0;
     }
@@ -152,8 +191,11 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS, o);
     CD_STEP_FOR(K, firstprivate(c, law, o) is_device_ptr(part))
     for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS, o);
-    CD_STEP_FOR(R, firstprivate(c, wall_law, o) is_device_ptr(part))
-    for (cd_long b = 0; b < nb.walls; b++) cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS, o);
+    cd_nb_lists d = sim->nb.d;
+    CD_STEP_FOR(R, firstprivate(c, d, wall_law, o) is_device_ptr(part))
+    for (cd_long b = 0; b < nb.walls; b++)
+        cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS, o, d.wall_start, d.wall_rows,
+                           d.wall_out);
     merge_tree(part, leaves(nb), total, 1);
     return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;
 }

@@ -170,7 +170,12 @@ static cd_int *sort_particles(cd_sim *sim, const cd_grid *g)
 
 /* Is field f moved with its rows?  The reference ends are not: the build
  * sets them at its end. */
-static int moves(const cd_field_info *f) { return strcmp(f->name, "prim_a_ref") && strcmp(f->name, "prim_b_ref"); }
+static int moves(const cd_field_info *f)
+{
+    /* not the host-only columns: a device does not hold them, and on host
+     * threads sync writes them anew (wallc_torque) */
+    return f->on_device && strcmp(f->name, "prim_a_ref") && strcmp(f->name, "prim_b_ref");
+}
 
 int cd_reorder_build(cd_sim *sim, int *moved)
 {

@@ -102,7 +102,7 @@ static void off_refresh_cols(cd_sim *sim, cd_off *o)
  * output-only columns, kernels/field_groups.h). */
 static void off_map_field(cd_sim *sim, cd_off *o, size_t f)
 {
-    void *p = cd_fields[f].group == CD_GROUP_PAIR_OUT ? NULL : *cd_field_ptr(&sim->s, &cd_fields[f]);
+    void *p = cd_fields[f].on_device ? *cd_field_ptr(&sim->s, &cd_fields[f]) : NULL;
     size_t bytes = alloc_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size;
     o->host[f] = p && bytes ? p : NULL;
     o->bytes[f] = o->host[f] ? bytes : 0;
@@ -312,7 +312,9 @@ static void wall_forces(cd_sim *sim)
     size_t n = W ? sim->nb.n_wall_rows : 0;
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, d, law) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
-    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, d.wall_rows[e], walls, W, law, dt, sin_parallel, blend);
+    for (size_t e = 0; e < n; e++)
+        cd_item_wall_row(c, d.wall_rows[e], d.wall_out + e, walls, W, law, dt, sin_parallel, blend);
+    sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
 }
 
 /* One work item per particle: gravity plus its contacts in fixed order,
@@ -329,7 +331,8 @@ static void gather_kick(cd_sim *sim, int kick)
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, d, g))
     for (size_t q = 0; q < n; q++) {
-        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, g, dim);
+        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, d.wall_out, g,
+                       dim);
         if (kick) cd_item_kick(c, (cd_particle_id)q, h);
     }
 }
@@ -357,12 +360,12 @@ __attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd
     for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
 }
 
-__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, size_t n, const cd_wall *walls,
-                                                         cd_int W, cd_law_params law, cd_real dt, cd_real sin_parallel,
-                                                         cd_int blend)
+__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, cd_wall_out *out, size_t n,
+                                                         const cd_wall *walls, cd_int W, cd_law_params law, cd_real dt,
+                                                         cd_real sin_parallel, cd_int blend)
 {
 #pragma omp for schedule(static)
-    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], walls, W, law, dt, sin_parallel, blend);
+    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], out + e, walls, W, law, dt, sin_parallel, blend);
 }
 
 __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 g,
@@ -372,7 +375,7 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
     for (size_t q = 0; q < n; q++)
         moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                             d.wall_rows, g, dim, dt, limit2, next);
+                                             d.wall_rows, d.wall_out, g, dim, dt, limit2, next);
     return moved;
 }
 #endif
@@ -407,9 +410,10 @@ static int forces_and_advance(cd_sim *sim, int next)
 #pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
     {
         pair_rows(c, n_pairs, law, dt, sin_parallel, blend);
-        wall_rows(c, d.wall_rows, n_walls, walls, W, wall_law, dt, sin_parallel, blend);
+        wall_rows(c, d.wall_rows, d.wall_out, n_walls, walls, W, wall_law, dt, sin_parallel, blend);
         moved |= gather_kick_advance(c, d, n, g, dim, dt, limit2, next);
     }
+    sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
     return moved;
 #endif
 }
@@ -482,9 +486,12 @@ static void omp_stop(cd_sim *sim)
     cd_reorder_forget(sim);
     off_release(sim);
 #else
-    if (cd_reorder_to_user(sim)) fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
+    /* the host keeps the step's wall-contact outputs too */
+    if (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim))
+        fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
     cd_reorder_forget(sim);
 #endif
+    sim->nb.wall_out_valid = sim->nb.wall_out_pending = 0;
 }
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen);
@@ -561,8 +568,9 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
                          cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
         }
 #endif
-    /* the host columns in user order (src/backend/omp/reorder.c) */
-    if (cd_reorder_to_user(sim)) {
+    /* the wall-contact outputs kept per candidate into the host's rows, then the
+     * host columns in user order (src/backend/omp/reorder.c) */
+    if (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim)) {
         snprintf(err, errlen, "out of memory putting the particles in user order");
         return -1;
     }
@@ -592,19 +600,22 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     cd_off *o = sim->backend_data;
     (void)err;
     (void)errlen;
-    if (!o) { /* not started: the host columns are current */
+    /* not started, or no forces since: the host columns are current */
+    if (!o || !sim->nb.wall_out_valid) {
         *load = cd_sim_wall_load_host(sim, w);
         return 0;
     }
     cd_cols c = o->dev;
+    cd_nb_lists d = sim->nb.d;
     double *part = o->part;
     size_t P = sim->s.n_prims, W = sim->s.n_walls, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
     const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
     double sum = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(nch, firstprivate(c) is_device_ptr(prim_at))
+    CD_STEP_FOR(nch, firstprivate(c, d) is_device_ptr(prim_at))
     for (size_t ch = 0; ch < nch; ch++)
-        part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at);
+        part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at, d.wall_start, d.wall_rows,
+                                           d.wall_out);
 #pragma omp target map(tofrom : sum)
     for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
     *load = sum;
@@ -615,19 +626,37 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
 #else
 /* Host threads: the host columns are the step's, summed in user order
  * whatever their memory order, without a sync (which would put them in
- * user order and back). */
+ * user order and back); the wall contacts' F_n from the candidate lists
+ * while these are newer than the host's rows (steps since the last sync),
+ * in the same order. */
 static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     (void)err;
     (void)errlen;
-    *load = cd_sim_wall_load_host(sim, w);
+    if (!sim->nb.wall_out_pending) {
+        *load = cd_sim_wall_load_host(sim, w);
+        return 0;
+    }
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    cd_long P = (cd_long)sim->s.n_prims;
+    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
+    double sum = 0;
+    for (cd_long ch = 0; ch * CD_LOAD_CHUNK < P; ch++)
+        sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w, prim_at, d.wall_start, d.wall_rows,
+                                       d.wall_out);
+    *load = sum;
     return 0;
 }
 
+/* The host's columns, with the wall contacts' outputs of the last steps
+ * (in the columns' memory order). */
 static int omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
-    (void)err;
-    (void)errlen;
+    if (cd_neighbors_wall_out_to_host(sim)) {
+        snprintf(err, errlen, "out of memory while summing the observables");
+        return -1;
+    }
     cd_observables_slots(sim, slots);
     return 0;
 }

@@ -32,7 +32,6 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 2, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 3, sizeof p->sin_parallel, &p->sin_parallel);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 4, sizeof p->parallel_blend, &p->parallel_blend);
-    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 2, sizeof cl->walls, &cl->walls);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 3, sizeof W, &W);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 4, sizeof p->wall_law, &p->wall_law);
@@ -42,7 +41,6 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 1, sizeof cl->gather_start, &cl->gather_start);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof cl->wall_start, &cl->wall_start);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->gravity, &p->gravity);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof p->dimension, &p->dimension);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
@@ -59,6 +57,11 @@ static void set_list_args(cd_cl *cl)
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F, sizeof n, &n);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F, sizeof cl->n_wall_rows, &cl->n_wall_rows);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 2, sizeof cl->gather_rows, &cl->gather_rows);
+    /* the wall candidates' lists, sized by the last build */
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 8, sizeof cl->wall_out, &cl->wall_out);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 9, sizeof cl->wall_out, &cl->wall_out);
 }
 
 /* Rebuild of the list, then steps 5-8 (forces, gather, second kick). */
@@ -71,6 +74,7 @@ static int forces(cd_cl *cl, cd_sim *sim, int rebuild)
     }
     cd_cl_run(cl, CD_CLK_PAIR_FORCES, cl->n_pairs);
     if (cl->n_wall_rows) cd_cl_run(cl, CD_CLK_WALL_FORCES, (size_t)cl->n_wall_rows);
+    cl->wall_out_valid = cl->wall_out_pending = 1;
     return cd_cl_run(cl, CD_CLK_GATHER_KICK, s->n_particles);
 }
 
@@ -208,8 +212,15 @@ static int cl_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errl
         snprintf(err, errlen, "the OpenCL backend was not started (cd_sim_start)");
         return -1;
     }
+    if (!cl->wall_out_valid) { /* no forces since the start: the host columns are current */
+        *load = cd_sim_wall_load_host(sim, w);
+        return 0;
+    }
     cd_int P = (cd_int)sim->s.n_prims, W = (cd_int)sim->s.n_walls, ww = w;
     cd_int nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 5, sizeof cl->wall_start, &cl->wall_start);
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 6, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 7, sizeof cl->wall_out, &cl->wall_out);
     cd_cl_arg(cl, CD_CLK_WALL_LOAD, F, sizeof P, &P);
     cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 1, sizeof W, &W);
     cd_cl_arg(cl, CD_CLK_WALL_LOAD, F + 2, sizeof ww, &ww);
@@ -234,7 +245,7 @@ static int cl_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errl
 static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     cd_cl *cl = sim->backend_data;
-    if (!cl) { /* not started: the host columns are current */
+    if (!cl || !cl->wall_out_valid) { /* not started, or no forces since: the host columns are current */
         cd_observables_slots(sim, slots);
         return 0;
     }
@@ -276,6 +287,9 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 2, sizeof sim->p.wall_law, &sim->p.wall_law);
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 3, sizeof cl->obs_part, &cl->obs_part);
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 4, sizeof first, &first);
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 5, sizeof cl->wall_start, &cl->wall_start);
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 6, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 7, sizeof cl->wall_out, &cl->wall_out);
     cd_cl_run(cl, CD_CLK_OBS_WALLS, (size_t)bw);
     /* the tree of the leaves (kernels/observe_items.h), level by level,
      * as src/backend/omp/observe.c runs it */

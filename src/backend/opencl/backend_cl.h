@@ -106,9 +106,13 @@ typedef struct cd_cl {
     cl_mem gather_count, gather_start, gather_cursor, gather_rows;
     size_t gather_cap;
     /* wall candidates of the last build (cd_item_wall_candidates): counts
-     * per particle, CSR offsets, rows (at most n_prims n_walls) */
+     * per particle, CSR offsets, rows (sized by the build's count) */
     cl_mem wall_count, wall_start, wall_rows;
+    cl_mem wall_out; /* cd_wall_out per candidate: outputs of its wall contact (fields.def, WALLC_OUT) */
     cd_int n_wall_rows;
+    size_t cap_wall_rows;             /* entries wall_rows and wall_out hold */
+    int wall_out_valid;               /* wall_out holds the step's wall-contact outputs (forces since start) */
+    int wall_out_pending;             /* ... newer than the host's columns (expanded at sync) */
     cd_wall host_walls[CD_MAX_WALLS]; /* the walls as the device moves them, for the rebuild test */
     int cols_dirty;                   /* a column buffer changed: rebind the column arguments */
 } cd_cl;
@@ -152,6 +156,8 @@ void cd_cl_buffers_release(cd_cl *cl);
  * hold at least n rows (with headroom).  Contents are kept only where no
  * buffer had to grow. */
 int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which);
+/* Room for n wall candidates in wall_rows and wall_out (contents dropped). */
+int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n);
 /* The buffer bound as column f (the current history set for pair_active
  * and pair_shear). */
 cl_mem cd_cl_col(const cd_cl *cl, int f);

@@ -135,6 +135,18 @@ int cd_cl_scan(cd_cl *cl, cl_mem in, size_t n, cl_mem out)
     return cl->status ? -1 : 0;
 }
 
+int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n)
+{
+    if (n <= cl->cap_wall_rows) return cl->status ? -1 : 0;
+    size_t want = n + n / 4 + 16;
+    release(&cl->wall_rows);
+    release(&cl->wall_out);
+    cl->wall_rows = cd_cl_buffer(cl, want * sizeof(cd_int), "allocating the wall lists");
+    cl->wall_out = cd_cl_buffer(cl, want * sizeof(cd_wall_out), "allocating the wall lists");
+    cl->cap_wall_rows = want;
+    return cl->status ? -1 : 0;
+}
+
 int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
 {
     const cd_state *s = &sim->s;
@@ -180,11 +192,10 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->gather_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_cursor = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the gather lists");
-    size_t wall_rows = (size_t)P * s->n_walls + 1;
     cl->wall_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the wall lists");
     cl->wall_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the wall lists");
-    cl->wall_rows = cd_cl_buffer(cl, wall_rows * sizeof(cd_int), "allocating the wall lists");
-    if (cl->status) return -1;
+    cl->cap_wall_rows = 0; /* wall_rows, wall_out: sized by the builds */
+    if (cl->status || cd_cl_reserve_wall_rows(cl, 1)) return -1;
     return cd_cl_bind_cols(cl);
 }
 
@@ -237,6 +248,28 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
     /* Not the walls: the host's copy is current after every call of step
      * and may since have been changed by a protocol (docs/opencl.md). */
     if (!cl->status) cd_cl_check(cl, clFinish(cl->queue), "downloading the state");
+    if (cl->status) return -1;
+    /* the wall-contact outputs the step keeps per candidate, into the host's rows */
+    size_t n = (size_t)cl->n_wall_rows;
+    if (!cl->wall_out_pending || !s->n_walls) return 0;
+    cd_int *rows = malloc((n + 1) * sizeof *rows);
+    cd_wall_out *out = malloc((n + 1) * sizeof *out);
+    if (!rows || !out) cd_cl_check(cl, CL_OUT_OF_HOST_MEMORY, "downloading the wall contacts");
+    if (!cl->status && n) {
+        cd_cl_check(cl,
+                    clEnqueueReadBuffer(cl->queue, cl->wall_rows, CL_TRUE, 0, n * sizeof *rows, rows, 0, NULL, NULL),
+                    "downloading the wall contacts");
+        if (!cl->status)
+            cd_cl_check(cl,
+                        clEnqueueReadBuffer(cl->queue, cl->wall_out, CL_TRUE, 0, n * sizeof *out, out, 0, NULL, NULL),
+                        "downloading the wall contacts");
+    }
+    if (!cl->status) {
+        cd_state_expand_wall_out(s, rows, out, n);
+        cl->wall_out_pending = 0;
+    }
+    free(rows);
+    free(out);
     return cl->status ? -1 : 0;
 }
 
@@ -254,7 +287,8 @@ void cd_cl_buffers_release(cd_cl *cl)
                        &cl->cell_cursor, &cl->cell_parts,   &cl->pair_count,   &cl->pair_offset,   &cl->block_sum,
                        &cl->cand,        &cl->gather_count, &cl->gather_start, &cl->gather_cursor, &cl->gather_rows,
                        &cl->wall_count,  &cl->wall_start,   &cl->wall_rows,    &cl->obs_touch,     &cl->obs_part,
-                       &cl->obs_total};
+                       &cl->obs_total,   &cl->wall_out};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
     cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
+    cl->cap_wall_rows = 0;
 }

@@ -112,8 +112,9 @@ static void gather_lists(cd_cl *cl, cd_int N, cd_int n_pairs)
 }
 
 /* Per-particle wall candidates (CSR wall_start / wall_rows, ascending):
- * count, scan, fill; the number of rows comes back (the wall kernel's
- * size), and the walls become the reference of the wall-motion test. */
+ * count, scan, fill; the number of rows comes back between scan and fill
+ * (the size of their lists and of the wall kernel), and the walls become
+ * the reference of the wall-motion test. */
 static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
 {
     cd_int W = (cd_int)sim->s.n_walls;
@@ -128,14 +129,16 @@ static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
     cd_cl_arg(cl, CD_CLK_WALL_CAND_COUNT, F + 4, sizeof cl->wall_count, &cl->wall_count);
     cd_cl_run(cl, CD_CLK_WALL_CAND_COUNT, (size_t)N);
     cd_cl_scan(cl, cl->wall_count, (size_t)N, cl->wall_start);
-    cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 4, sizeof cl->wall_start, &cl->wall_start);
-    cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 5, sizeof cl->wall_rows, &cl->wall_rows);
-    cd_cl_run(cl, CD_CLK_WALL_CAND_FILL, (size_t)N);
+    /* their number sizes their lists (set_list_args binds them anew) */
     if (!cl->status)
         cd_cl_check(cl,
                     clEnqueueReadBuffer(cl->queue, cl->wall_start, CL_TRUE, (size_t)N * sizeof(cd_int),
                                         sizeof cl->n_wall_rows, &cl->n_wall_rows, 0, NULL, NULL),
                     "reading the number of wall candidates");
+    if (cl->status || cd_cl_reserve_wall_rows(cl, (size_t)cl->n_wall_rows)) return;
+    cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 4, sizeof cl->wall_start, &cl->wall_start);
+    cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 5, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_run(cl, CD_CLK_WALL_CAND_FILL, (size_t)N);
     memcpy(sim->nb.walls_ref, cl->host_walls, sizeof sim->nb.walls_ref);
 }
 
