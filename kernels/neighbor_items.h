@@ -32,49 +32,93 @@
 
 CD_DEVICE_BEGIN
 
-/* Pass 1: bounding radius [m] of each particle of chunk g, [g chunk,
- * (g+1) chunk), into part_bound, and the chunk's box of centres and largest
- * bound as 7 reals (lo xyz, hi xyz, rmax) at partial + 7 g. */
-CD_INLINE void cd_nb_item_bounds(cd_cols c, cd_int g, cd_int chunk, cd_int n_particles, CD_GLOBAL cd_real *part_bound,
-                                 CD_GLOBAL cd_real *partial)
+/* Pass 1, in three steps shaped for a GPU (one item per particle, then
+ * a tree of boxes; a 256-particle chunk per item left a GPU a few hundred
+ * threads, 4.8 ms at 1e5 hexapods on an H100):
+ *   1a  bounding radius [m] of particle p into part_bound;
+ *   1b  box of the centres of chunk g of CD_BOX_CHUNK particles and its
+ *       largest bound, as 7 reals (lo xyz, hi xyz, rmax) at boxes + 7 g;
+ *   1c  while more than CD_BOX_CHUNK boxes remain: the boxes of chunk g of
+ *       them merged into one, a level up (the levels one after the other
+ *       in one array of 7 cd_nb_box_scratch(n) reals).
+ * Minimum and maximum are exact: the grid does not depend on the chunking. */
+#define CD_BOX_CHUNK 64
+
+/* Boxes of all levels of the tree over n particles; at least 1. */
+CD_INLINE cd_long cd_nb_box_scratch(cd_long n)
 {
-    cd_real lo[3], hi[3], rmax = 0;
-    for (int k = 0; k < 3; k++) {
-        lo[k] = (cd_real)INFINITY;
-        hi[k] = -(cd_real)INFINITY;
+    n = (n + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK;
+    cd_long s = n > 1 ? n : 1;
+    while (n > CD_BOX_CHUNK) {
+        n = (n + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK;
+        s += n;
     }
-    cd_int end = (g + 1) * chunk < n_particles ? (g + 1) * chunk : n_particles;
-    for (cd_int p = g * chunk; p < end; p++) {
-        cd_real b =
-            cd_bp_particle_bound(c.prim_a, c.prim_b, c.prim_radius, c.prim_first[p], c.prim_count[p], c.position[p]);
-        part_bound[p] = b;
-        cd_bp_bounds_add(lo, hi, &rmax, c.position[p], b);
-    }
-    for (int k = 0; k < 3; k++) {
-        partial[7 * g + k] = lo[k];
-        partial[7 * g + 3 + k] = hi[k];
-    }
-    partial[7 * g + 6] = rmax;
+    return s;
 }
 
-/* Pass 2 (one item): the boxes of n_chunks chunks merged (minimum and
- * maximum are exact, so the grid does not depend on the chunking) and the
- * grid made for skin [m]. */
-CD_INLINE void cd_nb_item_grid(const CD_GLOBAL cd_real *partial, cd_int n_chunks, cd_real skin, cd_int n_particles,
-                               CD_GLOBAL cd_grid *grid)
+CD_INLINE void cd_nb_item_bound(cd_cols c, cd_particle_id p, CD_GLOBAL cd_real *part_bound)
 {
-    cd_real lo[3], hi[3], rmax = 0;
+    part_bound[p] =
+        cd_bp_particle_bound(c.prim_a, c.prim_b, c.prim_radius, c.prim_first[p], c.prim_count[p], c.position[p]);
+}
+
+CD_INLINE void cd_nb_box_clear(cd_real *lo, cd_real *hi, cd_real *rmax)
+{
     for (int k = 0; k < 3; k++) {
         lo[k] = (cd_real)INFINITY;
         hi[k] = -(cd_real)INFINITY;
     }
-    for (cd_int g = 0; g < n_chunks; g++) {
-        for (int k = 0; k < 3; k++) {
-            if (partial[7 * g + k] < lo[k]) lo[k] = partial[7 * g + k];
-            if (partial[7 * g + 3 + k] > hi[k]) hi[k] = partial[7 * g + 3 + k];
-        }
-        if (partial[7 * g + 6] > rmax) rmax = partial[7 * g + 6];
+    *rmax = 0;
+}
+
+CD_INLINE void cd_nb_box_store(const cd_real *lo, const cd_real *hi, cd_real rmax, CD_GLOBAL cd_real *box)
+{
+    for (int k = 0; k < 3; k++) {
+        box[k] = lo[k];
+        box[3 + k] = hi[k];
     }
+    box[6] = rmax;
+}
+
+/* Boxes first .. end - 1 merged into lo, hi, rmax. */
+CD_INLINE void cd_nb_box_merge(const CD_GLOBAL cd_real *boxes, cd_long first, cd_long end, cd_real *lo, cd_real *hi,
+                               cd_real *rmax)
+{
+    for (cd_long g = first; g < end; g++) {
+        for (int k = 0; k < 3; k++) {
+            if (boxes[7 * g + k] < lo[k]) lo[k] = boxes[7 * g + k];
+            if (boxes[7 * g + 3 + k] > hi[k]) hi[k] = boxes[7 * g + 3 + k];
+        }
+        if (boxes[7 * g + 6] > *rmax) *rmax = boxes[7 * g + 6];
+    }
+}
+
+CD_INLINE void cd_nb_item_box(cd_cols c, cd_long g, cd_long n_particles, const CD_GLOBAL cd_real *part_bound,
+                              CD_GLOBAL cd_real *boxes)
+{
+    cd_real lo[3], hi[3], rmax;
+    cd_nb_box_clear(lo, hi, &rmax);
+    cd_long end = (g + 1) * CD_BOX_CHUNK < n_particles ? (g + 1) * CD_BOX_CHUNK : n_particles;
+    for (cd_long p = g * CD_BOX_CHUNK; p < end; p++) cd_bp_bounds_add(lo, hi, &rmax, c.position[p], part_bound[p]);
+    cd_nb_box_store(lo, hi, rmax, boxes + 7 * g);
+}
+
+CD_INLINE void cd_nb_item_box_up(const CD_GLOBAL cd_real *boxes, cd_long n, cd_long g, CD_GLOBAL cd_real *up)
+{
+    cd_real lo[3], hi[3], rmax;
+    cd_nb_box_clear(lo, hi, &rmax);
+    cd_nb_box_merge(boxes, g * CD_BOX_CHUNK, (g + 1) * CD_BOX_CHUNK < n ? (g + 1) * CD_BOX_CHUNK : n, lo, hi, &rmax);
+    cd_nb_box_store(lo, hi, rmax, up + 7 * g);
+}
+
+/* Pass 2 (one item): the last level's n_boxes boxes merged and the grid
+ * made for skin [m]. */
+CD_INLINE void cd_nb_item_grid(const CD_GLOBAL cd_real *boxes, cd_int n_boxes, cd_real skin, cd_int n_particles,
+                               CD_GLOBAL cd_grid *grid)
+{
+    cd_real lo[3], hi[3], rmax;
+    cd_nb_box_clear(lo, hi, &rmax);
+    cd_nb_box_merge(boxes, 0, n_boxes, lo, hi, &rmax);
     cd_grid gr;
     /* Centres not finite, or spread over more than 1e12 cell sizes: the
      * run blew up, and a grid of them would overflow its integer
@@ -275,37 +319,80 @@ CD_INLINE void cd_nb_item_gather_sort(cd_cols c, cd_order o, cd_particle_id q, c
     }
 }
 
-/* The prefix sums of passes 4, 6, 9 and 10: out[0] = 0, out[k+1] = out[k] +
- * in[k] (out has n + 1 entries, out[n] the total), in three steps: each
- * chunk sums its inputs, one item scans the chunk sums, each chunk writes
- * its outputs.  Integer arithmetic: exact whatever the chunking. */
-CD_INLINE void cd_scan_item_sum(const CD_GLOBAL cd_int *in, cd_int n, cd_int chunk, cd_int g,
-                                CD_GLOBAL cd_int *chunk_sum)
+/* The prefix sums of passes 4, 6, 9 and 10 (and of the reorder's radix
+ * sort): out[0] = 0, out[k+1] = out[k] + in[k] (out has n + 1 entries,
+ * out[n] the total), as a tree of chunks of CD_SCAN_CHUNK entries, shaped
+ * for a GPU as much as for host threads (docs/performance.md, "GPU-shaped
+ * reductions"):
+ *
+ *   up      level l+1 holds the sums of the chunks of level l (level 0 is
+ *           in), while level l has more than one chunk: cd_scan_item_sum;
+ *   top     one item scans the last level (at most one chunk) in place,
+ *           or in into out when n fits one chunk: cd_scan_item_top;
+ *   down    each chunk of level l, from the top level down, rewrites its
+ *           entries as prefix sums starting at its chunk's entry one level
+ *           up; level 0 writes into out: cd_scan_item_fill.
+ *
+ * 2n additions in all, and short serial loops: a chunk of 64 entries is
+ * one item, so 1e6 entries give 15,625 items at level 0 (1,024-entry chunks
+ * gave a GPU under a thousand threads with long dependent loops).  Integer
+ * arithmetic: exact, so the result does not depend on the chunking. The
+ * levels above 0 live in one scratch array of cd_scan_scratch(n) entries,
+ * level after level, each with one entry more for its total. */
+#define CD_SCAN_CHUNK 64
+
+/* Entries of the scratch of a scan of n entries (all levels above 0, and
+ * their totals); at least 1. */
+CD_INLINE cd_long cd_scan_scratch(cd_long n)
 {
-    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n, s = 0;
-    for (cd_int i = g * chunk; i < end; i++) s += in[i];
-    chunk_sum[g] = s;
+    cd_long s = 1;
+    while (n > CD_SCAN_CHUNK) {
+        n = (n + CD_SCAN_CHUNK - 1) / CD_SCAN_CHUNK;
+        s += n + 1;
+    }
+    return s;
 }
 
-CD_INLINE void cd_scan_item_top(CD_GLOBAL cd_int *chunk_sum, cd_int n_chunks, CD_GLOBAL cd_int *out, cd_int n)
+CD_INLINE cd_long cd_scan_chunk_end(cd_long g, cd_long n)
+{
+    return (g + 1) * CD_SCAN_CHUNK < n ? (g + 1) * CD_SCAN_CHUNK : n;
+}
+
+/* Up: sums[g] = the sum of chunk g of the n entries of in. */
+CD_INLINE void cd_scan_item_sum(const CD_GLOBAL cd_int *in, cd_long n, cd_long g, CD_GLOBAL cd_int *sums)
+{
+    cd_int s = 0;
+    for (cd_long i = g * CD_SCAN_CHUNK; i < cd_scan_chunk_end(g, n); i++) s += in[i];
+    sums[g] = s;
+}
+
+/* Top (one item): out[k] = in[0] + ... + in[k-1] for k <= n; in and out
+ * may be the same array (then it holds n + 1 entries). */
+CD_INLINE void cd_scan_item_top(const CD_GLOBAL cd_int *in, cd_long n, CD_GLOBAL cd_int *out)
 {
     cd_int run = 0;
-    for (cd_int g = 0; g < n_chunks; g++) {
-        cd_int t = chunk_sum[g];
-        chunk_sum[g] = run;
+    for (cd_long i = 0; i < n; i++) {
+        cd_int t = in[i];
+        out[i] = run;
         run += t;
     }
     out[n] = run;
 }
 
-CD_INLINE void cd_scan_item_fill(const CD_GLOBAL cd_int *in, cd_int n, cd_int chunk, cd_int g,
-                                 const CD_GLOBAL cd_int *chunk_sum, CD_GLOBAL cd_int *out)
+/* Down: chunk g of the n entries of in as prefix sums into out, starting
+ * at starts[g] (the scanned level above); the last chunk writes the total
+ * out[n].  in and out may be the same array. */
+CD_INLINE void cd_scan_item_fill(const CD_GLOBAL cd_int *in, cd_long n, cd_long g, const CD_GLOBAL cd_int *starts,
+                                 CD_GLOBAL cd_int *out)
 {
-    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n, run = chunk_sum[g];
-    for (cd_int i = g * chunk; i < end; i++) {
+    cd_long end = cd_scan_chunk_end(g, n);
+    cd_int run = starts[g];
+    for (cd_long i = g * CD_SCAN_CHUNK; i < end; i++) {
+        cd_int t = in[i];
         out[i] = run;
-        run += in[i];
+        run += t;
     }
+    if (end == n) out[n] = run;
 }
 
 CD_DEVICE_END

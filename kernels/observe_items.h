@@ -1,8 +1,11 @@
 /* The observables of the state (energies, contact counts, momentum, wall
  * forces, largest overlap; their SUM and MAX rows of kernels/observables.def
- * give the slots) as fixed-order reductions: rows in blocks of
- * CD_OBS_BLOCK, each block summed in row order into its own slots, then
- * the blocks merged in order (particles, pairs, wall rows).  Rows are
+ * give the slots) as fixed-order reductions, a fixed tree: rows in blocks
+ * of CD_OBS_BLOCK, each block summed in row order into its own slots (the
+ * leaves: particles, then pairs, then wall rows), then the leaves merged
+ * in order CD_OBS_FANIN at a time, level by level, into the total (docs/
+ * performance.md, "GPU-shaped reductions": 4,096-row blocks gave a GPU a
+ * few dozen serial loops, 25 ms an observation at 1e5 hexapods).  Rows are
  * visited in user order (cd_order, kernels/reorder_items.h; the identity
  * when the memory order is the user's), so the sums do not depend on it.  src/backend/omp/observe.c
  * runs the items on host threads or, in the offload variant, on the device
@@ -17,7 +20,8 @@
 #include "reorder_items.h"
 #include "step_items.h"
 
-#define CD_OBS_BLOCK 4096
+#define CD_OBS_BLOCK 64
+#define CD_OBS_FANIN 16
 
 /* Components of an observable (kernels/observables.def) in the slots:
  * every wall of CD_MAX_WALLS has its place, used or not. */
@@ -66,6 +70,18 @@ CD_INLINE void cd_obs_item_touch_wall(cd_cols c, cd_long row, cd_int n_walls, CD
     if (c.wallc_active[row]) cd_atomic_inc(&touch[c.prim_particle[row / n_walls]]);
 }
 
+/* Partial sums of the tree over n leaves: the leaves and the levels above
+ * them but the last (the total). */
+CD_INLINE cd_long cd_obs_tree_blocks(cd_long n)
+{
+    cd_long s = n;
+    while (n > CD_OBS_FANIN) {
+        n = (n + CD_OBS_FANIN - 1) / CD_OBS_FANIN;
+        s += n;
+    }
+    return s;
+}
+
 CD_INLINE void cd_obs_clear(CD_GLOBAL cd_real *acc)
 {
     for (int k = 0; k < CD_OBS_SLOTS; k++) acc[k] = 0;
@@ -76,53 +92,71 @@ CD_INLINE cd_long cd_obs_block_end(cd_long b, cd_long n)
     return (b + 1) * CD_OBS_BLOCK < n ? (b + 1) * CD_OBS_BLOCK : n;
 }
 
+/* The leaves sum into scalars (registers on a GPU; a private array of
+ * the slots was kept in device heap by Clang's offload, remark OMP112),
+ * written out once; per slot the additions are those of a sum into the
+ * slots, in row order. */
+
 /* Block b of the particles: kinetic and potential energy in gravity
  * [m/s^2], momentum. */
 CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 gravity, const CD_GLOBAL cd_int *touch,
                                       CD_GLOBAL cd_real *acc, cd_order o)
 {
-    cd_obs_clear(acc);
+    cd_real sum_kt = 0, sum_kr = 0, sum_kc = 0, sum_pe = 0; /* [J] */
+    cd_vec3 sum_p = cd_v3_zero();                           /* [kg m/s] */
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long q = cd_map(o.part_at, u);
         cd_vec3 v = c.velocity[q];
         cd_real m = c.mass[q];
         cd_real kt = CD_R(0.5) * m * cd_v3_norm2(v),
                 kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], c.inertia[q]);
-        acc[CD_OBS_KT] += kt;
-        acc[CD_OBS_KR] += kr;
-        if (touch[q]) acc[CD_OBS_KC] += kt + kr;
-        acc[CD_OBS_PE] -= m * cd_v3_dot(gravity, c.position[q]);
-        acc[CD_OBS_PX] += m * v.x;
-        acc[CD_OBS_PX + 1] += m * v.y;
-        acc[CD_OBS_PX + 2] += m * v.z;
+        sum_kt += kt;
+        sum_kr += kr;
+        if (touch[q]) sum_kc += kt + kr;
+        sum_pe -= m * cd_v3_dot(gravity, c.position[q]);
+        sum_p.x += m * v.x;
+        sum_p.y += m * v.y;
+        sum_p.z += m * v.z;
     }
+    cd_obs_clear(acc);
+    acc[CD_OBS_KT] = sum_kt;
+    acc[CD_OBS_KR] = sum_kr;
+    acc[CD_OBS_KC] = sum_kc;
+    acc[CD_OBS_PE] = sum_pe;
+    acc[CD_OBS_PX] = sum_p.x;
+    acc[CD_OBS_PX + 1] = sum_p.y;
+    acc[CD_OBS_PX + 2] = sum_p.z;
 }
 
 /* Block b of the pair rows: elastic energy, contacts, largest overlap. */
 CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc,
                                   cd_order o)
 {
-    cd_obs_clear(acc);
+    cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long k = cd_map(o.pair_at, u);
         if (!c.pair_active[k]) continue;
         cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
-        acc[CD_OBS_EL] +=
-            cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
-        acc[CD_OBS_NC] += 1;
+        el += cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
+        contacts += 1;
         cd_real ratio = c.pair_overlap[k] / (2 * (ri < rj ? ri : rj));
-        if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
+        if (ratio > most) most = ratio;
     }
+    cd_obs_clear(acc);
+    acc[CD_OBS_EL] = el;
+    acc[CD_OBS_NC] = contacts;
+    acc[CD_OBS_MAXOV] = most;
 }
 
 /* Block b of the primitive-wall rows (n_walls per primitive): elastic
- * energy, contacts, the particles' force on each wall, largest overlap.
- * The outputs of the rows in contact: wall_out per wall candidate
- * (cd_wall_out_place). */
+ * energy, contacts, the particles' force on each wall [N] (summed in
+ * place: its slot depends on the row), largest overlap.  The outputs of
+ * the rows in contact: wall_out per wall candidate (cd_wall_out_place). */
 CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
                                   CD_GLOBAL cd_real *acc, cd_order o, const CD_GLOBAL cd_int *wall_start,
                                   const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out)
 {
+    cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
     cd_obs_clear(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
@@ -130,23 +164,30 @@ CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_wall
         cd_long e = cd_wall_out_place(c, r, n_walls, wall_start, wall_rows);
         if (e < 0) continue; /* (a row in contact is a candidate) */
         cd_wall_out out = wall_out[e];
-        acc[CD_OBS_EL] += cd_contact_elastic_energy(wall_law, c.prim_radius[i], out.overlap, c.wallc_shear[r]);
-        acc[CD_OBS_NW] += 1;
+        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], out.overlap, c.wallc_shear[r]);
+        contacts += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
         acc[CD_OBS_WALL + 3 * w + 0] -= out.force.x;
         acc[CD_OBS_WALL + 3 * w + 1] -= out.force.y;
         acc[CD_OBS_WALL + 3 * w + 2] -= out.force.z;
         cd_real ratio = out.overlap / (2 * c.prim_radius[i]);
-        if (ratio > acc[CD_OBS_MAXOV]) acc[CD_OBS_MAXOV] = ratio;
+        if (ratio > most) most = ratio;
     }
+    acc[CD_OBS_EL] = el;
+    acc[CD_OBS_NW] = contacts;
+    acc[CD_OBS_MAXOV] = most;
 }
 
-/* One item: the n_blocks partial slots merged in order into total: the
- * SUM slots added, the MAX slots by maximum. */
-CD_INLINE void cd_obs_merge(const CD_GLOBAL cd_real *partial, cd_long n_blocks, CD_GLOBAL cd_real *total)
+/* Item g of a level of the tree: partial sums g FANIN .. (g + 1) FANIN - 1
+ * of the n at partial merged in order into out + g CD_OBS_SLOTS: the SUM
+ * slots added, the MAX slots by maximum.  The last level has one item,
+ * whose out is the total. */
+CD_INLINE void cd_obs_item_merge(const CD_GLOBAL cd_real *partial, cd_long n, cd_long g, CD_GLOBAL cd_real *out)
 {
+    CD_GLOBAL cd_real *total = out + g * CD_OBS_SLOTS;
     cd_obs_clear(total);
-    for (cd_long b = 0; b < n_blocks; b++) {
+    cd_long end = (g + 1) * CD_OBS_FANIN < n ? (g + 1) * CD_OBS_FANIN : n;
+    for (cd_long b = g * CD_OBS_FANIN; b < end; b++) {
         const CD_GLOBAL cd_real *p = partial + b * CD_OBS_SLOTS;
         for (int k = 0; k < CD_OBS_SUMS; k++) total[k] += p[k];
         for (int k = CD_OBS_SUMS; k < CD_OBS_SLOTS; k++)

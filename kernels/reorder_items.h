@@ -52,30 +52,48 @@ CD_INLINE void cd_reorder_item_key(cd_cols c, cd_particle_id q, const CD_GLOBAL 
     vals[q] = q;
 }
 
-/* Stable radix sort of (key, value), 8 bits a pass, in chunks: pass
- * `shift` counts the digits of chunk g into hist[digit n_chunks + g]; a
- * prefix sum over hist gives every (digit, chunk) its first place; each
- * chunk then writes its items in order.  Integer work only, the result
- * independent of the chunking: ties keep their memory order, so the
- * permutation is the same on every run and backend. */
-#define CD_RADIX_BINS 256
-CD_INLINE void cd_reorder_item_hist(const CD_GLOBAL cd_ulong *keys, cd_int n, cd_int chunk, cd_int n_chunks, cd_int g,
-                                    int shift, CD_GLOBAL cd_int *hist)
+/* Stable radix sort of (key, value), CD_RADIX_BITS bits a pass, in chunks
+ * of CD_SORT_CHUNK keys: pass `shift` counts the digits of chunk g into
+ * hist[digit n_chunks + g]; a prefix sum over hist (cd_scan_item_*) gives
+ * every (digit, chunk) its first place; each chunk then writes its items
+ * in order.  Small chunks and 16 bins keep a GPU busy (one item per 64
+ * keys, a histogram of n / 4 entries; 1,024-key chunks and 256 bins gave
+ * it a few hundred long serial loops) at the price of twice the passes.
+ * Integer work only, the result independent of the chunking and of the
+ * digit width: ties keep their memory order, so the permutation is the
+ * same on every run and backend. */
+#define CD_RADIX_BITS 4
+#define CD_RADIX_BINS (1 << CD_RADIX_BITS)
+#define CD_RADIX_MASK (CD_RADIX_BINS - 1)
+#define CD_SORT_CHUNK 64
+
+/* Entries of the histogram of a pass over n keys. */
+CD_INLINE cd_long cd_reorder_hist_entries(cd_long n)
 {
-    for (cd_int d = 0; d < CD_RADIX_BINS; d++) hist[d * n_chunks + g] = 0;
-    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n;
-    for (cd_int k = g * chunk; k < end; k++) hist[(cd_int)((keys[k] >> shift) & 0xff) * n_chunks + g]++;
+    return (cd_long)CD_RADIX_BINS * ((n + CD_SORT_CHUNK - 1) / CD_SORT_CHUNK);
+}
+
+CD_INLINE void cd_reorder_item_hist(const CD_GLOBAL cd_ulong *keys, cd_int n, cd_int n_chunks, cd_int g, int shift,
+                                    CD_GLOBAL cd_int *hist)
+{
+    cd_int count[CD_RADIX_BINS];
+    for (cd_int d = 0; d < CD_RADIX_BINS; d++) count[d] = 0;
+    cd_int end = (g + 1) * CD_SORT_CHUNK < n ? (g + 1) * CD_SORT_CHUNK : n;
+    for (cd_int k = g * CD_SORT_CHUNK; k < end; k++) count[(cd_int)((keys[k] >> shift) & CD_RADIX_MASK)]++;
+    for (cd_int d = 0; d < CD_RADIX_BINS; d++) hist[d * n_chunks + g] = count[d];
 }
 
 CD_INLINE void cd_reorder_item_scatter(const CD_GLOBAL cd_ulong *keys, const CD_GLOBAL cd_int *vals, cd_int n,
-                                       cd_int chunk, cd_int n_chunks, cd_int g, int shift, CD_GLOBAL cd_int *cursor,
+                                       cd_int n_chunks, cd_int g, int shift, const CD_GLOBAL cd_int *first,
                                        CD_GLOBAL cd_ulong *keys_out, CD_GLOBAL cd_int *vals_out)
 {
-    cd_int end = (g + 1) * chunk < n ? (g + 1) * chunk : n;
-    for (cd_int k = g * chunk; k < end; k++) {
-        cd_int at = cursor[(cd_int)((keys[k] >> shift) & 0xff) * n_chunks + g]++;
-        keys_out[at] = keys[k];
-        vals_out[at] = vals[k];
+    cd_int at[CD_RADIX_BINS];
+    for (cd_int d = 0; d < CD_RADIX_BINS; d++) at[d] = first[d * n_chunks + g];
+    cd_int end = (g + 1) * CD_SORT_CHUNK < n ? (g + 1) * CD_SORT_CHUNK : n;
+    for (cd_int k = g * CD_SORT_CHUNK; k < end; k++) {
+        cd_int to = at[(cd_int)((keys[k] >> shift) & CD_RADIX_MASK)]++;
+        keys_out[to] = keys[k];
+        vals_out[to] = vals[k];
     }
 }
 

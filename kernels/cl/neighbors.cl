@@ -8,20 +8,40 @@
 #include "../step_items.h"
 #include "../cols.h"
 
-/* Pass 1: bounds of the particles of chunk g. */
+/* Pass 1a: bounding radius of particle p. */
 __kernel void cd_cl_bounds(
 #include "col_params.h"
-    cd_int n_particles, cd_int chunk, __global cd_real *partial, __global cd_real *part_bound)
+    cd_int n_particles, __global cd_real *part_bound)
 {
 #include "col_bind.h"
-    cd_nb_item_bounds(c, (cd_int)get_global_id(0), chunk, n_particles, part_bound, partial);
+    cd_int p = (cd_int)get_global_id(0);
+    if (p < n_particles) cd_nb_item_bound(c, p, part_bound);
 }
 
-/* Pass 2 (one work-item): the grid. */
-__kernel void cd_cl_grid(__global const cd_real *partial, cd_int n_parts, cd_real skin, cd_int n_particles,
+/* Pass 1b: box of the particles of chunk g. */
+__kernel void cd_cl_box(
+#include "col_params.h"
+    cd_int n_particles, __global const cd_real *part_bound, __global cd_real *boxes)
+{
+#include "col_bind.h"
+    cd_long g = (cd_long)get_global_id(0);
+    if (g * CD_BOX_CHUNK < n_particles) cd_nb_item_box(c, g, n_particles, part_bound, boxes);
+}
+
+/* Pass 1c: the n boxes from box `at` merged by chunks into the level
+ * above, from box `up_at` (one buffer). */
+__kernel void cd_cl_box_up(__global const cd_real *boxes, cd_int at, cd_int n, __global cd_real *up, cd_int up_at)
+{
+    cd_long g = (cd_long)get_global_id(0);
+    if (g * CD_BOX_CHUNK < n) cd_nb_item_box_up(boxes + 7 * (cd_long)at, n, g, up + 7 * (cd_long)up_at);
+}
+
+/* Pass 2 (one work-item): the last level's boxes, from box `at`, merged;
+ * the grid. */
+__kernel void cd_cl_grid(__global const cd_real *boxes, cd_int at, cd_int n_boxes, cd_real skin, cd_int n_particles,
                          __global cd_grid *grid)
 {
-    cd_nb_item_grid(partial, n_parts, skin, n_particles, grid);
+    cd_nb_item_grid(boxes + 7 * (cd_long)at, n_boxes, skin, n_particles, grid);
 }
 
 /* Pass 3: cell of particle q, counted. */

@@ -1,7 +1,7 @@
 /* The observables summed on the device (kernels/observe_items.h): marks of
  * the particles in contact, the block sums of particles, pair rows and wall
- * rows, and their merge in order by one work-item; only the merged slots
- * go back to the host.  The same items and order as src/backend/omp/observe.c. */
+ * rows (the leaves), and the fixed tree merging them level by level; only
+ * the merged slots go back to the host.  The same items and order as src/backend/omp/observe.c. */
 #include "../observe_items.h"
 
 __kernel void cd_cl_obs_touch_pairs(
@@ -55,7 +55,12 @@ __kernel void cd_cl_obs_walls(
                            wall_start, wall_rows, wall_out);
 }
 
-__kernel void cd_cl_obs_merge(__global const cd_real *part, cd_long n_blocks, __global cd_real *total)
+/* One level of the tree: the n partial sums from block `at` of part merged
+ * CD_OBS_FANIN at a time into out from block `out_at` (the level above in
+ * part, or, for the last level of one item, the total). */
+__kernel void cd_cl_obs_merge(__global const cd_real *part, cd_long at, cd_long n, __global cd_real *out,
+                              cd_long out_at)
 {
-    cd_obs_merge(part, n_blocks, total);
+    cd_long g = (cd_long)get_global_id(0);
+    if (g == 0 || g * CD_OBS_FANIN < n) cd_obs_item_merge(part + at * CD_OBS_SLOTS, n, g, out + out_at * CD_OBS_SLOTS);
 }

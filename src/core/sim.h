@@ -49,7 +49,7 @@ typedef struct {
     /* scratch of the build */
     cd_grid *grid;       /* 1 */
     cd_real *part_bound; /* bounding radius per particle [m] */
-    cd_real *partial;    /* 7 per chunk of particles: box of centres, largest bound [m] */
+    cd_real *partial;    /* the tree of boxes (kernels/neighbor_items.h): 7 each, box of centres, largest bound [m] */
     cd_int *part_cell, *cell_count, *cell_start, *cell_parts; /* cell lists (CSR); count doubles as cursor */
     cd_int *pair_count, *pair_offset;                         /* rows per primitive, their offsets (n_prims + 1) */
     cd_prim_id *cand;                                         /* candidate slots, slot per primitive */
@@ -57,7 +57,8 @@ typedef struct {
     cd_int *old_active;                                       /* history of the old rows */
     cd_vec3 *old_shear;                                       /* [m] */
     cd_int *count;                                            /* per particle: gather and wall counts, then cursors */
-    cd_int *chunk_sum;                                        /* prefix sums' chunk totals */
+    cd_int *chunk_sum;                                        /* prefix sums' levels (cd_scan_scratch) */
+    cd_int *skin_flag; /* offload: 1 when the last advance found an end beyond half the skin (step_omp.c) */
     /* memory order (kernels/reorder_items.h, src/backend/omp/reorder.c; allocated at
      * the first build with neighbor.reorder: cells) */
     cd_int *part_uid, *part_at;  /* particle: memory slot -> user id, user id -> memory slot */

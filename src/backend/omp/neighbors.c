@@ -19,10 +19,6 @@
 #include "neighbor_items.h"
 #include "step_items.h"
 
-/* Particles per chunk of the bounds pass, entries per chunk of a prefix
- * sum: a few thousand items at 1e6 particles, enough for any device. */
-#define CD_NB_CHUNK   256
-#define CD_SCAN_CHUNK 1024
 /* Candidate slots per primitive at the first build (a hexapod arm in a
  * dense packing with a skin of 0.1 d has about 10); they double whenever a
  * primitive overflows its slot. */
@@ -45,7 +41,7 @@ void cd_neighbors_free(cd_neighbors *nb)
                    d->pair_count, d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active,
                    d->old_shear,  d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,
                    d->prim_at,    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
-                   d->sort_keys,  d->sort_vals,    d->hist,        d->move};
+                   d->sort_keys,  d->sort_vals,    d->hist,        d->move,       d->skin_flag};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -66,10 +62,15 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
     size_t N = s->n_particles, P = s->n_prims;
     if (!d->grid) {
         nb->cell_cap = 8 * N + 65; /* cd_grid_make: at most 8 N + 64 cells */
-        size_t chunks = (nb->cell_cap > P ? nb->cell_cap : P) / CD_SCAN_CHUNK + 2;
+        /* the longest scan: the cells, the primitives or the radix sort's
+         * histograms (src/backend/omp/reorder.c) */
+        size_t longest = nb->cell_cap > P ? nb->cell_cap : P;
+        if ((size_t)cd_reorder_hist_entries((cd_long)N) > longest)
+            longest = (size_t)cd_reorder_hist_entries((cd_long)N);
+        size_t chunks = (size_t)cd_scan_scratch((cd_long)longest);
         if (realloc_dev((void **)&d->grid, 1, sizeof(cd_grid)) ||
             realloc_dev((void **)&d->part_bound, N + 1, sizeof(cd_real)) ||
-            realloc_dev((void **)&d->partial, 7 * (N / CD_NB_CHUNK + 1), sizeof(cd_real)) ||
+            realloc_dev((void **)&d->partial, 7 * (size_t)cd_nb_box_scratch((cd_long)N), sizeof(cd_real)) ||
             realloc_dev((void **)&d->part_cell, N + 1, sizeof(cd_int)) ||
             realloc_dev((void **)&d->cell_count, nb->cell_cap + 1, sizeof(cd_int)) ||
             realloc_dev((void **)&d->cell_start, nb->cell_cap + 1, sizeof(cd_int)) ||
@@ -93,17 +94,40 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
     return 0;
 }
 
-/* out[0] = 0, out[k+1] = out[k] + in[k] for k < n (kernels/neighbor_items.h). */
-void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *chunk_sum)
+/* out[0] = 0, out[k+1] = out[k] + in[k] for k < n: the tree of chunks of
+ * kernels/neighbor_items.h, 2 L + 1 loops for L levels above the input
+ * (one loop up to 64 entries, three up to 4,096, five up to 262,144). */
+void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *scratch)
 {
-    cd_int chunk = CD_SCAN_CHUNK, n_chunks = (n + chunk - 1) / chunk;
+    cd_int *level[8]; /* levels above 0 in scratch: 64^7 > 2^31 entries */
+    cd_long len[8];
+    int L = 0;
+    len[0] = n;
+    cd_int *at = scratch;
     CD_WIDE_MIN
-    CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(in, chunk_sum)))
-    for (cd_int g = 0; g < n_chunks; g++) cd_scan_item_sum(in, n, chunk, g, chunk_sum);
-    CD_STEP_FOR(1, CD_DEV(is_device_ptr(out, chunk_sum)))
-    for (int one = 0; one < 1; one++) cd_scan_item_top(chunk_sum, n_chunks, out, n);
-    CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(in, out, chunk_sum)))
-    for (cd_int g = 0; g < n_chunks; g++) cd_scan_item_fill(in, n, chunk, g, chunk_sum, out);
+    while (len[L] > CD_SCAN_CHUNK) {
+        const cd_int *src = L ? level[L] : in;
+        cd_long n_src = len[L], m = (n_src + CD_SCAN_CHUNK - 1) / CD_SCAN_CHUNK;
+        cd_int *sums = at;
+        CD_STEP_FOR(m, CD_DEV(is_device_ptr(src, sums)))
+        for (cd_long g = 0; g < m; g++) cd_scan_item_sum(src, n_src, g, sums);
+        at += m + 1;
+        L++;
+        level[L] = sums;
+        len[L] = m;
+    }
+    cd_int *top = L ? level[L] : out;
+    const cd_int *top_in = L ? level[L] : in;
+    cd_long n_top = len[L];
+    CD_STEP_FOR(1, CD_DEV(is_device_ptr(top_in, top)))
+    for (int one = 0; one < 1; one++) cd_scan_item_top(top_in, n_top, top);
+    for (int l = L - 1; l >= 0; l--) {
+        const cd_int *src = l ? level[l] : in, *starts = level[l + 1];
+        cd_int *dst = l ? level[l] : out;
+        cd_long n_src = len[l], m = len[l + 1];
+        CD_STEP_FOR(m, CD_DEV(is_device_ptr(src, starts, dst)))
+        for (cd_long g = 0; g < m; g++) cd_scan_item_fill(src, n_src, g, starts, dst);
+    }
 }
 
 /* dst[k] = src[k] (k < n): a scan's output becomes the cursor of a fill. */
@@ -121,18 +145,31 @@ static void zero_ints(cd_int *dst, size_t n)
     for (size_t k = 0; k < n; k++) dst[k] = 0;
 }
 
-/* Passes 1-2: bounds and grid.  Returns 1 when the grid says the run blew
- * up (cd_nb_item_grid; the grid comes back, 56 bytes), 0 otherwise. */
+/* Passes 1-2: bounds, the tree of boxes, and grid (2 + L loops for L
+ * levels of boxes: 3 up to 4,096 particles, 4 up to 262,144).  Returns 1
+ * when the grid says the run blew up (cd_nb_item_grid; the grid comes
+ * back, 56 bytes), 0 otherwise. */
 static int make_grid(cd_sim *sim, cd_cols c, cd_nb_lists d)
 {
-    cd_int N = (cd_int)sim->s.n_particles;
-    cd_int chunk = CD_NB_CHUNK, n_chunks = (N + chunk - 1) / chunk;
-    cd_real skin = sim->nb.skin; /* [m] */
+    cd_long N = (cd_long)sim->s.n_particles, n = (N + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK;
+    cd_real skin = sim->nb.skin, *boxes = d.partial; /* [m] */
     CD_WIDE_MIN
-    CD_STEP_FOR(n_chunks, firstprivate(c, d))
-    for (cd_int g = 0; g < n_chunks; g++) cd_nb_item_bounds(c, g, chunk, N, d.part_bound, d.partial);
-    CD_STEP_FOR(1, firstprivate(d))
-    for (int one = 0; one < 1; one++) cd_nb_item_grid(d.partial, n_chunks, skin, N, d.grid);
+    CD_STEP_FOR(N, firstprivate(c, d))
+    for (cd_long p = 0; p < N; p++) cd_nb_item_bound(c, p, d.part_bound);
+    CD_STEP_FOR(n, firstprivate(c, d))
+    for (cd_long g = 0; g < n; g++) cd_nb_item_box(c, g, N, d.part_bound, d.partial);
+    while (n > CD_BOX_CHUNK) {
+        cd_long m = (n + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK, n_in = n;
+        cd_real *up = boxes + 7 * n;
+        CD_STEP_FOR(m, CD_DEV(is_device_ptr(boxes, up)))
+        for (cd_long g = 0; g < m; g++) cd_nb_item_box_up(boxes, n_in, g, up);
+        boxes = up;
+        n = m;
+    }
+    cd_int n_top = (cd_int)n;
+    cd_grid *grid = d.grid;
+    CD_STEP_FOR(1, CD_DEV(is_device_ptr(boxes, grid)))
+    for (int one = 0; one < 1; one++) cd_nb_item_grid(boxes, n_top, skin, (cd_int)N, grid);
     cd_grid g;
     return cd_dev_get(&g, d.grid, sizeof g) == 0 && g.dim[0] < 0;
 }

@@ -10,10 +10,35 @@
 #include "backend/omp/omp_loops.h"
 #include "observe_items.h"
 
-/* Blocks of the three reductions, in merge order. */
+/* Leaves of the three reductions, in merge order. */
 typedef struct {
     cd_long particles, pairs, walls;
 } obs_blocks;
+
+static cd_long leaves(obs_blocks n) { return n.particles + n.pairs + n.walls; }
+
+/* The tree of kernels/observe_items.h over the n leaves at part (the
+ * levels above them written after them) into total, on the offload device
+ * (dev) or on host threads: one loop a level, 1 up to 16 leaves, 2 up to
+ * 256, 3 up to 4,096. */
+static void merge_tree(cd_real *part, cd_long n, cd_real *total, int dev)
+{
+    CD_WIDE_MIN
+    for (cd_real *in = part;;) {
+        cd_long m = n > CD_OBS_FANIN ? (n + CD_OBS_FANIN - 1) / CD_OBS_FANIN : 1, n_in = n;
+        cd_real *out = m == 1 ? total : in + n * CD_OBS_SLOTS;
+        if (dev) {
+            CD_STEP_FOR(m, CD_DEV(is_device_ptr(in, out)))
+            for (cd_long g = 0; g < m; g++) cd_obs_item_merge(in, n_in, g, out);
+        } else {
+            CD_HOST_FOR(m, firstprivate(in, out))
+            for (cd_long g = 0; g < m; g++) cd_obs_item_merge(in, n_in, g, out);
+        }
+        if (m == 1) return;
+        in = out;
+        n = m;
+    }
+}
 
 static obs_blocks count_blocks(const cd_state *s)
 {
@@ -75,7 +100,7 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
     cd_order o = cd_sim_host_order(sim);
     cd_int *touch = calloc((size_t)N + 1, sizeof(cd_int));
-    double *part = malloc((size_t)(nb.particles + nb.pairs + nb.walls + 1) * CD_OBS_SLOTS * sizeof(double));
+    double *part = malloc((size_t)(cd_obs_tree_blocks(leaves(nb)) + 1) * CD_OBS_SLOTS * sizeof(double));
     cd_int *wall_start = NULL, *wall_rows = NULL;
     cd_wall_out *out = NULL;
     if (!touch || !part || host_wall_lists(s, &wall_start, &wall_rows, &out)) {
@@ -102,7 +127,7 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     CD_HOST_FOR(R, firstprivate(c, o))
     for (cd_long b = 0; b < nb.walls; b++)
         cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS, o, wall_start, wall_rows, out);
-    cd_obs_merge(part, nb.particles + nb.pairs + nb.walls, total);
+    merge_tree(part, leaves(nb), total, 0);
     free(touch);
     free(part);
     free(wall_start);
@@ -133,7 +158,7 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     }
     cd_sim_obs_scratch *x = &sim->obs;
     obs_blocks nb = count_blocks(s);
-    size_t blocks = (size_t)(nb.particles + nb.pairs + nb.walls) + 1;
+    size_t blocks = (size_t)cd_obs_tree_blocks(leaves(nb)) + 1;
     snprintf(err, errlen, "out of device memory while summing the observables");
     if (!x->touch) {
         x->touch = cd_dev_alloc((s->n_particles + 1) * sizeof(cd_int));
@@ -153,7 +178,7 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
     cd_int *touch = x->touch;
     cd_real *part = x->partial, *total = x->total;
-    cd_long pk = nb.particles * CD_OBS_SLOTS, pw = pk + nb.pairs * CD_OBS_SLOTS, n_blocks = (cd_long)blocks - 1;
+    cd_long pk = nb.particles * CD_OBS_SLOTS, pw = pk + nb.pairs * CD_OBS_SLOTS;
     CD_WIDE_MIN
     CD_STEP_FOR(N, firstprivate(c) is_device_ptr(touch))
     for (cd_long q = 0; q < N; q++) touch[q] = 0;
@@ -171,8 +196,7 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     for (cd_long b = 0; b < nb.walls; b++)
         cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS, o, d.wall_start, d.wall_rows,
                            d.wall_out);
-    CD_STEP_FOR(1, is_device_ptr(part, total))
-    for (int one = 0; one < 1; one++) cd_obs_merge(part, n_blocks, total);
+    merge_tree(part, leaves(nb), total, 1);
     return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;
 }
 #endif

@@ -69,6 +69,11 @@ static inline int cd_dev_get(void *dst, const void *src, size_t bytes)
 {
     return omp_target_memcpy(dst, (void *)src, bytes, 0, 0, omp_get_initial_device(), cd_dev_id());
 }
+/* bytes from host address src to device address dst (0 on success) */
+static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
+{
+    return omp_target_memcpy(dst, (void *)src, bytes, 0, 0, cd_dev_id(), omp_get_initial_device());
+}
 #else
 #define CD_OFFLOAD 0
 #define CD_WIDE_MIN
@@ -77,6 +82,11 @@ static inline int cd_dev_get(void *dst, const void *src, size_t bytes)
 static inline void *cd_dev_alloc(size_t bytes) { return malloc(bytes ? bytes : 1); }
 static inline void cd_dev_free(void *p) { free(p); }
 static inline int cd_dev_get(void *dst, const void *src, size_t bytes)
+{
+    memcpy(dst, src, bytes);
+    return 0;
+}
+static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
 {
     memcpy(dst, src, bytes);
     return 0;

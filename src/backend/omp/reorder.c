@@ -18,8 +18,6 @@
 #include "backend/omp/omp_loops.h"
 #include "reorder_items.h"
 
-/* Keys per chunk of the radix sort. */
-#define CD_SORT_CHUNK 1024
 /* A rebuild reorders when more than 1/CD_REORDER_DRIFT of the particle
  * slots hold a key below their predecessor's. */
 #define CD_REORDER_DRIFT 16
@@ -91,11 +89,11 @@ static size_t largest_column(const cd_state *s)
 static int begin(cd_sim *sim)
 {
     cd_nb_lists *d = &sim->nb.d;
-    size_t N = sim->s.n_particles, P = sim->s.n_prims, chunks = N / CD_SORT_CHUNK + 1;
+    size_t N = sim->s.n_particles, P = sim->s.n_prims, hist = (size_t)cd_reorder_hist_entries((cd_long)N);
     if (alloc_ints(&d->part_uid, N) || alloc_ints(&d->part_at, N) || alloc_ints(&d->prim_uid, P) ||
         alloc_ints(&d->prim_at, P) || alloc_ints(&d->pair_ustart, P + 1) || alloc_ints(&d->part_src, N) ||
         alloc_ints(&d->prim_src, P) || alloc_ints(&d->new_first, N + 1) || alloc_ints(&d->sort_vals, 2 * N) ||
-        alloc_ints(&d->hist, 2 * CD_RADIX_BINS * chunks))
+        alloc_ints(&d->hist, 2 * hist + 1))
         return -1;
     d->sort_keys = cd_dev_alloc((2 * N + 1) * sizeof(cd_ulong));
     d->move = cd_dev_alloc(largest_column(&sim->s) + 8);
@@ -145,20 +143,21 @@ static long particle_keys(cd_sim *sim, cd_cols c)
 static cd_int *sort_particles(cd_sim *sim, const cd_grid *g)
 {
     cd_nb_lists d = sim->nb.d;
-    cd_int N = (cd_int)sim->s.n_particles, chunk = CD_SORT_CHUNK, n_chunks = (N + chunk - 1) / chunk;
+    cd_int N = (cd_int)sim->s.n_particles, n_chunks = (N + CD_SORT_CHUNK - 1) / CD_SORT_CHUNK;
+    cd_int entries = (cd_int)cd_reorder_hist_entries(N);
     cd_long cells = g->dim[0] * g->dim[1] * g->dim[2];
     int bits = 0;
     while (bits < 62 && ((cd_long)1 << bits) < cells) bits++;
     cd_ulong *kin = d.sort_keys, *kout = d.sort_keys + N;
-    cd_int *vin = d.sort_vals, *vout = d.sort_vals + N, *hist = d.hist, *cursor = d.hist + CD_RADIX_BINS * n_chunks;
+    cd_int *vin = d.sort_vals, *vout = d.sort_vals + N, *hist = d.hist, *first = d.hist + entries;
     CD_WIDE_MIN
-    for (int shift = 0; shift < bits; shift += 8) {
+    for (int shift = 0; shift < bits; shift += CD_RADIX_BITS) {
         CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(kin, hist)))
-        for (cd_int b = 0; b < n_chunks; b++) cd_reorder_item_hist(kin, N, chunk, n_chunks, b, shift, hist);
-        cd_nb_scan(hist, CD_RADIX_BINS * n_chunks, cursor, d.chunk_sum);
-        CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(kin, vin, kout, vout, cursor)))
+        for (cd_int b = 0; b < n_chunks; b++) cd_reorder_item_hist(kin, N, n_chunks, b, shift, hist);
+        cd_nb_scan(hist, entries, first, d.chunk_sum);
+        CD_STEP_FOR(n_chunks, CD_DEV(is_device_ptr(kin, vin, kout, vout, first)))
         for (cd_int b = 0; b < n_chunks; b++)
-            cd_reorder_item_scatter(kin, vin, N, chunk, n_chunks, b, shift, cursor, kout, vout);
+            cd_reorder_item_scatter(kin, vin, N, n_chunks, b, shift, first, kout, vout);
         cd_ulong *kt = kin;
         kin = kout;
         kout = kt;

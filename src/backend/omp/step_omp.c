@@ -240,8 +240,32 @@ static int advance_particles(cd_sim *sim)
     size_t n = sim->s.n_particles;
     int moved = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c) reduction(| : moved) CD_DEV(map(tofrom : moved)))
+#if CD_OFFLOAD
+    /* The flag lives on the device (set to 1, never summed: the same
+     * whatever order the items run in), so one int comes back per step
+     * and none goes out; a `reduction(|)` mapped tofrom cost a copy each
+     * way and a cross-team combine (docs/offload.md, "Per-step copies"). */
+    cd_int *flag = sim->nb.d.skin_flag;
+    if (!flag) {
+        cd_int zero = 0;
+        if (!(flag = sim->nb.d.skin_flag = cd_dev_alloc(sizeof(cd_int))) || cd_dev_put(flag, &zero, sizeof zero))
+            return 1; /* without the flag: a rebuild each step, still correct */
+    }
+    CD_STEP_FOR(n, firstprivate(c) is_device_ptr(flag))
+    for (size_t q = 0; q < n; q++)
+        if (cd_item_advance(c, (cd_particle_id)q, dt, limit2)) {
+#pragma omp atomic write
+            flag[0] = 1;
+        }
+    if (cd_dev_get(&moved, flag, sizeof moved)) return 1;
+    if (moved) { /* cleared for the next step's test */
+        cd_int zero = 0;
+        cd_dev_put(flag, &zero, sizeof zero);
+    }
+#else
+    CD_STEP_FOR(n, firstprivate(c) reduction(| : moved))
     for (size_t q = 0; q < n; q++) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+#endif
     return moved;
 }
 

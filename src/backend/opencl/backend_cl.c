@@ -254,9 +254,10 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_long bp = (N + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, bk = (K + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
     cd_long bw = (R + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, n_blocks = bp + bk + bw, first = 0;
     cd_int W = (cd_int)s->n_walls, n_pairs = (cd_int)K;
-    if ((size_t)n_blocks + 1 > cl->obs_cap_blocks) {
+    size_t tree = (size_t)cd_obs_tree_blocks(n_blocks) + 1;
+    if (tree > cl->obs_cap_blocks) {
         if (cl->obs_part) clReleaseMemObject(cl->obs_part);
-        cl->obs_cap_blocks = (size_t)n_blocks + 1 + (size_t)n_blocks / 4;
+        cl->obs_cap_blocks = tree + tree / 4;
         cl->obs_part =
             cd_cl_buffer(cl, cl->obs_cap_blocks * CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
     }
@@ -290,10 +291,21 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 6, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F + 7, sizeof cl->wall_out, &cl->wall_out);
     cd_cl_run(cl, CD_CLK_OBS_WALLS, (size_t)bw);
-    cd_cl_arg(cl, CD_CLK_OBS_MERGE, 0, sizeof cl->obs_part, &cl->obs_part);
-    cd_cl_arg(cl, CD_CLK_OBS_MERGE, 1, sizeof n_blocks, &n_blocks);
-    cd_cl_arg(cl, CD_CLK_OBS_MERGE, 2, sizeof cl->obs_total, &cl->obs_total);
-    cd_cl_run(cl, CD_CLK_OBS_MERGE, 1);
+    /* the tree of the leaves (kernels/observe_items.h), level by level,
+     * as src/backend/omp/observe.c runs it */
+    for (cd_long at = 0, n = n_blocks;;) {
+        cd_long m = n > CD_OBS_FANIN ? (n + CD_OBS_FANIN - 1) / CD_OBS_FANIN : 1, up = m == 1 ? 0 : at + n;
+        cl_mem out = m == 1 ? cl->obs_total : cl->obs_part;
+        cd_cl_arg(cl, CD_CLK_OBS_MERGE, 0, sizeof cl->obs_part, &cl->obs_part);
+        cd_cl_arg(cl, CD_CLK_OBS_MERGE, 1, sizeof at, &at);
+        cd_cl_arg(cl, CD_CLK_OBS_MERGE, 2, sizeof n, &n);
+        cd_cl_arg(cl, CD_CLK_OBS_MERGE, 3, sizeof out, &out);
+        cd_cl_arg(cl, CD_CLK_OBS_MERGE, 4, sizeof up, &up);
+        cd_cl_run(cl, CD_CLK_OBS_MERGE, (size_t)m);
+        if (m == 1) break;
+        at = up;
+        n = m;
+    }
     if (!cl->status)
         cd_cl_check(cl,
                     clEnqueueReadBuffer(cl->queue, cl->obs_total, CL_TRUE, 0, CD_OBS_SLOTS * sizeof(double), slots, 0,

@@ -22,6 +22,8 @@ enum cd_cl_kernel {
     CD_CLK_WALL_LOAD,
     CD_CLK_WALL_LOAD_SUM,
     CD_CLK_BOUNDS,
+    CD_CLK_BOX,
+    CD_CLK_BOX_UP,
     CD_CLK_GRID,
     CD_CLK_BIN,
     CD_CLK_CELL_FILL,
@@ -64,9 +66,6 @@ typedef struct {
     size_t cap;                 /* rows */
 } cd_cl_pairset;
 
-/* Chunks of the two-level scan and of the bounds reduction. */
-#define CD_CL_MAX_BLOCKS 256
-
 typedef struct cd_cl {
     /* first error (sticky): later calls do nothing until it is reported */
     cl_int status;
@@ -98,7 +97,7 @@ typedef struct cd_cl {
     size_t obs_cap_blocks;
 
     /* neighbour-list workspace */
-    cl_mem partial, grid; /* bounds per chunk (7 reals), the cd_grid */
+    cl_mem partial, grid; /* the tree of boxes (7 reals each, kernels/neighbor_items.h), the cd_grid */
     cl_mem part_cell, part_bound, cell_count, cell_start, cell_cursor, cell_parts;
     size_t cell_cap; /* cells the grid may have: 8 n_prims + 64 */
     cl_mem pair_count, pair_offset, block_sum;

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "backend/opencl/backend_cl.h"
+#include "neighbor_items.h"
 #include "observe_items.h"
 #include "step_items.h"
 
@@ -95,30 +96,43 @@ int cd_cl_fill_int(cd_cl *cl, cl_mem buf, cd_int value, size_t first, size_t cou
     return cd_cl_check(cl, rc, "clearing a buffer") ? -1 : 0;
 }
 
+/* Arguments of a scan kernel: pairs of (buffer, index of its first entry),
+ * the entries' count after the first pair. */
+static void scan_args(cd_cl *cl, enum cd_cl_kernel k, cl_mem a, cd_int a_at, cd_int n, cl_mem b, cd_int b_at)
+{
+    cd_cl_arg(cl, k, 0, sizeof a, &a);
+    cd_cl_arg(cl, k, 1, sizeof a_at, &a_at);
+    cd_cl_arg(cl, k, 2, sizeof n, &n);
+    cd_cl_arg(cl, k, 3, sizeof b, &b);
+    cd_cl_arg(cl, k, 4, sizeof b_at, &b_at);
+}
+
 int cd_cl_scan(cd_cl *cl, cl_mem in, size_t n, cl_mem out)
 {
-    if (n == 0) return cd_cl_fill_int(cl, out, 0, 0, 1);
-    /* chunks of at least 64 entries, at most CD_CL_MAX_BLOCKS of them */
-    size_t blocks = (n + 63) / 64;
-    if (blocks > CD_CL_MAX_BLOCKS) blocks = CD_CL_MAX_BLOCKS;
-    cd_int chunk = (cd_int)((n + blocks - 1) / blocks), nn = (cd_int)n;
-    cd_int nb = (cd_int)((n + (size_t)chunk - 1) / (size_t)chunk);
-    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 0, sizeof in, &in);
-    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 1, sizeof nn, &nn);
-    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 2, sizeof chunk, &chunk);
-    cd_cl_arg(cl, CD_CLK_SCAN_BLOCKS, 3, sizeof cl->block_sum, &cl->block_sum);
-    cd_cl_run(cl, CD_CLK_SCAN_BLOCKS, (size_t)nb);
-    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 0, sizeof cl->block_sum, &cl->block_sum);
-    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 1, sizeof nb, &nb);
-    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 2, sizeof out, &out);
-    cd_cl_arg(cl, CD_CLK_SCAN_TOP, 3, sizeof nn, &nn);
+    /* levels above the input in block_sum (cd_scan_scratch entries), as
+     * src/backend/omp/neighbors.c's cd_nb_scan lays them out */
+    cd_int at[8], len[8], L = 0, next = 0;
+    len[0] = (cd_int)n;
+    at[0] = 0;
+    while (len[L] > CD_SCAN_CHUNK) {
+        cd_int m = (len[L] + CD_SCAN_CHUNK - 1) / CD_SCAN_CHUNK;
+        scan_args(cl, CD_CLK_SCAN_BLOCKS, L ? cl->block_sum : in, at[L], len[L], cl->block_sum, next);
+        cd_cl_run(cl, CD_CLK_SCAN_BLOCKS, (size_t)m);
+        L++;
+        at[L] = next;
+        len[L] = m;
+        next += m + 1;
+    }
+    scan_args(cl, CD_CLK_SCAN_TOP, L ? cl->block_sum : in, at[L], len[L], L ? cl->block_sum : out, at[L]);
     cd_cl_run(cl, CD_CLK_SCAN_TOP, 1);
-    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 0, sizeof in, &in);
-    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 1, sizeof nn, &nn);
-    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 2, sizeof chunk, &chunk);
-    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 3, sizeof cl->block_sum, &cl->block_sum);
-    cd_cl_arg(cl, CD_CLK_SCAN_FILL, 4, sizeof out, &out);
-    return cd_cl_run(cl, CD_CLK_SCAN_FILL, (size_t)nb);
+    for (int l = L - 1; l >= 0; l--) {
+        cl_mem src = l ? cl->block_sum : in, dst = l ? cl->block_sum : out;
+        scan_args(cl, CD_CLK_SCAN_FILL, src, at[l], len[l], cl->block_sum, at[l + 1]);
+        cd_cl_arg(cl, CD_CLK_SCAN_FILL, 5, sizeof dst, &dst);
+        cd_cl_arg(cl, CD_CLK_SCAN_FILL, 6, sizeof at[l], &at[l]);
+        cd_cl_run(cl, CD_CLK_SCAN_FILL, (size_t)len[l + 1]);
+    }
+    return cl->status ? -1 : 0;
 }
 
 int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n)
@@ -151,7 +165,8 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->obs_touch = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the observables' sums");
     cl->obs_total = cd_cl_buffer(cl, CD_OBS_SLOTS * sizeof(cd_real), "allocating the observables' sums");
     cl->obs_cap_blocks = 0; /* obs_part: at the first sum (cl_observe) */
-    cl->partial = cd_cl_buffer(cl, 7 * CD_CL_MAX_BLOCKS * sizeof(cd_real), "allocating the neighbour list");
+    cl->partial =
+        cd_cl_buffer(cl, 7 * (size_t)cd_nb_box_scratch((cd_long)N) * sizeof(cd_real), "allocating the neighbour list");
     cl->grid = cd_cl_buffer(cl, sizeof(cd_grid), "allocating the neighbour list");
     /* The grid has at most 8 N + 64 <= 8 P + 64 cells (cd_grid_make), so
      * the cell arrays never grow and the host never needs the cell count. */
@@ -171,7 +186,9 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     const char *slots = getenv("CAPDEM_OPENCL_SLOTS");
     cl->slot = slots && atoi(slots) > 0 ? atoi(slots) : 32;
     cl->cand = cd_cl_buffer(cl, P * (size_t)cl->slot * sizeof(cd_prim_id), "allocating the neighbour list");
-    cl->block_sum = cd_cl_buffer(cl, CD_CL_MAX_BLOCKS * sizeof(cd_int), "allocating the scan");
+    /* the longest scan: the cells */
+    cl->block_sum =
+        cd_cl_buffer(cl, (size_t)cd_scan_scratch((cd_long)cl->cell_cap) * sizeof(cd_int), "allocating the scan");
     cl->gather_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_cursor = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the gather lists");

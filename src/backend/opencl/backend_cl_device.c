@@ -17,36 +17,17 @@ static const struct {
     const char *name;
     int cols;
 } kernel_table[CD_CLK_COUNT] = {
-    {"cd_cl_advance", 1},
-    {"cd_cl_pair_forces", 1},
-    {"cd_cl_wall_forces", 1},
-    {"cd_cl_gather_kick", 1},
-    {"cd_cl_check_finite", 1},
-    {"cd_cl_wall_load", 1},
-    {"cd_cl_wall_load_sum", 0},
-    {"cd_cl_bounds", 1},
-    {"cd_cl_grid", 0},
-    {"cd_cl_bin", 1},
-    {"cd_cl_cell_fill", 0},
-    {"cd_cl_pair_collect", 1},
-    {"cd_cl_pair_place", 1},
-    {"cd_cl_pair_fill", 1},
-    {"cd_cl_pair_keys", 1},
-    {"cd_cl_pair_carry", 1},
-    {"cd_cl_gather_count", 1},
-    {"cd_cl_gather_fill", 1},
-    {"cd_cl_gather_sort", 0},
-    {"cd_cl_scan_blocks", 0},
-    {"cd_cl_scan_top", 0},
-    {"cd_cl_scan_fill", 0},
-    {"cd_cl_wall_cand_count", 1},
-    {"cd_cl_wall_cand_fill", 1},
-    {"cd_cl_obs_touch_pairs", 1},
-    {"cd_cl_obs_touch_walls", 1},
-    {"cd_cl_obs_particles", 1},
-    {"cd_cl_obs_pairs", 1},
-    {"cd_cl_obs_walls", 1},
-    {"cd_cl_obs_merge", 0},
+    {"cd_cl_advance", 1},         {"cd_cl_pair_forces", 1},    {"cd_cl_wall_forces", 1},
+    {"cd_cl_gather_kick", 1},     {"cd_cl_check_finite", 1},   {"cd_cl_wall_load", 1},
+    {"cd_cl_wall_load_sum", 0},   {"cd_cl_bounds", 1},         {"cd_cl_box", 1},
+    {"cd_cl_box_up", 0},          {"cd_cl_grid", 0},           {"cd_cl_bin", 1},
+    {"cd_cl_cell_fill", 0},       {"cd_cl_pair_collect", 1},   {"cd_cl_pair_place", 1},
+    {"cd_cl_pair_fill", 1},       {"cd_cl_pair_keys", 1},      {"cd_cl_pair_carry", 1},
+    {"cd_cl_gather_count", 1},    {"cd_cl_gather_fill", 1},    {"cd_cl_gather_sort", 0},
+    {"cd_cl_scan_blocks", 0},     {"cd_cl_scan_top", 0},       {"cd_cl_scan_fill", 0},
+    {"cd_cl_wall_cand_count", 1}, {"cd_cl_wall_cand_fill", 1}, {"cd_cl_obs_touch_pairs", 1},
+    {"cd_cl_obs_touch_walls", 1}, {"cd_cl_obs_particles", 1},  {"cd_cl_obs_pairs", 1},
+    {"cd_cl_obs_walls", 1},       {"cd_cl_obs_merge", 0},
 };
 
 int cd_cl_kernel_takes_cols(enum cd_cl_kernel k) { return kernel_table[k].cols; }
@@ -126,11 +107,6 @@ int cd_cl_run(cd_cl *cl, enum cd_cl_kernel k, size_t n)
     case CD_CLK_SCAN_TOP:
     case CD_CLK_WALL_LOAD_SUM:
         global = local = 1; /* one work-item */
-        break;
-    case CD_CLK_BOUNDS:
-    case CD_CLK_SCAN_BLOCKS:
-    case CD_CLK_SCAN_FILL:
-        lp = NULL; /* exactly n chunks, few: let the runtime group them */
         break;
     default:
         global = (n + local - 1) / local * local; /* the kernels skip items >= n */

@@ -10,6 +10,7 @@
 #include <string.h>
 #include "backend/opencl/backend_cl.h"
 #include "broadphase.h"
+#include "neighbor_items.h"
 
 #define F CD_CL_N_FIELDS /* first kernel argument after the columns */
 
@@ -23,20 +24,31 @@ static int copy(cd_cl *cl, cl_mem src, cl_mem dst, size_t bytes)
 /* Particle bounds, grid and cell lists (CSR cell_start / cell_parts). */
 static void bin_particles(cd_cl *cl, cd_int N, cd_real skin)
 {
-    cd_int parts = (N + 63) / 64;
-    if (parts > CD_CL_MAX_BLOCKS) parts = CD_CL_MAX_BLOCKS;
-    cd_int chunk = (N + parts - 1) / parts, cell_cap = (cd_int)cl->cell_cap;
-    parts = (N + chunk - 1) / chunk;
+    cd_int cell_cap = (cd_int)cl->cell_cap, n = (N + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK, at = 0;
     cd_cl_arg(cl, CD_CLK_BOUNDS, F, sizeof N, &N);
-    cd_cl_arg(cl, CD_CLK_BOUNDS, F + 1, sizeof chunk, &chunk);
-    cd_cl_arg(cl, CD_CLK_BOUNDS, F + 2, sizeof cl->partial, &cl->partial);
-    cd_cl_arg(cl, CD_CLK_BOUNDS, F + 3, sizeof cl->part_bound, &cl->part_bound);
-    cd_cl_run(cl, CD_CLK_BOUNDS, (size_t)parts);
+    cd_cl_arg(cl, CD_CLK_BOUNDS, F + 1, sizeof cl->part_bound, &cl->part_bound);
+    cd_cl_run(cl, CD_CLK_BOUNDS, (size_t)N);
+    cd_cl_arg(cl, CD_CLK_BOX, F, sizeof N, &N);
+    cd_cl_arg(cl, CD_CLK_BOX, F + 1, sizeof cl->part_bound, &cl->part_bound);
+    cd_cl_arg(cl, CD_CLK_BOX, F + 2, sizeof cl->partial, &cl->partial);
+    cd_cl_run(cl, CD_CLK_BOX, (size_t)n);
+    while (n > CD_BOX_CHUNK) { /* the tree of boxes (kernels/neighbor_items.h) */
+        cd_int m = (n + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK, up_at = at + n;
+        cd_cl_arg(cl, CD_CLK_BOX_UP, 0, sizeof cl->partial, &cl->partial);
+        cd_cl_arg(cl, CD_CLK_BOX_UP, 1, sizeof at, &at);
+        cd_cl_arg(cl, CD_CLK_BOX_UP, 2, sizeof n, &n);
+        cd_cl_arg(cl, CD_CLK_BOX_UP, 3, sizeof cl->partial, &cl->partial);
+        cd_cl_arg(cl, CD_CLK_BOX_UP, 4, sizeof up_at, &up_at);
+        cd_cl_run(cl, CD_CLK_BOX_UP, (size_t)m);
+        at = up_at;
+        n = m;
+    }
     cd_cl_arg(cl, CD_CLK_GRID, 0, sizeof cl->partial, &cl->partial);
-    cd_cl_arg(cl, CD_CLK_GRID, 1, sizeof parts, &parts);
-    cd_cl_arg(cl, CD_CLK_GRID, 2, sizeof skin, &skin);
-    cd_cl_arg(cl, CD_CLK_GRID, 3, sizeof N, &N);
-    cd_cl_arg(cl, CD_CLK_GRID, 4, sizeof cl->grid, &cl->grid);
+    cd_cl_arg(cl, CD_CLK_GRID, 1, sizeof at, &at);
+    cd_cl_arg(cl, CD_CLK_GRID, 2, sizeof n, &n);
+    cd_cl_arg(cl, CD_CLK_GRID, 3, sizeof skin, &skin);
+    cd_cl_arg(cl, CD_CLK_GRID, 4, sizeof N, &N);
+    cd_cl_arg(cl, CD_CLK_GRID, 5, sizeof cl->grid, &cl->grid);
     cd_cl_run(cl, CD_CLK_GRID, 1);
 
     /* The scan runs over every cell the grid may have: the empty tail
