@@ -1,7 +1,7 @@
 /* The run's global sums under MPI (docs/mpi.md, "Reductions"), with the
  * serial program's bits and without gathering the state: the observables
  * (kernels/observe_items.h: rows in blocks of CD_OBS_BLOCK, each block
- * summed in row order, the blocks merged in order) and the wall loads
+ * summed in row order, the blocks merged by its fixed tree) and the wall loads
  * (kernels/step_items.h: CD_LOAD_CHUNK primitives a chunk, the same).
  *
  * A block (or chunk) b belongs to rank b % R.  Each rank sends the rows it
@@ -225,19 +225,19 @@ static double *push(partials *v, long long block)
     return v->p[v->n++].acc;
 }
 
-/* Every block has one rank, so the n partials are all the blocks: merged
- * in order as the serial program merges them (cd_obs_merge). */
+/* Every block has one rank, so the n partials are all the leaves: merged
+ * by the serial program's tree (cd_obs_merge_serial). */
 static void merge_blocks(const char *all, size_t n, double *total)
 {
     obs_partial *p = (obs_partial *)all;
     qsort(p, n, sizeof *p, by_key);
-    double *flat = malloc((n + 1) * CD_OBS_SLOTS * sizeof *flat);
+    double *flat = malloc(((size_t)cd_obs_tree_blocks((cd_long)n) + 1) * CD_OBS_SLOTS * sizeof *flat);
     if (!flat) {
         for (int k = 0; k < CD_OBS_SLOTS; k++) total[k] = 0.0 / 0.0; /* (NaN: nothing known) */
         return;
     }
     for (size_t b = 0; b < n; b++) memcpy(flat + b * CD_OBS_SLOTS, p[b].acc, sizeof p[b].acc);
-    cd_obs_merge(flat, (cd_long)n, total);
+    cd_obs_merge_serial(flat, (cd_long)n, total);
     free(flat);
 }
 
