@@ -140,8 +140,8 @@ static long long chunk_bytes(hid_t dcpl, int rank, size_t elem, hsize_t ch[8])
 }
 
 /* Whether every chunk holding rows row0..row0+nrows-1 (all of every inner
- * dimension) is stored with exactly chunk_bytes (0 bytes: never written,
- * read as fill values). */
+ * dimension) is stored with exactly chunk_bytes (or never written, read as
+ * fill values). */
 static int chunks_fit(hid_t d, hid_t dcpl, int rank, size_t elem, const hsize_t *dims, hsize_t row0, hsize_t nrows)
 {
     hsize_t ch[8], off[8];
@@ -151,9 +151,13 @@ static int chunks_fit(hid_t d, hid_t dcpl, int rank, size_t elem, const hsize_t 
     for (off[0] = row0 - row0 % ch[0]; off[0] < row0 + nrows; off[0] += ch[0]) {
         for (int r = 1; r < rank; r++) off[r] = 0;
         for (;;) {
+            /* (the index's own entry: H5Dget_chunk_storage_size reports
+             * the implied size of an unfiltered chunk, not what is stored) */
+            unsigned filter_mask = 0;
+            haddr_t addr = HADDR_UNDEF;
             hsize_t bytes = 0;
-            if (H5Dget_chunk_storage_size(d, off, &bytes) < 0) return 0;
-            if (bytes != 0 && bytes != (hsize_t)want) return 0;
+            if (H5Dget_chunk_info_by_coord(d, off, &filter_mask, &addr, &bytes) < 0) return 0;
+            if (addr != HADDR_UNDEF && bytes != (hsize_t)want) return 0;
             int r = rank - 1;
             for (; r >= 1; r--) {
                 off[r] += ch[r];
