@@ -311,7 +311,7 @@ int main(int argc, char **argv)
             cd_observables after; /* the counts the traffic model uses */
             cd_sim_observe(&sim, &after);
             cd_traffic tr[CD_TRAFFIC_KERNELS];
-            cd_bench_traffic(&sim, tr);
+            cd_bench_traffic(&sim, (double)steps, tr);
             double moved = 0;
             char kernels[768];
             int at = 0;

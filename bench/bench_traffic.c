@@ -9,13 +9,16 @@
  * it would from a cache with good locality), except the pair rows' force
  * and point, which the gather reads once from each of the row's two
  * particles.  Sizes: cd_real 8 B, cd_int 4 B, cd_vec3 24 B, cd_quat 32 B.
- * The amortised neighbour-list rebuild is not counted.  When a kernel of
+ * The amortised neighbour-list rebuild is not counted; what runs once per
+ * call of the step (its first advance on omp, the blow-up check) is
+ * divided by the steps of the call.  When a kernel of
  * step_items.h changes what it reads or writes, this table changes with
  * it. */
 #include "bench_traffic.h"
+#include <string.h>
 #include "../kernels/broadphase.h"
 
-void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS])
+void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[CD_TRAFFIC_KERNELS])
 {
     const cd_state *s = &sim->s;
     double N = (double)s->n_particles, P = (double)s->n_prims, R = (double)s->n_pairs;
@@ -31,26 +34,41 @@ void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS])
      * reads v, L, F, T, x (24 each), m (8), q (32), I (24) and per primitive
      * its particle (4), body-frame ends (48) and ends at the last build
      * (48); writes x, q, v, L, omega and the primitives' world ends (48). */
-    out[0] = (cd_traffic){"advance", N * 184 + P * 100, N * 128 + P * 48};
+    cd_traffic advance = {"advance", N * 184 + P * 100, N * 128 + P * 48};
     /* cd_item_pair_force: every row its primitives and flag (12); the
      * primitives' particle, ends and radius (60); an active row its history
      * (24) and its particles' x, v, omega, m (80 per particle, counted for
-     * every particle); writes flag, history, point, force, overlap, F_n. */
-    out[1] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 92};
+     * every particle); writes flag, history, point, force (76), and the
+     * overlap and F_n (16) at the last step of a call only. */
+    out[0] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 76 + A * 16 / steps_per_call};
     /* cd_item_wall_row over the wall candidates: per candidate its entry,
      * flag and primitive (particle, ends, radius: 4 + 4 + 60, an upper
      * bound when a primitive has several); an active row its history (24)
      * and the particle's x, v, omega, m (80); writes flag, history, force,
      * torque, overlap, F_n. */
-    out[2] = (cd_traffic){"wall_forces", C * 68 + Aw * (24 + 80), Aw * 92};
-    /* gather and second kick (cd_item_gather, cd_item_kick): per particle
-     * m, x, its two CSR starts (40) and v, L, q, I (104); per wall
-     * candidate its entry and flag (8), per active wall row force and torque
-     * (48); per pair row two entries (8) and, active or not (an inactive
-     * row adds its zero force: no branch), its force and point from each
-     * side (2 x 48); writes F, T, v, L, omega. */
-    out[3] = (cd_traffic){"gather_kick", N * 144 + C * 8 + Aw * 48 + R * 8 + R * 96, N * 120};
-    /* the blow-up check at the end of cd_sim_step (x, v, L), amortised
-     * over the steps of one call: counted once per step as an upper bound */
-    out[4] = (cd_traffic){"finite_check", N * 72, 0};
+    out[1] = (cd_traffic){"wall_forces", C * 68 + Aw * (24 + 80), Aw * 92};
+    /* the gather's part: per wall candidate its entry and flag (8), per
+     * active wall row force and torque (48); per pair row two entries (8)
+     * and, active or not (an inactive row adds its zero force: no branch),
+     * its force and point from each side (2 x 48) */
+    double gather_rows = C * 8 + Aw * 48 + R * 8 + R * 96;
+    if (strcmp(sim->backend->name, "opencl") != 0) {
+        /* omp (host threads and offload): the gather, the second kick and
+         * the next step's advance in one item (cd_item_gather_kick_advance)
+         * reading the particle once: m, x, the two CSR starts (40), v, L, q,
+         * I (104), its primitive range (8), per primitive the body-frame
+         * and last-build ends (96); writes F, T, v, L, x, omega (144), q
+         * (32) and the primitives' world ends (48).  The advance of its own
+         * runs once per call of the step. */
+        out[2] = (cd_traffic){"gather_kick_advance", N * 152 + P * 96 + gather_rows, N * 176 + P * 48};
+        out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
+    } else {
+        /* OpenCL: gather and second kick (cd_item_gather, cd_item_kick):
+         * per particle m, x, its two CSR starts (40) and v, L, q, I (104);
+         * writes F, T, v, L, omega; the advance every step */
+        out[2] = (cd_traffic){"gather_kick", N * 144 + gather_rows, N * 120};
+        out[3] = advance;
+    }
+    /* the blow-up check at the end of each call of the step (x, v, L) */
+    out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};
 }

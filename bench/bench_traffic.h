@@ -13,7 +13,9 @@ typedef struct {
 /* The bytes each loop of one time step reads and writes, counted from the
  * code of kernels/step_items.h for the state's counts of particles,
  * primitives, pair rows, contacts and wall contacts (sim->s synced).
+ * steps_per_call: the steps of one cd_sim_step call (the per-call loops
+ * are amortised over them).  The loops are those of sim's backend.
  * Fills out[CD_TRAFFIC_KERNELS]. */
-void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS]);
+void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[CD_TRAFFIC_KERNELS]);
 
 #endif

@@ -89,7 +89,7 @@ TESTS=()
 for d in physics regression protocols unit config; do
     for f in "$ROOT"/tests/$d/test_*.c; do TESTS+=("$(basename "$f" .c)"); done
 done
-TESTS+=(test_parity)
+TESTS+=(test_parity test_drift_bound)
 
 # CMAKE_SKIP_RPATH: no path of this machine may be baked into a binary that
 # travels (the bundle sets LD_LIBRARY_PATH to its own lib folder).

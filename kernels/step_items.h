@@ -152,11 +152,15 @@ CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force
 /* Pair row k of the Verlet list: narrow phase and contact law with history
  * (docs/references.md, Contacts, Contact law).  law: particle-particle law, dt [s], sin_parallel [1],
  * parallel_blend 0/1 (material.parallel_blend).  An active row keeps what
- * the next step and the gather need: history, point, force on j, F_n and
- * the overlap (the observables' elastic energy); the normal, F_t and the
- * torques are derived on the host for output only (fields.def, PAIR_OUT). */
+ * the next step and the gather need: history, point, force on j; with
+ * outputs = 1 also F_n and the overlap, which only the observables (the
+ * elastic energy) and output read, between calls of the step: the step
+ * writes them at the last step of a call only (16 B per contact-step less;
+ * docs/performance.md, "Argument blocks on the device").  The normal, F_t
+ * and the torques are derived on the host for output only (fields.def,
+ * PAIR_OUT). */
 CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
-                                  cd_int parallel_blend)
+                                  cd_int parallel_blend, cd_int outputs)
 {
     cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
     cd_particle_id pi = c.prim_particle[i], pj = c.prim_particle[j];
@@ -201,8 +205,10 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     c.pair_shear[k] = shear;
     c.pair_point[k] = g.point;
     c.pair_force[k] = f.force_j;
-    c.pair_overlap[k] = g.overlap;
-    c.pair_fn[k] = f.fn;
+    if (outputs) {
+        c.pair_overlap[k] = g.overlap;
+        c.pair_fn[k] = f.fn;
+    }
 }
 
 /* Ends the contact of wall-contact row `row`: no history.  (Its outputs,

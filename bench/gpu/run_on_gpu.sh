@@ -17,8 +17,9 @@
 #               included), unit, config tests with OMP_TARGET_OFFLOAD=MANDATORY
 #   opencl      if an OpenCL ICD is there (the NVIDIA one, or one made from
 #               the driver's libnvidia-opencl.so.1): physics and regression
-#               tests on the OpenCL backend, and the omp/OpenCL parity test
-#               (omp on the host and omp on the GPU against OpenCL)
+#               tests on the OpenCL backend, the omp/OpenCL parity test
+#               (omp on the host and omp on the GPU against OpenCL) and
+#               test_drift_bound (host maths against the GPU's, bounded)
 #   ladder      throughput: settled hexapods alpha 3 at 1e4, 1e5 and 1e6
 #               (tiled) and spheres 1e6, Clang build, omp (and opencl when
 #               there): JSON lines in $OUT/ladder.jsonl
@@ -275,7 +276,7 @@ run_tests() { # variant backend label tests...
     done
     note "-- $label took $((SECONDS - t0))s"
 }
-ALL_TESTS=$(cd "$BIN/$(echo "$VARIANTS" | head -1)" && ls test_* | grep -v '^test_parity$')
+ALL_TESTS=$(cd "$BIN/$(echo "$VARIANTS" | head -1)" && ls test_* | grep -vE '^test_(parity|drift_bound)$')
 part_tests() { # variant
     # shellcheck disable=SC2086
     run_tests "$1" omp "tests-$1" $ALL_TESTS
@@ -297,6 +298,10 @@ part_opencl() {
     # CAPDEM_BUNDLE_HOST above; the first GPU machine's 16 threads did)
     step parity_omp_host 300 env OMP_TARGET_OFFLOAD=DISABLED OMP_NUM_THREADS=1 bash -c "mkdir -p '$W/parity-host' && cd '$W/parity-host' && '$BIN/$v/test_parity'"
     [ "$HOST" = 1 ] || step parity_omp_gpu 300 bash -c "mkdir -p '$W/parity-gpu' && cd '$W/parity-gpu' && '$BIN/$v/test_parity'"
+    # test_drift_bound: host maths (omp on the host) against the GPU's
+    # (OpenCL on it), trajectories within k sum S (docs/offload.md, "Which
+    # maths can differ"); its line gives the measured difference and bound.
+    step drift_host_gpu 200 env OMP_TARGET_OFFLOAD=DISABLED OMP_NUM_THREADS=1 bash -c "mkdir -p '$W/drift' && cd '$W/drift' && '$BIN/$v/test_drift_bound'"
     # shellcheck disable=SC2046
     run_tests "$v" opencl "opencl-$v" $(printf '%s\n' $ALL_TESTS | grep -E '^test_(binary_collision|conservation|coulomb_sliding|plane2d|rest|determinism|neighbors)$')
 }

@@ -20,14 +20,15 @@ __kernel void cd_cl_advance(
     if (q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
 }
 
-/* Step 5: narrow phase and contact law of pair row k. */
+/* Step 5: narrow phase and contact law of pair row k (outputs: 1 at the
+ * last step of a call, when the rows' overlap and F_n are written too). */
 __kernel void cd_cl_pair_forces(
 #include "col_params.h"
-    cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend)
+    cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend, cd_int outputs)
 {
 #include "col_bind.h"
     cd_int k = (cd_int)get_global_id(0);
-    if (k < n_pairs) cd_item_pair_force(c, k, law, dt, sin_parallel, parallel_blend);
+    if (k < n_pairs) cd_item_pair_force(c, k, law, dt, sin_parallel, parallel_blend, outputs);
 }
 
 /* Step 6: wall candidate e of the last build (its wall-contact row; its

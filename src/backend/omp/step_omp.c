@@ -17,6 +17,7 @@
  * test the mapping without a GPU).  The neighbour-list rebuild runs where
  * the steps run (src/backend/omp/neighbors.c). */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +38,25 @@ cd_cols cd_sim_host_cols(cd_state *s)
     return c;
 }
 
+/* What every loop of a step takes besides its row count: the columns, the
+ * lists, the laws and the walls, as one block.  In the offload variant the
+ * block lives on the device (off_args): the loops take its device address
+ * (is_device_ptr), so a launch copies and allocates nothing; a
+ * firstprivate struct was one packed host-to-device copy per launch
+ * (280-624 B; docs/offload.md, "Per-step copies").  The walls come last:
+ * they change every step while a protocol moves one, the rest only when a
+ * build or a re-map moves the buffers. */
+typedef struct {
+    cd_cols c;
+    cd_nb_lists d;
+    cd_law_params law, wall_law;
+    cd_vec3 gravity;                  /* [m/s^2] */
+    cd_real dt, sin_parallel, limit2; /* [s], [1], (skin/2)^2 [m^2] */
+    cd_int blend, dimension, n_walls; /* material.parallel_blend, 2 or 3, walls in use */
+    cd_int pad_;                      /* walls 8-byte aligned */
+    cd_wall walls[CD_MAX_WALLS];      /* the first n_walls are in use */
+} cd_step_args;
+
 /* ---- device residency (offload variant) -------------------------------- */
 #if CD_OFFLOAD
 typedef struct {
@@ -44,7 +64,10 @@ typedef struct {
     size_t *bytes; /* per field: bytes mapped */
     double *part;  /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
-    cd_cols dev; /* device addresses of the columns */
+    cd_cols dev;            /* device addresses of the columns */
+    cd_step_args *args_dev; /* the loops' argument block on the device (off_args) */
+    cd_step_args args_host; /* what it holds */
+    int args_sent;          /* 0 until the first block went out */
 } cd_off;
 
 
@@ -115,6 +138,7 @@ static void off_release(cd_sim *sim)
     if (!o) return;
     for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
     off_unmap(o->part, o->part_n * sizeof(double));
+    cd_dev_free(o->args_dev);
     free(o->part);
     free(o->host);
     free(o->bytes);
@@ -159,7 +183,7 @@ static int off_acquire(cd_sim *sim, char *err, size_t errlen)
     sim->backend_data = o;
     o->host = calloc(cd_n_fields, sizeof *o->host);
     o->bytes = calloc(cd_n_fields, sizeof *o->bytes);
-    o->part_n = sim->s.n_prims / CD_LOAD_CHUNK + 1;
+    o->part_n = sim->s.n_prims / CD_LOAD_CHUNK + 2; /* the chunks, then their total */
     o->part = calloc(o->part_n, sizeof(double));
     if (!o->host || !o->bytes || !o->part) {
         off_release(sim);
@@ -229,14 +253,90 @@ cd_cols cd_sim_step_cols(cd_sim *sim)
 
 /* ---- the loops of a step ------------------------------------------------ */
 
+/* The block for the state as it is now, padding zeroed (blocks are
+ * compared byte by byte). */
+static void step_args_fill(cd_sim *sim, cd_step_args *a)
+{
+    memset(a, 0, sizeof *a);
+    a->c = cd_sim_step_cols(sim);
+    a->d = sim->nb.d;
+    a->law = sim->p.law;
+    a->wall_law = sim->p.wall_law;
+    a->gravity = sim->p.gravity;
+    a->dt = sim->p.dt;
+    a->sin_parallel = sim->p.sin_parallel;
+    a->limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    a->blend = sim->p.parallel_blend;
+    a->dimension = sim->p.dimension;
+    a->n_walls = (cd_int)sim->s.n_walls;
+    memcpy(a->walls, sim->s.walls, sim->s.n_walls * sizeof(cd_wall));
+}
+
+#if CD_OFFLOAD
+/* The step's argument block on the device, brought up to date before a
+ * launch: what differs from the last block sent goes out (all of it after
+ * a start, the head after a build or re-map that moved a buffer or a
+ * change of the laws, the walls in use after they moved), nothing
+ * otherwise.  NULL when the device block could not be had. */
+static const cd_step_args *off_args(cd_sim *sim)
+{
+    cd_off *o = sim->backend_data;
+    cd_step_args a;
+    step_args_fill(sim, &a);
+    size_t head = offsetof(cd_step_args, walls), walls = sim->s.n_walls * sizeof(cd_wall);
+    if (!o->args_dev && !(o->args_dev = cd_dev_alloc(sizeof(cd_step_args)))) return NULL;
+    if (!o->args_sent || memcmp(&a, &o->args_host, head)) {
+        if (cd_dev_put(o->args_dev, &a, head)) return NULL;
+    }
+    if (walls && (!o->args_sent || memcmp(a.walls, o->args_host.walls, walls))) {
+        if (cd_dev_put(o->args_dev->walls, a.walls, walls)) return NULL;
+    }
+    o->args_host = a;
+    o->args_sent = 1;
+    return o->args_dev;
+}
+#define CD_ARGS(sim)                                                                                                   \
+    const cd_step_args *a = off_args(sim);                                                                             \
+    if (!a) abort(); /* a few hundred bytes of device memory: none left at all */
+#define CD_ARGS_IN is_device_ptr(a)
+
+/* The device's skin flag (1: an end moved beyond half the skin since it
+ * was cleared), allocated and cleared at its first use. */
+static cd_int *skin_flag(cd_sim *sim)
+{
+    cd_int zero = 0;
+    if (!sim->nb.d.skin_flag && (sim->nb.d.skin_flag = cd_dev_alloc(sizeof(cd_int))) &&
+        cd_dev_put(sim->nb.d.skin_flag, &zero, sizeof zero)) {
+        cd_dev_free(sim->nb.d.skin_flag);
+        sim->nb.d.skin_flag = NULL;
+    }
+    return sim->nb.d.skin_flag;
+}
+
+/* The skin flag's one int back; cleared on the device only after a step
+ * that set it. */
+static int skin_flag_read(cd_sim *sim)
+{
+    cd_int moved = 1, zero = 0;
+    if (cd_dev_get(&moved, sim->nb.d.skin_flag, sizeof moved)) return 1;
+    if (moved) cd_dev_put(sim->nb.d.skin_flag, &zero, sizeof zero);
+    return moved != 0;
+}
+#else
+#define CD_ARGS(sim)                                                                                                   \
+    cd_step_args a_;                                                                                                   \
+    step_args_fill(sim, &a_);                                                                                          \
+    const cd_step_args *a = &a_;
+#define CD_ARGS_IN firstprivate(a)
+#endif
+
 /* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
  * world ends of its primitives and the skin test.  Returns 1 when some end
  * moved more than half the skin; on the offload device one int comes
- * back. */
+ * back.  (Run once per call of the step; the next steps' advance is fused
+ * into the gather: gather_kick_advance.) */
 static int advance_particles(cd_sim *sim)
 {
-    cd_cols c = cd_sim_step_cols(sim);
-    cd_real dt = sim->p.dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
     size_t n = sim->s.n_particles;
     int moved = 0;
     CD_WIDE_MIN
@@ -245,26 +345,19 @@ static int advance_particles(cd_sim *sim)
      * whatever order the items run in), so one int comes back per step
      * and none goes out; a `reduction(|)` mapped tofrom cost a copy each
      * way and a cross-team combine (docs/offload.md, "Per-step copies"). */
-    cd_int *flag = sim->nb.d.skin_flag;
-    if (!flag) {
-        cd_int zero = 0;
-        if (!(flag = sim->nb.d.skin_flag = cd_dev_alloc(sizeof(cd_int))) || cd_dev_put(flag, &zero, sizeof zero))
-            return 1; /* without the flag: a rebuild each step, still correct */
-    }
-    CD_STEP_FOR(n, firstprivate(c) is_device_ptr(flag))
+    if (!skin_flag(sim)) return 1; /* without the flag: a rebuild each step, still correct */
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
-        if (cd_item_advance(c, (cd_particle_id)q, dt, limit2)) {
+        if (cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2)) {
 #pragma omp atomic write
-            flag[0] = 1;
+            a->d.skin_flag[0] = 1;
         }
-    if (cd_dev_get(&moved, flag, sizeof moved)) return 1;
-    if (moved) { /* cleared for the next step's test */
-        cd_int zero = 0;
-        cd_dev_put(flag, &zero, sizeof zero);
-    }
+    moved = skin_flag_read(sim);
 #else
-    CD_STEP_FOR(n, firstprivate(c) reduction(| : moved))
-    for (size_t q = 0; q < n; q++) moved |= cd_item_advance(c, (cd_particle_id)q, dt, limit2);
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN reduction(| : moved))
+    for (size_t q = 0; q < n; q++) moved |= cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2);
 #endif
     return moved;
 }
@@ -285,65 +378,51 @@ static int advance_walls(cd_sim *sim, int moved)
 }
 
 /* One work item per pair of the Verlet list: narrow phase + contact law. */
-static void pair_forces(cd_sim *sim)
+static void pair_forces(cd_sim *sim, cd_int outputs)
 {
-    cd_cols c = cd_sim_step_cols(sim);
-    cd_law_params law = sim->p.law;
-    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
-    cd_int blend = sim->p.parallel_blend;
     size_t n = sim->s.n_pairs;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, law))
-    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN)
+    for (size_t k = 0; k < n; k++)
+        cd_item_pair_force(a->c, (cd_pair_id)k, a->law, a->dt, a->sin_parallel, a->blend, outputs);
 }
 
 /* One work item per wall candidate of the last build (cd_item_wall_row).
- * The walls stay host data (the protocol drives them): a few hundred bytes
- * go out. */
+ * The walls stay host data (the protocol drives them): those in use go
+ * out in the argument block when they moved (off_args). */
 static void wall_forces(cd_sim *sim)
 {
-    cd_cols c = cd_sim_step_cols(sim);
-    cd_nb_lists d = sim->nb.d;
-    const cd_wall *walls = sim->s.walls;
-    cd_int W = (cd_int)sim->s.n_walls;
-    cd_law_params law = sim->p.wall_law;
-    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel;
-    cd_int blend = sim->p.parallel_blend;
-    size_t n = W ? sim->nb.n_wall_rows : 0;
+    size_t n = sim->s.n_walls ? sim->nb.n_wall_rows : 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, d, law) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t e = 0; e < n; e++)
-        cd_item_wall_row(c, d.wall_rows[e], d.wall_out + e, walls, W, law, dt, sin_parallel, blend);
+        cd_item_wall_row(a->c, a->d.wall_rows[e], a->d.wall_out + e, a->walls, a->n_walls, a->wall_law, a->dt,
+                         a->sin_parallel, a->blend);
     sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
 }
 
-/* One work item per particle: gravity plus its contacts in fixed order,
- * then (kick = 1) the second half kick with that force, in the same pass
- * (steps 7-8). */
-static void gather_kick(cd_sim *sim, int kick)
+/* One work item per particle: gravity plus its contacts in fixed order
+ * (step 7; the forces of a start, without a kick). */
+static void gather(cd_sim *sim)
 {
-    cd_cols c = cd_sim_step_cols(sim);
-    cd_nb_lists d = sim->nb.d;
-    cd_int dim = sim->p.dimension;
-    cd_vec3 g = sim->p.gravity;
-    cd_real h = 0.5 * sim->p.dt;
     size_t n = sim->s.n_particles;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, d, g))
-    for (size_t q = 0; q < n; q++) {
-        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, d.wall_out, g,
-                       dim);
-        if (kick) cd_item_kick(c, (cd_particle_id)q, h);
-    }
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN)
+    for (size_t q = 0; q < n; q++)
+        cd_item_gather(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start, a->d.wall_rows,
+                       a->d.wall_out, a->gravity, a->dimension);
 }
 
-/* Forces for the current positions (neighbour list up to date), and with
- * kick = 1 the second half kick. */
-static void compute_forces(cd_sim *sim, int kick)
+/* Forces for the current positions (neighbour list up to date), without
+ * a kick (a start). */
+static void compute_forces(cd_sim *sim)
 {
-    pair_forces(sim);
+    pair_forces(sim, 1);
     wall_forces(sim);
-    gather_kick(sim, kick);
+    gather(sim);
 }
 
 #if !CD_OFFLOAD
@@ -354,10 +433,10 @@ static void compute_forces(cd_sim *sim, int kick)
  * them instead of inlining them, 1.15x the instructions of the step
  * (callgrind). */
 __attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd_law_params law, cd_real dt,
-                                                         cd_real sin_parallel, cd_int blend)
+                                                         cd_real sin_parallel, cd_int blend, cd_int outputs)
 {
 #pragma omp for schedule(static) nowait
-    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
+    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend, outputs);
 }
 
 __attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, cd_wall_out *out, size_t n,
@@ -381,7 +460,8 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 #endif
 
 /* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
- * the next step (its advance; returns its skin test).
+ * the next step (its advance; returns its skin test); next = 0 (the call's
+ * last step): the pair rows' overlap and F_n are written too.
  * Host threads: one parallel region, where four loops used to fork and
  * join their threads each (docs/performance.md, "One parallel region per
  * step"): the pair loop without a barrier before the wall loop (they
@@ -390,12 +470,29 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
  * step's advance of particle q in the same item as q's gather and kick
  * (it reads only q's own rows).  Each item does the arithmetic it did in
  * its own loop, in the same order: the same bits.  An offload device runs
- * the loops one launch each, as before. */
+ * three launches: pair rows, wall candidates, and the gather with the
+ * kick and the next advance (the same item as on host threads; the skin
+ * flag stays on the device, one int back). */
 static int forces_and_advance(cd_sim *sim, int next)
 {
 #if CD_OFFLOAD
-    compute_forces(sim, 1);
-    return next ? advance_particles(sim) : 0;
+    pair_forces(sim, !next);
+    wall_forces(sim);
+    size_t n = sim->s.n_particles;
+    int flagged = next && skin_flag(sim);
+    CD_WIDE_MIN
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN)
+    for (size_t q = 0; q < n; q++)
+        if (cd_item_gather_kick_advance(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start,
+                                        a->d.wall_rows, a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2,
+                                        next) &&
+            flagged) {
+#pragma omp atomic write
+            a->d.skin_flag[0] = 1;
+        }
+    if (!next) return 0;
+    return flagged ? skin_flag_read(sim) : 1; /* without the flag: a rebuild, still correct */
 #else
     cd_cols c = cd_sim_step_cols(sim);
     cd_nb_lists d = sim->nb.d;
@@ -409,7 +506,7 @@ static int forces_and_advance(cd_sim *sim, int next)
     int moved = 0;
 #pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
     {
-        pair_rows(c, n_pairs, law, dt, sin_parallel, blend);
+        pair_rows(c, n_pairs, law, dt, sin_parallel, blend, !next);
         wall_rows(c, d.wall_rows, d.wall_out, n_walls, walls, W, wall_law, dt, sin_parallel, blend);
         moved |= gather_kick_advance(c, d, n, g, dim, dt, limit2, next);
     }
@@ -462,13 +559,13 @@ int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
 static int check_step_state(cd_sim *sim, char *err, size_t errlen)
 {
 #if CD_OFFLOAD
-    cd_cols c = cd_sim_step_cols(sim);
     long bad = -1;
     size_t n = sim->s.n_particles;
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c) reduction(max : bad) map(tofrom : bad))
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN reduction(max : bad) map(tofrom : bad))
     for (size_t q = 0; q < n; q++)
-        if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
+        if (cd_item_not_finite(a->c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
     cd_int uid = (cd_int)bad;
     if (bad >= 0 && sim->nb.ordered) cd_dev_get(&uid, sim->nb.d.part_uid + bad, sizeof uid);
     return report_bad(&sim->s, uid, err, errlen);
@@ -509,7 +606,7 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
     }
     /* without compute the neighbour list is rebuilt at the first step */
     if (compute) {
-        compute_forces(sim, 0);
+        compute_forces(sim);
         /* The new forces, contacts and wall contacts were computed on the
          * device: copy them back once, so that the host state is current
          * after start (tests and tools read energies right after it), as
@@ -605,20 +702,26 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
         *load = cd_sim_wall_load_host(sim, w);
         return 0;
     }
-    cd_cols c = o->dev;
-    cd_nb_lists d = sim->nb.d;
     double *part = o->part;
     size_t P = sim->s.n_prims, W = sim->s.n_walls, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    size_t total = o->part_n - 1; /* the slot after the chunks' */
     const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
-    double sum = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(nch, firstprivate(c, d) is_device_ptr(prim_at))
+    CD_ARGS(sim)
+    CD_STEP_FOR(nch, CD_ARGS_IN is_device_ptr(prim_at))
     for (size_t ch = 0; ch < nch; ch++)
-        part[ch] = cd_item_wall_load_chunk(c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at, d.wall_start, d.wall_rows,
-                                           d.wall_out);
-#pragma omp target map(tofrom : sum)
-    for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
-    *load = sum;
+        part[ch] = cd_item_wall_load_chunk(a->c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at, a->d.wall_start,
+                                           a->d.wall_rows, a->d.wall_out);
+        /* the chunks in order into the slot after them, which alone comes
+     * back: no mapping made per call, one double copied */
+#pragma omp target
+    {
+        double sum = 0;
+        for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
+        part[total] = sum;
+    }
+#pragma omp target update from(part [total:1])
+    *load = part[total];
     return 0;
 }
 #define CD_OMP_WALL_LOAD omp_wall_load

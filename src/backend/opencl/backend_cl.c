@@ -64,14 +64,17 @@ static void set_list_args(cd_cl *cl)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 9, sizeof cl->wall_out, &cl->wall_out);
 }
 
-/* Rebuild of the list, then steps 5-8 (forces, gather, second kick). */
-static int forces(cd_cl *cl, cd_sim *sim, int rebuild)
+/* Rebuild of the list, then steps 5-8 (forces, gather, second kick);
+ * outputs: 1 when the pair rows' overlap and F_n must be written too (the
+ * last step of a call, a start). */
+static int forces(cd_cl *cl, cd_sim *sim, int rebuild, cd_int outputs)
 {
     const cd_state *s = &sim->s;
     if (rebuild) {
         if (cd_cl_neighbors_build(cl, sim)) return -1;
         set_list_args(cl);
     }
+    cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 5, sizeof outputs, &outputs);
     cd_cl_run(cl, CD_CLK_PAIR_FORCES, cl->n_pairs);
     if (cl->n_wall_rows) cd_cl_run(cl, CD_CLK_WALL_FORCES, (size_t)cl->n_wall_rows);
     cl->wall_out_valid = cl->wall_out_pending = 1;
@@ -119,7 +122,7 @@ static int cl_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
     if (compute_forces) {
         cd_int no_kick = 0, one = 1;
         cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof no_kick, &no_kick);
-        forces(cl, sim, 1);
+        forces(cl, sim, 1, 1);
         cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
     }
     /* Not compute_forces: the forces of the checkpoint are kept and the
@@ -173,7 +176,7 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
                         "reading the skin flag");
             rebuild = moved != 0;
         }
-        forces(cl, sim, rebuild);
+        forces(cl, sim, rebuild, it + 1 == n);
         s->step++;
         s->time += sim->p.dt;
     }
