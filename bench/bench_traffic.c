@@ -15,7 +15,6 @@
  * step_items.h changes what it reads or writes, this table changes with
  * it. */
 #include "bench_traffic.h"
-#include <string.h>
 #include "../kernels/broadphase.h"
 
 void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[CD_TRAFFIC_KERNELS])
@@ -52,23 +51,15 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * and, active or not (an inactive row adds its zero force: no branch),
      * its force and point from each side (2 x 48) */
     double gather_rows = C * 8 + Aw * 48 + R * 8 + R * 96;
-    if (strcmp(sim->backend->name, "opencl") != 0) {
-        /* omp (host threads and offload): the gather, the second kick and
-         * the next step's advance in one item (cd_item_gather_kick_advance)
-         * reading the particle once: m, x, the two CSR starts (40), v, L, q,
-         * I (104), its primitive range (8), per primitive the body-frame
-         * and last-build ends (96); writes F, T, v, L, x, omega (144), q
-         * (32) and the primitives' world ends (48).  The advance of its own
-         * runs once per call of the step. */
-        out[2] = (cd_traffic){"gather_kick_advance", N * 152 + P * 96 + gather_rows, N * 176 + P * 48};
-        out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
-    } else {
-        /* OpenCL: gather and second kick (cd_item_gather, cd_item_kick):
-         * per particle m, x, its two CSR starts (40) and v, L, q, I (104);
-         * writes F, T, v, L, omega; the advance every step */
-        out[2] = (cd_traffic){"gather_kick", N * 144 + gather_rows, N * 120};
-        out[3] = advance;
-    }
+    /* The gather, the second kick and the next step's advance in one item
+     * (cd_item_gather_kick_advance; omp on host threads and offload, and
+     * OpenCL's cd_cl_gather_kick in mode 2) reading the particle once: m,
+     * x, the two CSR starts (40), v, L, q, I (104), its primitive range
+     * (8), per primitive the body-frame and last-build ends (96); writes
+     * F, T, v, L, x, omega (144), q (32) and the primitives' world ends
+     * (48).  The advance of its own runs once per call of the step. */
+    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + P * 96 + gather_rows, N * 176 + P * 48};
+    out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};
 }

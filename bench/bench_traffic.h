@@ -14,7 +14,7 @@ typedef struct {
  * code of kernels/step_items.h for the state's counts of particles,
  * primitives, pair rows, contacts and wall contacts (sim->s synced).
  * steps_per_call: the steps of one cd_sim_step call (the per-call loops
- * are amortised over them).  The loops are those of sim's backend.
+ * are amortised over them).
  * Fills out[CD_TRAFFIC_KERNELS]. */
 void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[CD_TRAFFIC_KERNELS]);
 

@@ -44,19 +44,31 @@ __kernel void cd_cl_wall_forces(
         cd_item_wall_row(c, wall_rows[e], wall_out + e, walls, n_walls, wall_law, dt, sin_parallel, parallel_blend);
 }
 
-/* Steps 7-8: gather of particle q in fixed order, then (kick = 1) the
- * second half kick.  kick = 0 computes the forces of a new run only. */
+/* Steps 7-8: gather of particle q in fixed order, then by mode: 0 nothing
+ * more (the forces of a new run); 1 the second half kick (the last step of
+ * a call); 2 the kick and the next step's steps 1-4 in the same item
+ * (cd_item_gather_kick_advance, as the omp backend runs it: the particle's
+ * state read once, docs/performance.md, "Argument blocks on the device"),
+ * raising flags[0] as cd_cl_advance does, and item w < n_walls moves wall
+ * w (no item of this kernel reads the walls). */
 __kernel void cd_cl_gather_kick(
 #include "col_params.h"
     cd_int n_particles, __global const cd_int *gather_start, __global const cd_pair_id *gather_rows,
-    __global const cd_int *wall_start, __global const cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_int kick,
-    cd_real dt, __global const cd_wall_out *wall_out)
+    __global const cd_int *wall_start, __global const cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_int mode,
+    cd_real dt, __global const cd_wall_out *wall_out, cd_real limit2, __global cd_wall *walls, cd_int n_walls,
+    __global cd_int *flags)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
+    if (mode == 2 && q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
     if (q >= n_particles) return;
-    cd_item_gather(c, q, gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity, dimension);
-    if (kick) cd_item_kick(c, q, CD_R(0.5) * dt);
+    if (mode == 0) {
+        cd_item_gather(c, q, gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity, dimension);
+        return;
+    }
+    if (cd_item_gather_kick_advance(c, q, gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity,
+                                    dimension, dt, limit2, mode == 2))
+        flags[0] = 1;
 }
 
 /* Blow-up check: the highest particle index with a non-finite state goes

@@ -99,6 +99,12 @@ static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
  * once the state is mapped, the host columns otherwise (src/backend/omp/step_omp.c). */
 cd_cols cd_sim_step_cols(cd_sim *sim);
 
+/* Copies of the step loops' argument block to the device since the
+ * backend started (src/backend/omp/step_omp.c, off_args): copies[0] of
+ * its head (addresses, laws), copies[1] of its walls; both 0 on host
+ * threads, where nothing is copied. */
+void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2]);
+
 /* The column of field f (cd_fields) the loops work on (src/backend/omp/step_omp.c). */
 void *cd_sim_step_field(cd_sim *sim, size_t f);
 

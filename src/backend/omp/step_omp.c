@@ -64,10 +64,11 @@ typedef struct {
     size_t *bytes; /* per field: bytes mapped */
     double *part;  /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
-    cd_cols dev;            /* device addresses of the columns */
-    cd_step_args *args_dev; /* the loops' argument block on the device (off_args) */
-    cd_step_args args_host; /* what it holds */
-    int args_sent;          /* 0 until the first block went out */
+    cd_cols dev;              /* device addresses of the columns */
+    cd_step_args *args_dev;   /* the loops' argument block on the device (off_args) */
+    cd_step_args args_host;   /* what it holds */
+    int args_sent;            /* 0 until the first block went out */
+    long long args_copies[2]; /* copies of the block's head and of its walls since start */
 } cd_off;
 
 
@@ -241,6 +242,17 @@ void *cd_sim_step_field(cd_sim *sim, size_t f)
     return *cd_field_ptr(&sim->s, &cd_fields[f]);
 }
 
+void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2])
+{
+    copies[0] = copies[1] = 0;
+#if CD_OFFLOAD
+    const cd_off *o = sim->backend_data;
+    if (o) memcpy(copies, o->args_copies, sizeof o->args_copies);
+#else
+    (void)sim;
+#endif
+}
+
 /* Columns the step loops work on: device addresses in the offload variant,
  * the host columns otherwise. */
 cd_cols cd_sim_step_cols(cd_sim *sim)
@@ -287,9 +299,11 @@ static const cd_step_args *off_args(cd_sim *sim)
     if (!o->args_dev && !(o->args_dev = cd_dev_alloc(sizeof(cd_step_args)))) return NULL;
     if (!o->args_sent || memcmp(&a, &o->args_host, head)) {
         if (cd_dev_put(o->args_dev, &a, head)) return NULL;
+        o->args_copies[0]++;
     }
     if (walls && (!o->args_sent || memcmp(a.walls, o->args_host.walls, walls))) {
         if (cd_dev_put(o->args_dev->walls, a.walls, walls)) return NULL;
+        o->args_copies[1]++;
     }
     o->args_host = a;
     o->args_sent = 1;

@@ -19,7 +19,7 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
 {
     const cd_state *s = &sim->s;
     const cd_step_params *p = &sim->p;
-    cd_int N = (cd_int)s->n_particles, W = (cd_int)s->n_walls, one = 1;
+    cd_int N = (cd_int)s->n_particles, W = (cd_int)s->n_walls;
     cd_real dt = p->dt, limit2 = cd_bp_skin_limit2(sim->nb.skin);
     if (cl->cols_dirty) cd_cl_bind_cols(cl);
     cd_cl_arg(cl, CD_CLK_ADVANCE, F, sizeof cl->walls, &cl->walls);
@@ -43,8 +43,11 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof cl->wall_start, &cl->wall_start);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->gravity, &p->gravity);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof p->dimension, &p->dimension);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 8, sizeof dt, &dt);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 10, sizeof limit2, &limit2);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 11, sizeof cl->walls, &cl->walls);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 12, sizeof W, &W);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 13, sizeof cl->flags, &cl->flags);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F + 1, sizeof cl->flags, &cl->flags);
 }
@@ -64,21 +67,25 @@ static void set_list_args(cd_cl *cl)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 9, sizeof cl->wall_out, &cl->wall_out);
 }
 
-/* Rebuild of the list, then steps 5-8 (forces, gather, second kick);
- * outputs: 1 when the pair rows' overlap and F_n must be written too (the
- * last step of a call, a start). */
-static int forces(cd_cl *cl, cd_sim *sim, int rebuild, cd_int outputs)
+/* Rebuild of the list, then steps 5-8 (forces, gather, second kick) and
+ * the next step's 1-4, by mode (cd_cl_gather_kick): 0 the forces of a
+ * start, 1 the last step of a call, 2 a step with the next one's advance.
+ * The pair rows' overlap and F_n are written where a call ends (modes 0
+ * and 1). */
+static int forces(cd_cl *cl, cd_sim *sim, int rebuild, cd_int mode)
 {
     const cd_state *s = &sim->s;
+    cd_int outputs = mode != 2;
     if (rebuild) {
         if (cd_cl_neighbors_build(cl, sim)) return -1;
         set_list_args(cl);
     }
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 5, sizeof outputs, &outputs);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof mode, &mode);
     cd_cl_run(cl, CD_CLK_PAIR_FORCES, cl->n_pairs);
     if (cl->n_wall_rows) cd_cl_run(cl, CD_CLK_WALL_FORCES, (size_t)cl->n_wall_rows);
     cl->wall_out_valid = cl->wall_out_pending = 1;
-    return cd_cl_run(cl, CD_CLK_GATHER_KICK, s->n_particles);
+    return cd_cl_run(cl, CD_CLK_GATHER_KICK, s->n_particles > s->n_walls ? s->n_particles : s->n_walls);
 }
 
 static void cl_stop(cd_sim *sim)
@@ -119,12 +126,7 @@ static int cl_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
     set_step_args(cl, sim);
     set_list_args(cl);
     memcpy(cl->host_walls, sim->s.walls, sizeof cl->host_walls);
-    if (compute_forces) {
-        cd_int no_kick = 0, one = 1;
-        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof no_kick, &no_kick);
-        forces(cl, sim, 1, 1);
-        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
-    }
+    if (compute_forces) forces(cl, sim, 1, 0);
     /* Not compute_forces: the forces of the checkpoint are kept and the
      * list is rebuilt at the first step (sim->nb.force_rebuild is set), as
      * on the omp backend.  Otherwise the new forces and contacts are copied
@@ -161,8 +163,10 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
     set_step_args(cl, sim);
     memcpy(cl->host_walls, s->walls, sizeof cl->host_walls);
     size_t items = s->n_particles > s->n_walls ? s->n_particles : s->n_walls;
+    /* the first step's advance; the next ones run inside the gather
+     * (mode 2 of cd_cl_gather_kick) */
+    cd_cl_run(cl, CD_CLK_ADVANCE, items);
     for (long long it = 0; it < n && !cl->status; it++) {
-        cd_cl_run(cl, CD_CLK_ADVANCE, items);
         /* the walls move on the device; their host mirror (the same
          * arithmetic) tells whether one moved far enough for a rebuild */
         int rebuild = sim->nb.force_rebuild;
@@ -176,7 +180,7 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
                         "reading the skin flag");
             rebuild = moved != 0;
         }
-        forces(cl, sim, rebuild, it + 1 == n);
+        forces(cl, sim, rebuild, it + 1 == n ? 1 : 2);
         s->step++;
         s->time += sim->p.dt;
     }
