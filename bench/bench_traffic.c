@@ -16,6 +16,7 @@
  * it. */
 #include "bench_traffic.h"
 #include "../kernels/broadphase.h"
+#include "../kernels/step_items.h"
 
 void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[CD_TRAFFIC_KERNELS])
 {
@@ -49,8 +50,11 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
     /* the gather's part: per wall candidate its entry and flag (8), per
      * active wall row force and torque (48); per pair row two entries (8)
      * and, active or not (an inactive row adds its zero force: no branch),
-     * its force and point from each side (2 x 48) */
-    double gather_rows = C * 8 + Aw * 48 + R * 8 + R * 96;
+     * its force and point from each side (2 x 48); where the gather skips
+     * the rows out of contact (CD_GATHER_SKIPS_INACTIVE: the offload
+     * variants) the row's flag from each side (2 x 4) and the force and
+     * point of the active rows only */
+    double gather_rows = C * 8 + Aw * 48 + R * 8 + (CD_GATHER_SKIPS_INACTIVE ? R * 8 + A * 96 : R * 96);
     /* The gather, the second kick and the next step's advance in one item
      * (cd_item_gather_kick_advance; omp on host threads and offload, and
      * OpenCL's cd_cl_gather_kick in mode 2) reading the particle once: m,

@@ -293,6 +293,21 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
     return n;
 }
 
+/* CD_GATHER_SKIPS_INACTIVE 1: the gather reads each pair row's flag and
+ * does not read the force and point of a row out of contact (48 B a side;
+ * docs/performance.md, "Argument blocks on the device"): the offload
+ * variants, whose step is bound by memory traffic.  0 on host threads and
+ * in OpenCL (PoCL vectorises the branch-free loop), where the flag's
+ * branch, mispredicted, costs more than the bytes.  The same bits either
+ * way (cd_gather_sum). */
+#ifndef CD_GATHER_SKIPS_INACTIVE
+#if defined(CAPDEM_OFFLOAD_TARGET) && CAPDEM_OFFLOAD_TARGET && !defined(__OPENCL_VERSION__)
+#define CD_GATHER_SKIPS_INACTIVE 1
+#else
+#define CD_GATHER_SKIPS_INACTIVE 0
+#endif
+#endif
+
 /* Total force *F_out [N] and torque *T_out [N m] of particle q (mass m
  * [kg], centre x [m]): gravity [m/s^2] times its mass,
  * then its wall contacts (its candidate rows wall_rows[wall_start[q] ..
@@ -318,6 +333,17 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
     }
     for (cd_int r = gather_start[q]; r < gather_start[q + 1]; r++) {
         cd_pair_id e = gather_rows[r], k = e >> 1;
+#if CD_GATHER_SKIPS_INACTIVE
+        if (!c.pair_active[k]) {
+            /* The zero force an inactive row holds, +0 for side 1 and -0
+             * for side 0, changes F only where a component is -0 (+0 + -0
+             * and -0 + +0 are +0): adding a +0 for side 1 does that
+             * without reading the row; its zero torque never changes T
+             * (below).  So the same bits as the sum over every row. */
+            if (e & 1) F = cd_v3_add(F, cd_v3_zero());
+            continue;
+        }
+#endif
         /* Every row, without a branch: an inactive row adds a zero force
          * (cd_nb_item_carry, cd_item_pair_force) and a zero torque, which
          * leave F and T as they are (F + 0 is F, but for a sum that is -0,

@@ -2,11 +2,13 @@
  * or particle calling the shared kernel headers (kernels/step_items.h, the
  * same functions the OpenCL kernels call), and forces reach particles by a
  * gather in fixed order (no floating-point atomics), so results are bitwise
- * identical for any thread count.  Four loops per step: advance (kick,
- * drift, primitive ends, skin test), pair forces, wall forces, gather with
- * the second kick; a neighbour-list rebuild between the first two when
- * the skin test asks for it.  On host threads the last three and the next
- * step's advance share one parallel region (forces_and_advance).
+ * identical for any thread count.  A step: pair forces, wall forces, and
+ * the gather with the second kick and the next step's advance (kick,
+ * drift, primitive ends, skin test); a call's first step has an advance
+ * of its own, and a neighbour-list rebuild comes before the forces when
+ * the skin test asks for it.  On host threads the three share one
+ * parallel region, on an offload device they are three launches
+ * (forces_and_advance) whose arguments live on the device (off_args).
  *
  * Two variants of the same loops (src/backend/omp/omp_loops.h, docs/offload.md): on
  * host threads over the host columns of sim->s, or on an offload device

@@ -1,8 +1,9 @@
 /* The OpenCL backend (docs/opencl.md): the operations of backend.h.  One
  * step enqueues the kernels of kernels/cl/step.cl in the order of
- * src/backend/omp/step_omp.c; the state stays on the device, and the host reads one
- * int per step (the skin flag), the pair count at a rebuild, and the walls
- * and a blow-up flag once per call of step. */
+ * src/backend/omp/step_omp.c (three a step: pair rows, wall candidates, the
+ * gather with the kick and the next advance); the state stays on the device,
+ * and the host reads one int per step (the skin flag), the pair count at a
+ * rebuild, and the walls and a blow-up flag once per call of step. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
