@@ -238,6 +238,10 @@ part_info() {
             echo "kernel launches: $(grep -c 'Launching kernel' "$LOGS/launches_clang.log")"
             grep 'Launching kernel' "$LOGS/launches_clang.log" | sed 's/.*Launching kernel //' | sort | uniq -c | sort -rn | head -20
             echo "copies: $(grep -c -i 'copying data' "$LOGS/launches_clang.log") lines"
+            # per direction, with bytes (docs/offload.md, "Per-step copies")
+            awk '/[Cc]opying data from host to device/ {n++; if (match($0, /Size=[0-9]+/)) b += substr($0, RSTART + 5, RLENGTH - 5)}
+                 /[Cc]opying data from device to host/ {m++; if (match($0, /Size=[0-9]+/)) c += substr($0, RSTART + 5, RLENGTH - 5)}
+                 END {printf "host to device: %d copies, %d B; device to host: %d copies, %d B\n", n, b, m, c}' "$LOGS/launches_clang.log"
         } >>"$INFO"
         [ "$HOST" = 1 ] || grep -q 'Launching kernel' "$LOGS/launches_clang.log" || note "FAIL launches_clang: no kernel launched on a device (LIBOMPTARGET_INFO)"
     fi
