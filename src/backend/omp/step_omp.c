@@ -311,10 +311,19 @@ static const cd_step_args *off_args(cd_sim *sim)
     o->args_sent = 1;
     return o->args_dev;
 }
-#define CD_ARGS(sim)                                                                                                   \
-    const cd_step_args *a = off_args(sim);                                                                             \
-    if (!a) abort(); /* a few hundred bytes of device memory: none left at all */
-#define CD_ARGS_IN is_device_ptr(a)
+/* The loops have no error path: a device that cannot take 1.5 kB is
+ * gone, and the run stops here rather than compute with stale arguments. */
+static const cd_step_args *off_args_or_die(cd_sim *sim)
+{
+    const cd_step_args *a = off_args(sim);
+    if (!a) {
+        fprintf(stderr, "capdem: the offload device refused the step's argument block (1.5 kB): stopping\n");
+        abort();
+    }
+    return a;
+}
+#define CD_ARGS(sim) const cd_step_args *a = off_args_or_die(sim);
+#define CD_ARGS_IN   is_device_ptr(a)
 
 /* The device's skin flag (1: an end moved beyond half the skin since it
  * was cleared), allocated and cleared at its first use. */
