@@ -208,10 +208,45 @@ typedef struct {
     size_t n, cap;
 } partials;
 
-/* The leaves of the whole tree: the first leaf of each kind, and all. */
+/* The leaves of the whole tree: the first leaf of each kind, and all; the
+ * tree's levels that the ranks merge themselves (levels, the first merge
+ * counted as 1) and the leaves under one item of the last of them (span =
+ * CD_OBS_FANIN^levels), which go to one rank. */
 typedef struct {
     long long particles, pairs, walls, n;
+    int levels;
+    long long span;
 } leaf_plan;
+
+/* Items of the tree's level j over n leaves (level 0: the leaves; the
+ * last level has one item, the total). */
+static long long level_items(long long n, int j)
+{
+    for (int k = 0; k < j && n > 1; k++) n = n > CD_OBS_FANIN ? (n + CD_OBS_FANIN - 1) / CD_OBS_FANIN : 1;
+    return n;
+}
+
+/* As many levels merged on the ranks as leave at least 4 items of the last
+ * of them per rank (at least the first merge, at most the whole tree): rank
+ * 0 then merges n / 16^levels partials, not one per leaf (1e8 hexapods:
+ * 3e7 leaves, 7,300 partials of 3 levels). */
+static void plan_levels(leaf_plan *lp, int ranks)
+{
+    const char *force = getenv("CAPDEM_MPI_MERGE_LEVELS"); /* that many levels where the tree has them, for the test */
+    int forced = force ? atoi(force) : 0;
+    lp->levels = 1;
+    lp->span = CD_OBS_FANIN;
+    while (forced > lp->levels && level_items(lp->n, lp->levels) > 1) {
+        lp->levels++;
+        lp->span *= CD_OBS_FANIN;
+    }
+    if (forced > 0) return;
+    while (level_items(lp->n, lp->levels) > 1 &&
+           (lp->n + lp->span * CD_OBS_FANIN - 1) / (lp->span * CD_OBS_FANIN) >= 4LL * ranks) {
+        lp->levels++;
+        lp->span *= CD_OBS_FANIN;
+    }
+}
 
 /* Room for one more partial, number `index`; its slots to fill, NULL when out of memory. */
 static double *push(partials *v, long long index)
@@ -227,14 +262,18 @@ static double *push(partials *v, long long index)
     return v->p[v->n++].acc;
 }
 
-/* Leaf L belongs to the rank of its group of CD_OBS_FANIN leaves (the items
- * of the tree's first merge), groups dealt round the ranks: a rank merges
- * its groups itself, and rank 0 gets one partial a group. */
-static int leaf_rank(const cd_mpi_ctx *x, long long leaf) { return (int)((leaf / CD_OBS_FANIN) % x->size); }
+/* Leaf L belongs to the rank of its group of lp.span leaves (an item of
+ * the last level the ranks merge), groups dealt round the ranks: a rank
+ * merges its groups itself, and rank 0 gets one partial a group. */
+static int leaf_rank(const cd_mpi_ctx *x, const leaf_plan *lp, long long leaf)
+{
+    return (int)((leaf / lp->span) % x->size);
+}
 
-/* Rank 0, the first merges of every group (n of them) gathered from every
- * rank: the rest of the serial program's tree (cd_obs_merge_serial from its
- * second level); a tree of one group has the total as its first merge. */
+/* Rank 0, the items of the ranks' last level (n of them) gathered from
+ * every rank: the rest of the serial program's tree (cd_obs_merge_serial
+ * from the next level on); when the ranks' levels were the whole tree, the
+ * one item is the total. */
 static void merge_groups(const char *all, size_t n, double *total)
 {
     obs_partial *p = (obs_partial *)all;
@@ -268,7 +307,7 @@ static int particle_leaves(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, le
         if (x->owned[q]) {
             mine[n] = (obs_particle){x->gid[q],    s->position[q],    s->velocity[q],
                                      s->angmom[q], s->orientation[q], touch_loc[q] != 0};
-            dest[n++] = leaf_rank(x, lp.particles + x->gid[q] / CD_OBS_BLOCK);
+            dest[n++] = leaf_rank(x, &lp, lp.particles + x->gid[q] / CD_OBS_BLOCK);
         }
     char *got = NULL;
     size_t len = 0;
@@ -284,7 +323,7 @@ static int particle_leaves(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, le
     }
     cd_cols c = cd_sim_host_cols(gs);
     for (cd_long b = 0; !rc && b < lp.pairs - lp.particles; b++) {
-        if (leaf_rank(x, lp.particles + b) != x->rank) continue;
+        if (leaf_rank(x, &lp, lp.particles + b) != x->rank) continue;
         double *acc = push(out, lp.particles + b);
         if (!acc) rc = -1;
         else cd_obs_block_particles(c, b, (cd_long)N, g->p.gravity, touch, acc, cd_order_identity());
@@ -316,7 +355,7 @@ static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
                 long long row = x->gprim[i] * (long long)W + (long long)w;
                 cd_wall_out o = {s->wallc_force[r], s->wallc_torque[r], s->wallc_overlap[r], s->wallc_fn[r]};
                 mine[n] = (obs_wall){row, s->wallc_shear[r], o, s->wallc_active[r]};
-                dest[n++] = leaf_rank(x, lp.walls + row / CD_OBS_BLOCK);
+                dest[n++] = leaf_rank(x, &lp, lp.walls + row / CD_OBS_BLOCK);
             }
     char *got = NULL;
     size_t len = 0, m = 0;
@@ -329,7 +368,7 @@ static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     cd_long nb = lp.n - lp.walls;
     for (cd_long b = 0; !rc && b < nb; b++)
         for (cd_long r = b * CD_OBS_BLOCK;
-             leaf_rank(x, lp.walls + b) == x->rank && r < cd_obs_block_end(b, (cd_long)rows); r++)
+             leaf_rank(x, &lp, lp.walls + b) == x->rank && r < cd_obs_block_end(b, (cd_long)rows); r++)
             gs->wallc_active[r] = 0;
     if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: particles ascending */
     for (size_t k = 0; !rc && k < m; k++) {
@@ -342,7 +381,7 @@ static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     for (size_t q = 0; !rc && q < N; q++) start[q + 1] += start[q];
     cd_cols c = cd_sim_host_cols(gs);
     for (cd_long b = 0; !rc && b < nb; b++) {
-        if (leaf_rank(x, lp.walls + b) != x->rank) continue;
+        if (leaf_rank(x, &lp, lp.walls + b) != x->rank) continue;
         double *acc = push(out, lp.walls + b);
         if (!acc) rc = -1;
         else
@@ -377,7 +416,7 @@ static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
         if (!s->pair_active[k] || !x->owned[s->prim_particle[i]]) continue;
         long long gi = x->gprim[i], gj = x->gprim[s->pair_prim_j[k]];
         mine[n] = (obs_pair){gi * P + gj, gi, gj, s->pair_shear[k], s->pair_overlap[k], s->pair_active[k]};
-        dest[n++] = leaf_rank(x, lp.pairs + gi / CD_OBS_BLOCK);
+        dest[n++] = leaf_rank(x, &lp, lp.pairs + gi / CD_OBS_BLOCK);
     }
     char *got = NULL;
     size_t len = 0;
@@ -406,7 +445,7 @@ static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     c.pair_shear = shear;
     c.prim_radius = g->s.prim_radius;
     for (cd_long b = 0; !rc && b < lp.walls - lp.pairs; b++) {
-        if (leaf_rank(x, lp.pairs + b) != x->rank) continue;
+        if (leaf_rank(x, &lp, lp.pairs + b) != x->rank) continue;
         double *acc = push(out, lp.pairs + b);
         if (!acc) rc = -1;
         else cd_obs_block_pairs(c, b, (cd_long)m, g->p.law, acc, cd_order_identity());
@@ -422,25 +461,35 @@ static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     return rc;
 }
 
-/* This rank's groups of leaves merged (the tree's first level, in place:
- * each group's first merge, cd_obs_item_merge over its own leaves, the
- * additions of the serial program's). */
-static int merge_own_groups(const partials *leaves, long long n_leaves, partials *groups)
+/* This rank's groups of leaves merged, level by level up to lp.levels:
+ * each item by cd_obs_item_merge over its own children (at most
+ * CD_OBS_FANIN, all this rank's), the additions of the serial program's
+ * tree.  The rank's items of level lp.levels into *groups. */
+static int merge_own_groups(const partials *leaves, leaf_plan lp, partials *groups)
 {
-    for (size_t k = 0; k < leaves->n;) { /* leaves pushed in ascending order */
-        long long grp = leaves->p[k].index / CD_OBS_FANIN;
-        size_t first = k;
-        double buf[CD_OBS_FANIN * CD_OBS_SLOTS];
-        for (; k < leaves->n && leaves->p[k].index / CD_OBS_FANIN == grp; k++)
-            memcpy(buf + (k - first) * CD_OBS_SLOTS, leaves->p[k].acc, sizeof leaves->p[k].acc);
-        long long in_group =
-            n_leaves - grp * CD_OBS_FANIN < CD_OBS_FANIN ? n_leaves - grp * CD_OBS_FANIN : CD_OBS_FANIN;
-        if ((long long)(k - first) != in_group) return -1; /* (every leaf of a group is its rank's) */
-        double *acc = push(groups, grp);
-        if (!acc) return -1;
-        cd_obs_item_merge(buf, in_group, 0, acc);
+    partials in = *leaves, out = {NULL, 0, 0};
+    int rc = 0;
+    for (int j = 1; !rc && j <= lp.levels; j++) {
+        long long n_in = level_items(lp.n, j - 1);
+        out.n = 0;
+        for (size_t k = 0; !rc && k < in.n;) { /* items in ascending order */
+            long long item = in.p[k].index / CD_OBS_FANIN;
+            size_t first = k;
+            double buf[CD_OBS_FANIN * CD_OBS_SLOTS];
+            for (; k < in.n && in.p[k].index / CD_OBS_FANIN == item; k++)
+                memcpy(buf + (k - first) * CD_OBS_SLOTS, in.p[k].acc, sizeof in.p[k].acc);
+            long long children = n_in - item * CD_OBS_FANIN < CD_OBS_FANIN ? n_in - item * CD_OBS_FANIN : CD_OBS_FANIN;
+            double *acc = (long long)(k - first) == children ? push(&out, item) : NULL; /* (every child here) */
+            if (!acc) rc = -1;
+            else cd_obs_item_merge(buf, children, 0, acc);
+        }
+        if (in.p != leaves->p) free(in.p);
+        in = out;
+        out = (partials){NULL, 0, 0};
     }
-    return 0;
+    if (rc && in.p != leaves->p) free(in.p);
+    if (!rc) *groups = in;
+    return rc;
 }
 
 int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total)
@@ -461,10 +510,11 @@ int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total)
     lp.pairs = ((long long)gs->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
     lp.walls = lp.pairs + cd_obs_pair_blocks((cd_long)gs->n_prims);
     lp.n = lp.walls + ((long long)(gs->n_prims * gs->n_walls) + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    plan_levels(&lp, x->size);
     partials leaves = {NULL, 0, 0}, groups = {NULL, 0, 0};
     /* (a rank out of memory stops all: the others wait in the exchanges) */
     if (particle_leaves(x, global, touch, lp, &leaves) || pair_leaves(x, global, lp, &leaves) ||
-        wall_leaves(x, global, lp, &leaves) || merge_own_groups(&leaves, lp.n, &groups) ||
+        wall_leaves(x, global, lp, &leaves) || merge_own_groups(&leaves, lp, &groups) ||
         gather_partials(x, (const char *)groups.p, (int)(groups.n * sizeof *groups.p), sizeof *groups.p, total,
                         CD_OBS_SLOTS, merge_groups))
         MPI_Abort(x->comm, 1);
