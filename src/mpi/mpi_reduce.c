@@ -11,8 +11,8 @@
  * partial sums go to rank 0, which merges them in block order and sends
  * the total to every rank.  The observables' leaves are functions of
  * global ids only (the pair rows' of their primitive i), dealt to the
- * ranks by groups of CD_OBS_FANIN leaves, so that each rank makes the
- * tree's first merges of its groups and rank 0 the rest.  Every exchange
+ * ranks by groups of CD_OBS_FANIN^k leaves, so that each rank makes the
+ * tree's first k levels of merges of its groups and rank 0 the rest.  Every exchange
  * moves each row once (no rank receives the whole state). */
 #include <stdlib.h>
 #include <string.h>
@@ -229,7 +229,7 @@ static long long level_items(long long n, int j)
 /* As many levels merged on the ranks as leave at least 4 items of the last
  * of them per rank (at least the first merge, at most the whole tree): rank
  * 0 then merges n / 16^levels partials, not one per leaf (1e8 hexapods:
- * 3e7 leaves, 7,300 partials of 3 levels). */
+ * 3e7 leaves on 64 ranks, about 450 partials of 4 levels). */
 static void plan_levels(leaf_plan *lp, int ranks)
 {
     const char *force = getenv("CAPDEM_MPI_MERGE_LEVELS"); /* that many levels where the tree has them, for the test */
