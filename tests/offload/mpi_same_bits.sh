@@ -38,6 +38,6 @@ for c in hexapod_pile:3 crosses_shear:4; do
     grep -B1 "differences found" "$work/$name.diff" | grep -v -- '^--' | head -20 | sed 's/^/    /'
     echo "FAIL: $name: $np ranks differ from the serial run"; fail=1
   fi
-  grep -E '^capdem: MPI (traffic|:)' "$work/$name-mpi.log" | sed 's/^/    /'
+  grep -E '^capdem: MPI(:| traffic)' "$work/$name-mpi.log" | sed 's/^/    /'
 done
 exit $fail
