@@ -44,7 +44,7 @@ static obs_blocks count_blocks(const cd_state *s)
 {
     obs_blocks n;
     n.particles = ((cd_long)s->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
-    n.pairs = ((cd_long)s->n_pairs + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    n.pairs = cd_obs_pair_blocks((cd_long)s->n_prims);
     n.walls = ((cd_long)(s->n_prims * s->n_walls) + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
     return n;
 }
@@ -94,7 +94,8 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     const cd_state *s = &sim->s;
     cd_cols c = cd_sim_host_cols((cd_state *)s); /* read only */
     obs_blocks nb = count_blocks(s);
-    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls),
+            P = (cd_long)s->n_prims;
     cd_int W = (cd_int)s->n_walls;
     cd_vec3 g = sim->p.gravity;
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
@@ -122,7 +123,7 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     double *pp = part, *pk = part + nb.particles * CD_OBS_SLOTS, *pw = pk + nb.pairs * CD_OBS_SLOTS;
     CD_HOST_FOR(N, firstprivate(c, o))
     for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, pp + b * CD_OBS_SLOTS, o);
-    CD_HOST_FOR(K, firstprivate(c, o))
+    CD_HOST_FOR(P, firstprivate(c, o))
     for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS, o);
     CD_HOST_FOR(R, firstprivate(c, o))
     for (cd_long b = 0; b < nb.walls; b++)
@@ -172,7 +173,8 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
         if (!x->partial) return -1;
     }
     cd_cols c = cd_sim_step_cols(sim);
-    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls),
+            P = (cd_long)s->n_prims;
     cd_int W = (cd_int)s->n_walls;
     cd_vec3 g = sim->p.gravity;
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
@@ -189,7 +191,7 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_order o = cd_sim_step_order(sim);
     CD_STEP_FOR(N, firstprivate(c, g, o) is_device_ptr(touch, part))
     for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS, o);
-    CD_STEP_FOR(K, firstprivate(c, law, o) is_device_ptr(part))
+    CD_STEP_FOR(P, firstprivate(c, law, o) is_device_ptr(part))
     for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS, o);
     cd_nb_lists d = sim->nb.d;
     CD_STEP_FOR(R, firstprivate(c, d, wall_law, o) is_device_ptr(part))

@@ -618,6 +618,19 @@ static void omp_stop(cd_sim *sim)
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen);
 
+int cd_sim_step_remap(cd_sim *sim, char *err, size_t errlen)
+{
+#if CD_OFFLOAD
+    omp_stop(sim);
+    return off_acquire(sim, err, errlen);
+#else
+    (void)sim;
+    (void)err;
+    (void)errlen;
+    return 0;
+#endif
+}
+
 static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 {
     omp_stop(sim);

@@ -259,7 +259,8 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     }
     const cd_state *s = &sim->s;
     cd_long N = (cd_long)s->n_particles, K = (cd_long)cl->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
-    cd_long bp = (N + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, bk = (K + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    cd_long P = (cd_long)s->n_prims;
+    cd_long bp = (N + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, bk = cd_obs_pair_blocks(P);
     cd_long bw = (R + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, n_blocks = bp + bk + bw, first = 0;
     cd_int W = (cd_int)s->n_walls, n_pairs = (cd_int)K;
     size_t tree = (size_t)cd_obs_tree_blocks(n_blocks) + 1;
@@ -288,6 +289,7 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 1, sizeof sim->p.law, &sim->p.law);
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 2, sizeof cl->obs_part, &cl->obs_part);
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 3, sizeof first, &first);
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 4, sizeof P, &P);
     cd_cl_run(cl, CD_CLK_OBS_PAIRS, (size_t)bk);
     first = bp + bk;
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F, sizeof R, &R);
