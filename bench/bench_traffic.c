@@ -37,15 +37,15 @@ void cd_bench_traffic(const cd_sim *sim, cd_traffic out[CD_TRAFFIC_KERNELS])
      * (24) and its particles' x, v, omega, m (80 per particle, counted for
      * every particle); writes flag, history, point, force, overlap, F_n. */
     out[1] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 92};
-    /* cd_item_wall_row over the wall candidates: per candidate its entry,
-     * flag and primitive (particle, ends, radius: 4 + 4 + 60, an upper
+    /* cd_item_wall_row over the wall candidates: per candidate its row,
+     * its entry's flag and its primitive (particle, ends, radius: 4 + 4 + 60, an upper
      * bound when a primitive has several); an active row its history (24)
      * and the particle's x, v, omega, m (80); writes flag, history, force,
      * torque, overlap, F_n. */
     out[2] = (cd_traffic){"wall_forces", C * 68 + Aw * (24 + 80), Aw * 92};
     /* gather and second kick (cd_item_gather, cd_item_kick): per particle
      * m, x, its two CSR starts (40) and v, L, q, I (104); per wall
-     * candidate its entry and flag (8), per active wall row force and torque
+     * candidate its row and its entry's flag (8), per active one force and torque
      * (48); per pair row two entries (8) and, active or not (an inactive
      * row adds its zero force: no branch), its force and point from each
      * side (2 x 48); writes F, T, v, L, omega. */

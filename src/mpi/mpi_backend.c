@@ -161,10 +161,15 @@ static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
     double t1 = MPI_Wtime();
     x->t_decide += t1 - t0;
     if (!any) return 0;
+    /* The wall contacts' history lives in the inner step's candidate lists:
+     * into the local rows first, so that it moves with its particles, and
+     * back into candidates at the build that follows (from the rows). */
+    if (agree_failure(x, x->inner->sync(loc, err, errlen), err, errlen)) return -1;
     if (cd_mpi_migrate(x)) {
         snprintf(err, errlen, "out of memory while moving particles to their new MPI ranks");
         MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
     }
+    loc->nb.walls_from_host = 1;
     x->t_migrate += MPI_Wtime() - t1;
     if (!loc->s.n_particles) { /* still none: no list to build (the build needs a particle) */
         loc->nb.force_rebuild = 0;

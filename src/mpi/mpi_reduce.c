@@ -185,7 +185,7 @@ typedef struct {
 typedef struct {
     long long row; /* global primitive x walls + wall */
     cd_vec3 shear;
-    cd_wall_out out; /* the row's outputs (kernels/geom_types.h) */
+    cd_wall_entry out; /* the row's history and outputs (kernels/geom_types.h) */
     long long active;
 } obs_wall;
 
@@ -384,7 +384,13 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
                 size_t r = (size_t)i * W + w;
                 if (!s->wallc_active[r]) continue; /* (an inactive row adds nothing) */
                 long long row = x->gprim[i] * (long long)W + (long long)w;
-                cd_wall_out o = {s->wallc_force[r], s->wallc_torque[r], s->wallc_overlap[r], s->wallc_fn[r]};
+                cd_wall_entry o = {s->wallc_force[r],
+                                   s->wallc_torque[r],
+                                   s->wallc_overlap[r],
+                                   s->wallc_fn[r],
+                                   s->wallc_shear[r],
+                                   s->wallc_active[r],
+                                   0};
                 mine[n] = (obs_wall){row, s->wallc_shear[r], o, s->wallc_active[r]};
                 dest[n++] = block_rank(x, row);
             }
@@ -394,7 +400,7 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
     m = len / sizeof(obs_wall);
     obs_wall *e = (obs_wall *)got;
     cd_int *start = calloc(N + 2, sizeof *start), *wrows = malloc((m + 1) * sizeof *wrows);
-    cd_wall_out *outs = malloc((m + 1) * sizeof *outs);
+    cd_wall_entry *outs = malloc((m + 1) * sizeof *outs);
     if (!start || !wrows || !outs) rc = -1;
     cd_long nb = ((cd_long)rows + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
     for (cd_long b = x->rank; !rc && b < nb; b += x->size)
@@ -515,8 +521,15 @@ int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total)
     if (!touch) MPI_Abort(x->comm, 1);
     cd_cols lc = cd_sim_host_cols(s);
     for (size_t k = 0; k < s->n_pairs; k++) cd_obs_item_touch_pair(lc, (cd_long)k, touch);
-    for (size_t r = 0; r < s->n_prims * s->n_walls; r++)
-        cd_obs_item_touch_wall(lc, (cd_long)r, (cd_int)s->n_walls, touch);
+    /* the wall rows in contact as the step's candidate entries (kernels/observe_items.h) */
+    size_t n_wall = cd_state_wall_entries(s, NULL, NULL);
+    cd_int *wrows = malloc((n_wall + 1) * sizeof *wrows);
+    cd_wall_entry *went = malloc((n_wall + 1) * sizeof *went);
+    if (!wrows || !went) MPI_Abort(x->comm, 1);
+    cd_state_wall_entries(s, wrows, went);
+    for (size_t e = 0; e < n_wall; e++) cd_obs_item_touch_wall(lc, (cd_long)e, (cd_int)s->n_walls, wrows, went, touch);
+    free(wrows);
+    free(went);
     cd_long nbp = ((cd_long)gs->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
     partials part = {NULL, 0, 0};
     long long nbk = 0;

@@ -331,8 +331,7 @@ static void gather_kick(cd_sim *sim, int kick)
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, d, g))
     for (size_t q = 0; q < n; q++) {
-        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_rows, d.wall_out, g,
-                       dim);
+        cd_item_gather(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_out, g, dim);
         if (kick) cd_item_kick(c, (cd_particle_id)q, h);
     }
 }
@@ -360,7 +359,7 @@ __attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd
     for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend);
 }
 
-__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, cd_wall_out *out, size_t n,
+__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, cd_wall_entry *out, size_t n,
                                                          const cd_wall *walls, cd_int W, cd_law_params law, cd_real dt,
                                                          cd_real sin_parallel, cd_int blend)
 {
@@ -375,7 +374,7 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
     for (size_t q = 0; q < n; q++)
         moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                             d.wall_rows, d.wall_out, g, dim, dt, limit2, next);
+                                             d.wall_out, g, dim, dt, limit2, next);
     return moved;
 }
 #endif
@@ -500,6 +499,9 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 {
     omp_stop(sim);
     cd_sim_refresh(sim);
+    /* the host's wall rows hold the contacts to carry on (a resumed run, a
+     * state put back): the first build turns them into candidate entries */
+    sim->nb.walls_from_host = 1;
 #if CD_OFFLOAD
     if (off_acquire(sim, err, errlen)) return -1;
 #endif

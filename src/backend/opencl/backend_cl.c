@@ -41,10 +41,10 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 1, sizeof cl->gather_start, &cl->gather_start);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof cl->wall_start, &cl->wall_start);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->gravity, &p->gravity);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof p->dimension, &p->dimension);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 8, sizeof dt, &dt);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof p->gravity, &p->gravity);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->dimension, &p->dimension);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof one, &one);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F + 1, sizeof cl->flags, &cl->flags);
 }
@@ -60,8 +60,7 @@ static void set_list_args(cd_cl *cl)
     /* the wall candidates' lists, sized by the last build */
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 8, sizeof cl->wall_out, &cl->wall_out);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof cl->wall_rows, &cl->wall_rows);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 9, sizeof cl->wall_out, &cl->wall_out);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 8, sizeof cl->wall_out, &cl->wall_out);
 }
 
 /* Rebuild of the list, then steps 5-8 (forces, gather, second kick). */
@@ -118,9 +117,9 @@ static int cl_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
     memcpy(cl->host_walls, sim->s.walls, sizeof cl->host_walls);
     if (compute_forces) {
         cd_int no_kick = 0, one = 1;
-        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof no_kick, &no_kick);
+        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof no_kick, &no_kick);
         forces(cl, sim, 1);
-        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof one, &one);
+        cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof one, &one);
     }
     /* Not compute_forces: the forces of the checkpoint are kept and the
      * list is rebuilt at the first step (sim->nb.force_rebuild is set), as
@@ -265,10 +264,13 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_TOUCH_PAIRS, F, sizeof n_pairs, &n_pairs);
     cd_cl_arg(cl, CD_CLK_OBS_TOUCH_PAIRS, F + 1, sizeof cl->obs_touch, &cl->obs_touch);
     cd_cl_run(cl, CD_CLK_OBS_TOUCH_PAIRS, (size_t)K);
-    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F, sizeof R, &R);
+    cd_long n_cand = W ? cl->n_wall_rows : 0;
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F, sizeof n_cand, &n_cand);
     cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 1, sizeof W, &W);
-    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 2, sizeof cl->obs_touch, &cl->obs_touch);
-    cd_cl_run(cl, CD_CLK_OBS_TOUCH_WALLS, (size_t)R);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 2, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 3, sizeof cl->wall_out, &cl->wall_out);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 4, sizeof cl->obs_touch, &cl->obs_touch);
+    cd_cl_run(cl, CD_CLK_OBS_TOUCH_WALLS, (size_t)n_cand);
     cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 1, sizeof sim->p.gravity, &sim->p.gravity);
     cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 2, sizeof cl->obs_touch, &cl->obs_touch);
