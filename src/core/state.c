@@ -137,20 +137,24 @@ void cd_state_expand_wall_entries(cd_state *s, const cd_int *rows, const cd_wall
     }
 }
 
+cd_wall_entry cd_state_wall_entry(const cd_state *s, size_t r)
+{
+    return (cd_wall_entry){s->wallc_force[r],
+                           s->wallc_torque[r],
+                           s->wallc_overlap[r],
+                           s->wallc_fn[r],
+                           s->wallc_shear[r],
+                           s->wallc_active[r],
+                           0};
+}
+
 size_t cd_state_wall_entries(const cd_state *s, cd_int *rows, cd_wall_entry *ent)
 {
     size_t n = 0, R = s->n_prims * s->n_walls;
     for (size_t r = 0; r < R; r++) {
         if (!s->wallc_active[r]) continue;
         if (rows) rows[n] = (cd_int)r;
-        if (ent)
-            ent[n] = (cd_wall_entry){s->wallc_force[r],
-                                     s->wallc_torque[r],
-                                     s->wallc_overlap[r],
-                                     s->wallc_fn[r],
-                                     s->wallc_shear[r],
-                                     s->wallc_active[r],
-                                     0};
+        if (ent) ent[n] = cd_state_wall_entry(s, r);
         n++;
     }
     return n;

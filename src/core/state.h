@@ -71,7 +71,9 @@ int cd_state_copy(cd_state *dst, const cd_state *src);
  * entries the step keeps per wall candidate: ent[e] for the candidate row
  * rows[e] (e < n) while it is in contact (active), 0 elsewhere. */
 void cd_state_expand_wall_entries(cd_state *s, const cd_int *rows, const cd_wall_entry *ent, size_t n);
-/* The reverse, at a start: the rows in contact (wallc_active) as candidate
+/* Host row r of the wall contacts as a candidate entry. */
+cd_wall_entry cd_state_wall_entry(const cd_state *s, size_t r);
+/* The reverse of the expansion, at a start: the rows in contact (wallc_active) as candidate
  * entries, ascending by row, into rows[] and ent[] (either may be null);
  * returns how many. */
 size_t cd_state_wall_entries(const cd_state *s, cd_int *rows, cd_wall_entry *ent);

@@ -183,10 +183,8 @@ typedef struct {
 } obs_particle;
 
 typedef struct {
-    long long row; /* global primitive x walls + wall */
-    cd_vec3 shear;
+    long long row;     /* global primitive x walls + wall */
     cd_wall_entry out; /* the row's history and outputs (kernels/geom_types.h) */
-    long long active;
 } obs_wall;
 
 typedef struct {
@@ -384,14 +382,8 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
                 size_t r = (size_t)i * W + w;
                 if (!s->wallc_active[r]) continue; /* (an inactive row adds nothing) */
                 long long row = x->gprim[i] * (long long)W + (long long)w;
-                cd_wall_entry o = {s->wallc_force[r],
-                                   s->wallc_torque[r],
-                                   s->wallc_overlap[r],
-                                   s->wallc_fn[r],
-                                   s->wallc_shear[r],
-                                   s->wallc_active[r],
-                                   0};
-                mine[n] = (obs_wall){row, s->wallc_shear[r], o, s->wallc_active[r]};
+                cd_wall_entry o = cd_state_wall_entry(s, r);
+                mine[n] = (obs_wall){row, o};
                 dest[n++] = block_rank(x, row);
             }
     char *got = NULL;
@@ -407,8 +399,8 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
         for (cd_long r = b * CD_OBS_BLOCK; r < cd_obs_block_end(b, (cd_long)rows); r++) gs->wallc_active[r] = 0;
     if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: particles ascending */
     for (size_t k = 0; !rc && k < m; k++) {
-        gs->wallc_active[e[k].row] = (cd_int)e[k].active;
-        gs->wallc_shear[e[k].row] = e[k].shear;
+        gs->wallc_active[e[k].row] = e[k].out.active;
+        gs->wallc_shear[e[k].row] = e[k].out.shear;
         start[gs->prim_particle[e[k].row / (long long)W] + 1]++;
         wrows[k] = (cd_int)e[k].row;
         outs[k] = e[k].out;

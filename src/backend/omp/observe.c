@@ -82,13 +82,7 @@ static int host_wall_lists(const cd_state *s, cd_int **start, cd_int **rows, cd_
         for (size_t r = first * W; r < last * W; r++) {
             if (!s->wallc_active[r]) continue;
             (*rows)[e] = (cd_int)r;
-            (*out)[e++] = (cd_wall_entry){s->wallc_force[r],
-                                          s->wallc_torque[r],
-                                          s->wallc_overlap[r],
-                                          s->wallc_fn[r],
-                                          s->wallc_shear[r],
-                                          s->wallc_active[r],
-                                          0};
+            (*out)[e++] = cd_state_wall_entry(s, r);
         }
     }
     (*start)[N] = e;
