@@ -569,8 +569,13 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
                 off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
                          cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
         }
+    /* The host's wall rows anew as well, whenever the step has entries:
+     * cd_reorder_to_user below moves every host column from memory order
+     * at every sync, so rows not written again (a second sync without a
+     * step between) would be moved twice. */
+    if (sim->nb.wall_out_valid) sim->nb.wall_out_pending = 1;
 #endif
-    /* the wall-contact outputs kept per candidate into the host's rows, then the
+    /* the wall contacts kept per candidate into the host's rows, then the
      * host columns in user order (src/backend/omp/reorder.c) */
     if (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim)) {
         snprintf(err, errlen, "out of memory putting the particles in user order");
