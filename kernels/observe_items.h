@@ -72,9 +72,11 @@ CD_INLINE void cd_obs_item_touch_pair(cd_cols c, cd_long k, CD_GLOBAL cd_int *to
     cd_atomic_inc(&touch[c.prim_particle[c.pair_prim_j[k]]]);
 }
 
-CD_INLINE void cd_obs_item_touch_wall(cd_cols c, cd_long row, cd_int n_walls, CD_GLOBAL cd_int *touch)
+/* Wall candidate e (row wall_rows[e], entry wall_out[e]: kernels/step_items.h). */
+CD_INLINE void cd_obs_item_touch_wall(cd_cols c, cd_long e, cd_int n_walls, const CD_GLOBAL cd_int *wall_rows,
+                                      const CD_GLOBAL cd_wall_entry *wall_out, CD_GLOBAL cd_int *touch)
 {
-    if (c.wallc_active[row]) cd_atomic_inc(&touch[c.prim_particle[row / n_walls]]);
+    if (wall_out[e].active) cd_atomic_inc(&touch[c.prim_particle[wall_rows[e] / n_walls]]);
 }
 
 /* Partial sums of the tree over n leaves: the leaves and the levels above
@@ -179,21 +181,21 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
 
 /* Block b of the primitive-wall rows (n_walls per primitive): elastic
  * energy, contacts, the particles' force on each wall [N] (summed in
- * place: its slot depends on the row), largest overlap.  The outputs of
- * the rows in contact: wall_out per wall candidate (cd_wall_out_place). */
+ * place: its slot depends on the row), largest overlap.  The history and
+ * outputs of the rows: wall_out per wall candidate (cd_wall_out_place; a
+ * row that is none is not in contact). */
 CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
                                   CD_GLOBAL cd_real *acc, cd_order o, const CD_GLOBAL cd_int *wall_start,
-                                  const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out)
+                                  const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_entry *wall_out)
 {
     cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
     cd_obs_clear(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
-        if (!c.wallc_active[r]) continue;
         cd_long e = cd_wall_out_place(c, r, n_walls, wall_start, wall_rows);
-        if (e < 0) continue; /* (a row in contact is a candidate) */
-        cd_wall_out out = wall_out[e];
-        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], out.overlap, c.wallc_shear[r]);
+        if (e < 0 || !wall_out[e].active) continue;
+        cd_wall_entry out = wall_out[e];
+        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], out.overlap, out.shear);
         contacts += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
         acc[CD_OBS_WALL + 3 * w + 0] -= out.force.x;

@@ -161,12 +161,19 @@ static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
     double t1 = MPI_Wtime();
     x->t_decide += t1 - t0;
     if (!any) return 0;
-    int left = cd_mpi_dev_leave(x, err, errlen); /* an offload device's state back to the host */
+    /* The wall contacts' history lives in the inner step's candidate lists:
+     * into the local rows first (a sync; on an offload device
+     * cd_mpi_dev_leave syncs the whole state back to the host), so that it
+     * moves with its particles, and back into candidates at the build that
+     * follows (from the rows). */
+    int left = cd_mpi_dev_leave(x, err, errlen);
+    if (!left && agree_failure(x, x->inner->sync(loc, err, errlen), err, errlen)) return -1;
     if (left < 0 || cd_mpi_migrate(x)) {
         if (left >= 0) snprintf(err, errlen, "out of memory while moving particles to their new MPI ranks");
         MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
     }
     if (left && cd_mpi_dev_return(x, err, errlen)) MPI_Abort(x->comm, 1);
+    loc->nb.walls_from_host = 1;
     x->t_migrate += MPI_Wtime() - t1;
     if (!loc->s.n_particles) { /* still none: no list to build (the build needs a particle) */
         loc->nb.force_rebuild = 0;

@@ -184,10 +184,8 @@ typedef struct {
 } obs_particle;
 
 typedef struct {
-    long long row; /* global primitive x walls + wall */
-    cd_vec3 shear;
-    cd_wall_out out; /* the row's outputs (kernels/geom_types.h) */
-    long long active;
+    long long row;     /* global primitive x walls + wall */
+    cd_wall_entry out; /* the row's history and outputs (kernels/geom_types.h) */
 } obs_wall;
 
 typedef struct {
@@ -353,8 +351,8 @@ static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
                 size_t r = (size_t)i * W + w;
                 if (!s->wallc_active[r]) continue; /* (an inactive row adds nothing) */
                 long long row = x->gprim[i] * (long long)W + (long long)w;
-                cd_wall_out o = {s->wallc_force[r], s->wallc_torque[r], s->wallc_overlap[r], s->wallc_fn[r]};
-                mine[n] = (obs_wall){row, s->wallc_shear[r], o, s->wallc_active[r]};
+                cd_wall_entry o = cd_state_wall_entry(s, r);
+                mine[n] = (obs_wall){row, o};
                 dest[n++] = leaf_rank(x, &lp, lp.walls + row / CD_OBS_BLOCK);
             }
     char *got = NULL;
@@ -363,7 +361,7 @@ static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     m = len / sizeof(obs_wall);
     obs_wall *e = (obs_wall *)got;
     cd_int *start = calloc(N + 2, sizeof *start), *wrows = malloc((m + 1) * sizeof *wrows);
-    cd_wall_out *outs = malloc((m + 1) * sizeof *outs);
+    cd_wall_entry *outs = malloc((m + 1) * sizeof *outs);
     if (!start || !wrows || !outs) rc = -1;
     cd_long nb = lp.n - lp.walls;
     for (cd_long b = 0; !rc && b < nb; b++)
@@ -372,8 +370,8 @@ static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
             gs->wallc_active[r] = 0;
     if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: particles ascending */
     for (size_t k = 0; !rc && k < m; k++) {
-        gs->wallc_active[e[k].row] = (cd_int)e[k].active;
-        gs->wallc_shear[e[k].row] = e[k].shear;
+        gs->wallc_active[e[k].row] = e[k].out.active;
+        gs->wallc_shear[e[k].row] = e[k].out.shear;
         start[gs->prim_particle[e[k].row / (long long)W] + 1]++;
         wrows[k] = (cd_int)e[k].row;
         outs[k] = e[k].out;
@@ -502,8 +500,15 @@ int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total)
     if (!touch) MPI_Abort(x->comm, 1);
     cd_cols lc = cd_sim_host_cols(s);
     for (size_t k = 0; k < s->n_pairs; k++) cd_obs_item_touch_pair(lc, (cd_long)k, touch);
-    for (size_t r = 0; r < s->n_prims * s->n_walls; r++)
-        cd_obs_item_touch_wall(lc, (cd_long)r, (cd_int)s->n_walls, touch);
+    /* the wall rows in contact as the step's candidate entries (kernels/observe_items.h) */
+    size_t n_wall = cd_state_wall_entries(s, NULL, NULL);
+    cd_int *wrows = malloc((n_wall + 1) * sizeof *wrows);
+    cd_wall_entry *went = malloc((n_wall + 1) * sizeof *went);
+    if (!wrows || !went) MPI_Abort(x->comm, 1);
+    cd_state_wall_entries(s, wrows, went);
+    for (size_t e = 0; e < n_wall; e++) cd_obs_item_touch_wall(lc, (cd_long)e, (cd_int)s->n_walls, wrows, went, touch);
+    free(wrows);
+    free(went);
     /* the leaves: a function of the global counts only (kernels/observe_items.h) */
     leaf_plan lp;
     lp.particles = 0;
