@@ -19,7 +19,8 @@ printf '%s\n' 'solver: mpm' 'run: {dt: 2.0e-6, steps: 100, snapshot_every: 50, t
 "$capdem" run disk.yaml --output disk.h5 --quiet > out 2> err && ok || bad "diametral run: exit status $?"
 "$capdem" export disk.h5 > out 2> err && [ -f disk.xmf ] && grep -q "3 snapshots, 208 material points, 2 walls" out && ok \
   || bad "export of the diametral run: exit status $?, $(cat out)"
-xmllint --noout disk.xmf 2> err && ok || bad "disk.xmf: not well-formed XML"
+# well-formed XML: xmllint where installed (libxml2-utils); check_mpm_export.py parses it in any case
+if command -v xmllint > /dev/null; then xmllint --noout disk.xmf 2> err && ok || bad "disk.xmf: not well-formed XML"; fi
 check disk.xmf disk.h5 && ok || bad "disk.xmf: $(cat msg)"
 
 "$capdem" run "$src/configs/mpm/ci/deposit_disks.yaml" --quiet > out 2> err && ok || bad "the CI deposit did not run"
