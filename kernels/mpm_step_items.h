@@ -52,16 +52,26 @@ typedef struct {
     cd_real h, ox, oy; /* [m] */
 } cd_mpm_cols;
 
-/* A plane wall as the items see it: a point, the unit normal into the material. */
+/* The plane walls as the items see them: a point [m] and the unit normal
+ * into the material [1] of each, and the penalty stiffness k [N/m per m]. */
 typedef struct {
-    cd_real px, py, nx, ny; /* [m], [1] */
-} cd_mpm_item_wall;
+    cd_real px[CD_MPM_ITEM_MAX_WALLS], py[CD_MPM_ITEM_MAX_WALLS];
+    cd_real nx[CD_MPM_ITEM_MAX_WALLS], ny[CD_MPM_ITEM_MAX_WALLS];
+    cd_int n;
+    cd_real k;
+} cd_mpm_item_walls;
+
+/* Wall w's penalty overlap with point p [m] (<= 0: none). */
+CD_INLINE cd_real cd_mpm_item_wall_overlap(cd_mpm_cols c, cd_ulong p, cd_mpm_item_walls walls, cd_int w)
+{
+    return cd_mpm_wall_overlap(c.x[p], c.y[p], c.half[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p], walls.px[w],
+                               walls.py[w], walls.nx[w], walls.ny[w]);
+}
 
 /* Point p: its stencil (weights, gradients, first nodes) and the walls'
- * penalty force on it (stiffness wall_k [N/m per m]).  Returns 1 when its
- * stencil leaves the mesh (then first nodes 0), else 0. */
-CD_INLINE cd_int cd_mpm_item_prepare(cd_mpm_cols c, cd_ulong p, const cd_mpm_item_wall *walls, cd_int n_walls,
-                                     cd_real wall_k)
+ * penalty force on it.  Returns 1 when its stencil leaves the mesh (then
+ * first nodes 0), else 0. */
+CD_INLINE cd_int cd_mpm_item_prepare(cd_mpm_cols c, cd_ulong p, cd_mpm_item_walls walls)
 {
     cd_int bx = cd_mpm_weights_1d((c.x[p] - c.ox) / c.h, c.h, c.wx + CD_MPM_STENCIL * p, c.dwx + CD_MPM_STENCIL * p);
     cd_int by = cd_mpm_weights_1d((c.y[p] - c.oy) / c.h, c.h, c.wy + CD_MPM_STENCIL * p, c.dwy + CD_MPM_STENCIL * p);
@@ -70,12 +80,11 @@ CD_INLINE cd_int cd_mpm_item_prepare(cd_mpm_cols c, cd_ulong p, const cd_mpm_ite
     c.bx[p] = bx;
     c.by[p] = by;
     cd_real ex = 0, ey = 0; /* [N/m] */
-    for (cd_int w = 0; w < n_walls; w++) {
-        cd_real d = cd_mpm_wall_overlap(c.x[p], c.y[p], c.half[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p],
-                                        walls[w].px, walls[w].py, walls[w].nx, walls[w].ny);
+    for (cd_int w = 0; w < walls.n; w++) {
+        cd_real d = cd_mpm_item_wall_overlap(c, p, walls, w);
         if (d > 0) {
-            ex += wall_k * d * walls[w].nx;
-            ey += wall_k * d * walls[w].ny;
+            ex += walls.k * d * walls.nx[w];
+            ey += walls.k * d * walls.ny[w];
         }
     }
     c.ex[p] = ex;
@@ -251,6 +260,113 @@ CD_INLINE cd_int cd_mpm_item_stress(cd_mpm_cols c, cd_ulong p, cd_real dt, cd_mp
     c.f_yy[p] = gyx * fxy + (1 + gyy) * fyy;
     c.vol[p] *= cd_mpm_volume_ratio(gxx, gxy, gyx, gyy);
     return !(isfinite(c.x[p]) && isfinite(c.y[p]) && isfinite(s.xx) && isfinite(s.yy) && c.vol[p] > 0);
+}
+
+/* ---- the step's serial parts, as one-item loops (run where the loops run,
+ * so the state stays there; each in a fixed order: the same bits anywhere) */
+
+/* Wall w's force from the n points [N/m]: the reaction of their penalty
+ * forces, summed in point order, into f[2 w], f[2 w + 1]. */
+CD_INLINE void cd_mpm_item_wall_force(cd_mpm_cols c, cd_ulong n, cd_mpm_item_walls walls, cd_int w,
+                                      CD_GLOBAL cd_real *f)
+{
+    cd_real fx = 0, fy = 0;
+    for (cd_ulong p = 0; p < n; p++) {
+        cd_real d = cd_mpm_item_wall_overlap(c, p, walls, w);
+        if (d > 0) {
+            fx -= walls.k * d * walls.nx[w];
+            fy -= walls.k * d * walls.ny[w];
+        }
+    }
+    f[2 * w] = fx;
+    f[2 * w + 1] = fy;
+}
+
+/* The windows' first body-nodes (win_off[0] = 0 stays); their total into *total. */
+CD_INLINE void cd_mpm_item_window_offsets(cd_mpm_cols c, CD_GLOBAL cd_ulong *total)
+{
+    for (cd_int k = 0; k < c.n_bodies; k++)
+        c.win_off[k + 1] = c.win_off[k] + (cd_ulong)c.win_nx[k] * (cd_ulong)c.win_ny[k];
+    *total = c.win_off[c.n_bodies];
+}
+
+/* Body k's body-nodes name it. */
+CD_INLINE void cd_mpm_item_bnode_body(cd_mpm_cols c, cd_int k)
+{
+    for (cd_ulong t = c.win_off[k]; t < c.win_off[k + 1]; t++) c.bnode_body[t] = k;
+}
+
+/* The n points sorted by (body, cell) into order, stably (a counting sort
+ * over the nbn body-cells), and each cell's first entry in cell_start. */
+CD_INLINE void cd_mpm_item_sort_points(cd_mpm_cols c, cd_ulong n, cd_ulong nbn)
+{
+    CD_GLOBAL cd_ulong *cs = c.cell_start;
+    for (cd_ulong q = 0; q <= nbn; q++) cs[q] = 0;
+    for (cd_ulong p = 0; p < n; p++) cs[cd_mpm_point_cell(c, p) + 1]++;
+    for (cd_ulong q = 0; q < nbn; q++) cs[q + 1] += cs[q];
+    for (cd_ulong p = 0; p < n; p++) c.order[cs[cd_mpm_point_cell(c, p)]++] = p;
+    for (cd_ulong q = nbn; q > 0; q--) cs[q] = cs[q - 1];
+    cs[0] = 0;
+}
+
+/* Sum of m_i v_i^2 / 2 over the nbn body-nodes, in their order [J/m]. */
+CD_INLINE void cd_mpm_item_mesh_kinetic(cd_mpm_cols c, cd_ulong nbn, CD_GLOBAL cd_real *e)
+{
+    cd_real sum = 0;
+    for (cd_ulong t = 0; t < nbn; t++) sum += CD_R(0.5) * c.gm[t] * (c.gvx[t] * c.gvx[t] + c.gvy[t] * c.gvy[t]);
+    *e = sum;
+}
+
+/* The common node of body-node t. */
+CD_INLINE cd_ulong cd_mpm_common_node(cd_mpm_cols c, cd_ulong t)
+{
+    cd_int k = c.bnode_body[t];
+    cd_ulong local = t - c.win_off[k];
+    cd_int i = c.win_i0[k] + (cd_int)(local % (cd_ulong)c.win_nx[k]);
+    cd_int j = c.win_j0[k] + (cd_int)(local / (cd_ulong)c.win_nx[k]);
+    return (cd_ulong)j * (cd_ulong)c.nx + (cd_ulong)i;
+}
+
+/* The common nodes' body-nodes with mass, sorted by common node (a stable
+ * counting sort: bodies ascending), into cn_start / cn_entry; the common
+ * nodes holding two or more into cn_list, their count into *listed. */
+CD_INLINE void cd_mpm_item_contact_nodes(cd_mpm_cols c, cd_ulong nbn, CD_GLOBAL cd_ulong *listed)
+{
+    cd_ulong nn = (cd_ulong)c.nx * (cd_ulong)c.ny;
+    CD_GLOBAL cd_ulong *cs = c.cn_start;
+    for (cd_ulong g = 0; g <= nn; g++) cs[g] = 0;
+    for (cd_ulong t = 0; t < nbn; t++)
+        if (c.gm[t] > 0) cs[cd_mpm_common_node(c, t) + 1]++;
+    for (cd_ulong g = 0; g < nn; g++) cs[g + 1] += cs[g];
+    for (cd_ulong t = 0; t < nbn; t++)
+        if (c.gm[t] > 0) c.cn_entry[cs[cd_mpm_common_node(c, t)]++] = t;
+    for (cd_ulong g = nn; g > 0; g--) cs[g] = cs[g - 1];
+    cs[0] = 0;
+    cd_ulong n_cn = 0;
+    for (cd_ulong g = 0; g < nn; g++)
+        if (cs[g + 1] - cs[g] >= 2) c.cn_list[n_cn++] = g;
+    *listed = n_cn;
+}
+
+/* The body pairs in contact at the n_cn listed nodes (bit q of cn_active
+ * for a node's q-th pair), as keys k n_bodies + l, node by node, into keys
+ * when not NULL; their number into *count. */
+CD_INLINE void cd_mpm_item_pair_keys(cd_mpm_cols c, cd_ulong n_cn, CD_GLOBAL cd_long *keys, CD_GLOBAL cd_ulong *count)
+{
+    cd_ulong w = 0;
+    for (cd_ulong ci = 0; ci < n_cn; ci++) {
+        cd_ulong g = c.cn_list[ci], first = c.cn_start[g], cnt = c.cn_start[g + 1] - first;
+        cd_int q = 0;
+        for (cd_ulong a = 0; a < cnt; a++)
+            for (cd_ulong b = a + 1; b < cnt; b++, q++)
+                if (c.cn_active[ci] >> q & 1u) {
+                    if (keys)
+                        keys[w] = (cd_long)c.bnode_body[c.cn_entry[first + a]] * c.n_bodies +
+                                  c.bnode_body[c.cn_entry[first + b]];
+                    w++;
+                }
+    }
+    *count = w;
 }
 
 CD_DEVICE_END

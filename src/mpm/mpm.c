@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mpm/mpm.h"
-#include "core/sim.h" /* CD_PARALLEL: small loops on one thread */
+#include "backend/omp/omp_loops.h" /* CD_STEP_FOR: the loops of the step, on the host or the offload device */
 #include "mpm_step_items.h"
 
 int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, double oy, char *err, size_t errlen)
@@ -43,6 +43,7 @@ int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, doubl
 
 void cd_mpm_free(cd_mpm *m)
 {
+    cd_mpm_device_stop(m);
     void *cols[] = {m->x,          m->y,        m->vx,       m->vy,       m->mass,      m->vol,      m->half,
                     m->sxx,        m->syy,      m->sxy,      m->szz,      m->eps_p,     m->f_xx,     m->f_xy,
                     m->f_yx,       m->f_yy,     m->ex,       m->ey,       m->wx,        m->wy,       m->dwx,
@@ -198,17 +199,21 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
 {
     size_t n = m->n;
     long long bad = -1;
-    cd_mpm_item_wall walls[CD_MPM_ITEM_MAX_WALLS];
-    int nw = m->n_walls;
-    for (int w = 0; w < nw; w++)
-        walls[w] = (cd_mpm_item_wall){m->walls[w].px, m->walls[w].py, m->walls[w].nx, m->walls[w].ny};
-    double wall_k = m->wall_k;
-    cd_mpm_cols c = cd_mpm_step_cols(m);
-#pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(n))
+    cd_mpm_item_walls walls = {.n = m->n_walls, .k = m->wall_k};
+    for (int w = 0; w < m->n_walls; w++) {
+        walls.px[w] = m->walls[w].px;
+        walls.py[w] = m->walls[w].py;
+        walls.nx[w] = m->walls[w].nx;
+        walls.ny[w] = m->walls[w].ny;
+    }
+    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, walls) reduction(max : bad) CD_DEV(map(tofrom : bad)))
     for (size_t p = 0; p < n; p++)
-        if (cd_mpm_item_prepare(c, p, walls, nw, wall_k)) bad = (long long)p > bad ? (long long)p : bad;
+        if (cd_mpm_item_prepare(c, p, walls)) bad = (long long)p > bad ? (long long)p : bad;
     if (bad >= 0) {
         size_t p = (size_t)bad;
+        cd_mpm_device_sync(m);
         snprintf(err, errlen,
                  "material point %zu at (%.6g, %.6g) m (t = %.9g s, step %lld) left the background mesh "
                  "[%.6g, %.6g] x [%.6g, %.6g] m: the run blew up, or the set-up leaves too little room",
@@ -217,41 +222,36 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
         return -1;
     }
     /* wall forces: the reaction of the points' penalty forces, summed in point order */
-    for (int w = 0; w < m->n_walls; w++) {
-        cd_mpm_wall *W = &m->walls[w];
-        double fx = 0, fy = 0;
-        for (size_t p = 0; p < n; p++) {
-            double d = cd_mpm_wall_overlap(m->x[p], m->y[p], m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p], m->f_yy[p],
-                                           W->px, W->py, W->nx, W->ny);
-            if (d > 0) {
-                fx -= m->wall_k * d * W->nx;
-                fy -= m->wall_k * d * W->ny;
-            }
-        }
-        W->fx = fx;
-        W->fy = fy;
+    double *wf = m->loop_wall_f, f[2 * CD_MPM_MAX_WALLS]; /* [N/m] */
+    int nw = m->n_walls;
+    CD_STEP_FOR(nw, firstprivate(c, walls, n) CD_DEV(is_device_ptr(wf)))
+    for (int w = 0; w < nw; w++) cd_mpm_item_wall_force(c, n, walls, w, wf);
+    cd_dev_get(f, wf, 2 * (size_t)nw * sizeof(double));
+    for (int w = 0; w < nw; w++) {
+        m->walls[w].fx = f[2 * w];
+        m->walls[w].fy = f[2 * w + 1];
     }
-    /* each body's window: the nodes its points' stencils reach */
+    /* each body's window: the nodes its points' stencils reach, and where its nodes start */
     int nb = m->n_bodies;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(n))
+    CD_STEP_FOR(nb, firstprivate(c))
     for (int k = 0; k < nb; k++) cd_mpm_item_window(c, k);
-    for (int k = 0; k < nb; k++) m->win_off[k + 1] = m->win_off[k] + (size_t)m->win_nx[k] * (size_t)m->win_ny[k];
-    size_t nbn = m->win_off[nb];
+    cd_ulong *count = m->loop_count, nbn;
+    CD_STEP_FOR(1, firstprivate(c) CD_DEV(is_device_ptr(count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_window_offsets(c, count);
+    cd_dev_get(&nbn, count, sizeof nbn);
     if (reserve_bnodes(m, nbn, err, errlen)) return -1;
+    if (cd_mpm_device_reserve(m, nbn)) {
+        snprintf(err, errlen, "out of device memory for %zu body-nodes", (size_t)nbn);
+        return -1;
+    }
     m->n_bnodes = nbn;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(n))
-    for (int k = 0; k < nb; k++)
-        for (size_t t = m->win_off[k]; t < m->win_off[k + 1]; t++) m->bnode_body[t] = k;
+    c = cd_mpm_loop_cols(m); /* the body-node columns may have moved */
+    CD_STEP_FOR(nb, firstprivate(c))
+    for (int k = 0; k < nb; k++) cd_mpm_item_bnode_body(c, k);
     /* stable counting sort by (body, cell): a point's cell is its stencil's
      * second node, numbered like the body's nodes */
-    size_t *cs = m->cell_start;
-    memset(cs, 0, (nbn + 1) * sizeof(size_t));
-    c = cd_mpm_step_cols(m); /* the body-node columns may have moved */
-    for (size_t p = 0; p < n; p++) cs[cd_mpm_point_cell(c, p) + 1]++;
-    for (size_t q = 0; q < nbn; q++) cs[q + 1] += cs[q];
-    for (size_t p = 0; p < n; p++) m->order[cs[cd_mpm_point_cell(c, p)]++] = p;
-    for (size_t q = nbn; q > 0; q--) cs[q] = cs[q - 1];
-    cs[0] = 0;
+    CD_STEP_FOR(1, firstprivate(c, n, nbn))
+    for (int one = 0; one < 1; one++) cd_mpm_item_sort_points(c, n, nbn);
     return 0;
 }
 
@@ -259,36 +259,36 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
 {
     double dt = m->dt;
     if (m->n_bodies == 0 && cd_mpm_bodies(m, err, errlen)) return -1;
-    if (prepare(m, err, errlen)) return -1;
-    cd_mpm_cols c = cd_mpm_step_cols(m);
-    long nbn = (long)m->n_bnodes;
+    if (cd_mpm_device_start(m, err, errlen) || prepare(m, err, errlen)) return -1;
+    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    size_t n = m->n, nbn = m->n_bnodes;
     int normals = m->n_bodies > 1;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(nbn))
-    for (long t = 0; t < nbn; t++) cd_mpm_item_to_grid(c, (size_t)t, normals);
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(nbn))
-    for (long t = 0; t < nbn; t++) cd_mpm_item_node_update(c, (size_t)t, dt);
-    if (m->n_bodies > 1) {
-        cd_mpm_contact_nodes(m);
-        if (cd_mpm_contact_correct(m, err, errlen)) return -1;
-    }
+    CD_WIDE_MIN
+    CD_STEP_FOR(nbn, firstprivate(c, normals))
+    for (size_t t = 0; t < nbn; t++) cd_mpm_item_to_grid(c, t, normals);
+    CD_STEP_FOR(nbn, firstprivate(c, dt))
+    for (size_t t = 0; t < nbn; t++) cd_mpm_item_node_update(c, t, dt);
+    if (m->n_bodies > 1 && (cd_mpm_contact_nodes(m), cd_mpm_contact_correct(m, err, errlen))) return -1;
     double pic = m->pic_fraction; /* [1] */
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(m->n))
-    for (size_t p = 0; p < m->n; p++) cd_mpm_item_point_update(c, p, dt, pic);
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(nbn))
-    for (long t = 0; t < nbn; t++) cd_mpm_item_remap(c, (size_t)t);
-    double mesh_kinetic = 0; /* [J/m], summed in body-node order: the same bits for any thread count */
-    for (size_t t = 0; t < m->n_bnodes; t++)
-        mesh_kinetic += 0.5 * m->gm[t] * (m->gvx[t] * m->gvx[t] + m->gvy[t] * m->gvy[t]);
-    m->mesh_kinetic = mesh_kinetic;
+    CD_STEP_FOR(n, firstprivate(c, dt, pic))
+    for (size_t p = 0; p < n; p++) cd_mpm_item_point_update(c, p, dt, pic);
+    CD_STEP_FOR(nbn, firstprivate(c))
+    for (size_t t = 0; t < nbn; t++) cd_mpm_item_remap(c, t);
+    /* [J/m], summed in body-node order: the same bits for any thread count */
+    double *e = m->loop_real;
+    CD_STEP_FOR(1, firstprivate(c, nbn) CD_DEV(is_device_ptr(e)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_mesh_kinetic(c, nbn, e);
+    cd_dev_get(&m->mesh_kinetic, e, sizeof(double));
     /* no second contact correction of the remapped velocities: the strain follows each body's own
      * remapped field, the motion its points made; re-imposing the contact there, on the contact's
      * widened nodes, made strain the points' motion did not have and fed energy (docs/mpm.md) */
     long long bad = -1;
     cd_mpm_material mat = m->mat;
-#pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(m->n))
-    for (size_t p = 0; p < m->n; p++)
+    CD_STEP_FOR(n, firstprivate(c, dt, mat) reduction(max : bad) CD_DEV(map(tofrom : bad)))
+    for (size_t p = 0; p < n; p++)
         if (cd_mpm_item_stress(c, p, dt, mat)) bad = (long long)p > bad ? (long long)p : bad;
     if (bad >= 0) {
+        cd_mpm_device_sync(m);
         snprintf(err, errlen,
                  "material point %lld is not finite or has a volume <= 0 at step %lld (t = %.9g s): the run "
                  "blew up; reduce run.dt (limit %.3g s) or check the material",

@@ -81,6 +81,14 @@ typedef struct {
                           * points' kinetic energy the mesh sees (docs/mpm.md "FLIP's noise") */
     double dt, time;     /* [s] */
     long long step;
+
+    /* where the step's loops run (src/mpm/mpm_device.c, docs/mpm.md "Work items") */
+    int loop_on;                     /* 1 from the first step on (offload builds: the state is on the device) */
+    cd_mpm_cols loop_cols;           /* offload builds: the device addresses of the columns */
+    size_t loop_cap, loop_cap_keys;  /* offload builds: body-nodes allocated there; pair keys allocated */
+    double *loop_wall_f, *loop_real; /* where the loops run: wall forces [N/m], the mesh's kinetic energy */
+    cd_ulong *loop_count;            /* where the loops run: counts the serial parts return */
+    cd_long *loop_keys;              /* where the loops run: the contact pairs' keys */
 } cd_mpm;
 
 /* Allocates n points and an nx x ny node mesh of cell size h [m] whose
@@ -128,9 +136,24 @@ void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double
  * than CD_MPM_NODE_BODIES (kernels/mpm_contact.h) meet at a node. */
 void cd_mpm_contact_nodes(cd_mpm *m);
 int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen);
-/* The columns and mesh the step's items (kernels/mpm_step_items.h) work
- * on: m's own (valid until the body-node columns grow). */
+/* The columns and mesh of m's own (host) memory (valid until the
+ * body-node columns grow). */
 cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m);
+
+/* Where the step's loops run (src/mpm/mpm_device.c).  The default build
+ * runs them on host threads over m's columns; offload builds put the state
+ * on the offload device at the first step (cd_mpm_device_start, which
+ * cd_mpm_step calls), and its host columns are current only after
+ * cd_mpm_device_sync.  A host change to the columns after the first step
+ * needs cd_mpm_device_stop first.  cd_mpm_loop_cols: the columns the
+ * loops work on; cd_mpm_device_reserve / _keys: room there for n
+ * body-nodes / contact keys (0, or -1 out of memory). */
+int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen);
+void cd_mpm_device_sync(cd_mpm *m);
+void cd_mpm_device_stop(cd_mpm *m);
+cd_mpm_cols cd_mpm_loop_cols(const cd_mpm *m);
+int cd_mpm_device_reserve(cd_mpm *m, size_t n);
+int cd_mpm_device_keys(cd_mpm *m, size_t n);
 /* The common-mesh coordinates (i, j) of body-node t. */
 static inline void cd_mpm_bnode_ij(const cd_mpm *m, size_t t, int *i, int *j)
 {

@@ -18,31 +18,19 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mpm/mpm.h"
-#include "core/sim.h" /* CD_PARALLEL */
+#include "backend/omp/omp_loops.h" /* CD_STEP_FOR */
 #include "mpm_contact.h"
 
 
-static size_t common_node(const cd_mpm *m, size_t t)
-{
-    int i, j;
-    cd_mpm_bnode_ij(m, t, &i, &j);
-    return (size_t)j * (size_t)m->nx + (size_t)i;
-}
-
 void cd_mpm_contact_nodes(cd_mpm *m)
 {
-    size_t nn = (size_t)m->nx * (size_t)m->ny, nbn = m->n_bnodes, *cs = m->cn_start;
-    memset(cs, 0, (nn + 1) * sizeof(size_t));
-    for (size_t t = 0; t < nbn; t++)
-        if (m->gm[t] > 0) cs[common_node(m, t) + 1]++;
-    for (size_t g = 0; g < nn; g++) cs[g + 1] += cs[g];
-    for (size_t t = 0; t < nbn; t++)
-        if (m->gm[t] > 0) m->cn_entry[cs[common_node(m, t)]++] = t;
-    for (size_t g = nn; g > 0; g--) cs[g] = cs[g - 1];
-    cs[0] = 0;
-    m->n_cn = 0;
-    for (size_t g = 0; g < nn; g++)
-        if (cs[g + 1] - cs[g] >= 2) m->cn_list[m->n_cn++] = g;
+    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    cd_ulong *listed = m->loop_count, nbn = m->n_bnodes, n_cn;
+    CD_WIDE_MIN
+    CD_STEP_FOR(1, firstprivate(c, nbn) CD_DEV(is_device_ptr(listed)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_contact_nodes(c, nbn, listed);
+    cd_dev_get(&n_cn, listed, sizeof n_cn);
+    m->n_cn = n_cn;
 }
 
 static int cmp_key(const void *a, const void *b)
@@ -55,27 +43,31 @@ static int cmp_key(const void *a, const void *b)
  * contact bits. */
 static int count_pairs(cd_mpm *m, char *err, size_t errlen)
 {
-    size_t n = 0;
-    for (size_t c = 0; c < m->n_cn; c++) n += (size_t)__builtin_popcount(m->cn_active[c]);
+    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    cd_ulong *count = m->loop_count, n_cn = m->n_cn, n;
+    cd_long *none = NULL;
+    CD_WIDE_MIN
+    CD_STEP_FOR(1, firstprivate(c, n_cn, none) CD_DEV(is_device_ptr(count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, none, count);
+    cd_dev_get(&n, count, sizeof n);
     if (n > m->cap_pairs) {
         long long *q = realloc(m->pair_keys, (n + 64) * sizeof(long long));
         if (!q) {
-            snprintf(err, errlen, "out of memory for %zu contact pairs", n);
+            snprintf(err, errlen, "out of memory for %zu contact pairs", (size_t)n);
             return -1;
         }
         m->pair_keys = q;
         m->cap_pairs = n + 64;
     }
-    size_t w = 0;
-    for (size_t c = 0; c < m->n_cn; c++) {
-        size_t g = m->cn_list[c], first = m->cn_start[g], cnt = m->cn_start[g + 1] - first;
-        int q = 0;
-        for (size_t a = 0; a < cnt; a++)
-            for (size_t b = a + 1; b < cnt; b++, q++)
-                if (m->cn_active[c] >> q & 1u)
-                    m->pair_keys[w++] = (long long)m->bnode_body[m->cn_entry[first + a]] * m->n_bodies +
-                                        m->bnode_body[m->cn_entry[first + b]];
+    if (cd_mpm_device_keys(m, n)) {
+        snprintf(err, errlen, "out of device memory for %zu contact pairs", (size_t)n);
+        return -1;
     }
+    cd_long *keys = m->loop_keys;
+    CD_STEP_FOR(1, firstprivate(c, n_cn) CD_DEV(is_device_ptr(keys, count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, keys, count);
+    cd_dev_get(m->pair_keys, keys, n * sizeof(cd_long));
+    size_t w = (size_t)n;
     if (w) qsort(m->pair_keys, w, sizeof(long long), cmp_key); /* (no keys: pair_keys may be NULL) */
     long distinct = 0;
     for (size_t i = 0; i < w; i++) distinct += i == 0 || m->pair_keys[i] != m->pair_keys[i - 1];
@@ -89,18 +81,20 @@ int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen)
     double pen = 0, dt = m->dt;
     long ncn = (long)m->n_cn;
     double gap_max = m->contact_gap; /* [m] */
-    cd_mpm_cols c = cd_mpm_step_cols(m);
-#pragma omp parallel for schedule(static) reduction(max : bad, pen) if (CD_PARALLEL(ncn))
+    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    CD_WIDE_MIN
+    CD_STEP_FOR(ncn, firstprivate(c, gap_max, dt) reduction(max : bad, pen) CD_DEV(map(tofrom : bad, pen)))
     for (long ci = 0; ci < ncn; ci++) {
         double over = pen;
         if (cd_mpm_item_contact(c, (size_t)ci, gap_max, dt, &over)) {
-            long long g = (long long)m->cn_list[ci];
+            long long g = (long long)c.cn_list[ci];
             bad = g > bad ? g : bad;
         }
         pen = over;
     }
     if (bad >= 0) {
         size_t g = (size_t)bad;
+        cd_mpm_device_sync(m); /* the common node's body count, for the message */
         snprintf(err, errlen,
                  "common node (%zu, %zu) at step %lld: %zu bodies meet there, more than the %d the contact "
                  "handles: refine the mesh (mpm.cells_per_diameter)",
