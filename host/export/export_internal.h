@@ -97,6 +97,11 @@ int cd_export_snapshots_group(cd_export_ctx *x);
 int cd_export_describe(hid_t f, const char *path, cd_export_field *fl);
 hid_t cd_export_reuse(hid_t parent, const char *name, H5D_layout_t layout, int rank, const hsize_t *dims);
 int cd_export_read_attr_ll(hid_t loc, const char *name, long long *v, int n);
+/* export_viz.c: opens /visualization when its int64 attributes names[0..n-1]
+ * hold want[], else makes a fresh one with them, the string attributes
+ * solver (when not NULL) and about.  0, or -1 with x failed. */
+int cd_export_open_viz_with(cd_export_ctx *x, int n, const char *const *names, const long long *want,
+                            const char *solver, const char *about);
 void cd_export_write_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype, int n, const void *v);
 
 /* export_xdmf.c: the .xmf's pieces.  A <DataItem> naming file:path of

@@ -172,42 +172,16 @@ static int mpm_read(cd_export_ctx *x)
     return 0;
 }
 
-/* Opens /visualization, or makes a fresh one when the stored one was made for
- * another layout, solver or count. */
+/* /visualization of an mpm run: for this layout version and these point
+ * and wall counts. */
 static int mpm_open_viz(cd_export_ctx *x)
 {
-    long long want[3] = {CD_EXPORT_LAYOUT, (long long)x->N, (long long)x->P}, have[3];
     const char *names[3] = {"layout", "n_points", "n_walls"};
-    if (H5Lexists(x->vf, "visualization", H5P_DEFAULT) > 0) {
-        hid_t g = H5Gopen2(x->vf, "visualization", H5P_DEFAULT);
-        int same = g >= 0;
-        for (int i = 0; i < 3 && same; i++)
-            same = !cd_export_read_attr_ll(g, names[i], &have[i], 1) && have[i] == want[i];
-        if (same) {
-            x->viz = g;
-            return 0;
-        }
-        if (g >= 0) H5Gclose(g);
-        H5Ldelete(x->vf, "visualization", H5P_DEFAULT);
-    }
-    x->viz = H5Gcreate2(x->vf, "visualization", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (x->viz < 0) {
-        char why[256];
-        return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization (HDF5: %s)", x->path,
-                              cd_export_h5_reason(why));
-    }
-    for (int i = 0; i < 3; i++) cd_export_write_attr(x->viz, names[i], H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[i]);
-    const char *text[2][2] = {
-        {"solver", "mpm"},
-        {"about", "helper datasets of `capdem export` (docs/visualization.md): connectivity, walls, particle "
-                  "outlines, and virtual datasets selecting one snapshot of the run's datasets; safe to delete"}};
-    for (int i = 0; i < 2; i++) {
-        hid_t t = H5Tcopy(H5T_C_S1);
-        H5Tset_size(t, strlen(text[i][1]) + 1);
-        cd_export_write_attr(x->viz, text[i][0], t, t, 1, text[i][1]);
-        H5Tclose(t);
-    }
-    return 0;
+    long long want[3] = {CD_EXPORT_LAYOUT, (long long)x->N, (long long)x->P};
+    return cd_export_open_viz_with(
+        x, 3, names, want, "mpm",
+        "helper datasets of `capdem export` (docs/visualization.md): connectivity, walls, particle outlines, "
+        "and virtual datasets selecting one snapshot of the run's datasets; safe to delete");
 }
 
 static int mpm_fixed_helpers(cd_export_ctx *x)

@@ -172,16 +172,14 @@ void cd_export_write_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
     H5Sclose(sp);
 }
 
-/* Opens /visualization, or makes a fresh one when the stored one was made for
- * another layout version or another particle / primitive count. */
-static int cd_export_open_viz(cd_export_ctx *x)
+int cd_export_open_viz_with(cd_export_ctx *x, int n, const char *const *names, const long long *want,
+                            const char *solver, const char *about)
 {
-    long long want[3] = {CD_EXPORT_LAYOUT, (long long)x->N, (long long)x->P}, have[3];
     if (H5Lexists(x->vf, "visualization", H5P_DEFAULT) > 0) {
         hid_t g = H5Gopen2(x->vf, "visualization", H5P_DEFAULT);
-        int same = g >= 0 && !cd_export_read_attr_ll(g, "layout", &have[0], 1) &&
-                   !cd_export_read_attr_ll(g, "n_particles", &have[1], 1) &&
-                   !cd_export_read_attr_ll(g, "n_prims", &have[2], 1) && !memcmp(want, have, sizeof want);
+        int same = g >= 0;
+        long long have;
+        for (int i = 0; i < n && same; i++) same = !cd_export_read_attr_ll(g, names[i], &have, 1) && have == want[i];
         if (same) {
             x->viz = g;
             return 0;
@@ -195,17 +193,27 @@ static int cd_export_open_viz(cd_export_ctx *x)
         return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization (HDF5: %s)", x->path,
                               cd_export_h5_reason(why));
     }
-    cd_export_write_attr(x->viz, "layout", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[0]);
-    cd_export_write_attr(x->viz, "n_particles", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[1]);
-    cd_export_write_attr(x->viz, "n_prims", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[2]);
-    const char *about =
-        "helper datasets of `capdem export` (docs/visualization.md): connectivity, and virtual datasets "
-        "selecting one snapshot of the run's datasets; safe to delete";
-    hid_t t = H5Tcopy(H5T_C_S1);
-    H5Tset_size(t, strlen(about) + 1);
-    cd_export_write_attr(x->viz, "about", t, t, 1, about);
-    H5Tclose(t);
+    for (int i = 0; i < n; i++) cd_export_write_attr(x->viz, names[i], H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[i]);
+    const char *text[2][2] = {{"solver", solver}, {"about", about}};
+    for (int i = solver ? 0 : 1; i < 2; i++) {
+        hid_t t = H5Tcopy(H5T_C_S1);
+        H5Tset_size(t, strlen(text[i][1]) + 1);
+        cd_export_write_attr(x->viz, text[i][0], t, t, 1, text[i][1]);
+        H5Tclose(t);
+    }
     return 0;
+}
+
+/* /visualization of a DEM run: for this layout version and these particle
+ * and primitive counts. */
+static int cd_export_open_viz(cd_export_ctx *x)
+{
+    const char *names[3] = {"layout", "n_particles", "n_prims"};
+    long long want[3] = {CD_EXPORT_LAYOUT, (long long)x->N, (long long)x->P};
+    return cd_export_open_viz_with(
+        x, 3, names, want, NULL,
+        "helper datasets of `capdem export` (docs/visualization.md): connectivity, and virtual datasets "
+        "selecting one snapshot of the run's datasets; safe to delete");
 }
 
 /* The helpers shared by every snapshot. */

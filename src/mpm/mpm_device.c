@@ -83,6 +83,28 @@ static void *devptr(void *p)
 
 #define MPM_MAPPED 40
 
+enum { MAP_ENTER, MAP_UPDATE_FROM, MAP_DELETE };
+
+/* Every mapped column: mapped to the device, brought back, or unmapped. */
+static void map_all(cd_mpm *m, int op)
+{
+    void *host[MPM_MAPPED];
+    size_t bytes[MPM_MAPPED];
+    int k = mapped_cols(m, host, bytes);
+    for (int i = 0; i < k; i++) {
+        char *c = host[i];
+        size_t nb = bytes[i];
+        if (!c || !nb) continue;
+        if (op == MAP_ENTER) {
+#pragma omp target enter data map(to : c [0:nb])
+        } else if (op == MAP_UPDATE_FROM) {
+#pragma omp target update from(c [0:nb])
+        } else {
+#pragma omp target exit data map(delete : c [0:nb])
+        }
+    }
+}
+
 static void free_bnodes(cd_mpm *m)
 {
     cd_mpm_cols *c = &m->loop_cols;
@@ -114,16 +136,7 @@ int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen)
         return -1;
     }
 #if CD_OFFLOAD
-    void *host[MPM_MAPPED];
-    size_t bytes[MPM_MAPPED];
-    int k = mapped_cols(m, host, bytes);
-    for (int i = 0; i < k; i++) {
-        char *c = host[i];
-        size_t nb = bytes[i];
-        if (c && nb) {
-#pragma omp target enter data map(to : c [0:nb])
-        }
-    }
+    map_all(m, MAP_ENTER);
     cd_mpm_cols c = cd_mpm_step_cols(m);
     CD_GLOBAL cd_real **dcols[] = {&c.x,   &c.y,   &c.vx,  &c.vy,    &c.mass, &c.vol,  &c.half, &c.sxx,
                                    &c.syy, &c.sxy, &c.szz, &c.eps_p, &c.f_xx, &c.f_xy, &c.f_yx, &c.f_yy,
@@ -193,17 +206,7 @@ cd_mpm_cols cd_mpm_loop_cols(const cd_mpm *m)
 void cd_mpm_device_sync(cd_mpm *m)
 {
 #if CD_OFFLOAD
-    if (!m->loop_on) return;
-    void *host[MPM_MAPPED];
-    size_t bytes[MPM_MAPPED];
-    int k = mapped_cols(m, host, bytes);
-    for (int i = 0; i < k; i++) {
-        char *c = host[i];
-        size_t nb = bytes[i];
-        if (c && nb) {
-#pragma omp target update from(c [0:nb])
-        }
-    }
+    if (m->loop_on) map_all(m, MAP_UPDATE_FROM);
 #else
     (void)m;
 #endif
@@ -213,16 +216,7 @@ void cd_mpm_device_stop(cd_mpm *m)
 {
 #if CD_OFFLOAD
     if (m->loop_on) {
-        void *host[MPM_MAPPED];
-        size_t bytes[MPM_MAPPED];
-        int k = mapped_cols(m, host, bytes);
-        for (int i = 0; i < k; i++) {
-            char *c = host[i];
-            size_t nb = bytes[i];
-            if (c && nb) {
-#pragma omp target exit data map(delete : c [0:nb])
-            }
-        }
+        map_all(m, MAP_DELETE);
         free_bnodes(m);
     }
 #endif
