@@ -103,6 +103,13 @@ CD_INLINE void cd_mpm_contact_extent(cd_mpm_cols c, cd_int k, cd_int gi, cd_int 
     }
 }
 
+/* 1 when more than CD_MPM_NODE_BODIES bodies meet at listed common node ci. */
+CD_INLINE cd_int cd_mpm_item_contact_crowded(cd_mpm_cols c, cd_ulong ci)
+{
+    cd_ulong g = c.cn_list[ci];
+    return c.cn_start[g + 1] - c.cn_start[g] > CD_MPM_NODE_BODIES;
+}
+
 /* Listed common node ci: every pair of its bodies whose material comes
  * within gap_max [m] of each other on the lines is in contact (bit q of
  * cn_active); an approaching pair loses the normal component of its
@@ -113,8 +120,8 @@ CD_INLINE void cd_mpm_contact_extent(cd_mpm_cols c, cd_int k, cd_int gi, cd_int 
  * CD_MPM_NODE_BODIES bodies meet at the node (nothing done), else 0. */
 CD_INLINE cd_int cd_mpm_item_contact(cd_mpm_cols c, cd_ulong ci, cd_real gap_max, cd_real dt, cd_real *pen)
 {
+    if (cd_mpm_item_contact_crowded(c, ci)) return 1;
     cd_ulong g = c.cn_list[ci], first = c.cn_start[g], cnt = c.cn_start[g + 1] - first;
-    if (cnt > CD_MPM_NODE_BODIES) return 1;
     cd_int gi = (cd_int)(g % (cd_ulong)c.nx), gj = (cd_int)(g / (cd_ulong)c.nx);
     cd_real xi = c.ox + gi * c.h, yi = c.oy + gj * c.h; /* node position [m] */
     cd_uint act = 0u, moved = 0u;
