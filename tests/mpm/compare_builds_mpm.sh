@@ -2,7 +2,7 @@
 # The material point method on two capdem binaries (docs/offload.md, "Host
 # offload devices in CI"; docs/mpm.md, "Work items"): first the offload
 # binary must really launch the step's loops on offload device 0 and copy
-# data back (LIBOMPTARGET_INFO: 16 kernels a step on the CI packing), so a
+# data back (LIBOMPTARGET_INFO: 17 kernels a step on the CI packing), so a
 # silent host fallback fails; then the plastic CI disk (300 steps) and the
 # CI elastic packing (600 steps, stopped at 300 and resumed) run on a
 # default build's capdem and on the host-offload build's, and their run
