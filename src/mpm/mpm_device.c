@@ -22,52 +22,20 @@
 static int mapped_cols(cd_mpm *m, void **host, size_t *bytes)
 {
     size_t n = m->n, nb = (size_t)m->n_bodies, nn = (size_t)m->nx * (size_t)m->ny, d = sizeof(double),
-           st = CD_MPM_STENCIL;
-    void *h[] = {m->x,      m->y,        m->vx,     m->vy,     m->mass,     m->vol,     m->half,
-                 m->sxx,    m->syy,      m->sxy,    m->szz,    m->eps_p,    m->f_xx,    m->f_xy,
-                 m->f_yx,   m->f_yy,     m->ex,     m->ey,     m->wx,       m->wy,      m->dwx,
-                 m->dwy,    m->particle, m->bx,     m->by,     m->order,    m->pfirst,  m->win_off,
-                 m->win_i0, m->win_j0,   m->win_nx, m->win_ny, m->cn_start, m->cn_list, m->cn_active};
-    size_t b[] = {n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  n * d,
-                  st * n * d,
-                  st * n * d,
-                  st * n * d,
-                  st * n * d,
-                  n * sizeof(int),
-                  n * sizeof(int),
-                  n * sizeof(int),
-                  n * sizeof(cd_ulong),
-                  (nb + 1) * sizeof(cd_ulong),
-                  (nb + 1) * sizeof(cd_ulong),
-                  nb * sizeof(int),
-                  nb * sizeof(int),
-                  nb * sizeof(int),
-                  nb * sizeof(int),
-                  (nn + 1) * sizeof(cd_ulong),
-                  nn * sizeof(cd_ulong),
-                  nn * sizeof(cd_uint)};
-    int k = (int)(sizeof h / sizeof h[0]);
-    for (int i = 0; i < k; i++) {
-        host[i] = h[i];
-        bytes[i] = b[i];
-    }
+           u = sizeof(cd_ulong), i4 = sizeof(int);
+    /* per point: 18 doubles, then the 4 stencil columns */
+    double *pd[] = {m->x,   m->y,   m->vx,    m->vy,   m->mass, m->vol,  m->half, m->sxx, m->syy,
+                    m->sxy, m->szz, m->eps_p, m->f_xx, m->f_xy, m->f_yx, m->f_yy, m->ex,  m->ey};
+    double *ps[] = {m->wx, m->wy, m->dwx, m->dwy};
+    int k = 0;
+    for (size_t i = 0; i < sizeof pd / sizeof pd[0]; i++, k++) host[k] = pd[i], bytes[k] = n * d;
+    for (size_t i = 0; i < sizeof ps / sizeof ps[0]; i++, k++) host[k] = ps[i], bytes[k] = CD_MPM_STENCIL * n * d;
+    /* per point ints and order; per body; per common node */
+    void *rest[] = {m->particle, m->bx,     m->by,     m->order,    m->pfirst,  m->win_off,  m->win_i0,
+                    m->win_j0,   m->win_nx, m->win_ny, m->cn_start, m->cn_list, m->cn_active};
+    size_t rest_b[] = {n * i4,  n * i4,  n * i4,  n * u,        (nb + 1) * u, (nb + 1) * u,        nb * i4,
+                       nb * i4, nb * i4, nb * i4, (nn + 1) * u, nn * u,       nn * sizeof(cd_uint)};
+    for (size_t i = 0; i < sizeof rest / sizeof rest[0]; i++, k++) host[k] = rest[i], bytes[k] = rest_b[i];
     return k;
 }
 
