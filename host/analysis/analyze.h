@@ -367,6 +367,17 @@ int cd_an_fit_line(const double *x, const double *y, size_t n, cd_an_linfit *out
  * 1/R; a corner of angle theta alone in the arc: (pi - theta) / (2 scale));
  * NAN with fewer than 3 points or a perimeter under 4 scale. */
 double cd_an_max_boundary_curvature(double *xy, size_t n, double scale);
+/* The convex hull of the n points xy (x, y pairs, reordered), counter-
+ * clockwise without repeating its first point, into hull (room for 2 n + 2
+ * points); returns its vertex count. */
+size_t cd_an_convex_hull(double *xy, size_t n, double *hull);
+/* The outline of a particle's points a .. b-1 as the analysis sees it: the
+ * corners of each point's parallelogram x_p + F_p [-l/2, l/2]^2 (l the
+ * point's initial side sqrt(V / det F)), 4 (b - a) of them into xy (x, y
+ * pairs); x (n, 2) [m], v (n) [m^3/m], F (n, 4) (xx, xy, yx, yy) are one
+ * snapshot's.  Returns the particle's initial area sum V / det F [m^2/m].
+ * `capdem analyze` takes kappa from their hull, `capdem export` draws it. */
+double cd_an_mpm_corners(const double *x, const double *v, const double *F, size_t a, size_t b, double *xy);
 /* The measures and fits of an mpm packing run file (every committed
  * snapshot; opt->snapshot picks the one reported alone).  0, 2 when the
  * file lacks what they need (reason in err), 1 on other failures. */

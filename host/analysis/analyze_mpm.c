@@ -68,18 +68,11 @@ static double cross(const double *o, const double *a, const double *b)
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
 }
 
-double cd_an_max_boundary_curvature(double *xy, size_t n, double scale)
+size_t cd_an_convex_hull(double *xy, size_t n, double *hull)
 {
-    if (n < 3 || !(scale > 0)) return NAN;
-    /* convex hull, Andrew's monotone chain, counter-clockwise, into hull */
+    if (n == 0) return 0;
+    /* Andrew's monotone chain, counter-clockwise; hull needs room for 2 n + 2 points */
     qsort(xy, n, 2 * sizeof(double), cmp_xy);
-    double *hull = malloc((2 * n + 2) * 2 * sizeof(double)), *arc = malloc((2 * n + 2) * 2 * sizeof(double));
-    if (!hull || !arc) {
-        free(hull);
-        free(arc);
-        return NAN;
-    }
-    double *turn = arc + 2 * n + 2;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         while (m >= 2 && cross(hull + 2 * (m - 2), hull + 2 * (m - 1), xy + 2 * i) <= 0) m--;
@@ -89,7 +82,36 @@ double cd_an_max_boundary_curvature(double *xy, size_t n, double scale)
         while (m >= lower && cross(hull + 2 * (m - 2), hull + 2 * (m - 1), xy + 2 * i) <= 0) m--;
         memcpy(hull + 2 * m++, xy + 2 * i, 2 * sizeof(double));
     }
-    m--; /* the last point repeats the first */
+    return m > 1 ? m - 1 : m; /* the last point repeats the first */
+}
+
+double cd_an_mpm_corners(const double *x, const double *v, const double *F, size_t a, size_t b, double *xy)
+{
+    double a0 = 0; /* initial area [m^2/m] */
+    for (size_t p = a; p < b; p++) {
+        const double *f = F + 4 * p; /* xx, xy, yx, yy */
+        double J = f[0] * f[3] - f[1] * f[2], l = sqrt(v[p] / J), s = 0.5 * l;
+        a0 += v[p] / J;
+        static const double cx[4] = {-1, 1, 1, -1}, cy[4] = {-1, -1, 1, 1};
+        for (int c = 0; c < 4; c++) {
+            xy[2 * (4 * (p - a) + (size_t)c)] = x[2 * p] + s * (f[0] * cx[c] + f[1] * cy[c]);
+            xy[2 * (4 * (p - a) + (size_t)c) + 1] = x[2 * p + 1] + s * (f[2] * cx[c] + f[3] * cy[c]);
+        }
+    }
+    return a0;
+}
+
+double cd_an_max_boundary_curvature(double *xy, size_t n, double scale)
+{
+    if (n < 3 || !(scale > 0)) return NAN;
+    double *hull = malloc((2 * n + 2) * 2 * sizeof(double)), *arc = malloc((2 * n + 2) * 2 * sizeof(double));
+    if (!hull || !arc) {
+        free(hull);
+        free(arc);
+        return NAN;
+    }
+    double *turn = arc + 2 * n + 2;
+    size_t m = cd_an_convex_hull(xy, n, hull);
     double kmax = NAN;
     if (m >= 3) {
         /* exterior angle (turning of the tangent) at each vertex [rad] and arc length to it [m] */
@@ -267,18 +289,8 @@ static int snapshot_measures(const mpm_data *d, size_t k, double *phi, double *s
     size_t nb = 0;
     for (size_t a = 0; a < n;) {
         size_t b = a;
-        double a0 = 0; /* initial area [m^2/m] */
-        while (b < n && d->particle[b] == d->particle[a]) {
-            const double *f = F + 4 * b; /* xx, xy, yx, yy */
-            double J = f[0] * f[3] - f[1] * f[2], l = sqrt(v[b] / J), s = 0.5 * l;
-            a0 += v[b] / J;
-            static const double cx[4] = {-1, 1, 1, -1}, cy[4] = {-1, -1, 1, 1};
-            for (int c = 0; c < 4; c++) {
-                xy[2 * (4 * (b - a) + (size_t)c)] = x[2 * b] + s * (f[0] * cx[c] + f[1] * cy[c]);
-                xy[2 * (4 * (b - a) + (size_t)c) + 1] = x[2 * b + 1] + s * (f[2] * cx[c] + f[3] * cy[c]);
-            }
-            b++;
-        }
+        while (b < n && d->particle[b] == d->particle[a]) b++;
+        double a0 = cd_an_mpm_corners(x, v, F, a, b, xy);  /* initial area [m^2/m] */
         double dk = sqrt(4 * a0 / 3.14159265358979323846); /* [m] */
         double kmax = cd_an_max_boundary_curvature(xy, 4 * (b - a), dk / 8);
         if (isfinite(kmax)) {

@@ -245,7 +245,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "shape")) return cmd_shape(argc - 2, argv + 2);
     if (!strcmp(cmd, "recover")) return cmd_recover(argc - 2, argv + 2);
-    if (!strcmp(cmd, "export") || !strcmp(cmd, "render"))
+    if (!strcmp(cmd, "render"))
         for (int i = 2; i < argc; i++) {
             if (argv[i][0] == '-') continue;
             cdh5_guard_begin(cmd, argv[i]);

@@ -10,7 +10,7 @@
 
 /* Shape and XDMF number type of a dataset; -1 when it is missing or not a
  * plain integer or floating-point array of rank 1..3. */
-static int cd_export_describe(hid_t f, const char *path, cd_export_field *fl)
+int cd_export_describe(hid_t f, const char *path, cd_export_field *fl)
 {
     memset(fl, 0, sizeof *fl);
     snprintf(fl->src, sizeof fl->src, "%s", path);

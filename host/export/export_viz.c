@@ -40,24 +40,9 @@ static void cd_export_copy_unit(cd_export_ctx *x, const char *src, hid_t dst)
     H5Dclose(d);
 }
 
-static void cd_export_set_unit_one(hid_t d)
-{
-    if (H5Aexists(d, "unit") > 0) return;
-    hid_t t = H5Tcopy(H5T_C_S1);
-    H5Tset_size(t, 2);
-    H5Tset_strpad(t, H5T_STR_NULLTERM);
-    hid_t s = H5Screate(H5S_SCALAR), a = H5Acreate2(d, "unit", t, s, H5P_DEFAULT, H5P_DEFAULT);
-    if (a >= 0) {
-        H5Awrite(a, t, "1");
-        H5Aclose(a);
-    }
-    H5Sclose(s);
-    H5Tclose(t);
-}
-
 /* Opens parent/name when it is a dataset of the given layout and shape;
  * otherwise removes whatever is there and returns 0 (the caller creates it). */
-static hid_t cd_export_reuse(hid_t parent, const char *name, H5D_layout_t layout, int rank, const hsize_t *dims)
+hid_t cd_export_reuse(hid_t parent, const char *name, H5D_layout_t layout, int rank, const hsize_t *dims)
 {
     if (H5Lexists(parent, name, H5P_DEFAULT) <= 0) return 0;
     hid_t d = H5Dopen2(parent, name, H5P_DEFAULT);
@@ -79,17 +64,8 @@ static hid_t cd_export_reuse(hid_t parent, const char *name, H5D_layout_t layout
     return 0;
 }
 
-/* One block of a virtual dataset: the source's hyperslab (start, count) goes
- * to the virtual hyperslab (vstart, vcount); both hold the same number of
- * elements. */
-typedef struct {
-    const cd_export_field *src;
-    hsize_t start[3], count[3];
-    hsize_t vstart[3], vcount[3];
-} cd_export_block;
-
-static int cd_export_vds(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims, int nblock,
-                         const cd_export_block *blocks)
+int cd_export_vds(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims, int nblock,
+                  const cd_export_block *blocks)
 {
     hid_t d = cd_export_reuse(parent, name, H5D_VIRTUAL, rank, dims);
     if (d > 0) {
@@ -126,30 +102,54 @@ static int cd_export_vds(cd_export_ctx *x, hid_t parent, const char *name, int r
     return 0;
 }
 
-/* Writes a real int32 helper dataset (created, or overwritten in place when
- * one of the same shape is there: a resume may have changed its values). */
-static int cd_export_ints(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims, const int *v)
+/* Writes a real helper dataset of file type ftype (created, or overwritten in
+ * place when one of the same shape is there: a resume may have changed its
+ * values); its unit attribute is unit ("1" for ids).  0, or -1 with x failed. */
+static int cd_export_data(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims, hid_t ftype,
+                          hid_t mtype, const void *v, const char *unit)
 {
     hid_t d = cd_export_reuse(parent, name, H5D_CONTIGUOUS, rank, dims);
     if (d == 0) {
         hid_t sp = H5Screate_simple(rank, dims, NULL);
-        d = H5Dcreate2(parent, name, H5T_STD_I32LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        d = H5Dcreate2(parent, name, ftype, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         H5Sclose(sp);
     }
     hsize_t n = 1;
     for (int i = 0; i < rank; i++) n *= dims[i];
-    if (d < 0 || (n > 0 && H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0)) {
+    if (d < 0 || (n > 0 && H5Dwrite(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0)) {
         char why[256];
         if (d >= 0) H5Dclose(d);
         return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write /visualization/.../%s (HDF5: %s)", x->path, name,
                               cd_export_h5_reason(why));
     }
-    cd_export_set_unit_one(d);
+    if (H5Aexists(d, "unit") <= 0) {
+        hid_t t = H5Tcopy(H5T_C_S1);
+        H5Tset_size(t, strlen(unit) + 1);
+        H5Tset_strpad(t, H5T_STR_NULLTERM);
+        hid_t sp = H5Screate(H5S_SCALAR), a = H5Acreate2(d, "unit", t, sp, H5P_DEFAULT, H5P_DEFAULT);
+        if (a >= 0) {
+            H5Awrite(a, t, unit);
+            H5Aclose(a);
+        }
+        H5Sclose(sp);
+        H5Tclose(t);
+    }
     H5Dclose(d);
     return 0;
 }
 
-static int cd_export_read_attr_ll(hid_t loc, const char *name, long long *v, int n)
+int cd_export_ints(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims, const int *v)
+{
+    return cd_export_data(x, parent, name, rank, dims, H5T_STD_I32LE, H5T_NATIVE_INT, v, "1");
+}
+
+int cd_export_doubles(cd_export_ctx *x, hid_t parent, const char *name, int rank, const hsize_t *dims, const double *v,
+                      const char *unit)
+{
+    return cd_export_data(x, parent, name, rank, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, v, unit);
+}
+
+int cd_export_read_attr_ll(hid_t loc, const char *name, long long *v, int n)
 {
     if (H5Aexists(loc, name) <= 0) return -1;
     hid_t a = H5Aopen(loc, name, H5P_DEFAULT), sp = H5Aget_space(a);
@@ -159,7 +159,7 @@ static int cd_export_read_attr_ll(hid_t loc, const char *name, long long *v, int
     return ok ? 0 : -1;
 }
 
-static void cd_export_write_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype, int n, const void *v)
+void cd_export_write_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype, int n, const void *v)
 {
     if (H5Aexists(loc, name) > 0) H5Adelete(loc, name);
     hsize_t dim = (hsize_t)n;
@@ -172,16 +172,14 @@ static void cd_export_write_attr(hid_t loc, const char *name, hid_t ftype, hid_t
     H5Sclose(sp);
 }
 
-/* Opens /visualization, or makes a fresh one when the stored one was made for
- * another layout version or another particle / primitive count. */
-static int cd_export_open_viz(cd_export_ctx *x)
+int cd_export_open_viz_with(cd_export_ctx *x, int n, const char *const *names, const long long *want,
+                            const char *solver, const char *about)
 {
-    long long want[3] = {CD_EXPORT_LAYOUT, (long long)x->N, (long long)x->P}, have[3];
     if (H5Lexists(x->vf, "visualization", H5P_DEFAULT) > 0) {
         hid_t g = H5Gopen2(x->vf, "visualization", H5P_DEFAULT);
-        int same = g >= 0 && !cd_export_read_attr_ll(g, "layout", &have[0], 1) &&
-                   !cd_export_read_attr_ll(g, "n_particles", &have[1], 1) &&
-                   !cd_export_read_attr_ll(g, "n_prims", &have[2], 1) && !memcmp(want, have, sizeof want);
+        int same = g >= 0;
+        long long have;
+        for (int i = 0; i < n && same; i++) same = !cd_export_read_attr_ll(g, names[i], &have, 1) && have == want[i];
         if (same) {
             x->viz = g;
             return 0;
@@ -195,17 +193,27 @@ static int cd_export_open_viz(cd_export_ctx *x)
         return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization (HDF5: %s)", x->path,
                               cd_export_h5_reason(why));
     }
-    cd_export_write_attr(x->viz, "layout", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[0]);
-    cd_export_write_attr(x->viz, "n_particles", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[1]);
-    cd_export_write_attr(x->viz, "n_prims", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[2]);
-    const char *about =
-        "helper datasets of `capdem export` (docs/visualization.md): connectivity, and virtual datasets "
-        "selecting one snapshot of the run's datasets; safe to delete";
-    hid_t t = H5Tcopy(H5T_C_S1);
-    H5Tset_size(t, strlen(about) + 1);
-    cd_export_write_attr(x->viz, "about", t, t, 1, about);
-    H5Tclose(t);
+    for (int i = 0; i < n; i++) cd_export_write_attr(x->viz, names[i], H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &want[i]);
+    const char *text[2][2] = {{"solver", solver}, {"about", about}};
+    for (int i = solver ? 0 : 1; i < 2; i++) {
+        hid_t t = H5Tcopy(H5T_C_S1);
+        H5Tset_size(t, strlen(text[i][1]) + 1);
+        cd_export_write_attr(x->viz, text[i][0], t, t, 1, text[i][1]);
+        H5Tclose(t);
+    }
     return 0;
+}
+
+/* /visualization of a DEM run: for this layout version and these particle
+ * and primitive counts. */
+static int cd_export_open_viz(cd_export_ctx *x)
+{
+    const char *names[3] = {"layout", "n_particles", "n_prims"};
+    long long want[3] = {CD_EXPORT_LAYOUT, (long long)x->N, (long long)x->P};
+    return cd_export_open_viz_with(
+        x, 3, names, want, NULL,
+        "helper datasets of `capdem export` (docs/visualization.md): connectivity, and virtual datasets "
+        "selecting one snapshot of the run's datasets; safe to delete");
 }
 
 /* The helpers shared by every snapshot. */
@@ -353,9 +361,8 @@ static int cd_export_snapshot_helpers(cd_export_ctx *x, int k)
     return rc;
 }
 
-int cd_export_helpers(cd_export_ctx *x)
+int cd_export_snapshots_group(cd_export_ctx *x)
 {
-    if (cd_export_open_viz(x) || cd_export_fixed_helpers(x)) return -1;
     if (H5Lexists(x->viz, "snapshots", H5P_DEFAULT) <= 0) {
         hid_t g = H5Gcreate2(x->viz, "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         if (g < 0) return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot create /visualization/snapshots", x->path);
@@ -380,6 +387,12 @@ int cd_export_helpers(cd_export_ctx *x)
         free(stale);
     }
     if (snaps >= 0) H5Gclose(snaps);
+    return 0;
+}
+
+int cd_export_helpers(cd_export_ctx *x)
+{
+    if (cd_export_open_viz(x) || cd_export_fixed_helpers(x) || cd_export_snapshots_group(x)) return -1;
     for (int k = 0; k < x->S; k++)
         if (cd_export_snapshot_helpers(x, k)) return -1;
     return 0;

@@ -60,6 +60,7 @@
 #include "io/io_h5.h"
 #include "io/io_h5_guard.h"
 #include "export/export_internal.h"
+#include "mpm/mpm_output.h"
 
 /* Records the first failure (later ones are usually consequences). */
 int cd_export_fail(cd_export_ctx *x, int status, const char *fmt, ...)
@@ -117,8 +118,8 @@ static void cd_export_xml_text(FILE *o, const char *s)
 }
 
 /* <DataItem> naming file:path, of the given shape (rank 1 or 2). */
-static void cd_export_xml_item(FILE *o, const char *indent, const char *file, const char *path, hsize_t rows, int ncomp,
-                               const char *number_type, int precision)
+void cd_export_xml_item(FILE *o, const char *indent, const char *file, const char *path, hsize_t rows, int ncomp,
+                        const char *number_type, int precision)
 {
     fprintf(o, "%s<DataItem Dimensions=\"%llu", indent, (unsigned long long)rows);
     if (ncomp > 1) fprintf(o, " %d", ncomp);
@@ -134,8 +135,8 @@ static const char *cd_export_attr_type(int ncomp)
     return ncomp == 1 ? "Scalar" : ncomp == 3 ? "Vector" : ncomp == 6 ? "Tensor6" : ncomp == 9 ? "Tensor" : "Matrix";
 }
 
-static void cd_export_xml_attr(FILE *o, const char *name, const char *center, const char *file, const char *path,
-                               hsize_t rows, const cd_export_field *fl)
+void cd_export_xml_attr(FILE *o, const char *name, const char *center, const char *file, const char *path, hsize_t rows,
+                        const cd_export_field *fl)
 {
     fputs("      <Attribute Name=\"", o);
     cd_export_xml_text(o, name);
@@ -144,15 +145,14 @@ static void cd_export_xml_attr(FILE *o, const char *name, const char *center, co
     fputs("      </Attribute>\n", o);
 }
 
-static void cd_export_xml_time(FILE *o, const cd_export_ctx *x, int k)
+void cd_export_xml_time(FILE *o, const cd_export_ctx *x, int k)
 {
     fprintf(o, "      <Time Value=\"%.17g\"/>\n", x->time[k]);
 }
 
 /* <Topology> of n cells of the given type, nodes points each, whose
  * connectivity is the int32 helper dataset cells (n, nodes). */
-static void cd_export_xml_topology(FILE *o, const cd_export_ctx *x, const char *type, int nodes, hsize_t n,
-                                   const char *cells)
+void cd_export_xml_topology(FILE *o, const cd_export_ctx *x, const char *type, int nodes, hsize_t n, const char *cells)
 {
     fprintf(o, "      <Topology TopologyType=\"%s\" NodesPerElement=\"%d\" NumberOfElements=\"%llu\">\n", type, nodes,
             (unsigned long long)n);
@@ -161,7 +161,7 @@ static void cd_export_xml_topology(FILE *o, const cd_export_ctx *x, const char *
 }
 
 /* <Geometry> of snapshot k: the n points of /visualization/snapshots/<k>/<points>. */
-static void cd_export_xml_geometry(FILE *o, const cd_export_ctx *x, int k, const char *points, hsize_t n)
+void cd_export_xml_geometry(FILE *o, const cd_export_ctx *x, int k, const char *points, hsize_t n)
 {
     char path[200];
     fprintf(o, "      <Geometry GeometryType=\"XYZ\">\n");
@@ -227,7 +227,8 @@ static void cd_export_xml_contacts(FILE *o, const cd_export_ctx *x, int k)
     fprintf(o, "    </Grid>\n");
 }
 
-static int cd_export_write_xml(cd_export_ctx *x, const char *out)
+int cd_export_write_xml_with(cd_export_ctx *x, const char *out, const char *comment,
+                             void (*body)(FILE *, const cd_export_ctx *))
 {
     /* Written aside under a name nobody can guess (mkstemp: a new file,
      * O_EXCL, never through a planted link), then renamed over out, which
@@ -249,22 +250,9 @@ static int cd_export_write_xml(cd_export_ctx *x, const char *out)
     fprintf(o, "<!-- Written by `capdem export` from ");
     /* "--" is not allowed inside an XML comment. */
     for (const char *s = x->h5_ref; *s; s++) fputc(s[0] == '-' && s[1] == '-' ? '_' : s[0], o);
-    fprintf(o,
-            ": %d snapshots, %llu particles, %llu arms, %lld contact rows.\n"
-            "     Three temporal collections: arms (lines; radius as point and cell data, for the Tube filter),\n"
-            "     particles (centres) and contacts (lines between the centres of touching particles).\n"
-            "     Every data item points into the run file or into its /visualization helpers: no copy of the data.\n"
-            "     ParaView: any of its XDMF readers; docs/visualization.md. -->\n",
-            x->S, (unsigned long long)x->N, (unsigned long long)x->P, x->off[x->S]);
+    fputs(comment, o);
     fprintf(o, "<Xdmf Version=\"2.0\">\n  <Domain>\n");
-    void (*grids[3])(FILE *, const cd_export_ctx *, int) = {cd_export_xml_arms, cd_export_xml_particles,
-                                                            cd_export_xml_contacts};
-    const char *names[3] = {"arms", "particles", "contacts"};
-    for (int g = 0; g < 3; g++) {
-        fprintf(o, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", names[g]);
-        for (int k = 0; k < x->S; k++) grids[g](o, x, k);
-        fprintf(o, "  </Grid>\n");
-    }
+    body(o, x);
     fprintf(o, "  </Domain>\n</Xdmf>\n");
     int bad = ferror(o);
     bad |= fclose(o) != 0;
@@ -274,6 +262,32 @@ static int cd_export_write_xml(cd_export_ctx *x, const char *out)
         return cd_export_fail(x, CD_EXPORT_FAIL, "%s: cannot write (%s)", out, strerror(e));
     }
     return 0;
+}
+
+/* The DEM run's three temporal collections. */
+static void cd_export_dem_grids(FILE *o, const cd_export_ctx *x)
+{
+    void (*grids[3])(FILE *, const cd_export_ctx *, int) = {cd_export_xml_arms, cd_export_xml_particles,
+                                                            cd_export_xml_contacts};
+    const char *names[3] = {"arms", "particles", "contacts"};
+    for (int g = 0; g < 3; g++) {
+        fprintf(o, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", names[g]);
+        for (int k = 0; k < x->S; k++) grids[g](o, x, k);
+        fprintf(o, "  </Grid>\n");
+    }
+}
+
+static int cd_export_write_xml(cd_export_ctx *x, const char *out)
+{
+    char comment[1024];
+    snprintf(comment, sizeof comment,
+             ": %d snapshots, %llu particles, %llu arms, %lld contact rows.\n"
+             "     Three temporal collections: arms (lines; radius as point and cell data, for the Tube filter),\n"
+             "     particles (centres) and contacts (lines between the centres of touching particles).\n"
+             "     Every data item points into the run file or into its /visualization helpers: no copy of the data.\n"
+             "     ParaView: any of its XDMF readers; docs/visualization.md. -->\n",
+             x->S, (unsigned long long)x->N, (unsigned long long)x->P, x->off[x->S]);
+    return cd_export_write_xml_with(x, out, comment, cd_export_dem_grids);
 }
 
 /* ---- command ------------------------------------------------------------ */
@@ -445,6 +459,7 @@ int cd_cmd_export(int argc, char **argv)
     /* (the run file is opened journaled: what export adds reaches it only at its commit) */
     cdh5_guard_begin("export", run);
     htri_t is_h5 = H5Fis_hdf5(run);
+    int mpm = is_h5 > 0 && cd_mpm_is_run_file(run); /* solver mpm: its own layout (export_mpm.c) */
     if (is_h5 <= 0) {
         cd_export_fail(x, CD_EXPORT_BAD_INPUT, "%s: not an HDF5 file", run);
     } else if ((x->S = cd_h5_snapshot_count(run, err, sizeof err)) < 0) {
@@ -452,7 +467,9 @@ int cd_cmd_export(int argc, char **argv)
         int locked = strstr(err, "lock") != NULL;
         cd_export_fail(x, locked ? CD_EXPORT_FAIL : CD_EXPORT_BAD_INPUT, "%s%s", err,
                        locked ? " (is a run still writing it? export it when the run has ended)" : "");
-    } else if (!cd_export_open(x, out) && !cd_export_read_run(x) && !cd_export_discover(x) && !cd_export_helpers(x)) {
+    } else if (!cd_export_open(x, out) &&
+               (mpm ? !cd_export_mpm_helpers(x)
+                    : !cd_export_read_run(x) && !cd_export_discover(x) && !cd_export_helpers(x))) {
         if (x->viz >= 0) {
             H5Gclose(x->viz);
             x->viz = -1;
@@ -464,7 +481,8 @@ int cd_cmd_export(int argc, char **argv)
                            cd_export_h5_reason(why));
         } else {
             cdh5_guard_end(); /* the run file has been read */
-            cd_export_write_xml(x, out);
+            if (mpm) cd_export_mpm_write_xml(x, out);
+            else cd_export_write_xml(x, out);
         }
     }
     if (x->viz >= 0) H5Gclose(x->viz);
@@ -478,6 +496,10 @@ int cd_cmd_export(int argc, char **argv)
     int status = x->status;
     if (status) {
         fprintf(stderr, "capdem export: %s\n", x->err);
+    } else if (mpm) {
+        printf("capdem export: wrote %s (%d snapshots, %llu material points, %llu walls, particle outlines; "
+               "helper datasets in %s:/visualization)\n",
+               out, x->S, (unsigned long long)x->N, (unsigned long long)x->P, x->viz_ref);
     } else {
         if (x->bad_contacts)
             fprintf(stderr,
@@ -488,6 +510,7 @@ int cd_cmd_export(int argc, char **argv)
                "helper datasets in %s:/visualization)\n",
                out, x->S, (unsigned long long)x->N, (unsigned long long)x->P, x->off[x->S], x->viz_ref);
     }
+    cd_export_mpm_free(x);
     free(x->off);
     free(x->step);
     free(x->time);

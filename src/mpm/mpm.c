@@ -8,9 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mpm/mpm.h"
-#include "core/sim.h" /* CD_PARALLEL: small loops on one thread */
-#include "mpm_shape.h"
-#include "mpm_wall.h"
+#include "backend/omp/omp_loops.h" /* CD_STEP_FOR: the loops of the step, on the host or the offload device */
+#include "mpm_step_items.h"
 
 int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, double oy, char *err, size_t errlen)
 {
@@ -44,6 +43,7 @@ int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, doubl
 
 void cd_mpm_free(cd_mpm *m)
 {
+    cd_mpm_device_stop(m);
     void *cols[] = {m->x,          m->y,        m->vx,       m->vy,       m->mass,      m->vol,      m->half,
                     m->sxx,        m->syy,      m->sxy,      m->szz,      m->eps_p,     m->f_xx,     m->f_xy,
                     m->f_yx,       m->f_yy,     m->ex,       m->ey,       m->wx,        m->wy,       m->dwx,
@@ -135,13 +135,62 @@ double cd_mpm_dt_limit(const cd_mpm *m)
     return lim;
 }
 
-/* The body-cell of point p: its stencil's second node, numbered like the
- * body's nodes. */
-static inline size_t point_cell(const cd_mpm *m, size_t p)
+cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m)
 {
-    int k = m->particle[p];
-    return m->win_off[k] + (size_t)(m->by[p] + 1 - m->win_j0[k]) * (size_t)m->win_nx[k] +
-           (size_t)(m->bx[p] + 1 - m->win_i0[k]);
+    cd_mpm_cols c = {.x = m->x,
+                     .y = m->y,
+                     .vx = m->vx,
+                     .vy = m->vy,
+                     .mass = m->mass,
+                     .vol = m->vol,
+                     .half = m->half,
+                     .sxx = m->sxx,
+                     .syy = m->syy,
+                     .sxy = m->sxy,
+                     .szz = m->szz,
+                     .eps_p = m->eps_p,
+                     .f_xx = m->f_xx,
+                     .f_xy = m->f_xy,
+                     .f_yx = m->f_yx,
+                     .f_yy = m->f_yy,
+                     .particle = m->particle,
+                     .bx = m->bx,
+                     .by = m->by,
+                     .wx = m->wx,
+                     .wy = m->wy,
+                     .dwx = m->dwx,
+                     .dwy = m->dwy,
+                     .ex = m->ex,
+                     .ey = m->ey,
+                     .order = m->order,
+                     .pfirst = m->pfirst,
+                     .win_off = m->win_off,
+                     .win_i0 = m->win_i0,
+                     .win_j0 = m->win_j0,
+                     .win_nx = m->win_nx,
+                     .win_ny = m->win_ny,
+                     .bnode_body = m->bnode_body,
+                     .cell_start = m->cell_start,
+                     .gm = m->gm,
+                     .gpx = m->gpx,
+                     .gpy = m->gpy,
+                     .gfx = m->gfx,
+                     .gfy = m->gfy,
+                     .gvx = m->gvx,
+                     .gvy = m->gvy,
+                     .gnx = m->gnx,
+                     .gny = m->gny,
+                     .cn_start = m->cn_start,
+                     .cn_entry = m->cn_entry,
+                     .cn_list = m->cn_list,
+                     .cn_active = m->cn_active,
+                     .nx = m->nx,
+                     .ny = m->ny,
+                     .n_bodies = m->n_bodies,
+                     .h = m->h,
+                     .ox = m->ox,
+                     .oy = m->oy};
+    return c;
 }
 
 /* Stencil of every point, the wall forces on it, each body's window of
@@ -150,33 +199,21 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
 {
     size_t n = m->n;
     long long bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(n))
-    for (size_t p = 0; p < n; p++) {
-        int bx =
-            cd_mpm_weights_1d((m->x[p] - m->ox) / m->h, m->h, m->wx + CD_MPM_STENCIL * p, m->dwx + CD_MPM_STENCIL * p);
-        int by =
-            cd_mpm_weights_1d((m->y[p] - m->oy) / m->h, m->h, m->wy + CD_MPM_STENCIL * p, m->dwy + CD_MPM_STENCIL * p);
-        if (!(bx >= 0 && by >= 0 && bx + CD_MPM_STENCIL <= m->nx && by + CD_MPM_STENCIL <= m->ny)) {
-            bad = (long long)p > bad ? (long long)p : bad;
-            bx = by = 0;
-        }
-        m->bx[p] = bx;
-        m->by[p] = by;
-        double ex = 0, ey = 0; /* [N/m] */
-        for (int w = 0; w < m->n_walls; w++) {
-            const cd_mpm_wall *W = &m->walls[w];
-            double d = cd_mpm_wall_overlap(m->x[p], m->y[p], m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p], m->f_yy[p],
-                                           W->px, W->py, W->nx, W->ny);
-            if (d > 0) {
-                ex += m->wall_k * d * W->nx;
-                ey += m->wall_k * d * W->ny;
-            }
-        }
-        m->ex[p] = ex;
-        m->ey[p] = ey;
+    cd_mpm_item_walls walls = {.n = m->n_walls, .k = m->wall_k};
+    for (int w = 0; w < m->n_walls; w++) {
+        walls.px[w] = m->walls[w].px;
+        walls.py[w] = m->walls[w].py;
+        walls.nx[w] = m->walls[w].nx;
+        walls.ny[w] = m->walls[w].ny;
     }
+    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(c, walls) reduction(max : bad) CD_DEV(map(tofrom : bad)))
+    for (size_t p = 0; p < n; p++)
+        if (cd_mpm_item_prepare(c, p, walls)) bad = (long long)p > bad ? (long long)p : bad;
     if (bad >= 0) {
         size_t p = (size_t)bad;
+        cd_mpm_device_sync(m);
         snprintf(err, errlen,
                  "material point %zu at (%.6g, %.6g) m (t = %.9g s, step %lld) left the background mesh "
                  "[%.6g, %.6g] x [%.6g, %.6g] m: the run blew up, or the set-up leaves too little room",
@@ -185,228 +222,73 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
         return -1;
     }
     /* wall forces: the reaction of the points' penalty forces, summed in point order */
-    for (int w = 0; w < m->n_walls; w++) {
-        cd_mpm_wall *W = &m->walls[w];
-        double fx = 0, fy = 0;
-        for (size_t p = 0; p < n; p++) {
-            double d = cd_mpm_wall_overlap(m->x[p], m->y[p], m->half[p], m->f_xx[p], m->f_xy[p], m->f_yx[p], m->f_yy[p],
-                                           W->px, W->py, W->nx, W->ny);
-            if (d > 0) {
-                fx -= m->wall_k * d * W->nx;
-                fy -= m->wall_k * d * W->ny;
-            }
-        }
-        W->fx = fx;
-        W->fy = fy;
+    double *wf = m->loop_wall_f, f[2 * CD_MPM_MAX_WALLS]; /* [N/m] */
+    int nw = m->n_walls;
+    CD_STEP_FOR(nw, firstprivate(c, walls, n) CD_DEV(is_device_ptr(wf)))
+    for (int w = 0; w < nw; w++) cd_mpm_item_wall_force(c, n, walls, w, wf);
+    cd_dev_get(f, wf, 2 * (size_t)nw * sizeof(double));
+    for (int w = 0; w < nw; w++) {
+        m->walls[w].fx = f[2 * w];
+        m->walls[w].fy = f[2 * w + 1];
     }
-    /* each body's window: the nodes its points' stencils reach */
+    /* each body's window: the nodes its points' stencils reach, and where its nodes start */
     int nb = m->n_bodies;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(n))
-    for (int k = 0; k < nb; k++) {
-        int i0 = m->nx, j0 = m->ny, i1 = 0, j1 = 0;
-        for (size_t p = m->pfirst[k]; p < m->pfirst[k + 1]; p++) {
-            if (m->bx[p] < i0) i0 = m->bx[p];
-            if (m->by[p] < j0) j0 = m->by[p];
-            if (m->bx[p] > i1) i1 = m->bx[p];
-            if (m->by[p] > j1) j1 = m->by[p];
-        }
-        m->win_i0[k] = i0;
-        m->win_j0[k] = j0;
-        m->win_nx[k] = i1 - i0 + CD_MPM_STENCIL;
-        m->win_ny[k] = j1 - j0 + CD_MPM_STENCIL;
-    }
-    for (int k = 0; k < nb; k++) m->win_off[k + 1] = m->win_off[k] + (size_t)m->win_nx[k] * (size_t)m->win_ny[k];
-    size_t nbn = m->win_off[nb];
+    CD_STEP_FOR(nb, firstprivate(c))
+    for (int k = 0; k < nb; k++) cd_mpm_item_window(c, k);
+    cd_ulong *count = m->loop_count, nbn;
+    CD_STEP_FOR(1, firstprivate(c) CD_DEV(is_device_ptr(count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_window_offsets(c, count);
+    cd_dev_get(&nbn, count, sizeof nbn);
     if (reserve_bnodes(m, nbn, err, errlen)) return -1;
+    if (cd_mpm_device_reserve(m, nbn)) {
+        snprintf(err, errlen, "out of device memory for %zu body-nodes", (size_t)nbn);
+        return -1;
+    }
     m->n_bnodes = nbn;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(n))
-    for (int k = 0; k < nb; k++)
-        for (size_t t = m->win_off[k]; t < m->win_off[k + 1]; t++) m->bnode_body[t] = k;
+    c = cd_mpm_loop_cols(m); /* the body-node columns may have moved */
+    CD_STEP_FOR(nb, firstprivate(c))
+    for (int k = 0; k < nb; k++) cd_mpm_item_bnode_body(c, k);
     /* stable counting sort by (body, cell): a point's cell is its stencil's
      * second node, numbered like the body's nodes */
-    size_t *cs = m->cell_start;
-    memset(cs, 0, (nbn + 1) * sizeof(size_t));
-    for (size_t p = 0; p < n; p++) cs[point_cell(m, p) + 1]++;
-    for (size_t c = 0; c < nbn; c++) cs[c + 1] += cs[c];
-    for (size_t p = 0; p < n; p++) m->order[cs[point_cell(m, p)]++] = p;
-    for (size_t c = nbn; c > 0; c--) cs[c] = cs[c - 1];
-    cs[0] = 0;
+    CD_STEP_FOR(1, firstprivate(c, n, nbn))
+    for (int one = 0; one < 1; one++) cd_mpm_item_sort_points(c, n, nbn);
     return 0;
-}
-
-/* The points whose stencil holds body-node t lie in the body's cells
- * i-2 .. i+1 and j-2 .. j+1 (window coordinates): visited in that order,
- * each cell's points in index order.  a, b: the node's place in the
- * point's stencil. */
-#define FOR_SUPPORT(m, t, p, a, b, ...)                                                                                \
-    do {                                                                                                               \
-        int k_ = (m)->bnode_body[t], wnx_ = (m)->win_nx[k_], wny_ = (m)->win_ny[k_];                                   \
-        size_t off_ = (m)->win_off[k_], loc_ = (t)-off_;                                                               \
-        int li_ = (int)(loc_ % (size_t)wnx_), lj_ = (int)(loc_ / (size_t)wnx_);                                        \
-        int gi_ = (m)->win_i0[k_] + li_, gj_ = (m)->win_j0[k_] + lj_;                                                  \
-        for (int cy_ = lj_ - 2; cy_ <= lj_ + 1; cy_++) {                                                               \
-            if (cy_ < 0 || cy_ >= wny_) continue;                                                                      \
-            for (int cx_ = li_ - 2; cx_ <= li_ + 1; cx_++) {                                                           \
-                if (cx_ < 0 || cx_ >= wnx_) continue;                                                                  \
-                size_t c_ = off_ + (size_t)cy_ * (size_t)wnx_ + (size_t)cx_;                                           \
-                for (size_t e_ = (m)->cell_start[c_]; e_ < (m)->cell_start[c_ + 1]; e_++) {                            \
-                    size_t p = (m)->order[e_];                                                                         \
-                    int a = gi_ - (m)->bx[p], b = gj_ - (m)->by[p];                                                    \
-                    __VA_ARGS__                                                                                        \
-                }                                                                                                      \
-            }                                                                                                          \
-        }                                                                                                              \
-    } while (0)
-
-/* Node mass, momentum and force from the points (the paper's eq. (3):
- * lumped mass, f_int = -sum V sigma grad N, f_ext = sum N f_p); with more
- * than one body also the mass gradient, the bodies' normals at contacts. */
-static void to_grid(cd_mpm *m)
-{
-    long nbn = (long)m->n_bnodes;
-    int normals = m->n_bodies > 1;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(nbn))
-    for (long tt = 0; tt < nbn; tt++) {
-        size_t t = (size_t)tt;
-        double gm = 0, px = 0, py = 0, fx = 0, fy = 0, nx = 0, ny = 0;
-        FOR_SUPPORT(m, t, p, a, b, {
-            double wa = m->wx[CD_MPM_STENCIL * p + a], wb = m->wy[CD_MPM_STENCIL * p + b];
-            double N = wa * wb;                              /* [1] */
-            double gx = m->dwx[CD_MPM_STENCIL * p + a] * wb; /* dN/dx [1/m] */
-            double gy = wa * m->dwy[CD_MPM_STENCIL * p + b]; /* dN/dy [1/m] */
-            double mN = N * m->mass[p];
-            gm += mN;
-            px += mN * m->vx[p];
-            py += mN * m->vy[p];
-            fx += N * m->ex[p] - m->vol[p] * (m->sxx[p] * gx + m->sxy[p] * gy);
-            fy += N * m->ey[p] - m->vol[p] * (m->sxy[p] * gx + m->syy[p] * gy);
-            if (normals) {
-                nx += m->mass[p] * gx;
-                ny += m->mass[p] * gy;
-            }
-        });
-        m->gm[t] = gm;
-        m->gpx[t] = px;
-        m->gpy[t] = py;
-        m->gfx[t] = fx;
-        m->gfy[t] = fy;
-        m->gnx[t] = nx;
-        m->gny[t] = ny;
-    }
-}
-
-/* MUSL's second gather: node velocities from the updated point momenta. */
-static void remap_velocity(cd_mpm *m)
-{
-    long nbn = (long)m->n_bnodes;
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(nbn))
-    for (long tt = 0; tt < nbn; tt++) {
-        size_t t = (size_t)tt;
-        double px = 0, py = 0;
-        FOR_SUPPORT(m, t, p, a, b, {
-            double mN = m->wx[CD_MPM_STENCIL * p + a] * m->wy[CD_MPM_STENCIL * p + b] * m->mass[p];
-            px += mN * m->vx[p];
-            py += mN * m->vy[p];
-        });
-        double gm = m->gm[t];
-        m->gvx[t] = gm > 0 ? px / gm : 0;
-        m->gvy[t] = gm > 0 ? py / gm : 0;
-    }
-}
-
-/* The body-node of point p's stencil entry (a, b) is stencil_base + b *
- * win_nx + a. */
-static inline size_t stencil_base(const cd_mpm *m, size_t p)
-{
-    int k = m->particle[p];
-    return m->win_off[k] + (size_t)(m->by[p] - m->win_j0[k]) * (size_t)m->win_nx[k] + (size_t)(m->bx[p] - m->win_i0[k]);
 }
 
 int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
 {
     double dt = m->dt;
     if (m->n_bodies == 0 && cd_mpm_bodies(m, err, errlen)) return -1;
-    if (prepare(m, err, errlen)) return -1;
-    to_grid(m);
-    long nbn = (long)m->n_bnodes;
-    /* node acceleration a = f / m into gf, new node velocity into gv */
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(nbn))
-    for (long t = 0; t < nbn; t++) {
-        double gm = m->gm[t];
-        double ax = gm > 0 ? m->gfx[t] / gm : 0, ay = gm > 0 ? m->gfy[t] / gm : 0; /* [m/s^2] */
-        m->gfx[t] = ax;
-        m->gfy[t] = ay;
-        m->gvx[t] = gm > 0 ? m->gpx[t] / gm + dt * ax : 0;
-        m->gvy[t] = gm > 0 ? m->gpy[t] / gm + dt * ay : 0;
-    }
-    if (m->n_bodies > 1) {
-        cd_mpm_contact_nodes(m);
-        if (cd_mpm_contact_correct(m, err, errlen)) return -1;
-    }
-    /* points: velocity from the node accelerations (FLIP) blended with the new node velocities
-     * (PIC, a share pic_fraction: damps the velocity modes the mesh does not see, which FLIP
-     * keeps and the compaction feeds; docs/mpm.md "FLIP's noise"); position from the new node
-     * velocities */
+    if (cd_mpm_device_start(m, err, errlen) || prepare(m, err, errlen)) return -1;
+    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    size_t n = m->n, nbn = m->n_bnodes;
+    int normals = m->n_bodies > 1;
+    CD_WIDE_MIN
+    CD_STEP_FOR(nbn, firstprivate(c, normals))
+    for (size_t t = 0; t < nbn; t++) cd_mpm_item_to_grid(c, t, normals);
+    CD_STEP_FOR(nbn, firstprivate(c, dt))
+    for (size_t t = 0; t < nbn; t++) cd_mpm_item_node_update(c, t, dt);
+    if (m->n_bodies > 1 && (cd_mpm_contact_nodes(m), cd_mpm_contact_correct(m, err, errlen))) return -1;
     double pic = m->pic_fraction; /* [1] */
-#pragma omp parallel for schedule(static) if (CD_PARALLEL(m->n))
-    for (size_t p = 0; p < m->n; p++) {
-        double ax = 0, ay = 0, ux = 0, uy = 0;
-        size_t base = stencil_base(m, p), row = (size_t)m->win_nx[m->particle[p]];
-        for (int b = 0; b < CD_MPM_STENCIL; b++)
-            for (int a = 0; a < CD_MPM_STENCIL; a++) {
-                size_t node = base + (size_t)b * row + (size_t)a;
-                double N = m->wx[CD_MPM_STENCIL * p + a] * m->wy[CD_MPM_STENCIL * p + b];
-                ax += N * m->gfx[node];
-                ay += N * m->gfy[node];
-                ux += N * m->gvx[node];
-                uy += N * m->gvy[node];
-            }
-        m->vx[p] = (1 - pic) * (m->vx[p] + dt * ax) + pic * ux;
-        m->vy[p] = (1 - pic) * (m->vy[p] + dt * ay) + pic * uy;
-        m->x[p] += dt * ux;
-        m->y[p] += dt * uy;
-    }
-    remap_velocity(m);
-    double mesh_kinetic = 0; /* [J/m], summed in body-node order: the same bits for any thread count */
-    for (size_t t = 0; t < m->n_bnodes; t++)
-        mesh_kinetic += 0.5 * m->gm[t] * (m->gvx[t] * m->gvx[t] + m->gvy[t] * m->gvy[t]);
-    m->mesh_kinetic = mesh_kinetic;
+    CD_STEP_FOR(n, firstprivate(c, dt, pic))
+    for (size_t p = 0; p < n; p++) cd_mpm_item_point_update(c, p, dt, pic);
+    CD_STEP_FOR(nbn, firstprivate(c))
+    for (size_t t = 0; t < nbn; t++) cd_mpm_item_remap(c, t);
+    /* [J/m], summed in body-node order: the same bits for any thread count */
+    double *e = m->loop_real;
+    CD_STEP_FOR(1, firstprivate(c, nbn) CD_DEV(is_device_ptr(e)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_mesh_kinetic(c, nbn, e);
+    cd_dev_get(&m->mesh_kinetic, e, sizeof(double));
     /* no second contact correction of the remapped velocities: the strain follows each body's own
      * remapped field, the motion its points made; re-imposing the contact there, on the contact's
      * widened nodes, made strain the points' motion did not have and fed energy (docs/mpm.md) */
-    /* points: velocity gradient, stress, deformation gradient and volume */
     long long bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : bad) if (CD_PARALLEL(m->n))
-    for (size_t p = 0; p < m->n; p++) {
-        double lxx = 0, lxy = 0, lyx = 0, lyy = 0; /* dv_a/dx_b [1/s] */
-        size_t base = stencil_base(m, p), row = (size_t)m->win_nx[m->particle[p]];
-        for (int b = 0; b < CD_MPM_STENCIL; b++)
-            for (int a = 0; a < CD_MPM_STENCIL; a++) {
-                size_t node = base + (size_t)b * row + (size_t)a;
-                double wa = m->wx[CD_MPM_STENCIL * p + a], wb = m->wy[CD_MPM_STENCIL * p + b];
-                double gx = m->dwx[CD_MPM_STENCIL * p + a] * wb, gy = wa * m->dwy[CD_MPM_STENCIL * p + b];
-                lxx += m->gvx[node] * gx;
-                lxy += m->gvx[node] * gy;
-                lyx += m->gvy[node] * gx;
-                lyy += m->gvy[node] * gy;
-            }
-        double gxx = dt * lxx, gxy = dt * lxy, gyx = dt * lyx, gyy = dt * lyy; /* grad du [1] */
-        cd_mpm_stress s = {m->sxx[p], m->syy[p], m->sxy[p], m->szz[p]};
-        cd_mpm_stress_update(m->mat, &s, &m->eps_p[p], gxx, gyy, 0.5 * (gxy + gyx));
-        m->sxx[p] = s.xx;
-        m->syy[p] = s.yy;
-        m->sxy[p] = s.xy;
-        m->szz[p] = s.zz;
-        double fxx = m->f_xx[p], fxy = m->f_xy[p], fyx = m->f_yx[p], fyy = m->f_yy[p];
-        m->f_xx[p] = (1 + gxx) * fxx + gxy * fyx;
-        m->f_xy[p] = (1 + gxx) * fxy + gxy * fyy;
-        m->f_yx[p] = gyx * fxx + (1 + gyy) * fyx;
-        m->f_yy[p] = gyx * fxy + (1 + gyy) * fyy;
-        m->vol[p] *= cd_mpm_volume_ratio(gxx, gxy, gyx, gyy);
-        if (!(isfinite(m->x[p]) && isfinite(m->y[p]) && isfinite(s.xx) && isfinite(s.yy) && m->vol[p] > 0))
-            bad = (long long)p > bad ? (long long)p : bad;
-    }
+    cd_mpm_material mat = m->mat;
+    CD_STEP_FOR(n, firstprivate(c, dt, mat) reduction(max : bad) CD_DEV(map(tofrom : bad)))
+    for (size_t p = 0; p < n; p++)
+        if (cd_mpm_item_stress(c, p, dt, mat)) bad = (long long)p > bad ? (long long)p : bad;
     if (bad >= 0) {
+        cd_mpm_device_sync(m);
         snprintf(err, errlen,
                  "material point %lld is not finite or has a volume <= 0 at step %lld (t = %.9g s): the run "
                  "blew up; reduce run.dt (limit %.3g s) or check the material",

@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include "config/config.h"
 #include "mpm_material.h"
+#include "mpm_step_items.h"
 
 #define CD_MPM_MAX_WALLS 4
 
@@ -34,7 +35,7 @@ typedef struct {
     int *bx, *by;                /* first node of the stencil in x and y (common mesh) */
     double *wx, *wy, *dwx, *dwy; /* 4 weights [1] and gradients [1/m] per point and direction */
     double *ex, *ey;             /* external (wall) force on the point [N/m] */
-    size_t *order;               /* point indices sorted by (body, cell), stable */
+    cd_ulong *order;             /* point indices sorted by (body, cell), stable */
 
     /* the common background mesh: nodes (i, j) at (ox + i h, oy + j h), i < nx, j < ny */
     int nx, ny;
@@ -43,13 +44,13 @@ typedef struct {
     /* bodies (docs/mpm.md, "Contact"): each has its own nodes on a window
      * of the common mesh, nodes (i0 + a, j0 + b), a < wnx, b < wny, stored
      * from win_off[k] on; found at the first step from the particle column */
-    int n_bodies;   /* 0 until the first step */
-    size_t *pfirst; /* points of body k: pfirst[k] .. pfirst[k+1]-1 */
+    int n_bodies;     /* 0 until the first step */
+    cd_ulong *pfirst; /* points of body k: pfirst[k] .. pfirst[k+1]-1 */
     int *win_i0, *win_j0, *win_nx, *win_ny;
-    size_t *win_off;             /* n_bodies + 1 */
+    cd_ulong *win_off;           /* n_bodies + 1 */
     size_t n_bnodes, cap_bnodes; /* body-nodes in use, allocated */
     int *bnode_body;             /* body of each body-node */
-    size_t *cell_start;          /* first entry in order of each body-cell (indexed like the body-nodes); + 1 */
+    cd_ulong *cell_start;        /* first entry in order of each body-cell (indexed like the body-nodes); + 1 */
     double *gm;                  /* node mass [kg/m] */
     double *gpx, *gpy;           /* node momentum [kg/s] per metre */
     double *gfx, *gfy;           /* node force [N/m], then acceleration [m/s^2] */
@@ -58,10 +59,10 @@ typedef struct {
         *gny; /* sum m_p grad N(x_p - x_i) [kg/m^2]: minus the node's mass gradient, the body's outward normal */
 
     /* contact: common nodes holding two or more bodies (src/mpm/mpm_contact.c) */
-    size_t *cn_start;     /* per common node (nx * ny + 1): its body-nodes in cn_entry */
-    size_t *cn_entry;     /* body-nodes sorted by common node, bodies ascending (cap_bnodes) */
-    size_t *cn_list;      /* common nodes with >= 2 bodies (nx * ny) */
-    unsigned *cn_active;  /* per listed node: bit q set when its q-th body pair is in contact (gap <= contact_gap) */
+    cd_ulong *cn_start;   /* per common node (nx * ny + 1): its body-nodes in cn_entry */
+    cd_ulong *cn_entry;   /* body-nodes sorted by common node, bodies ascending (cap_bnodes) */
+    cd_ulong *cn_list;    /* common nodes with >= 2 bodies (nx * ny) */
+    cd_uint *cn_active;   /* per listed node: bit q set when its q-th body pair is in contact (gap <= contact_gap) */
     size_t n_cn;          /* listed nodes */
     long long *pair_keys; /* scratch: k * n_bodies + l of the pairs in contact */
     size_t cap_pairs;
@@ -80,6 +81,14 @@ typedef struct {
                           * points' kinetic energy the mesh sees (docs/mpm.md "FLIP's noise") */
     double dt, time;     /* [s] */
     long long step;
+
+    /* where the step's loops run (src/mpm/mpm_device.c, docs/mpm.md "Work items") */
+    int loop_on;                     /* 1 from the first step on (offload builds: the state is on the device) */
+    cd_mpm_cols loop_cols;           /* offload builds: the device addresses of the columns */
+    size_t loop_cap, loop_cap_keys;  /* offload builds: body-nodes allocated there; pair keys allocated */
+    double *loop_wall_f, *loop_real; /* where the loops run: wall forces [N/m], the mesh's kinetic energy */
+    cd_ulong *loop_count;            /* where the loops run: counts the serial parts return */
+    cd_long *loop_keys;              /* where the loops run: the contact pairs' keys */
 } cd_mpm;
 
 /* Allocates n points and an nx x ny node mesh of cell size h [m] whose
@@ -124,10 +133,27 @@ void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double
  * nodes two or more bodies share; after the forces, detects the contacts
  * there, corrects the bodies' node velocities, sets the accelerations to
  * match and counts the body pairs.  -1 with a message when more bodies
- * than CD_MPM_NODE_BODIES meet at a node. */
-#define CD_MPM_NODE_BODIES 8
+ * than CD_MPM_NODE_BODIES (kernels/mpm_contact.h) meet at a node. */
 void cd_mpm_contact_nodes(cd_mpm *m);
 int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen);
+/* The columns and mesh of m's own (host) memory (valid until the
+ * body-node columns grow). */
+cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m);
+
+/* Where the step's loops run (src/mpm/mpm_device.c).  The default build
+ * runs them on host threads over m's columns; offload builds put the state
+ * on the offload device at the first step (cd_mpm_device_start, which
+ * cd_mpm_step calls), and its host columns are current only after
+ * cd_mpm_device_sync.  A host change to the columns after the first step
+ * needs cd_mpm_device_stop first.  cd_mpm_loop_cols: the columns the
+ * loops work on; cd_mpm_device_reserve / _keys: room there for n
+ * body-nodes / contact keys (0, or -1 out of memory). */
+int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen);
+void cd_mpm_device_sync(cd_mpm *m);
+void cd_mpm_device_stop(cd_mpm *m);
+cd_mpm_cols cd_mpm_loop_cols(const cd_mpm *m);
+int cd_mpm_device_reserve(cd_mpm *m, size_t n);
+int cd_mpm_device_keys(cd_mpm *m, size_t n);
 /* The common-mesh coordinates (i, j) of body-node t. */
 static inline void cd_mpm_bnode_ij(const cd_mpm *m, size_t t, int *i, int *j)
 {

@@ -109,6 +109,11 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
             break;
         }
         int last_step = m.step == cfg->steps;
+        double t = now_seconds();
+        int show = !opt->quiet && t - last >= (tty ? 0.5 : 10.0);
+        /* offload builds: the host columns the output and the progress line read, from the device */
+        if (m.step % cfg->thermo_every == 0 || m.step % cfg->snapshot_every == 0 || last_step || show)
+            cd_mpm_device_sync(&m);
         if ((m.step % cfg->thermo_every == 0 || last_step) &&
             cd_mpm_output_series(out, &m, cd_mpm_kinetic_energy(&m), err, sizeof err)) {
             fprintf(stderr, "\ncapdem: %s\n", err);
@@ -119,8 +124,7 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
             fprintf(stderr, "\ncapdem: %s\n", err);
             status = 1;
         }
-        double t = now_seconds();
-        if (!opt->quiet && t - last >= (tty ? 0.5 : 10.0)) {
+        if (show) {
             last = t;
             progress(&m, cfg, t0, step0, tty, 0);
         }

@@ -66,6 +66,7 @@ static void step(cd_mpm *m)
 {
     char err[512];
     if (cd_mpm_step(m, err, sizeof err)) fail_msg("step: %s", err);
+    cd_mpm_device_sync(m); /* offload builds: the columns the test reads, from the device */
 }
 
 /* Overlap [m] of the two disks along the x axis: the rightmost reach of
