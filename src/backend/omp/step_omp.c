@@ -510,8 +510,7 @@ static int forces_and_advance(cd_sim *sim, int next)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
         if (cd_item_gather_kick_advance(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start,
-                                        a->d.wall_rows, a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2,
-                                        next) &&
+                                        a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2, next) &&
             flagged) {
 #pragma omp atomic write
             a->d.skin_flag[0] = 1;
