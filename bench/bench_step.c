@@ -77,8 +77,10 @@ static size_t state_bytes(const cd_sim *sim)
         b += rows * cd_fields[f].elem_size;
     }
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
-    /* the wall candidates: CSR starts, rows and their outputs (cd_wall_out) */
-    b += (sim->s.n_particles + 1) * sizeof(cd_int) + sim->nb.cap_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_out));
+    /* the wall candidates: CSR starts, rows and their entries (cd_wall_entry:
+     * history and outputs), and the build before's, kept for the carry-over */
+    b += (sim->s.n_particles + 1) * sizeof(cd_int) +
+         (sim->nb.cap_wall_rows + sim->nb.cap_old_wall_rows) * (sizeof(cd_int) + sizeof(cd_wall_entry));
     return b;
 }
 

@@ -41,8 +41,8 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * every particle); writes flag, history, point, force (76), and the
      * overlap and F_n (16) at the last step of a call only. */
     out[0] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 76 + A * 16 / steps_per_call};
-    /* cd_item_wall_row over the wall candidates: per candidate its entry,
-     * flag and primitive (particle, ends, radius: 4 + 4 + 60, an upper
+    /* cd_item_wall_row over the wall candidates: per candidate its row,
+     * its entry's flag and its primitive (particle, ends, radius: 4 + 4 + 60, an upper
      * bound when a primitive has several); an active row its history (24)
      * and the particle's x, v, omega, m (80); writes flag, history, force,
      * torque, overlap, F_n. */

@@ -35,17 +35,22 @@ typedef struct {
 } cd_wall;
 
 /* What the step keeps of a wall contact per wall candidate of the last
- * neighbour-list build (not per primitive and wall): the outputs of the
- * candidate's wall-contact row, valid while the row is in contact
- * (wallc_active).  Sync expands them into the host's columns of the same
- * names (kernels/fields.def, group WALLC_OUT).  Plain struct for an OpenCL
- * buffer: 64 bytes on every backend. */
+ * neighbour-list build (not per primitive and wall): the history (flag and
+ * tangential spring, carried over at each build by matching the candidates'
+ * rows, src/backend/omp/neighbors.c and the OpenCL twin) and the outputs,
+ * valid while the entry is in contact (active).  Sync expands the entries
+ * into the host's columns of the same names (kernels/fields.def, groups
+ * WALLC and WALLC_OUT).  Plain struct for an OpenCL buffer: 96 bytes on
+ * every backend. */
 typedef struct {
     cd_vec3 force;   /* force of the wall on the primitive [N] */
     cd_vec3 torque;  /* torque of that force about the particle centre [N m] */
     cd_real overlap; /* normal overlap [m] */
     cd_real fn;      /* normal force magnitude F_n [N] (pushes the wall outwards) */
-} cd_wall_out;
+    cd_vec3 shear;   /* tangential spring elongation [m] (history; zero while not in contact) */
+    cd_int active;   /* 1 while the primitive overlaps the wall (history) */
+    cd_int pad_;     /* keeps the size a multiple of 8 bytes on every backend */
+} cd_wall_entry;
 
 /* Walls a simulation may have (the state's table, the observables' slots). */
 #define CD_MAX_WALLS 8

@@ -20,13 +20,14 @@
 #include "reorder_items.h"
 #include "step_items.h"
 
-/* Rows a leaf: 4,096, not the 64 a GPU wants (one thread a leaf), because
- * the MPI reduction (src/mpi/mpi_reduce.c) numbers pair rows as the serial
- * list does only up to the inactive rows, which a leaf of 64 rows exposes
- * (a bulk-probe restore: 90 rows against the serial 209, so other leaf
- * boundaries and other bits of the elastic energy); docs/mpi.md, "Not done
- * yet". */
-#define CD_OBS_BLOCK 4096
+/* Rows a leaf: 64, so that a GPU has one thread a leaf and many leaves
+ * (docs/performance.md, "GPU-shaped reductions").  A leaf's rows are a
+ * function of global ids only: particles by id, wall rows by primitive x
+ * walls + wall, and the pair rows of 64 primitives (their prim_i), however
+ * many rows the list holds: the MPI reduction (src/mpi/mpi_reduce.c), whose
+ * lists have other inactive rows than the serial one, sums the same rows
+ * in the same leaves (docs/mpi.md, "Reductions"). */
+#define CD_OBS_BLOCK 64
 #define CD_OBS_FANIN 16
 
 /* Components of an observable (kernels/observables.def) in the slots:
@@ -71,9 +72,11 @@ CD_INLINE void cd_obs_item_touch_pair(cd_cols c, cd_long k, CD_GLOBAL cd_int *to
     cd_atomic_inc(&touch[c.prim_particle[c.pair_prim_j[k]]]);
 }
 
-CD_INLINE void cd_obs_item_touch_wall(cd_cols c, cd_long row, cd_int n_walls, CD_GLOBAL cd_int *touch)
+/* Wall candidate e (row wall_rows[e], entry wall_out[e]: kernels/step_items.h). */
+CD_INLINE void cd_obs_item_touch_wall(cd_cols c, cd_long e, cd_int n_walls, const CD_GLOBAL cd_int *wall_rows,
+                                      const CD_GLOBAL cd_wall_entry *wall_out, CD_GLOBAL cd_int *touch)
 {
-    if (c.wallc_active[row]) cd_atomic_inc(&touch[c.prim_particle[row / n_walls]]);
+    if (wall_out[e].active) cd_atomic_inc(&touch[c.prim_particle[wall_rows[e] / n_walls]]);
 }
 
 /* Partial sums of the tree over n leaves: the leaves and the levels above
@@ -134,12 +137,34 @@ CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 g
     acc[CD_OBS_PX + 2] = sum_p.z;
 }
 
-/* Block b of the pair rows: elastic energy, contacts, largest overlap. */
+/* Leaves of the pair rows: one per CD_OBS_BLOCK primitives (n_prims). */
+CD_INLINE cd_long cd_obs_pair_blocks(cd_long n_prims) { return (n_prims + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK; }
+
+/* The first of the n pair rows in user order whose primitive i has a user
+ * id >= p (n if none): the rows are in key order (user id of i, then of
+ * j: the list build, kernels/neighbor_items.h, and the file's rows), so a
+ * binary search. */
+CD_INLINE cd_long cd_obs_pair_first(cd_cols c, cd_long n, cd_long p, cd_order o)
+{
+    cd_long lo = 0, hi = n;
+    while (lo < hi) {
+        cd_long mid = lo + (hi - lo) / 2;
+        if (cd_map(o.prim_uid, c.pair_prim_i[cd_map(o.pair_at, mid)]) < p) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* Block b of the pair rows (n of them), the rows of primitives i = b
+ * CD_OBS_BLOCK .. (b + 1) CD_OBS_BLOCK - 1 (user ids): elastic energy,
+ * contacts, largest overlap.  Inactive rows add nothing, so the sums do not
+ * depend on how many a list holds. */
 CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc,
                                   cd_order o)
 {
     cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
-    for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
+    cd_long end = cd_obs_pair_first(c, n, (b + 1) * CD_OBS_BLOCK, o);
+    for (cd_long u = cd_obs_pair_first(c, n, b * CD_OBS_BLOCK, o); u < end; u++) {
         cd_long k = cd_map(o.pair_at, u);
         if (!c.pair_active[k]) continue;
         cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
@@ -156,21 +181,21 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
 
 /* Block b of the primitive-wall rows (n_walls per primitive): elastic
  * energy, contacts, the particles' force on each wall [N] (summed in
- * place: its slot depends on the row), largest overlap.  The outputs of
- * the rows in contact: wall_out per wall candidate (cd_wall_out_place). */
+ * place: its slot depends on the row), largest overlap.  The history and
+ * outputs of the rows: wall_out per wall candidate (cd_wall_out_place; a
+ * row that is none is not in contact). */
 CD_INLINE void cd_obs_block_walls(cd_cols c, cd_long b, cd_long n, cd_int n_walls, cd_law_params wall_law,
                                   CD_GLOBAL cd_real *acc, cd_order o, const CD_GLOBAL cd_int *wall_start,
-                                  const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out)
+                                  const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_entry *wall_out)
 {
     cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
     cd_obs_clear(acc);
     for (cd_long u = b * CD_OBS_BLOCK; u < cd_obs_block_end(b, n); u++) {
         cd_long w = u % n_walls, i = cd_map(o.prim_at, u / n_walls), r = i * n_walls + w;
-        if (!c.wallc_active[r]) continue;
         cd_long e = cd_wall_out_place(c, r, n_walls, wall_start, wall_rows);
-        if (e < 0) continue; /* (a row in contact is a candidate) */
-        cd_wall_out out = wall_out[e];
-        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], out.overlap, c.wallc_shear[r]);
+        if (e < 0 || !wall_out[e].active) continue;
+        cd_wall_entry out = wall_out[e];
+        el += cd_contact_elastic_energy(wall_law, c.prim_radius[i], out.overlap, out.shear);
         contacts += 1;
         /* The particle pushes the wall with the opposite of the wall's force. */
         acc[CD_OBS_WALL + 3 * w + 0] -= out.force.x;

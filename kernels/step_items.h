@@ -211,14 +211,6 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     }
 }
 
-/* Ends the contact of wall-contact row `row`: no history.  (Its outputs,
- * kept per candidate, are read only while a row is in contact.) */
-CD_INLINE void cd_wall_row_clear(cd_cols c, cd_long row)
-{
-    c.wallc_active[row] = 0;
-    c.wallc_shear[row] = cd_v3_zero();
-}
-
 /* The place e of wall-contact row `row` (primitive i = row / n_walls)
  * among the wall candidates of i's particle (wall_rows[wall_start[q] ..
  * wall_start[q+1]), cd_item_wall_candidates), or -1 when it is none. */
@@ -235,8 +227,9 @@ CD_INLINE cd_long cd_wall_out_place(cd_cols c, cd_long row, cd_int n_walls, cons
  * (docs/references.md, Contacts (walls), Contact law).  The step runs it for the candidate rows of the last
  * neighbour-list build only (cd_item_wall_candidates).  wall_law: the
  * particle-wall law (its mu is replaced by the wall's friction).  *out:
- * the candidate's outputs (cd_wall_out), written while in contact. */
-CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_out *out, const CD_GLOBAL cd_wall *walls,
+ * the candidate's entry (cd_wall_entry): its history read and written,
+ * its outputs written while in contact. */
+CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_entry *out, const CD_GLOBAL cd_wall *walls,
                                 cd_int n_walls, cd_law_params wall_law, cd_real dt, cd_real sin_parallel,
                                 cd_int parallel_blend)
 {
@@ -248,20 +241,24 @@ CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_out *o
     if (!apart)
         cd_wall_contact_rule(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, parallel_blend, &g);
     if (apart || !(g.overlap > 0)) {
-        /* written only when it changes, to spare the bandwidth */
-        if (c.wallc_active[row]) cd_wall_row_clear(c, row);
+        /* the contact and its history end; written only when it changes,
+         * to spare the bandwidth (the outputs are read only while active) */
+        if (out->active) {
+            out->active = 0;
+            out->shear = cd_v3_zero();
+        }
         return;
     }
     cd_vec3 vi = cd_rigid_point_velocity(c.position[pi], c.velocity[pi], c.angvel[pi], g.point);
     cd_vec3 vw = cd_wall_velocity_at(&wall, g.point);
     cd_law_params law = wall_law;
     law.mu = wall.friction;
-    cd_vec3 shear = c.wallc_shear[row];
+    cd_vec3 shear = out->shear;
     /* The particle is body i, the wall body j of infinite mass and radius. */
     cd_contact_force f = cd_contact_law(law, c.mass[pi], c.prim_radius[i], &g, cd_v3_sub(vw, vi), dt, &shear);
     cd_vec3 fi = cd_v3_neg(f.force_j);
-    c.wallc_active[row] = 1;
-    c.wallc_shear[row] = shear;
+    out->active = 1;
+    out->shear = shear;
     out->force = fi;
     out->torque = cd_contact_torque(g.point, c.position[pi], fi);
     out->overlap = g.overlap;
@@ -273,8 +270,8 @@ CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_out *o
  * clearly apart from with its radius grown by the skin [m]
  * (cd_bp_wall_candidate), in ascending order.  Writes them from out[0]
  * unless out is null (the counting pass) and returns how many.  A row
- * left out can hold no contact; one still marked active (impossible while
- * the skin criteria hold) is ended, so that no stale force stays behind. */
+ * left out can hold no contact (its history, impossible while the skin
+ * criteria hold, is not carried over: cd_item_wall_carry). */
 CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_wall *walls, cd_int n_walls,
                                          cd_real skin, CD_GLOBAL cd_int *out)
 {
@@ -286,8 +283,6 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
             if (cd_bp_wall_candidate(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], skin)) {
                 if (out) out[n] = (cd_int)row;
                 n++;
-            } else if (c.wallc_active[row]) {
-                cd_wall_row_clear(c, row);
             }
         }
     return n;
@@ -308,11 +303,48 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
 #endif
 #endif
 
+/* History of new wall candidate e (row rows[e] = i n_walls + w) at a
+ * build: the old candidate with the same row keeps its flag and spring
+ * [m]; a row new to the lists starts without history.  The old rows
+ * old_rows[0 .. n_old) ascend (each build writes them in particle order,
+ * whose primitives' slots ascend; a start writes the host's rows in
+ * order), so a binary search finds them.  prim_src: the memory slot each
+ * primitive had when the old rows were made (null: the same;
+ * src/backend/omp/reorder.c).  The outputs start at zero: the wall pass
+ * writes them before anybody reads an active entry's. */
+CD_INLINE void cd_item_wall_carry(cd_long e, const CD_GLOBAL cd_int *rows, CD_GLOBAL cd_wall_entry *ent,
+                                  const CD_GLOBAL cd_int *old_rows, cd_long n_old,
+                                  const CD_GLOBAL cd_wall_entry *old_ent, const CD_GLOBAL cd_int *prim_src,
+                                  cd_int n_walls)
+{
+    cd_int row = rows[e];
+    if (prim_src) row = prim_src[row / n_walls] * n_walls + row % n_walls;
+    cd_long lo = 0, hi = n_old; /* the first old row >= row is in [lo, hi] */
+    while (lo < hi) {
+        cd_long mid = lo + (hi - lo) / 2;
+        if (old_rows[mid] < row) lo = mid + 1;
+        else hi = mid;
+    }
+    cd_wall_entry x;
+    x.force = cd_v3_zero();
+    x.torque = cd_v3_zero();
+    x.overlap = 0;
+    x.fn = 0;
+    x.shear = cd_v3_zero();
+    x.active = 0;
+    x.pad_ = 0;
+    if (lo < n_old && old_rows[lo] == row) {
+        x.shear = old_ent[lo].shear;
+        x.active = old_ent[lo].active;
+    }
+    ent[e] = x;
+}
+
 /* Total force *F_out [N] and torque *T_out [N m] of particle q (mass m
  * [kg], centre x [m]): gravity [m/s^2] times its mass,
- * then its wall contacts (its candidate rows wall_rows[wall_start[q] ..
- * wall_start[q+1]), ascending, i.e. primitive by primitive and wall by
- * wall; wall_out[e]: the outputs of candidate e), then its pair rows in
+ * then its wall contacts (its candidates' entries wall_out[wall_start[q]
+ * .. wall_start[q+1]), ascending by row, i.e. primitive by primitive and
+ * wall by wall), then its pair rows in
  * ascending row order, so the sum has one fixed order on every backend.
  * gather_rows[gather_start[q] .. gather_start[q+1]) hold 2 k + side for
  * pair row k: side 1 when q owns the row's primitive j (it gets +F_j), 0
@@ -320,14 +352,13 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
  * row's force and point.  dimension 2 keeps the motion in the x-y plane. */
 CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, const CD_GLOBAL cd_int *gather_start,
                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                             const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out, cd_vec3 gravity,
-                             cd_int dimension, cd_vec3 *F_out, cd_vec3 *T_out)
+                             const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension, cd_vec3 *F_out,
+                             cd_vec3 *T_out)
 {
     cd_vec3 F = cd_v3_scale(gravity, m);
     cd_vec3 T = cd_v3_zero();
     for (cd_int r = wall_start[q]; r < wall_start[q + 1]; r++) {
-        cd_int row = wall_rows[r];
-        if (!c.wallc_active[row]) continue;
+        if (!wall_out[r].active) continue;
         F = cd_v3_add(F, wall_out[r].force);
         T = cd_v3_add(T, wall_out[r].torque);
     }
@@ -369,12 +400,11 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
 /* cd_gather_sum for particle q, stored as its force and torque. */
 CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                               const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                              const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out, cd_vec3 gravity,
-                              cd_int dimension)
+                              const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension)
 {
     cd_vec3 F, T;
-    cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity,
-                  dimension, &F, &T);
+    cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension,
+                  &F, &T);
     c.force[q] = F;
     c.torque[q] = T;
 }
@@ -385,13 +415,12 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
  * arithmetic in the same order as the three items one after the other. */
 CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                                           const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                                          const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out,
-                                          cd_vec3 gravity, cd_int dimension, cd_real dt, cd_real limit2, int next)
+                                          const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
+                                          cd_real dt, cd_real limit2, int next)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
-    cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity,
-                  dimension, &F, &T);
+    cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F, &T);
     c.force[q] = F;
     c.torque[q] = T;
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
@@ -412,19 +441,18 @@ CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_
 /* Sum of the normal forces F_n [N] that the primitives of chunk ch exert
  * on wall w, in user primitive order (prim_at: user id -> memory slot,
  * null for the identity; kernels/reorder_items.h): the rows in contact,
- * whose outputs wall_out holds per wall candidate (cd_wall_out_place; the
+ * whose entries wall_out holds per wall candidate (cd_wall_out_place; the
  * rows not in contact have F_n = +0, which leaves a sum as it is). */
 CD_INLINE cd_real cd_item_wall_load_chunk(cd_cols c, cd_long ch, cd_long n_prims, cd_int n_walls, cd_int w,
                                           const CD_GLOBAL cd_int *prim_at, const CD_GLOBAL cd_int *wall_start,
-                                          const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_out *wall_out)
+                                          const CD_GLOBAL cd_int *wall_rows, const CD_GLOBAL cd_wall_entry *wall_out)
 {
     cd_long end = (ch + 1) * CD_LOAD_CHUNK < n_prims ? (ch + 1) * CD_LOAD_CHUNK : n_prims;
     cd_real acc = 0;
     for (cd_long u = ch * CD_LOAD_CHUNK; u < end; u++) {
         cd_long row = cd_map(prim_at, u) * n_walls + w;
-        if (!c.wallc_active[row]) continue;
         cd_long e = cd_wall_out_place(c, row, n_walls, wall_start, wall_rows);
-        if (e >= 0) acc += wall_out[e].fn;
+        if (e >= 0 && wall_out[e].active) acc += wall_out[e].fn;
     }
     return acc;
 }

@@ -180,3 +180,14 @@ __kernel void cd_cl_wall_cand_fill(
     cd_int q = (cd_int)get_global_id(0);
     if (q < n_particles) cd_item_wall_candidates(c, q, walls, n_walls, skin, wall_rows + wall_start[q]);
 }
+
+/* Pass 10, last: the history of wall candidate e from the old candidates
+ * (no reordering here: prim_src null). */
+__kernel void cd_cl_wall_carry(cd_int n_rows, __global const cd_int *wall_rows, __global cd_wall_entry *wall_out,
+                               __global const cd_int *old_rows, cd_int n_old, __global const cd_wall_entry *old_out,
+                               cd_int n_walls)
+{
+    cd_long e = (cd_long)get_global_id(0);
+    if (e < n_rows)
+        cd_item_wall_carry(e, wall_rows, wall_out, old_rows, n_old, old_out, (__global const cd_int *)0, n_walls);
+}

@@ -13,13 +13,15 @@ __kernel void cd_cl_obs_touch_pairs(
     if (k < n_pairs) cd_obs_item_touch_pair(c, k, touch);
 }
 
+/* One work-item per wall candidate of the last build. */
 __kernel void cd_cl_obs_touch_walls(
 #include "col_params.h"
-    cd_long n_rows, cd_int n_walls, __global cd_int *touch)
+    cd_long n_cand, cd_int n_walls, __global const cd_int *wall_rows, __global const cd_wall_entry *wall_out,
+    __global cd_int *touch)
 {
 #include "col_bind.h"
-    cd_long r = (cd_long)get_global_id(0);
-    if (r < n_rows) cd_obs_item_touch_wall(c, r, n_walls, touch);
+    cd_long e = (cd_long)get_global_id(0);
+    if (e < n_cand) cd_obs_item_touch_wall(c, e, n_walls, wall_rows, wall_out, touch);
 }
 
 /* One work-item per block; part: CD_OBS_SLOTS reals per block, this
@@ -34,19 +36,21 @@ __kernel void cd_cl_obs_particles(
         cd_obs_block_particles(c, b, n, gravity, touch, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
 }
 
+/* n pair rows, their leaves by blocks of n_prims primitives. */
 __kernel void cd_cl_obs_pairs(
 #include "col_params.h"
-    cd_long n, cd_law_params law, __global cd_real *part, cd_long first)
+    cd_long n, cd_law_params law, __global cd_real *part, cd_long first, cd_long n_prims)
 {
 #include "col_bind.h"
     cd_long b = (cd_long)get_global_id(0);
-    if (b * CD_OBS_BLOCK < n) cd_obs_block_pairs(c, b, n, law, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
+    if (b < cd_obs_pair_blocks(n_prims))
+        cd_obs_block_pairs(c, b, n, law, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
 }
 
 __kernel void cd_cl_obs_walls(
 #include "col_params.h"
     cd_long n, cd_int n_walls, cd_law_params wall_law, __global cd_real *part, cd_long first,
-    __global const cd_int *wall_start, __global const cd_int *wall_rows, __global const cd_wall_out *wall_out)
+    __global const cd_int *wall_start, __global const cd_int *wall_rows, __global const cd_wall_entry *wall_out)
 {
 #include "col_bind.h"
     cd_long b = (cd_long)get_global_id(0);

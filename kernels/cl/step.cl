@@ -36,7 +36,7 @@ __kernel void cd_cl_pair_forces(
 __kernel void cd_cl_wall_forces(
 #include "col_params.h"
     cd_int n_rows, __global const cd_int *wall_rows, __global const cd_wall *walls, cd_int n_walls,
-    cd_law_params wall_law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend, __global cd_wall_out *wall_out)
+    cd_law_params wall_law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend, __global cd_wall_entry *wall_out)
 {
 #include "col_bind.h"
     cd_int e = (cd_int)get_global_id(0);
@@ -54,8 +54,8 @@ __kernel void cd_cl_wall_forces(
 __kernel void cd_cl_gather_kick(
 #include "col_params.h"
     cd_int n_particles, __global const cd_int *gather_start, __global const cd_pair_id *gather_rows,
-    __global const cd_int *wall_start, __global const cd_int *wall_rows, cd_vec3 gravity, cd_int dimension, cd_int mode,
-    cd_real dt, __global const cd_wall_out *wall_out, cd_real limit2, __global cd_wall *walls, cd_int n_walls,
+    __global const cd_int *wall_start, cd_vec3 gravity, cd_int dimension, cd_int mode, cd_real dt,
+    __global const cd_wall_entry *wall_out, cd_real limit2, __global cd_wall *walls, cd_int n_walls,
     __global cd_int *flags)
 {
 #include "col_bind.h"
@@ -63,11 +63,11 @@ __kernel void cd_cl_gather_kick(
     if (mode == 2 && q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
     if (q >= n_particles) return;
     if (mode == 0) {
-        cd_item_gather(c, q, gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity, dimension);
+        cd_item_gather(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension);
         return;
     }
-    if (cd_item_gather_kick_advance(c, q, gather_start, gather_rows, wall_start, wall_rows, wall_out, gravity,
-                                    dimension, dt, limit2, mode == 2))
+    if (cd_item_gather_kick_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, dt,
+                                    limit2, mode == 2))
         flags[0] = 1;
 }
 
@@ -88,7 +88,7 @@ __kernel void cd_cl_check_finite(
 __kernel void cd_cl_wall_load(
 #include "col_params.h"
     cd_int n_prims, cd_int n_walls, cd_int w, __global cd_real *part, cd_int n_chunks,
-    __global const cd_int *wall_start, __global const cd_int *wall_rows, __global const cd_wall_out *wall_out)
+    __global const cd_int *wall_start, __global const cd_int *wall_rows, __global const cd_wall_entry *wall_out)
 {
 #include "col_bind.h"
     cd_int ch = (cd_int)get_global_id(0);

@@ -116,19 +116,46 @@ int cd_state_copy(cd_state *dst, const cd_state *src)
     return 0;
 }
 
-void cd_state_expand_wall_out(cd_state *s, const cd_int *rows, const cd_wall_out *out, size_t n)
+void cd_state_expand_wall_entries(cd_state *s, const cd_int *rows, const cd_wall_entry *ent, size_t n)
 {
     size_t R = s->n_prims * s->n_walls;
+    memset(s->wallc_active, 0, R * sizeof *s->wallc_active);
+    memset(s->wallc_shear, 0, R * sizeof *s->wallc_shear);
     memset(s->wallc_force, 0, R * sizeof *s->wallc_force);
     memset(s->wallc_torque, 0, R * sizeof *s->wallc_torque);
     memset(s->wallc_overlap, 0, R * sizeof *s->wallc_overlap);
     memset(s->wallc_fn, 0, R * sizeof *s->wallc_fn);
     for (size_t e = 0; e < n; e++) {
         size_t r = (size_t)rows[e];
-        if (!s->wallc_active[r]) continue;
-        s->wallc_force[r] = out[e].force;
-        s->wallc_torque[r] = out[e].torque;
-        s->wallc_overlap[r] = out[e].overlap;
-        s->wallc_fn[r] = out[e].fn;
+        if (!ent[e].active) continue;
+        s->wallc_active[r] = ent[e].active;
+        s->wallc_shear[r] = ent[e].shear;
+        s->wallc_force[r] = ent[e].force;
+        s->wallc_torque[r] = ent[e].torque;
+        s->wallc_overlap[r] = ent[e].overlap;
+        s->wallc_fn[r] = ent[e].fn;
     }
+}
+
+cd_wall_entry cd_state_wall_entry(const cd_state *s, size_t r)
+{
+    return (cd_wall_entry){s->wallc_force[r],
+                           s->wallc_torque[r],
+                           s->wallc_overlap[r],
+                           s->wallc_fn[r],
+                           s->wallc_shear[r],
+                           s->wallc_active[r],
+                           0};
+}
+
+size_t cd_state_wall_entries(const cd_state *s, cd_int *rows, cd_wall_entry *ent)
+{
+    size_t n = 0, R = s->n_prims * s->n_walls;
+    for (size_t r = 0; r < R; r++) {
+        if (!s->wallc_active[r]) continue;
+        if (rows) rows[n] = (cd_int)r;
+        if (ent) ent[n] = cd_state_wall_entry(s, r);
+        n++;
+    }
+    return n;
 }

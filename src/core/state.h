@@ -67,9 +67,15 @@ void cd_state_free(cd_state *s);
  * allocated for the same particles, primitives and walls (its pair columns
  * grow as needed).  Returns 0, or -1 (out of memory, or other sizes). */
 int cd_state_copy(cd_state *dst, const cd_state *src);
-/* The host's wall-contact outputs (fields.def, WALLC_OUT) from those the
- * step keeps per wall candidate: out[e] for the candidate row rows[e]
- * (e < n) while it is in contact (wallc_active), 0 elsewhere. */
-void cd_state_expand_wall_out(cd_state *s, const cd_int *rows, const cd_wall_out *out, size_t n);
+/* The host's wall-contact rows (fields.def, WALLC and WALLC_OUT) from the
+ * entries the step keeps per wall candidate: ent[e] for the candidate row
+ * rows[e] (e < n) while it is in contact (active), 0 elsewhere. */
+void cd_state_expand_wall_entries(cd_state *s, const cd_int *rows, const cd_wall_entry *ent, size_t n);
+/* Host row r of the wall contacts as a candidate entry. */
+cd_wall_entry cd_state_wall_entry(const cd_state *s, size_t r);
+/* The reverse of the expansion, at a start: the rows in contact (wallc_active) as candidate
+ * entries, ascending by row, into rows[] and ent[] (either may be null);
+ * returns how many. */
+size_t cd_state_wall_entries(const cd_state *s, cd_int *rows, cd_wall_entry *ent);
 
 #endif

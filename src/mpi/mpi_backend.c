@@ -161,10 +161,19 @@ static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
     double t1 = MPI_Wtime();
     x->t_decide += t1 - t0;
     if (!any) return 0;
-    if (cd_mpi_migrate(x)) {
-        snprintf(err, errlen, "out of memory while moving particles to their new MPI ranks");
+    /* The wall contacts' history lives in the inner step's candidate lists:
+     * into the local rows first (a sync; on an offload device
+     * cd_mpi_dev_leave syncs the whole state back to the host), so that it
+     * moves with its particles, and back into candidates at the build that
+     * follows (from the rows). */
+    int left = cd_mpi_dev_leave(x, err, errlen);
+    if (!left && agree_failure(x, x->inner->sync(loc, err, errlen), err, errlen)) return -1;
+    if (left < 0 || cd_mpi_migrate(x)) {
+        if (left >= 0) snprintf(err, errlen, "out of memory while moving particles to their new MPI ranks");
         MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
     }
+    if (left && cd_mpi_dev_return(x, err, errlen)) MPI_Abort(x->comm, 1);
+    loc->nb.walls_from_host = 1;
     x->t_migrate += MPI_Wtime() - t1;
     if (!loc->s.n_particles) { /* still none: no list to build (the build needs a particle) */
         loc->nb.force_rebuild = 0;
@@ -376,16 +385,38 @@ static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     return 0;
 }
 
+/* The devices the ranks took (cd_mpi_dev_choose), on rank 0 in rank
+ * order, for the run's first line; empty in a build without offload
+ * (every rank: host threads). */
+static char rank_devices[1024];
+
+static void devices_taken(cd_mpi_ctx *x)
+{
+    enum { LEN = 128 };
+    char mine[LEN] = "", *all = x->rank == 0 ? calloc((size_t)x->size, LEN) : NULL;
+    cd_mpi_dev_choose(x, mine, sizeof mine);
+    MPI_Gather(mine, LEN, MPI_CHAR, all, LEN, MPI_CHAR, 0, x->comm);
+    rank_devices[0] = 0;
+#if defined(CAPDEM_OFFLOAD_TARGET)
+    size_t at = 0;
+    for (int r = 0; all && r < x->size && at < sizeof rank_devices; r++) {
+        int n = snprintf(rank_devices + at, sizeof rank_devices - at, "%srank %d: %s", r ? "; " : "", r,
+                         all + (size_t)r * LEN);
+        at += n > 0 ? (size_t)n : 0;
+    }
+#endif
+    free(all);
+}
+
 static const char *mpi_device(const cd_sim *sim)
 {
-    static char buf[192];
+    static char buf[1280];
     const cd_mpi_ctx *x = sim->backend_data;
-    if (x->grid.kind == CD_DECOMP_RCB)
-        snprintf(buf, sizeof buf, "%d MPI ranks (sub-domains by recursive coordinate bisection), each: %s", x->size,
-                 x->inner->device(&x->loc));
-    else
-        snprintf(buf, sizeof buf, "%d MPI ranks (sub-domains %d x %d x %d), each: %s", x->size, x->grid.dims[0],
-                 x->grid.dims[1], x->grid.dims[2], x->inner->device(&x->loc));
+    char grid[96];
+    if (x->grid.kind == CD_DECOMP_RCB) snprintf(grid, sizeof grid, "sub-domains by recursive coordinate bisection");
+    else snprintf(grid, sizeof grid, "sub-domains %d x %d x %d", x->grid.dims[0], x->grid.dims[1], x->grid.dims[2]);
+    if (rank_devices[0]) snprintf(buf, sizeof buf, "%d MPI ranks (%s): %s", x->size, grid, rank_devices);
+    else snprintf(buf, sizeof buf, "%d MPI ranks (%s), each: %s", x->size, grid, x->inner->device(&x->loc));
     return buf;
 }
 
@@ -399,11 +430,6 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
         snprintf(err, errlen, "--backend %s: several MPI ranks run the omp backend only so far (docs/mpi.md)", backend);
         return -1;
     }
-#if defined(CAPDEM_OFFLOAD_TARGET)
-    snprintf(err, errlen, "this build offloads (%s): several MPI ranks run on host threads only so far (docs/mpi.md)",
-             CAPDEM_OFFLOAD_VARIANT);
-    return -1;
-#endif
     cd_mpi_ctx *x = calloc(1, sizeof *x);
     if (!x) {
         snprintf(err, errlen, "out of memory");
@@ -412,6 +438,7 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     x->comm = MPI_COMM_WORLD;
     MPI_Comm_rank(x->comm, &x->rank);
     MPI_Comm_size(x->comm, &x->size);
+    devices_taken(x); /* an offload build: each rank its device, before anything is mapped */
     const char *all = getenv("CAPDEM_MPI_ALL_RANKS"); /* the fallback path of a migration, for its test */
     x->all_ranks = all && !strcmp(all, "1");
     /* one run file, every rank writing its particles' rows (docs/mpi.md,

@@ -199,6 +199,7 @@ static int plan_refresh(cd_mpi_ctx *x)
             free(x->recv_buf);
             x->send_list = malloc(((size_t)ns + 1) * sizeof(int));
             x->recv_list = malloc(((size_t)nr + 1) * sizeof(int));
+            x->dev_stale = 1; /* (the device's copies follow at the next refresh) */
             x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
             x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
             if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) {
@@ -369,19 +370,6 @@ int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char *
     return *recv ? 0 : -1;
 }
 
-/* The ghost columns of particle q to or from b. */
-static void ghost_io(cd_state *s, size_t q, double *b, int pack)
-{
-    double *cols[] = {&s->position[q].x, &s->orientation[q].w, &s->velocity[q].x, &s->angmom[q].x,
-                      &s->angvel[q].x,   &s->force[q].x,       &s->torque[q].x};
-    int len[] = {3, 4, 3, 3, 3, 3, 3};
-    for (int c = 0; c < 7; c++) {
-        if (pack) memcpy(b, cols[c], (size_t)len[c] * sizeof(double));
-        else memcpy(cols[c], b, (size_t)len[c] * sizeof(double));
-        b += len[c];
-    }
-}
-
 int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
 {
     cd_state *s = &x->loc.s;
@@ -395,22 +383,25 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
             MPI_Irecv(x->recv_buf + (size_t)x->recv_displ[r] * G, x->recv_count[r] * G, MPI_DOUBLE, r,
                       CD_MPI_TAG_GHOSTS, x->comm, &x->requests[n++]);
     }
+    cd_cols c = cd_sim_host_cols(s);
+    int host = cd_mpi_dev_pack(x); /* on an offload device: every send row packed there */
+    if (host < 0) MPI_Abort(x->comm, 1);
     for (int k = 0; k < x->n_neighbors; k++) {
         int r = x->neighbors[k];
         if (!x->send_count[r]) continue;
         double *b = x->send_buf + (size_t)x->send_displ[r] * G;
-        for (int e = 0; e < x->send_count[r]; e++)
-            ghost_io(s, (size_t)x->send_list[x->send_displ[r] + e], b + (size_t)e * G, 1);
+        for (int e = 0; host && e < x->send_count[r]; e++)
+            cd_mpi_ghost_io(c, x->send_list[x->send_displ[r] + e], b + (size_t)e * G, 1);
         MPI_Isend(b, x->send_count[r] * G, MPI_DOUBLE, r, CD_MPI_TAG_GHOSTS, x->comm, &x->requests[n++]);
         x->refresh_msgs++;
         x->refresh_bytes += (long long)x->send_count[r] * G * (long long)sizeof(double);
     }
     MPI_Waitall(n, x->requests, MPI_STATUSES_IGNORE);
-    for (int k = 0; k < x->n_neighbors; k++) {
+    if (!host && cd_mpi_dev_unpack(x)) MPI_Abort(x->comm, 1); /* the ghosts' rows written there */
+    for (int k = 0; host && k < x->n_neighbors; k++) {
         int r = x->neighbors[k];
         for (int e = 0; e < x->recv_count[r]; e++)
-            ghost_io(s, (size_t)x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G,
-                     0);
+            cd_mpi_ghost_io(c, x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G, 0);
     }
     x->refreshes++;
     return first;
@@ -540,6 +531,7 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
 
 void cd_mpi_halo_free(cd_mpi_ctx *x)
 {
+    cd_mpi_dev_free(x);
     free(x->gid);
     free(x->gprim);
     free(x->owned);

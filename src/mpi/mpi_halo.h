@@ -22,6 +22,13 @@ typedef struct {
     int *send_count, *send_displ, *recv_count, *recv_displ; /* per rank, in particles */
     int *send_list, *recv_list;
     double *send_buf, *recv_buf;
+    /* the same lists and buffers on the offload device (src/mpi/mpi_device.c),
+     * where the local state runs in an offload build: the halo is packed
+     * and unpacked there and only its rows cross to the host (NULL on host
+     * threads); dev_stale: the lists changed since they were copied */
+    int *dev_send_list, *dev_recv_list;
+    double *dev_send_buf, *dev_recv_buf;
+    int dev_stale;
     /* the ranks whose sub-domain comes within the halo and the skin of this
      * one's (cd_decomp_neighbors): the only ones it exchanges with, but for
      * a migration that finds a particle beyond them (then all ranks) */
@@ -51,6 +58,44 @@ typedef struct {
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,
  * velocity 3, angmom 3, angvel 3, force 3, torque 3. */
 #define CD_MPI_GHOST_DOUBLES 22
+
+/* The ghost columns of local particle q (c: host or device columns) to
+ * (pack) or from the CD_MPI_GHOST_DOUBLES doubles at b: one function for
+ * the host's refresh and the device's (src/mpi/mpi_device.c). */
+CD_DEVICE_BEGIN
+static inline void cd_mpi_ghost_io(cd_cols c, cd_int q, double *b, int pack)
+{
+    double *cols[7] = {&c.position[q].x, &c.orientation[q].w, &c.velocity[q].x, &c.angmom[q].x,
+                       &c.angvel[q].x,   &c.force[q].x,       &c.torque[q].x};
+    const int len[7] = {3, 4, 3, 3, 3, 3, 3};
+    for (int k = 0; k < 7; k++) {
+        for (int e = 0; e < len[k]; e++) {
+            if (pack) b[e] = cols[k][e];
+            else cols[k][e] = b[e];
+        }
+        b += len[k];
+    }
+}
+CD_DEVICE_END
+
+/* The ghost refresh's packing where the local state runs: on the offload
+ * device (offload builds, the state mapped there) the send rows packed
+ * there into x->send_buf, or the received x->recv_buf unpacked there into
+ * the ghosts' rows; only the halo's bytes cross.  Returns 1 when the state
+ * is on the host (the caller packs), 0 done, -1 out of device memory. */
+int cd_mpi_dev_pack(cd_mpi_ctx *x);
+int cd_mpi_dev_unpack(cd_mpi_ctx *x);
+void cd_mpi_dev_free(cd_mpi_ctx *x);
+/* The offload device of this rank: its node-local rank (MPI_COMM_TYPE_SHARED)
+ * modulo the node's devices, made the default device before anything is
+ * mapped; what it took, in words, into desc.  Collective. */
+void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len);
+/* Around a migration, which rebuilds the local state on the host: the
+ * device's state copied back and let go (leave: 1, or 0 when the state is
+ * on the host, -1 with err set), mapped again (return, after a leave that
+ * returned 1: 0, or -1 with err set). */
+int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen);
+int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen);
 
 /* The local state of this rank cut from a global state (every rank holds
  * the same one at start): owned particles, ghosts, the active pair rows

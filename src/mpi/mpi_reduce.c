@@ -9,10 +9,11 @@
  * rows that add something; a block's rank sums it with the serial block
  * function, in row order, from exactly the serial inputs; the blocks'
  * partial sums go to rank 0, which merges them in block order and sends
- * the total to every rank.  The pair rows' blocks are blocks of the serial
- * list's row numbers (inactive rows included), found by a prefix sum of
- * the rows of each primitive, itself distributed by blocks of primitives.
- * Every exchange moves each row once (no rank receives the whole state). */
+ * the total to every rank.  The observables' leaves are functions of
+ * global ids only (the pair rows' of their primitive i), dealt to the
+ * ranks by groups of CD_OBS_FANIN^k leaves, so that each rank makes the
+ * tree's first k levels of merges of its groups and rank 0 the rest.  Every exchange
+ * moves each row once (no rank receives the whole state). */
 #include <stdlib.h>
 #include <string.h>
 #include "mpi/mpi_halo.h"
@@ -171,10 +172,10 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
 
 /* ---- observables ------------------------------------------------------------ */
 
-/* What a block of each kind reads of a row (kernels/observe_items.h): a
+/* What a leaf of each kind reads of a row (kernels/observe_items.h): a
  * particle's moving columns (its mass and inertia are the set-up's, on
  * every rank) and whether it touches; an active wall row; an active pair
- * row with its place in the serial list. */
+ * row with its global primitives. */
 typedef struct {
     long long gid;
     cd_vec3 position, velocity, angmom;
@@ -183,36 +184,70 @@ typedef struct {
 } obs_particle;
 
 typedef struct {
-    long long row; /* global primitive x walls + wall */
-    cd_vec3 shear;
-    cd_wall_out out; /* the row's outputs (kernels/geom_types.h) */
-    long long active;
+    long long row;     /* global primitive x walls + wall */
+    cd_wall_entry out; /* the row's history and outputs (kernels/geom_types.h) */
 } obs_wall;
 
 typedef struct {
-    long long row, gi, gj; /* the serial list's row; global primitives */
+    long long key, gi, gj; /* gi x (global primitives) + gj: the serial list's order; global primitives */
     cd_vec3 shear;
     double overlap;
     long long active;
 } obs_pair;
 
 typedef struct {
-    long long prim, value, from; /* global primitive, rows or first row, the asking rank */
-} prim_rows;
-
-typedef struct {
-    long long block; /* in merge order: particles, pairs, wall rows */
+    long long index; /* leaf (merge order: particles, pairs, wall rows), or group of CD_OBS_FANIN leaves */
     double acc[CD_OBS_SLOTS];
 } obs_partial;
 
-/* This rank's partials, grown as blocks come. */
+/* This rank's partials, grown as leaves come. */
 typedef struct {
     obs_partial *p;
     size_t n, cap;
 } partials;
 
-/* Room for one more partial, block `block`; its slots to fill, NULL when out of memory. */
-static double *push(partials *v, long long block)
+/* The leaves of the whole tree: the first leaf of each kind, and all; the
+ * tree's levels that the ranks merge themselves (levels, the first merge
+ * counted as 1) and the leaves under one item of the last of them (span =
+ * CD_OBS_FANIN^levels), which go to one rank. */
+typedef struct {
+    long long particles, pairs, walls, n;
+    int levels;
+    long long span;
+} leaf_plan;
+
+/* Items of the tree's level j over n leaves (level 0: the leaves; the
+ * last level has one item, the total). */
+static long long level_items(long long n, int j)
+{
+    for (int k = 0; k < j && n > 1; k++) n = n > CD_OBS_FANIN ? (n + CD_OBS_FANIN - 1) / CD_OBS_FANIN : 1;
+    return n;
+}
+
+/* As many levels merged on the ranks as leave at least 4 items of the last
+ * of them per rank (at least the first merge, at most the whole tree): rank
+ * 0 then merges n / 16^levels partials, not one per leaf (1e8 hexapods:
+ * 3e7 leaves on 64 ranks, about 450 partials of 4 levels). */
+static void plan_levels(leaf_plan *lp, int ranks)
+{
+    const char *force = getenv("CAPDEM_MPI_MERGE_LEVELS"); /* that many levels where the tree has them, for the test */
+    int forced = force ? atoi(force) : 0;
+    lp->levels = 1;
+    lp->span = CD_OBS_FANIN;
+    while (forced > lp->levels && level_items(lp->n, lp->levels) > 1) {
+        lp->levels++;
+        lp->span *= CD_OBS_FANIN;
+    }
+    if (forced > 0) return;
+    while (level_items(lp->n, lp->levels) > 1 &&
+           (lp->n + lp->span * CD_OBS_FANIN - 1) / (lp->span * CD_OBS_FANIN) >= 4LL * ranks) {
+        lp->levels++;
+        lp->span *= CD_OBS_FANIN;
+    }
+}
+
+/* Room for one more partial, number `index`; its slots to fill, NULL when out of memory. */
+static double *push(partials *v, long long index)
 {
     if (v->n == v->cap) {
         size_t cap = v->cap ? 2 * v->cap : 16;
@@ -221,111 +256,44 @@ static double *push(partials *v, long long block)
         v->p = p;
         v->cap = cap;
     }
-    v->p[v->n].block = block;
+    v->p[v->n].index = index;
     return v->p[v->n++].acc;
 }
 
-/* Every block has one rank, so the n partials are all the leaves: merged
- * by the serial program's tree (cd_obs_merge_serial). */
-static void merge_blocks(const char *all, size_t n, double *total)
+/* Leaf L belongs to the rank of its group of lp.span leaves (an item of
+ * the last level the ranks merge), groups dealt round the ranks: a rank
+ * merges its groups itself, and rank 0 gets one partial a group. */
+static int leaf_rank(const cd_mpi_ctx *x, const leaf_plan *lp, long long leaf)
+{
+    return (int)((leaf / lp->span) % x->size);
+}
+
+/* Rank 0, the items of the ranks' last level (n of them) gathered from
+ * every rank: the rest of the serial program's tree (cd_obs_merge_serial
+ * from the next level on); when the ranks' levels were the whole tree, the
+ * one item is the total. */
+static void merge_groups(const char *all, size_t n, double *total)
 {
     obs_partial *p = (obs_partial *)all;
     qsort(p, n, sizeof *p, by_key);
+    if (n == 1) {
+        memcpy(total, p[0].acc, sizeof p[0].acc);
+        return;
+    }
     double *flat = malloc(((size_t)cd_obs_tree_blocks((cd_long)n) + 1) * CD_OBS_SLOTS * sizeof *flat);
     if (!flat) {
         for (int k = 0; k < CD_OBS_SLOTS; k++) total[k] = 0.0 / 0.0; /* (NaN: nothing known) */
         return;
     }
-    for (size_t b = 0; b < n; b++) memcpy(flat + b * CD_OBS_SLOTS, p[b].acc, sizeof p[b].acc);
+    for (size_t g = 0; g < n; g++) memcpy(flat + g * CD_OBS_SLOTS, p[g].acc, sizeof p[g].acc);
     cd_obs_merge_serial(flat, (cd_long)n, total);
     free(flat);
 }
 
-static int block_rank(const cd_mpi_ctx *x, long long row) { return (int)((row / CD_OBS_BLOCK) % x->size); }
-
-/* The serial list's first row of each owned primitive with rows (first,
- * by global primitive, into *firsts, sorted; *n_firsts of them) and the
- * list's length (*K): the rows per primitive go to the ranks of the
- * primitives' blocks, which sum them in primitive order; the block totals
- * (one long long per block of primitives, each from its rank) are summed
- * over the ranks and prefixed on every rank; each first row goes back. */
-static int serial_rows(cd_mpi_ctx *x, const long long *rows, prim_rows **firsts, size_t *n_firsts, long long *K,
-                       size_t n_prims_global)
-{
-    cd_state *s = &x->loc.s;
-    size_t n = 0, nb = (n_prims_global + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
-    prim_rows *mine = malloc((s->n_prims + 1) * sizeof *mine);
-    int *dest = malloc((s->n_prims + 1) * sizeof *dest);
-    long long *tot = calloc(nb + 1, sizeof *tot), *start = calloc(nb + 1, sizeof *start);
-    if (!mine || !dest || !tot || !start) return -1;
-    for (size_t q = 0; q < s->n_particles; q++)
-        for (cd_int i = s->prim_first[q]; x->owned[q] && i < s->prim_first[q] + s->prim_count[q]; i++)
-            if (rows[i]) {
-                mine[n] = (prim_rows){x->gprim[i], rows[i], x->rank};
-                dest[n++] = block_rank(x, x->gprim[i]);
-            }
-    char *got = NULL, *back = NULL;
-    size_t len = 0, blen = 0;
-    int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
-    size_t m = len / sizeof(prim_rows);
-    prim_rows *e = (prim_rows *)got;
-    if (!rc) {
-        qsort(e, m, sizeof *e, by_key);
-        for (size_t k = 0; k < m; k++) tot[e[k].prim / CD_OBS_BLOCK] += e[k].value;
-        /* each entry from one rank, the others' zeros: an integer sum, exact */
-        MPI_Allreduce(tot, start, (int)nb, MPI_LONG_LONG, MPI_SUM, x->comm);
-        long long run = 0;
-        for (size_t b = 0; b < nb; b++) { /* exclusive prefix: the first row of each block of primitives */
-            long long t = start[b];
-            start[b] = run;
-            run += t;
-        }
-        *K = run;
-        long long at = -1, blk = -1;
-        free(dest);
-        dest = malloc((m + 1) * sizeof *dest);
-        if (!dest) rc = -1;
-        for (size_t k = 0; dest && k < m; k++) {
-            if (e[k].prim / CD_OBS_BLOCK != blk) {
-                blk = e[k].prim / CD_OBS_BLOCK;
-                at = start[blk];
-            }
-            long long r = e[k].value;
-            e[k].value = at;
-            at += r;
-            dest[k] = (int)e[k].from;
-        }
-        if (!rc) rc = route(x, got, dest, m, sizeof *e, &back, &blen);
-    }
-    if (!rc) {
-        *firsts = (prim_rows *)back;
-        *n_firsts = blen / sizeof(prim_rows);
-        qsort(*firsts, *n_firsts, sizeof **firsts, by_key);
-    } else free(back);
-    free(mine);
-    free(dest);
-    free(tot);
-    free(start);
-    free(got);
-    return rc;
-}
-
-/* The first row of global primitive gp in the serial list (firsts sorted). */
-static long long first_row(const prim_rows *firsts, size_t n, long long gp)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (firsts[mid].prim < gp) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo < n && firsts[lo].prim == gp ? firsts[lo].value : -1;
-}
-
-/* The particle blocks of this rank, summed on the global state's columns
+/* The particle leaves of this rank, summed on the global state's columns
  * (their rows written from the owners' records; mass and inertia are the
  * set-up's) with the touch flags of the owners. */
-static int particle_blocks(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, partials *out)
+static int particle_leaves(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, leaf_plan lp, partials *out)
 {
     cd_state *s = &x->loc.s, *gs = &g->s;
     size_t n = 0, N = gs->n_particles;
@@ -337,7 +305,7 @@ static int particle_blocks(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, pa
         if (x->owned[q]) {
             mine[n] = (obs_particle){x->gid[q],    s->position[q],    s->velocity[q],
                                      s->angmom[q], s->orientation[q], touch_loc[q] != 0};
-            dest[n++] = block_rank(x, x->gid[q]);
+            dest[n++] = leaf_rank(x, &lp, lp.particles + x->gid[q] / CD_OBS_BLOCK);
         }
     char *got = NULL;
     size_t len = 0;
@@ -352,9 +320,9 @@ static int particle_blocks(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, pa
         touch[r.gid] = (cd_int)r.touch;
     }
     cd_cols c = cd_sim_host_cols(gs);
-    cd_long nb = ((cd_long)N + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
-    for (cd_long b = x->rank; !rc && b < nb; b += x->size) {
-        double *acc = push(out, b);
+    for (cd_long b = 0; !rc && b < lp.pairs - lp.particles; b++) {
+        if (leaf_rank(x, &lp, lp.particles + b) != x->rank) continue;
+        double *acc = push(out, lp.particles + b);
         if (!acc) rc = -1;
         else cd_obs_block_particles(c, b, (cd_long)N, g->p.gravity, touch, acc, cd_order_identity());
     }
@@ -365,13 +333,12 @@ static int particle_blocks(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, pa
     return rc;
 }
 
-/* The wall-row blocks of this rank (first block first_block in merge
- * order), summed on the global state's wall columns (this rank's blocks
- * cleared, then the active rows written from the owners' records) with
- * the rows' outputs in the form of the step's candidate lists
- * (kernels/step_items.h, cd_wall_out_place): per particle its rows in
- * contact, ascending. */
-static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials *out)
+/* The wall-row leaves of this rank, summed on the global state's wall
+ * columns (this rank's leaves cleared, then the active rows written from
+ * the owners' records) with the rows' outputs in the form of the step's
+ * candidate lists (kernels/step_items.h, cd_wall_out_place): per particle
+ * its rows in contact, ascending. */
+static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
 {
     cd_state *s = &x->loc.s, *gs = &g->s;
     size_t W = s->n_walls, n = 0, rows = gs->n_prims * W, N = gs->n_particles;
@@ -384,9 +351,9 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
                 size_t r = (size_t)i * W + w;
                 if (!s->wallc_active[r]) continue; /* (an inactive row adds nothing) */
                 long long row = x->gprim[i] * (long long)W + (long long)w;
-                cd_wall_out o = {s->wallc_force[r], s->wallc_torque[r], s->wallc_overlap[r], s->wallc_fn[r]};
-                mine[n] = (obs_wall){row, s->wallc_shear[r], o, s->wallc_active[r]};
-                dest[n++] = block_rank(x, row);
+                cd_wall_entry o = cd_state_wall_entry(s, r);
+                mine[n] = (obs_wall){row, o};
+                dest[n++] = leaf_rank(x, &lp, lp.walls + row / CD_OBS_BLOCK);
             }
     char *got = NULL;
     size_t len = 0, m = 0;
@@ -394,23 +361,26 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
     m = len / sizeof(obs_wall);
     obs_wall *e = (obs_wall *)got;
     cd_int *start = calloc(N + 2, sizeof *start), *wrows = malloc((m + 1) * sizeof *wrows);
-    cd_wall_out *outs = malloc((m + 1) * sizeof *outs);
+    cd_wall_entry *outs = malloc((m + 1) * sizeof *outs);
     if (!start || !wrows || !outs) rc = -1;
-    cd_long nb = ((cd_long)rows + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
-    for (cd_long b = x->rank; !rc && b < nb; b += x->size)
-        for (cd_long r = b * CD_OBS_BLOCK; r < cd_obs_block_end(b, (cd_long)rows); r++) gs->wallc_active[r] = 0;
+    cd_long nb = lp.n - lp.walls;
+    for (cd_long b = 0; !rc && b < nb; b++)
+        for (cd_long r = b * CD_OBS_BLOCK;
+             leaf_rank(x, &lp, lp.walls + b) == x->rank && r < cd_obs_block_end(b, (cd_long)rows); r++)
+            gs->wallc_active[r] = 0;
     if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: particles ascending */
     for (size_t k = 0; !rc && k < m; k++) {
-        gs->wallc_active[e[k].row] = (cd_int)e[k].active;
-        gs->wallc_shear[e[k].row] = e[k].shear;
+        gs->wallc_active[e[k].row] = e[k].out.active;
+        gs->wallc_shear[e[k].row] = e[k].out.shear;
         start[gs->prim_particle[e[k].row / (long long)W] + 1]++;
         wrows[k] = (cd_int)e[k].row;
         outs[k] = e[k].out;
     }
     for (size_t q = 0; !rc && q < N; q++) start[q + 1] += start[q];
     cd_cols c = cd_sim_host_cols(gs);
-    for (cd_long b = x->rank; !rc && b < nb; b += x->size) {
-        double *acc = push(out, first_block + b);
+    for (cd_long b = 0; !rc && b < nb; b++) {
+        if (leaf_rank(x, &lp, lp.walls + b) != x->rank) continue;
+        double *acc = push(out, lp.walls + b);
         if (!acc) rc = -1;
         else
             cd_obs_block_walls(c, b, (cd_long)rows, (cd_int)W, g->p.wall_law, acc, cd_order_identity(), start, wrows,
@@ -425,75 +395,59 @@ static int wall_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
     return rc;
 }
 
-/* The pair-row blocks of this rank (first block first_block in merge
- * order): the active rows of the serial list, each sent by the owner of
- * its particle i, into a block's own columns (the rows of the block at
- * 0..), summed by the serial block function; prim_radius is the set-up's. */
-static int pair_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials *out, long long *n_blocks)
+/* The pair-row leaves of this rank: the active rows, each sent by the
+ * owner of its particle i to the rank of its primitive i's leaf, put in
+ * the serial list's order (by global primitive i, then j: the order of the
+ * rows of the serial list, inactive rows aside, which add nothing) into
+ * columns of their own, summed by the serial leaf function, which finds
+ * each leaf's rows by their primitive i; prim_radius is the set-up's. */
+static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
 {
     cd_state *s = &x->loc.s;
-    size_t P = s->n_prims, n = 0, n_firsts = 0;
-    long long *row0 = malloc((P + 1) * sizeof *row0), *rows = calloc(P + 1, sizeof *rows), K = 0;
-    prim_rows *firsts = NULL;
-    if (!row0 || !rows) return -1;
-    /* the rows of each primitive: contiguous, the list being in key order */
-    for (size_t k = s->n_pairs; k-- > 0;) {
-        row0[s->pair_prim_i[k]] = (long long)k;
-        rows[s->pair_prim_i[k]]++;
-    }
-    int rc = serial_rows(x, rows, &firsts, &n_firsts, &K, g->s.n_prims);
+    long long P = (long long)g->s.n_prims;
+    size_t n = 0;
     obs_pair *mine = malloc((s->n_pairs + 1) * sizeof *mine);
     int *dest = malloc((s->n_pairs + 1) * sizeof *dest);
-    if (!mine || !dest) rc = -1;
-    for (size_t k = 0; !rc && k < s->n_pairs; k++) {
+    if (!mine || !dest) return -1;
+    for (size_t k = 0; k < s->n_pairs; k++) {
         cd_int i = s->pair_prim_i[k];
         if (!s->pair_active[k] || !x->owned[s->prim_particle[i]]) continue;
-        long long row = first_row(firsts, n_firsts, x->gprim[i]) + ((long long)k - row0[i]);
-        mine[n] = (obs_pair){
-            row, x->gprim[i], x->gprim[s->pair_prim_j[k]], s->pair_shear[k], s->pair_overlap[k], s->pair_active[k]};
-        dest[n++] = block_rank(x, row);
+        long long gi = x->gprim[i], gj = x->gprim[s->pair_prim_j[k]];
+        mine[n] = (obs_pair){gi * P + gj, gi, gj, s->pair_shear[k], s->pair_overlap[k], s->pair_active[k]};
+        dest[n++] = leaf_rank(x, &lp, lp.pairs + gi / CD_OBS_BLOCK);
     }
     char *got = NULL;
     size_t len = 0;
-    if (!rc) rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
-    cd_long nb = (K + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
-    *n_blocks = nb;
-    /* one block's columns, rows from 0 */
-    cd_int *active = malloc(CD_OBS_BLOCK * sizeof *active), *pi = malloc(CD_OBS_BLOCK * sizeof *pi),
-           *pj = malloc(CD_OBS_BLOCK * sizeof *pj);
-    double *overlap = malloc(CD_OBS_BLOCK * sizeof *overlap);
-    cd_vec3 *shear = malloc(CD_OBS_BLOCK * sizeof *shear);
-    if (!active || !pi || !pj || !overlap || !shear) rc = -1;
+    int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
     size_t m = len / sizeof(obs_pair);
-    for (cd_long b = x->rank; !rc && b < nb; b += x->size) {
-        cd_long b0 = b * CD_OBS_BLOCK, len_b = cd_obs_block_end(b, K) - b0;
-        memset(active, 0, CD_OBS_BLOCK * sizeof *active);
-        for (size_t k = 0; k < m; k++) {
-            obs_pair r;
-            memcpy(&r, got + k * sizeof r, sizeof r);
-            if (r.row < b0 || r.row >= b0 + len_b) continue;
-            size_t at = (size_t)(r.row - b0);
-            active[at] = (cd_int)r.active;
-            pi[at] = (cd_int)r.gi;
-            pj[at] = (cd_int)r.gj;
-            overlap[at] = r.overlap;
-            shear[at] = r.shear;
-        }
-        cd_cols c;
-        memset(&c, 0, sizeof c);
-        c.pair_active = active;
-        c.pair_prim_i = pi;
-        c.pair_prim_j = pj;
-        c.pair_overlap = overlap;
-        c.pair_shear = shear;
-        c.prim_radius = g->s.prim_radius;
-        double *acc = push(out, first_block + b);
-        if (!acc) rc = -1;
-        else cd_obs_block_pairs(c, 0, len_b, g->p.law, acc, cd_order_identity());
+    obs_pair *e = (obs_pair *)got;
+    cd_int *active = malloc((m + 1) * sizeof *active), *pi = malloc((m + 1) * sizeof *pi),
+           *pj = malloc((m + 1) * sizeof *pj);
+    double *overlap = malloc((m + 1) * sizeof *overlap);
+    cd_vec3 *shear = malloc((m + 1) * sizeof *shear);
+    if (!active || !pi || !pj || !overlap || !shear) rc = -1;
+    if (!rc) qsort(e, m, sizeof *e, by_key);
+    for (size_t k = 0; !rc && k < m; k++) {
+        active[k] = (cd_int)e[k].active;
+        pi[k] = (cd_int)e[k].gi;
+        pj[k] = (cd_int)e[k].gj;
+        overlap[k] = e[k].overlap;
+        shear[k] = e[k].shear;
     }
-    free(row0);
-    free(rows);
-    free(firsts);
+    cd_cols c;
+    memset(&c, 0, sizeof c);
+    c.pair_active = active;
+    c.pair_prim_i = pi;
+    c.pair_prim_j = pj;
+    c.pair_overlap = overlap;
+    c.pair_shear = shear;
+    c.prim_radius = g->s.prim_radius;
+    for (cd_long b = 0; !rc && b < lp.walls - lp.pairs; b++) {
+        if (leaf_rank(x, &lp, lp.pairs + b) != x->rank) continue;
+        double *acc = push(out, lp.pairs + b);
+        if (!acc) rc = -1;
+        else cd_obs_block_pairs(c, b, (cd_long)m, g->p.law, acc, cd_order_identity());
+    }
     free(mine);
     free(dest);
     free(got);
@@ -502,6 +456,37 @@ static int pair_blocks(cd_mpi_ctx *x, cd_sim *g, long long first_block, partials
     free(pj);
     free(overlap);
     free(shear);
+    return rc;
+}
+
+/* This rank's groups of leaves merged, level by level up to lp.levels:
+ * each item by cd_obs_item_merge over its own children (at most
+ * CD_OBS_FANIN, all this rank's), the additions of the serial program's
+ * tree.  The rank's items of level lp.levels into *groups. */
+static int merge_own_groups(const partials *leaves, leaf_plan lp, partials *groups)
+{
+    partials in = *leaves, out = {NULL, 0, 0};
+    int rc = 0;
+    for (int j = 1; !rc && j <= lp.levels; j++) {
+        long long n_in = level_items(lp.n, j - 1);
+        out.n = 0;
+        for (size_t k = 0; !rc && k < in.n;) { /* items in ascending order */
+            long long item = in.p[k].index / CD_OBS_FANIN;
+            size_t first = k;
+            double buf[CD_OBS_FANIN * CD_OBS_SLOTS];
+            for (; k < in.n && in.p[k].index / CD_OBS_FANIN == item; k++)
+                memcpy(buf + (k - first) * CD_OBS_SLOTS, in.p[k].acc, sizeof in.p[k].acc);
+            long long children = n_in - item * CD_OBS_FANIN < CD_OBS_FANIN ? n_in - item * CD_OBS_FANIN : CD_OBS_FANIN;
+            double *acc = (long long)(k - first) == children ? push(&out, item) : NULL; /* (every child here) */
+            if (!acc) rc = -1;
+            else cd_obs_item_merge(buf, children, 0, acc);
+        }
+        if (in.p != leaves->p) free(in.p);
+        in = out;
+        out = (partials){NULL, 0, 0};
+    }
+    if (rc && in.p != leaves->p) free(in.p);
+    if (!rc) *groups = in;
     return rc;
 }
 
@@ -515,19 +500,32 @@ int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total)
     if (!touch) MPI_Abort(x->comm, 1);
     cd_cols lc = cd_sim_host_cols(s);
     for (size_t k = 0; k < s->n_pairs; k++) cd_obs_item_touch_pair(lc, (cd_long)k, touch);
-    for (size_t r = 0; r < s->n_prims * s->n_walls; r++)
-        cd_obs_item_touch_wall(lc, (cd_long)r, (cd_int)s->n_walls, touch);
-    cd_long nbp = ((cd_long)gs->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
-    partials part = {NULL, 0, 0};
-    long long nbk = 0;
+    /* the wall rows in contact as the step's candidate entries (kernels/observe_items.h) */
+    size_t n_wall = cd_state_wall_entries(s, NULL, NULL);
+    cd_int *wrows = malloc((n_wall + 1) * sizeof *wrows);
+    cd_wall_entry *went = malloc((n_wall + 1) * sizeof *went);
+    if (!wrows || !went) MPI_Abort(x->comm, 1);
+    cd_state_wall_entries(s, wrows, went);
+    for (size_t e = 0; e < n_wall; e++) cd_obs_item_touch_wall(lc, (cd_long)e, (cd_int)s->n_walls, wrows, went, touch);
+    free(wrows);
+    free(went);
+    /* the leaves: a function of the global counts only (kernels/observe_items.h) */
+    leaf_plan lp;
+    lp.particles = 0;
+    lp.pairs = ((long long)gs->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    lp.walls = lp.pairs + cd_obs_pair_blocks((cd_long)gs->n_prims);
+    lp.n = lp.walls + ((long long)(gs->n_prims * gs->n_walls) + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    plan_levels(&lp, x->size);
+    partials leaves = {NULL, 0, 0}, groups = {NULL, 0, 0};
     /* (a rank out of memory stops all: the others wait in the exchanges) */
-    if (particle_blocks(x, global, touch, &part) || pair_blocks(x, global, nbp, &part, &nbk) ||
-        wall_blocks(x, global, nbp + nbk, &part) ||
-        gather_partials(x, (const char *)part.p, (int)(part.n * sizeof *part.p), sizeof *part.p, total, CD_OBS_SLOTS,
-                        merge_blocks))
+    if (particle_leaves(x, global, touch, lp, &leaves) || pair_leaves(x, global, lp, &leaves) ||
+        wall_leaves(x, global, lp, &leaves) || merge_own_groups(&leaves, lp, &groups) ||
+        gather_partials(x, (const char *)groups.p, (int)(groups.n * sizeof *groups.p), sizeof *groups.p, total,
+                        CD_OBS_SLOTS, merge_groups))
         MPI_Abort(x->comm, 1);
     x->reduces++;
     free(touch);
-    free(part.p);
+    free(leaves.p);
+    free(groups.p);
     return 0;
 }

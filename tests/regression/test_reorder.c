@@ -22,6 +22,17 @@ static const char *pile = "run: {dt: 8.5e-6, steps: 0, seed: 7}\n"
                           "domain: {type: box, width: 0.06, thickness: 0.06, height: 0.3}\n"
                           "init: {placement: random, exclusion: shape, speed: 0.2}\n";
 
+/* The same pile on frictional walls: the wall contacts' tangential springs
+ * (history kept per wall candidate, carried over at each rebuild through
+ * the reorder's map of old slots) decide the bits. */
+static const char *pile_frictional_walls =
+    "run: {dt: 8.5e-6, steps: 0, seed: 7}\n"
+    "physics: {gravity: [0, -490.5, 0]}\n"
+    "material: {density: 1000, kn: 1.0e5, kt: 5.0e4, damping_normal: 0.2, friction: 0.5, wall_friction: 0.5}\n"
+    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 300, polydispersity: 0.2}]\n"
+    "domain: {type: box, width: 0.06, thickness: 0.06, height: 0.3}\n"
+    "init: {placement: random, exclusion: shape, speed: 0.2}\n";
+
 /* Is column f one a pair row keeps while inactive?  (The point, force,
  * overlap and F_n of an inactive row are whatever its memory row last
  * held, in either order: nobody reads them, kernels/step_items.h.) */
@@ -49,21 +60,22 @@ static void assert_same_group(const cd_state *a, const cd_state *b, enum cd_fiel
     }
 }
 
-/* Runs the pile with reorder setting `reorder` in a and none in b. */
-static void check_reorder(int reorder)
+/* Runs the pile (config text cfg) with reorder setting `reorder` in a and
+ * none in b. */
+static void check_reorder(int reorder, const char *cfg)
 {
     static cd_sim a, b;
     cd_config ca, cb;
     char err[512];
     omp_set_num_threads(2);
-    cdt_setup(&a, &ca, pile);
-    cdt_setup(&b, &cb, pile);
+    cdt_setup(&a, &ca, cfg);
+    cdt_setup(&b, &cb, cfg);
     assert_int_equal(a.nb.reorder, 1); /* the default */
     a.nb.reorder = reorder;
     b.nb.reorder = 0;
     assert_int_equal(cd_sim_initial_forces(&a), 0);
     assert_int_equal(cd_sim_initial_forces(&b), 0);
-    double contacts = 0, wall_contacts = 0;
+    double contacts = 0, wall_contacts = 0, springs = 0; /* springs: wall contacts with a loaded spring */
     for (int k = 0; k < 16; k++) {
         cd_sim *sims[2] = {&a, &b};
         cd_observables o[2];
@@ -93,6 +105,8 @@ static void check_reorder(int reorder)
         assert_same_group(&a.s, &b.s, CD_GROUP_WALLC, a.s.n_prims * a.s.n_walls, a.s.step);
         contacts += o[0].n_contacts;
         wall_contacts += o[0].n_wall_contacts;
+        for (size_t r = 0; r < a.s.n_prims * a.s.n_walls; r++)
+            springs += a.s.wallc_active[r] && cd_v3_norm(a.s.wallc_shear[r]) > 0;
     }
     /* the user's order after a sync: each particle owns its primitives in
      * order, and pair rows are sorted by (prim_i, prim_j), i < j */
@@ -101,9 +115,11 @@ static void check_reorder(int reorder)
     for (size_t k = 1; k < a.s.n_pairs; k++)
         assert_true(cd_bp_pair_key(a.s.pair_prim_i[k - 1], a.s.pair_prim_j[k - 1]) <
                     cd_bp_pair_key(a.s.pair_prim_i[k], a.s.pair_prim_j[k]));
-    print_message("%s: %lld rebuilds, %lld of them reordered; %zu pair rows, %g contacts and %g wall contacts seen\n",
-                  cdt_backend(), a.nb.builds, a.nb.reorders, a.s.n_pairs, contacts, wall_contacts);
+    print_message("%s: %lld rebuilds, %lld of them reordered; %zu pair rows, %g contacts and %g wall contacts seen, "
+                  "%g with a loaded spring\n",
+                  cdt_backend(), a.nb.builds, a.nb.reorders, a.s.n_pairs, contacts, wall_contacts, springs);
     assert_true(contacts > 1000 && wall_contacts > 300);
+    if (cfg == pile_frictional_walls) assert_true(springs > 300);
     assert_int_equal(b.nb.reorders, 0);
     /* the particles did move in memory: once for the default (the random
      * placement's order, then the cells', which the pile keeps), at
@@ -118,7 +134,7 @@ static void check_reorder(int reorder)
 static void test_reorder_changes_no_bit(void **state)
 {
     (void)state;
-    check_reorder(1);
+    check_reorder(1, pile);
 }
 
 /* The same with a reorder at every rebuild that changes the order (not
@@ -127,7 +143,14 @@ static void test_reorder_changes_no_bit(void **state)
 static void test_reorder_at_every_rebuild_changes_no_bit(void **state)
 {
     (void)state;
-    check_reorder(CD_NB_REORDER_ALWAYS);
+    check_reorder(CD_NB_REORDER_ALWAYS, pile);
+}
+
+/* The same on frictional walls. */
+static void test_reorder_with_frictional_walls_changes_no_bit(void **state)
+{
+    (void)state;
+    check_reorder(CD_NB_REORDER_ALWAYS, pile_frictional_walls);
 }
 
 int main(void)
@@ -135,6 +158,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reorder_changes_no_bit),
         cmocka_unit_test(test_reorder_at_every_rebuild_changes_no_bit),
+        cmocka_unit_test(test_reorder_with_frictional_walls_changes_no_bit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

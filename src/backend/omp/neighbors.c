@@ -31,17 +31,19 @@ void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder)
     nb->reorder = reorder;
     nb->force_rebuild = 1;
     nb->slot = CD_NB_SLOT;
+    nb->walls_from_host = 1; /* no candidates yet: the host's wall rows hold the history */
 }
 
 void cd_neighbors_free(cd_neighbors *nb)
 {
     cd_nb_lists *d = &nb->d;
-    void *all[] = {d->wall_out,   d->gather_start, d->gather_rows, d->wall_start, d->wall_rows,  d->grid,
-                   d->part_bound, d->partial,      d->part_cell,   d->cell_count, d->cell_start, d->cell_parts,
-                   d->pair_count, d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active,
-                   d->old_shear,  d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,
-                   d->prim_at,    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
-                   d->sort_keys,  d->sort_vals,    d->hist,        d->move,       d->skin_flag};
+    void *all[] = {d->wall_out,   d->old_wall_rows, d->old_wall_out, d->gather_start, d->gather_rows, d->wall_start,
+                   d->wall_rows,  d->grid,          d->part_bound,   d->partial,      d->part_cell,   d->cell_count,
+                   d->cell_start, d->cell_parts,    d->pair_count,   d->pair_offset,  d->cand,        d->keys,
+                   d->old_keys,   d->old_active,    d->old_shear,    d->count,        d->chunk_sum,   d->part_uid,
+                   d->part_at,    d->prim_uid,      d->prim_at,      d->pair_at,      d->pair_ustart, d->part_src,
+                   d->prim_src,   d->new_first,     d->sort_keys,    d->sort_vals,    d->hist,        d->move,
+                   d->skin_flag};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -240,7 +242,7 @@ static int reserve_wall_rows(cd_neighbors *nb, size_t n)
     if (n <= nb->cap_wall_rows && nb->d.wall_rows) return 0;
     size_t cap = n + n / 4 + 16;
     if (realloc_dev((void **)&nb->d.wall_rows, cap, sizeof(cd_int)) ||
-        realloc_dev((void **)&nb->d.wall_out, cap, sizeof(cd_wall_out)))
+        realloc_dev((void **)&nb->d.wall_out, cap, sizeof(cd_wall_entry)))
         return -1;
     nb->cap_wall_rows = cap;
     return 0;
@@ -252,12 +254,12 @@ int cd_neighbors_wall_out_to_host(cd_sim *sim)
     size_t n = nb->n_wall_rows;
     if (!nb->wall_out_pending || !sim->s.n_walls) return 0;
     cd_int *rows = malloc((n + 1) * sizeof *rows);
-    cd_wall_out *out = malloc((n + 1) * sizeof *out);
+    cd_wall_entry *out = malloc((n + 1) * sizeof *out);
     int rc = rows && out ? 0 : -1;
     if (!rc && n)
         rc = cd_dev_get(rows, nb->d.wall_rows, n * sizeof *rows) || cd_dev_get(out, nb->d.wall_out, n * sizeof *out);
     if (!rc) {
-        cd_state_expand_wall_out(&sim->s, rows, out, n);
+        cd_state_expand_wall_entries(&sim->s, rows, out, n);
         nb->wall_out_pending = 0;
     }
     free(rows);
@@ -265,9 +267,49 @@ int cd_neighbors_wall_out_to_host(cd_sim *sim)
     return rc ? -1 : 0;
 }
 
+/* Before the candidates are replaced: they become the old ones, whose
+ * history the build carries over (cd_item_wall_carry).  After a start the
+ * host's rows in contact take their place (cd_state_wall_entries), in the
+ * slots the step columns have before this build's reorder. */
+static int keep_wall_history(cd_sim *sim)
+{
+    cd_neighbors *nb = &sim->nb;
+    if (nb->walls_from_host) {
+        size_t n = cd_state_wall_entries(&sim->s, NULL, NULL);
+        cd_int *rows = malloc((n + 1) * sizeof *rows);
+        cd_wall_entry *ent = malloc((n + 1) * sizeof *ent);
+        int rc = rows && ent ? reserve_wall_rows(nb, n) : -1;
+        if (!rc) {
+            cd_state_wall_entries(&sim->s, rows, ent);
+            rc = n ? cd_dev_put(nb->d.wall_rows, rows, n * sizeof *rows) ||
+                         cd_dev_put(nb->d.wall_out, ent, n * sizeof *ent)
+                   : 0;
+        }
+        free(rows);
+        free(ent);
+        if (rc) return -1;
+        nb->n_wall_rows = n;
+        nb->walls_from_host = 0;
+    }
+    cd_nb_lists *d = &nb->d;
+    cd_int *rows = d->wall_rows;
+    cd_wall_entry *ent = d->wall_out;
+    size_t cap = nb->cap_wall_rows;
+    d->wall_rows = d->old_wall_rows;
+    d->wall_out = d->old_wall_out;
+    nb->cap_wall_rows = nb->cap_old_wall_rows;
+    d->old_wall_rows = rows;
+    d->old_wall_out = ent;
+    nb->cap_old_wall_rows = cap;
+    nb->n_old_wall_rows = nb->n_wall_rows;
+    nb->n_wall_rows = 0;
+    return 0;
+}
+
 /* Passes 9 (gather lists) and 10 (wall candidates; their number comes
- * back, to size their lists). */
-static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
+ * back, to size their lists; their history carried over from the old
+ * ones, whose primitives had the slots prim_src names: null, the same). */
+static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d, const cd_int *prim_src)
 {
     cd_state *s = &sim->s;
     cd_int N = (cd_int)s->n_particles, W = (cd_int)s->n_walls;
@@ -294,6 +336,10 @@ static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d)
     d = sim->nb.d; /* the candidate lists may have moved */
     CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
     for (cd_int q = 0; q < N; q++) cd_item_wall_candidates(c, q, walls, W, skin, d.wall_rows + d.wall_start[q]);
+    cd_long n_old = (cd_long)sim->nb.n_old_wall_rows;
+    CD_STEP_FOR(n_rows, firstprivate(d) CD_DEV(is_device_ptr(prim_src)))
+    for (cd_int e = 0; e < n_rows; e++)
+        cd_item_wall_carry(e, d.wall_rows, d.wall_out, d.old_wall_rows, n_old, d.old_wall_out, prim_src, W);
     sim->nb.n_wall_rows = (size_t)n_rows;
     memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
     return 0;
@@ -312,7 +358,7 @@ int cd_neighbors_build(cd_sim *sim)
     if (cd_reorder_to_memory(sim) || reserve(nb, s, s->n_pairs)) return -1;
     cd_cols c = cd_sim_step_cols(sim);
     /* the old rows' history aside, keyed in the order they were made in */
-    if (keep_history(sim, c)) return -1;
+    if (keep_history(sim, c) || keep_wall_history(sim)) return -1;
     if (make_grid(sim, c, nb->d)) return CD_NB_BLOWUP;
     int moved = 0;
     if (cd_reorder_build(sim, &moved)) return -1;
@@ -350,7 +396,7 @@ int cd_neighbors_build(cd_sim *sim)
     CD_STEP_FOR(n_new, firstprivate(c, d) CD_DEV(is_device_ptr(prim_src)))
     for (cd_int k = 0; k < n_new; k++)
         cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active, d.old_shear, prim_src);
-    if (particle_lists(sim, c, d) || cd_reorder_pair_rows(sim)) return -1;
+    if (particle_lists(sim, c, d, prim_src) || cd_reorder_pair_rows(sim)) return -1;
     CD_STEP_FOR(P, firstprivate(c))
     for (cd_int i = 0; i < P; i++) {
         c.prim_a_ref[i] = c.prim_a[i];

@@ -44,7 +44,7 @@ static obs_blocks count_blocks(const cd_state *s)
 {
     obs_blocks n;
     n.particles = ((cd_long)s->n_particles + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
-    n.pairs = ((cd_long)s->n_pairs + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    n.pairs = cd_obs_pair_blocks((cd_long)s->n_prims);
     n.walls = ((cd_long)(s->n_prims * s->n_walls) + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
     return n;
 }
@@ -65,9 +65,9 @@ static void unpack(const double *t, cd_observables *o)
 
 /* The host's wall contacts in the form of the step's candidate lists
  * (kernels/step_items.h, cd_wall_out_place): per particle the rows in
- * contact of its primitives, ascending, with their outputs from the
- * host's columns.  0, or -1 (out of memory). */
-static int host_wall_lists(const cd_state *s, cd_int **start, cd_int **rows, cd_wall_out **out)
+ * contact of its primitives, ascending, with their history and outputs
+ * from the host's columns.  0, or -1 (out of memory). */
+static int host_wall_lists(const cd_state *s, cd_int **start, cd_int **rows, cd_wall_entry **out)
 {
     size_t N = s->n_particles, W = s->n_walls, n = 0;
     for (size_t r = 0; r < s->n_prims * W; r++) n += s->wallc_active[r] != 0;
@@ -82,7 +82,7 @@ static int host_wall_lists(const cd_state *s, cd_int **start, cd_int **rows, cd_
         for (size_t r = first * W; r < last * W; r++) {
             if (!s->wallc_active[r]) continue;
             (*rows)[e] = (cd_int)r;
-            (*out)[e++] = (cd_wall_out){s->wallc_force[r], s->wallc_torque[r], s->wallc_overlap[r], s->wallc_fn[r]};
+            (*out)[e++] = cd_state_wall_entry(s, r);
         }
     }
     (*start)[N] = e;
@@ -94,7 +94,8 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     const cd_state *s = &sim->s;
     cd_cols c = cd_sim_host_cols((cd_state *)s); /* read only */
     obs_blocks nb = count_blocks(s);
-    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls),
+            P = (cd_long)s->n_prims;
     cd_int W = (cd_int)s->n_walls;
     cd_vec3 g = sim->p.gravity;
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
@@ -102,7 +103,7 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     cd_int *touch = calloc((size_t)N + 1, sizeof(cd_int));
     double *part = malloc((size_t)(cd_obs_tree_blocks(leaves(nb)) + 1) * CD_OBS_SLOTS * sizeof(double));
     cd_int *wall_start = NULL, *wall_rows = NULL;
-    cd_wall_out *out = NULL;
+    cd_wall_entry *out = NULL;
     if (!touch || !part || host_wall_lists(s, &wall_start, &wall_rows, &out)) {
         /* without memory: what is known is nothing */
         free(touch);
@@ -117,12 +118,13 @@ void cd_observables_slots(const cd_sim *sim, double *total)
      * forever): relaxation criteria look at the particles that touch. */
     CD_HOST_FOR(K, firstprivate(c))
     for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
-    CD_HOST_FOR(R, firstprivate(c))
-    for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
+    cd_long n_cand = wall_start[N];
+    CD_HOST_FOR(n_cand, firstprivate(c, wall_rows, out))
+    for (cd_long e = 0; e < n_cand; e++) cd_obs_item_touch_wall(c, e, W, wall_rows, out, touch);
     double *pp = part, *pk = part + nb.particles * CD_OBS_SLOTS, *pw = pk + nb.pairs * CD_OBS_SLOTS;
     CD_HOST_FOR(N, firstprivate(c, o))
     for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, pp + b * CD_OBS_SLOTS, o);
-    CD_HOST_FOR(K, firstprivate(c, o))
+    CD_HOST_FOR(P, firstprivate(c, o))
     for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS, o);
     CD_HOST_FOR(R, firstprivate(c, o))
     for (cd_long b = 0; b < nb.walls; b++)
@@ -172,7 +174,8 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
         if (!x->partial) return -1;
     }
     cd_cols c = cd_sim_step_cols(sim);
-    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
+    cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls),
+            P = (cd_long)s->n_prims;
     cd_int W = (cd_int)s->n_walls;
     cd_vec3 g = sim->p.gravity;
     cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
@@ -184,14 +187,15 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     for (cd_long q = 0; q < N; q++) touch[q] = 0;
     CD_STEP_FOR(K, firstprivate(c) is_device_ptr(touch))
     for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
-    CD_STEP_FOR(R, firstprivate(c) is_device_ptr(touch))
-    for (cd_long r = 0; r < R; r++) cd_obs_item_touch_wall(c, r, W, touch);
+    cd_nb_lists d = sim->nb.d;
+    cd_long n_cand = W ? (cd_long)sim->nb.n_wall_rows : 0;
+    CD_STEP_FOR(n_cand, firstprivate(c, d) is_device_ptr(touch))
+    for (cd_long e = 0; e < n_cand; e++) cd_obs_item_touch_wall(c, e, W, d.wall_rows, d.wall_out, touch);
     cd_order o = cd_sim_step_order(sim);
     CD_STEP_FOR(N, firstprivate(c, g, o) is_device_ptr(touch, part))
     for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS, o);
-    CD_STEP_FOR(K, firstprivate(c, law, o) is_device_ptr(part))
+    CD_STEP_FOR(P, firstprivate(c, law, o) is_device_ptr(part))
     for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS, o);
-    cd_nb_lists d = sim->nb.d;
     CD_STEP_FOR(R, firstprivate(c, d, wall_law, o) is_device_ptr(part))
     for (cd_long b = 0; b < nb.walls; b++)
         cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS, o, d.wall_start, d.wall_rows,

@@ -112,6 +112,11 @@ static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
 /* The columns the loops work on: device addresses in the offload variant
  * once the state is mapped, the host columns otherwise (src/backend/omp/step_omp.c). */
 cd_cols cd_sim_step_cols(cd_sim *sim);
+/* The offload variant: the state's columns mapped to the device again
+ * after the host replaced them (the MPI migration, src/mpi/mpi_device.c,
+ * with the backend stopped before), without start's refresh of the
+ * derived columns, which are current.  0, or -1 with err set. */
+int cd_sim_step_remap(cd_sim *sim, char *err, size_t errlen);
 
 /* Copies of the step loops' argument block to the device since the
  * backend started (src/backend/omp/step_omp.c, off_args): copies[0] of

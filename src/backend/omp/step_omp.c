@@ -437,8 +437,8 @@ static void gather(cd_sim *sim)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
-        cd_item_gather(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start, a->d.wall_rows,
-                       a->d.wall_out, a->gravity, a->dimension);
+        cd_item_gather(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start, a->d.wall_out,
+                       a->gravity, a->dimension);
 }
 
 /* Forces for the current positions (neighbour list up to date), without
@@ -464,7 +464,7 @@ __attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd
     for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend, outputs);
 }
 
-__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, cd_wall_out *out, size_t n,
+__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, cd_wall_entry *out, size_t n,
                                                          const cd_wall *walls, cd_int W, cd_law_params law, cd_real dt,
                                                          cd_real sin_parallel, cd_int blend)
 {
@@ -479,7 +479,7 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
     for (size_t q = 0; q < n; q++)
         moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                             d.wall_rows, d.wall_out, g, dim, dt, limit2, next);
+                                             d.wall_out, g, dim, dt, limit2, next);
     return moved;
 }
 #endif
@@ -510,8 +510,7 @@ static int forces_and_advance(cd_sim *sim, int next)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
         if (cd_item_gather_kick_advance(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start,
-                                        a->d.wall_rows, a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2,
-                                        next) &&
+                                        a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2, next) &&
             flagged) {
 #pragma omp atomic write
             a->d.skin_flag[0] = 1;
@@ -615,10 +614,26 @@ static void omp_stop(cd_sim *sim)
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen);
 
+int cd_sim_step_remap(cd_sim *sim, char *err, size_t errlen)
+{
+#if CD_OFFLOAD
+    omp_stop(sim);
+    return off_acquire(sim, err, errlen);
+#else
+    (void)sim;
+    (void)err;
+    (void)errlen;
+    return 0;
+#endif
+}
+
 static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 {
     omp_stop(sim);
     cd_sim_refresh(sim);
+    /* the host's wall rows hold the contacts to carry on (a resumed run, a
+     * state put back): the first build turns them into candidate entries */
+    sim->nb.walls_from_host = 1;
 #if CD_OFFLOAD
     if (off_acquire(sim, err, errlen)) return -1;
 #endif
@@ -686,8 +701,15 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
                 off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
                          cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
         }
+    /* The host's wall rows anew as well, whenever the step has entries:
+     * cd_reorder_to_user below moves every host column from memory order
+     * at every sync, so rows not written again (a second sync without a
+     * step between) would be moved twice.  In host memory (the host
+     * fallback) the columns are the step's: a second sync finds them in
+     * user order and moves nothing, as on host threads. */
+    if (sim->nb.wall_out_valid && !cd_step_memory_is_host()) sim->nb.wall_out_pending = 1;
 #endif
-    /* the wall-contact outputs kept per candidate into the host's rows, then the
+    /* the wall contacts kept per candidate into the host's rows, then the
      * host columns in user order (src/backend/omp/reorder.c) */
     if (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim)) {
         snprintf(err, errlen, "out of memory putting the particles in user order");

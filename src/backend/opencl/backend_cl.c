@@ -42,13 +42,13 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 1, sizeof cl->gather_start, &cl->gather_start);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 3, sizeof cl->wall_start, &cl->wall_start);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->gravity, &p->gravity);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof p->dimension, &p->dimension);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 8, sizeof dt, &dt);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 10, sizeof limit2, &limit2);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 11, sizeof cl->walls, &cl->walls);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 12, sizeof W, &W);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 13, sizeof cl->flags, &cl->flags);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof p->gravity, &p->gravity);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 5, sizeof p->dimension, &p->dimension);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof dt, &dt);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 9, sizeof limit2, &limit2);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 10, sizeof cl->walls, &cl->walls);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 11, sizeof W, &W);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 12, sizeof cl->flags, &cl->flags);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F + 1, sizeof cl->flags, &cl->flags);
 }
@@ -64,8 +64,7 @@ static void set_list_args(cd_cl *cl)
     /* the wall candidates' lists, sized by the last build */
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 8, sizeof cl->wall_out, &cl->wall_out);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 4, sizeof cl->wall_rows, &cl->wall_rows);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 9, sizeof cl->wall_out, &cl->wall_out);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 8, sizeof cl->wall_out, &cl->wall_out);
 }
 
 /* Rebuild of the list, then steps 5-8 (forces, gather, second kick) and
@@ -82,7 +81,7 @@ static int forces(cd_cl *cl, cd_sim *sim, int rebuild, cd_int mode)
         set_list_args(cl);
     }
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 5, sizeof outputs, &outputs);
-    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 7, sizeof mode, &mode);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 6, sizeof mode, &mode);
     cd_cl_run(cl, CD_CLK_PAIR_FORCES, cl->n_pairs);
     if (cl->n_wall_rows) cd_cl_run(cl, CD_CLK_WALL_FORCES, (size_t)cl->n_wall_rows);
     cl->wall_out_valid = cl->wall_out_pending = 1;
@@ -259,7 +258,8 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     }
     const cd_state *s = &sim->s;
     cd_long N = (cd_long)s->n_particles, K = (cd_long)cl->n_pairs, R = (cd_long)(s->n_prims * s->n_walls);
-    cd_long bp = (N + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, bk = (K + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK;
+    cd_long P = (cd_long)s->n_prims;
+    cd_long bp = (N + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, bk = cd_obs_pair_blocks(P);
     cd_long bw = (R + CD_OBS_BLOCK - 1) / CD_OBS_BLOCK, n_blocks = bp + bk + bw, first = 0;
     cd_int W = (cd_int)s->n_walls, n_pairs = (cd_int)K;
     size_t tree = (size_t)cd_obs_tree_blocks(n_blocks) + 1;
@@ -273,10 +273,13 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_TOUCH_PAIRS, F, sizeof n_pairs, &n_pairs);
     cd_cl_arg(cl, CD_CLK_OBS_TOUCH_PAIRS, F + 1, sizeof cl->obs_touch, &cl->obs_touch);
     cd_cl_run(cl, CD_CLK_OBS_TOUCH_PAIRS, (size_t)K);
-    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F, sizeof R, &R);
+    cd_long n_cand = W ? cl->n_wall_rows : 0;
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F, sizeof n_cand, &n_cand);
     cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 1, sizeof W, &W);
-    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 2, sizeof cl->obs_touch, &cl->obs_touch);
-    cd_cl_run(cl, CD_CLK_OBS_TOUCH_WALLS, (size_t)R);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 2, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 3, sizeof cl->wall_out, &cl->wall_out);
+    cd_cl_arg(cl, CD_CLK_OBS_TOUCH_WALLS, F + 4, sizeof cl->obs_touch, &cl->obs_touch);
+    cd_cl_run(cl, CD_CLK_OBS_TOUCH_WALLS, (size_t)n_cand);
     cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 1, sizeof sim->p.gravity, &sim->p.gravity);
     cd_cl_arg(cl, CD_CLK_OBS_PARTICLES, F + 2, sizeof cl->obs_touch, &cl->obs_touch);
@@ -288,6 +291,7 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 1, sizeof sim->p.law, &sim->p.law);
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 2, sizeof cl->obs_part, &cl->obs_part);
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 3, sizeof first, &first);
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 4, sizeof P, &P);
     cd_cl_run(cl, CD_CLK_OBS_PAIRS, (size_t)bk);
     first = bp + bk;
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F, sizeof R, &R);

@@ -40,6 +40,7 @@ enum cd_cl_kernel {
     CD_CLK_SCAN_FILL,
     CD_CLK_WALL_CAND_COUNT,
     CD_CLK_WALL_CAND_FILL,
+    CD_CLK_WALL_CARRY,
     CD_CLK_OBS_TOUCH_PAIRS,
     CD_CLK_OBS_TOUCH_WALLS,
     CD_CLK_OBS_PARTICLES,
@@ -108,9 +109,14 @@ typedef struct cd_cl {
     /* wall candidates of the last build (cd_item_wall_candidates): counts
      * per particle, CSR offsets, rows (sized by the build's count) */
     cl_mem wall_count, wall_start, wall_rows;
-    cl_mem wall_out; /* cd_wall_out per candidate: outputs of its wall contact (fields.def, WALLC_OUT) */
+    cl_mem wall_out; /* cd_wall_entry per candidate: history and outputs of its wall contact (fields.def, WALLC*) */
     cd_int n_wall_rows;
-    size_t cap_wall_rows;             /* entries wall_rows and wall_out hold */
+    size_t cap_wall_rows; /* entries wall_rows and wall_out hold */
+    /* the candidates of the build before (or the host's rows in contact,
+     * uploaded at the start), whose history a build carries over */
+    cl_mem old_wall_rows, old_wall_out;
+    cd_int n_old_wall_rows;
+    size_t cap_old_wall_rows;
     int wall_out_valid;               /* wall_out holds the step's wall-contact outputs (forces since start) */
     int wall_out_pending;             /* ... newer than the host's columns (expanded at sync) */
     cd_wall host_walls[CD_MAX_WALLS]; /* the walls as the device moves them, for the rebuild test */
@@ -158,6 +164,9 @@ void cd_cl_buffers_release(cd_cl *cl);
 int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which);
 /* Room for n wall candidates in wall_rows and wall_out (contents dropped). */
 int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n);
+/* The wall candidates become the old ones (their history for the build's
+ * carry-over); the old buffers become the new, empty candidates'. */
+void cd_cl_keep_wall_rows(cd_cl *cl);
 /* The buffer bound as column f (the current history set for pair_active
  * and pair_shear). */
 cl_mem cd_cl_col(const cd_cl *cl, int f);

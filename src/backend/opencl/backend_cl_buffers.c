@@ -142,9 +142,23 @@ int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n)
     release(&cl->wall_rows);
     release(&cl->wall_out);
     cl->wall_rows = cd_cl_buffer(cl, want * sizeof(cd_int), "allocating the wall lists");
-    cl->wall_out = cd_cl_buffer(cl, want * sizeof(cd_wall_out), "allocating the wall lists");
+    cl->wall_out = cd_cl_buffer(cl, want * sizeof(cd_wall_entry), "allocating the wall lists");
     cl->cap_wall_rows = want;
     return cl->status ? -1 : 0;
+}
+
+void cd_cl_keep_wall_rows(cd_cl *cl)
+{
+    cl_mem rows = cl->wall_rows, ent = cl->wall_out;
+    size_t cap = cl->cap_wall_rows;
+    cl->wall_rows = cl->old_wall_rows;
+    cl->wall_out = cl->old_wall_out;
+    cl->cap_wall_rows = cl->cap_old_wall_rows;
+    cl->old_wall_rows = rows;
+    cl->old_wall_out = ent;
+    cl->cap_old_wall_rows = cap;
+    cl->n_old_wall_rows = cl->n_wall_rows;
+    cl->n_wall_rows = 0;
 }
 
 int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
@@ -196,6 +210,8 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->wall_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the wall lists");
     cl->cap_wall_rows = 0; /* wall_rows, wall_out: sized by the builds */
     if (cl->status || cd_cl_reserve_wall_rows(cl, 1)) return -1;
+    cd_cl_keep_wall_rows(cl); /* the same for the old ones */
+    if (cd_cl_reserve_wall_rows(cl, 1)) return -1;
     return cd_cl_bind_cols(cl);
 }
 
@@ -226,6 +242,20 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_FIELDS, sizeof n, &n);
     cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_FIELDS + 1, sizeof keys, &keys);
     cd_cl_run(cl, CD_CLK_PAIR_KEYS, cl->n_pairs);
+    /* The wall rows in contact as the candidates of a build before, so
+     * that the first rebuild carries their history over. */
+    size_t nw = cd_state_wall_entries(s, NULL, NULL);
+    cd_int *rows = malloc((nw + 1) * sizeof *rows);
+    cd_wall_entry *ent = malloc((nw + 1) * sizeof *ent);
+    if (!rows || !ent) cd_cl_check(cl, CL_OUT_OF_HOST_MEMORY, "uploading the wall contacts");
+    if (!cl->status && !cd_cl_reserve_wall_rows(cl, nw)) {
+        cd_state_wall_entries(s, rows, ent);
+        write(cl, cl->wall_rows, nw * sizeof *rows, rows, "uploading the wall contacts");
+        write(cl, cl->wall_out, nw * sizeof *ent, ent, "uploading the wall contacts");
+        cl->n_wall_rows = (cd_int)nw;
+    }
+    free(rows);
+    free(ent);
     return cl->status ? -1 : 0;
 }
 
@@ -249,11 +279,11 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
      * and may since have been changed by a protocol (docs/opencl.md). */
     if (!cl->status) cd_cl_check(cl, clFinish(cl->queue), "downloading the state");
     if (cl->status) return -1;
-    /* the wall-contact outputs the step keeps per candidate, into the host's rows */
+    /* the wall contacts the step keeps per candidate, into the host's rows */
     size_t n = (size_t)cl->n_wall_rows;
     if (!cl->wall_out_pending || !s->n_walls) return 0;
     cd_int *rows = malloc((n + 1) * sizeof *rows);
-    cd_wall_out *out = malloc((n + 1) * sizeof *out);
+    cd_wall_entry *out = malloc((n + 1) * sizeof *out);
     if (!rows || !out) cd_cl_check(cl, CL_OUT_OF_HOST_MEMORY, "downloading the wall contacts");
     if (!cl->status && n) {
         cd_cl_check(cl,
@@ -265,7 +295,7 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
                         "downloading the wall contacts");
     }
     if (!cl->status) {
-        cd_state_expand_wall_out(s, rows, out, n);
+        cd_state_expand_wall_entries(s, rows, out, n);
         cl->wall_out_pending = 0;
     }
     free(rows);
@@ -282,13 +312,13 @@ void cd_cl_buffers_release(cd_cl *cl)
         release(&cl->hist[h].keys);
         cl->hist[h].cap = 0;
     }
-    cl_mem *other[] = {&cl->walls,       &cl->flags,        &cl->scratch_real, &cl->load_part,     &cl->partial,
-                       &cl->grid,        &cl->part_cell,    &cl->part_bound,   &cl->cell_count,    &cl->cell_start,
-                       &cl->cell_cursor, &cl->cell_parts,   &cl->pair_count,   &cl->pair_offset,   &cl->block_sum,
-                       &cl->cand,        &cl->gather_count, &cl->gather_start, &cl->gather_cursor, &cl->gather_rows,
-                       &cl->wall_count,  &cl->wall_start,   &cl->wall_rows,    &cl->obs_touch,     &cl->obs_part,
-                       &cl->obs_total,   &cl->wall_out};
+    cl_mem *other[] = {&cl->walls,       &cl->flags,        &cl->scratch_real,  &cl->load_part,     &cl->partial,
+                       &cl->grid,        &cl->part_cell,    &cl->part_bound,    &cl->cell_count,    &cl->cell_start,
+                       &cl->cell_cursor, &cl->cell_parts,   &cl->pair_count,    &cl->pair_offset,   &cl->block_sum,
+                       &cl->cand,        &cl->gather_count, &cl->gather_start,  &cl->gather_cursor, &cl->gather_rows,
+                       &cl->wall_count,  &cl->wall_start,   &cl->wall_rows,     &cl->obs_touch,     &cl->obs_part,
+                       &cl->obs_total,   &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
     cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
-    cl->cap_wall_rows = 0;
+    cl->cap_wall_rows = cl->cap_old_wall_rows = 0;
 }

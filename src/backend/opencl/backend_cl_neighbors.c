@@ -113,13 +113,14 @@ static void gather_lists(cd_cl *cl, cd_int N, cd_int n_pairs)
 
 /* Per-particle wall candidates (CSR wall_start / wall_rows, ascending):
  * count, scan, fill; the number of rows comes back between scan and fill
- * (the size of their lists and of the wall kernel), and the walls become
+ * (the size of their lists and of the wall kernel); their history carried
+ * over from the old candidates (cd_item_wall_carry); and the walls become
  * the reference of the wall-motion test. */
 static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
 {
     cd_int W = (cd_int)sim->s.n_walls;
     cd_real skin = sim->nb.skin; /* [m] */
-    cl->n_wall_rows = 0;         /* without walls the passes run too: wall_start all 0 for the gather */
+    cd_cl_keep_wall_rows(cl);    /* n_wall_rows 0: without walls the passes run too (wall_start all 0 for the gather) */
     for (int k = CD_CLK_WALL_CAND_COUNT; k <= CD_CLK_WALL_CAND_FILL; k++) {
         cd_cl_arg(cl, k, F, sizeof N, &N);
         cd_cl_arg(cl, k, F + 1, sizeof cl->walls, &cl->walls);
@@ -139,6 +140,14 @@ static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
     cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 4, sizeof cl->wall_start, &cl->wall_start);
     cd_cl_arg(cl, CD_CLK_WALL_CAND_FILL, F + 5, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_run(cl, CD_CLK_WALL_CAND_FILL, (size_t)N);
+    cd_cl_arg(cl, CD_CLK_WALL_CARRY, 0, sizeof cl->n_wall_rows, &cl->n_wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_CARRY, 1, sizeof cl->wall_rows, &cl->wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_CARRY, 2, sizeof cl->wall_out, &cl->wall_out);
+    cd_cl_arg(cl, CD_CLK_WALL_CARRY, 3, sizeof cl->old_wall_rows, &cl->old_wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_CARRY, 4, sizeof cl->n_old_wall_rows, &cl->n_old_wall_rows);
+    cd_cl_arg(cl, CD_CLK_WALL_CARRY, 5, sizeof cl->old_wall_out, &cl->old_wall_out);
+    cd_cl_arg(cl, CD_CLK_WALL_CARRY, 6, sizeof W, &W);
+    cd_cl_run(cl, CD_CLK_WALL_CARRY, (size_t)cl->n_wall_rows);
     memcpy(sim->nb.walls_ref, cl->host_walls, sizeof sim->nb.walls_ref);
 }
 

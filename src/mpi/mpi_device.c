@@ -1,0 +1,146 @@
+/* The MPI decomposition with the omp backend's offload variant (docs/mpi.md,
+ * "GPUs"): each rank takes one offload device, that of its node-local rank
+ * modulo the node's devices; its local state lives there between
+ * migrations, and the ghost refresh of every step packs the rows its
+ * neighbours need on the device, brings only those to the host (the MPI
+ * messages are host buffers: no CUDA-aware MPI is assumed), and unpacks the
+ * received ghosts there.  A migration (at a neighbour-list rebuild) copies
+ * the local state back, rebuilds it on the host (src/mpi/mpi_migrate.c) and
+ * maps it again.  In a build without offload every function here says
+ * "host" and the refresh packs on the host (src/mpi/mpi_halo.c). */
+#include <stdio.h>
+#include "mpi/mpi_halo.h"
+#include "backend/omp/omp_loops.h"
+
+#if CD_OFFLOAD
+/* Is the local state mapped on the device?  (The inner backend's data is
+ * its mapping: src/backend/omp/step_omp.c.) */
+static int on_device(const cd_mpi_ctx *x) { return x->loc.backend_data != NULL; }
+
+/* Rows sent and received per refresh (the lists of plan_refresh, over all
+ * ranks). */
+static int total_rows(const int *count, const int *displ, int R) { return displ[R - 1] + count[R - 1]; }
+
+/* The lists on the device, copied again after a migration re-planned them;
+ * the buffers with them. */
+static int dev_lists(cd_mpi_ctx *x, int ns, int nr)
+{
+    if (!x->dev_stale && x->dev_send_list) return 0;
+    cd_mpi_dev_free(x);
+    int G = CD_MPI_GHOST_DOUBLES;
+    x->dev_send_list = cd_dev_alloc(((size_t)ns + 1) * sizeof(int));
+    x->dev_recv_list = cd_dev_alloc(((size_t)nr + 1) * sizeof(int));
+    x->dev_send_buf = cd_dev_alloc(((size_t)ns * G + 1) * sizeof(double));
+    x->dev_recv_buf = cd_dev_alloc(((size_t)nr * G + 1) * sizeof(double));
+    if (!x->dev_send_list || !x->dev_recv_list || !x->dev_send_buf || !x->dev_recv_buf) return -1;
+    if ((ns && cd_dev_put(x->dev_send_list, x->send_list, (size_t)ns * sizeof(int))) ||
+        (nr && cd_dev_put(x->dev_recv_list, x->recv_list, (size_t)nr * sizeof(int))))
+        return -1;
+    x->dev_stale = 0;
+    return 0;
+}
+
+int cd_mpi_dev_pack(cd_mpi_ctx *x)
+{
+    if (!on_device(x)) return 1;
+    int ns = total_rows(x->send_count, x->send_displ, x->size), nr = total_rows(x->recv_count, x->recv_displ, x->size);
+    if (dev_lists(x, ns, nr)) return -1;
+    if (!ns) return 0;
+    cd_cols c = cd_sim_step_cols(&x->loc);
+    int *list = x->dev_send_list;
+    double *buf = x->dev_send_buf;
+    CD_WIDE_MIN
+    CD_STEP_FOR(ns, firstprivate(c) is_device_ptr(list, buf))
+    for (int e = 0; e < ns; e++) cd_mpi_ghost_io(c, list[e], buf + (size_t)e * CD_MPI_GHOST_DOUBLES, 1);
+    return cd_dev_get(x->send_buf, buf, (size_t)ns * CD_MPI_GHOST_DOUBLES * sizeof(double)) ? -1 : 0;
+}
+
+int cd_mpi_dev_unpack(cd_mpi_ctx *x)
+{
+    if (!on_device(x)) return 1;
+    int nr = total_rows(x->recv_count, x->recv_displ, x->size);
+    if (!nr) return 0;
+    cd_cols c = cd_sim_step_cols(&x->loc);
+    int *list = x->dev_recv_list;
+    double *buf = x->dev_recv_buf;
+    if (cd_dev_put(buf, x->recv_buf, (size_t)nr * CD_MPI_GHOST_DOUBLES * sizeof(double))) return -1;
+    CD_WIDE_MIN
+    CD_STEP_FOR(nr, firstprivate(c) is_device_ptr(list, buf))
+    for (int e = 0; e < nr; e++) cd_mpi_ghost_io(c, list[e], buf + (size_t)e * CD_MPI_GHOST_DOUBLES, 0);
+    return 0;
+}
+
+void cd_mpi_dev_free(cd_mpi_ctx *x)
+{
+    cd_dev_free(x->dev_send_list);
+    cd_dev_free(x->dev_recv_list);
+    cd_dev_free(x->dev_send_buf);
+    cd_dev_free(x->dev_recv_buf);
+    x->dev_send_list = x->dev_recv_list = NULL;
+    x->dev_send_buf = x->dev_recv_buf = NULL;
+    x->dev_stale = 1;
+}
+
+void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len)
+{
+    MPI_Comm node;
+    int local = 0, devices = omp_get_num_devices();
+    if (MPI_Comm_split_type(x->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
+        MPI_Comm_rank(node, &local);
+        MPI_Comm_free(&node);
+    }
+    if (devices > 0) {
+        omp_set_default_device(local % devices);
+        snprintf(desc, len, "%s offload device %d of %d (node-local rank %d)", CAPDEM_OFFLOAD_VARIANT, local % devices,
+                 devices, local);
+    } else
+        snprintf(desc, len, "host (built for %s offload, no device; node-local rank %d)", CAPDEM_OFFLOAD_VARIANT,
+                 local);
+}
+
+int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen)
+{
+    if (!on_device(x)) return 0;
+    if (x->inner->sync(&x->loc, err, errlen)) return -1;
+    x->inner->stop(&x->loc);
+    return 1;
+}
+
+int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen) { return cd_sim_step_remap(&x->loc, err, errlen); }
+#else
+int cd_mpi_dev_pack(cd_mpi_ctx *x)
+{
+    (void)x;
+    return 1;
+}
+
+int cd_mpi_dev_unpack(cd_mpi_ctx *x)
+{
+    (void)x;
+    return 1;
+}
+
+void cd_mpi_dev_free(cd_mpi_ctx *x) { (void)x; }
+
+void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len)
+{
+    (void)x;
+    snprintf(desc, len, "host");
+}
+
+int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen)
+{
+    (void)x;
+    (void)err;
+    (void)errlen;
+    return 0;
+}
+
+int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen)
+{
+    (void)x;
+    (void)err;
+    (void)errlen;
+    return 0;
+}
+#endif
