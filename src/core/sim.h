@@ -100,8 +100,9 @@ typedef struct {
     int reorder;                     /* neighbor.reorder: 1 cells (the grid cells' order at rebuilds), 0 none;
                                  CD_NB_REORDER_ALWAYS (tests): at every rebuild that changes the order */
     int ordered;                     /* the order maps of d are set (from the first build after start) */
-    int host_user;                   /* host variant: a sync put the columns in user order; the next step
-                                 puts them back in memory order (src/backend/omp/reorder.c) */
+    int host_user;                   /* host memory (host variant, offload build's host fallback): a sync put
+                                 the columns in user order; the next step puts them back in memory order
+                                 (src/backend/omp/reorder.c) */
     long long reorders;              /* rebuilds that moved particles */
     size_t pair_at_cap;              /* rows d.pair_at holds */
 } cd_neighbors;

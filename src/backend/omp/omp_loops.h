@@ -53,6 +53,19 @@ static inline size_t cd_wide_min(void)
 /* Clauses only the offload variant needs. */
 #define CD_DEV(...) __VA_ARGS__
 
+/* 1 when the loops run on the host's own columns: a runtime without an
+ * offload device (libgomp's host fallback) runs the target regions in the
+ * one memory, where mapping is the identity and a "device" column is the
+ * host column.  The backend then keeps the host variant's memory-order
+ * state (src/backend/omp/reorder.c): a sync puts the columns the steps run
+ * on in user order, and the next step or build puts them back. */
+static inline int cd_step_memory_is_host(void)
+{
+    static int devices = -1;
+    if (devices < 0) devices = omp_get_num_devices();
+    return devices == 0;
+}
+
 /* The device the loops run on: the default offload device, or the host
  * when the runtime finds none (the loops then fall back to it too). */
 static inline int cd_dev_id(void)
@@ -79,6 +92,7 @@ static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
 #define CD_WIDE_MIN
 #define CD_STEP_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
 #define CD_DEV(...)
+static inline int cd_step_memory_is_host(void) { return 1; }
 static inline void *cd_dev_alloc(size_t bytes) { return malloc(bytes ? bytes : 1); }
 static inline void cd_dev_free(void *p) { free(p); }
 static inline int cd_dev_get(void *dst, const void *src, size_t bytes)

@@ -42,14 +42,12 @@ cd_order cd_sim_step_order(const cd_sim *sim)
     return o;
 }
 
+/* The host columns are in user order after every sync of an offload
+ * device; where the steps run on them (cd_step_memory_is_host), they are
+ * in the steps' order. */
 cd_order cd_sim_host_order(const cd_sim *sim)
 {
-#if CD_OFFLOAD
-    (void)sim;
-    return cd_order_identity();
-#else
-    return cd_sim_step_order(sim);
-#endif
+    return cd_step_memory_is_host() ? cd_sim_step_order(sim) : cd_order_identity();
 }
 
 void cd_reorder_forget(cd_sim *sim)
@@ -360,9 +358,10 @@ int cd_reorder_to_user(cd_sim *sim)
     free_host_map(prim_at);
     free_host_map(pair_at);
     free_host_map(prim_uid);
-    /* host threads: these are the step's columns, now in user order until
-     * the next step; an offload device keeps its own in memory order */
-    if (!rc && !CD_OFFLOAD) nb->host_user = 1;
+    /* host memory (host threads, or an offload build's host fallback):
+     * these are the step's columns, now in user order until the next step;
+     * an offload device keeps its own in memory order */
+    if (!rc && cd_step_memory_is_host()) nb->host_user = 1;
     return rc;
 }
 
@@ -370,7 +369,7 @@ int cd_reorder_to_memory(cd_sim *sim)
 {
     cd_neighbors *nb = &sim->nb;
     if (!nb->ordered || !nb->host_user) return 0;
-    /* host threads only: the maps are host memory */
+    /* host memory only (host_user): the maps are host memory too */
     if (move_host(&sim->s, nb->d.part_uid, nb->d.prim_uid, nb->d.pair_at, 1, nb->d.prim_at)) return -1;
     nb->host_user = 0;
     return 0;

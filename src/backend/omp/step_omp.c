@@ -572,10 +572,8 @@ int cd_sim_check_state(const cd_sim *sim, char *err, size_t errlen)
     CD_HOST_FOR(n, reduction(max : bad))
     for (size_t q = 0; q < n; q++)
         if (cd_item_not_finite(c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
-#if !CD_OFFLOAD
-    /* host threads: the host columns may be in memory order */
-    if (bad >= 0) bad = (long)cd_map(cd_sim_step_order(sim).part_uid, bad);
-#endif
+    /* host memory: the host columns may be in memory order */
+    if (bad >= 0 && cd_step_memory_is_host()) bad = (long)cd_map(cd_sim_step_order(sim).part_uid, bad);
     return report_bad(s, bad, err, errlen);
 }
 
@@ -598,19 +596,18 @@ static int check_step_state(cd_sim *sim, char *err, size_t errlen)
 #endif
 }
 
-/* The backend lets go of the state: on host threads the host columns go
- * back to user order (they are the current state); an offload device's
- * state is dropped (the host keeps what the last sync brought). */
+/* The backend lets go of the state: in host memory (host threads, or an
+ * offload build's host fallback) the host columns go back to user order
+ * (they are the current state); an offload device's state is dropped (the
+ * host keeps what the last sync brought). */
 static void omp_stop(cd_sim *sim)
 {
-#if CD_OFFLOAD
-    cd_reorder_forget(sim);
-    off_release(sim);
-#else
     /* the host keeps the step's wall-contact outputs too */
-    if (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim))
+    if (cd_step_memory_is_host() && (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim)))
         fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
     cd_reorder_forget(sim);
+#if CD_OFFLOAD
+    off_release(sim);
 #endif
     sim->nb.wall_out_valid = sim->nb.wall_out_pending = 0;
 }
@@ -707,8 +704,10 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
     /* The host's wall rows anew as well, whenever the step has entries:
      * cd_reorder_to_user below moves every host column from memory order
      * at every sync, so rows not written again (a second sync without a
-     * step between) would be moved twice. */
-    if (sim->nb.wall_out_valid) sim->nb.wall_out_pending = 1;
+     * step between) would be moved twice.  In host memory (the host
+     * fallback) the columns are the step's: a second sync finds them in
+     * user order and moves nothing, as on host threads. */
+    if (sim->nb.wall_out_valid && !cd_step_memory_is_host()) sim->nb.wall_out_pending = 1;
 #endif
     /* the wall contacts kept per candidate into the host's rows, then the
      * host columns in user order (src/backend/omp/reorder.c) */
@@ -734,14 +733,50 @@ static const char *omp_device(const cd_sim *sim)
     return buf;
 }
 
+/* Host memory (host threads, or an offload build's host fallback): the
+ * host columns are the step's, summed in user order whatever their memory
+ * order, without a sync (which would put them in user order and back); the
+ * wall contacts' F_n from the candidate lists while these are newer than
+ * the host's rows (steps since the last sync), in the same order. */
+static int host_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    (void)err;
+    (void)errlen;
+    if (!sim->nb.wall_out_pending) {
+        *load = cd_sim_wall_load_host(sim, w);
+        return 0;
+    }
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    cd_long P = (cd_long)sim->s.n_prims;
+    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
+    double sum = 0;
+    for (cd_long ch = 0; ch * CD_LOAD_CHUNK < P; ch++)
+        sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w, prim_at, d.wall_start, d.wall_rows,
+                                       d.wall_out);
+    *load = sum;
+    return 0;
+}
+
+/* The host's columns, with the wall contacts' outputs of the last steps
+ * (in the columns' memory order). */
+static int host_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    if (cd_neighbors_wall_out_to_host(sim)) {
+        snprintf(err, errlen, "out of memory while summing the observables");
+        return -1;
+    }
+    cd_observables_slots(sim, slots);
+    return 0;
+}
+
 #if CD_OFFLOAD
 /* Normal load on wall w summed on the device: per-chunk partial sums in
  * parallel, then the chunks in order (deterministic, one double back). */
 static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     cd_off *o = sim->backend_data;
-    (void)err;
-    (void)errlen;
+    if (cd_step_memory_is_host()) return host_wall_load(sim, w, load, err, errlen);
     /* not started, or no forces since: the host columns are current */
     if (!o || !sim->nb.wall_out_valid) {
         *load = cd_sim_wall_load_host(sim, w);
@@ -769,48 +804,19 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     *load = part[total];
     return 0;
 }
-#define CD_OMP_WALL_LOAD omp_wall_load
-#define CD_OMP_OBSERVE   cd_omp_observe_device /* src/backend/omp/observe.c */
-#else
-/* Host threads: the host columns are the step's, summed in user order
- * whatever their memory order, without a sync (which would put them in
- * user order and back); the wall contacts' F_n from the candidate lists
- * while these are newer than the host's rows (steps since the last sync),
- * in the same order. */
-static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
-{
-    (void)err;
-    (void)errlen;
-    if (!sim->nb.wall_out_pending) {
-        *load = cd_sim_wall_load_host(sim, w);
-        return 0;
-    }
-    cd_cols c = cd_sim_step_cols(sim);
-    cd_nb_lists d = sim->nb.d;
-    cd_long P = (cd_long)sim->s.n_prims;
-    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
-    double sum = 0;
-    for (cd_long ch = 0; ch * CD_LOAD_CHUNK < P; ch++)
-        sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w, prim_at, d.wall_start, d.wall_rows,
-                                       d.wall_out);
-    *load = sum;
-    return 0;
-}
 
-/* The host's columns, with the wall contacts' outputs of the last steps
- * (in the columns' memory order). */
+/* The observables where the steps run: on the device (src/backend/omp/observe.c),
+ * or, in the host fallback, as on host threads: the device's lists are in
+ * memory order while a sync has put the one set of columns in user order. */
 static int omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
-    if (cd_neighbors_wall_out_to_host(sim)) {
-        snprintf(err, errlen, "out of memory while summing the observables");
-        return -1;
-    }
-    cd_observables_slots(sim, slots);
-    return 0;
+    if (cd_step_memory_is_host()) return host_observe(sim, slots, err, errlen);
+    return cd_omp_observe_device(sim, slots, err, errlen);
 }
-#define CD_OMP_WALL_LOAD omp_wall_load
-#define CD_OMP_OBSERVE   omp_observe
+#else
+#define omp_wall_load host_wall_load
+#define omp_observe   host_observe
 #endif
 
-const cd_backend cd_backend_omp = {"omp",    omp_start,  omp_step,         omp_sync,
-                                   omp_stop, omp_device, CD_OMP_WALL_LOAD, CD_OMP_OBSERVE};
+const cd_backend cd_backend_omp = {"omp",    omp_start,  omp_step,      omp_sync,
+                                   omp_stop, omp_device, omp_wall_load, omp_observe};
