@@ -95,14 +95,15 @@ static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
 static inline int cd_step_memory_is_host(void) { return 1; }
 static inline void *cd_dev_alloc(size_t bytes) { return malloc(bytes ? bytes : 1); }
 static inline void cd_dev_free(void *p) { free(p); }
+/* (no bytes: either address may be null, which memcpy does not allow) */
 static inline int cd_dev_get(void *dst, const void *src, size_t bytes)
 {
-    memcpy(dst, src, bytes);
+    if (bytes) memcpy(dst, src, bytes);
     return 0;
 }
 static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
 {
-    memcpy(dst, src, bytes);
+    if (bytes) memcpy(dst, src, bytes);
     return 0;
 }
 #endif
