@@ -120,7 +120,7 @@ cd_cols cd_sim_step_cols(cd_sim *sim);
 int cd_sim_step_remap(cd_sim *sim, char *err, size_t errlen);
 
 /* Copies of the step loops' argument block to the device since the
- * backend started (src/backend/omp/step_omp.c, off_args): copies[0] of
+ * backend started (src/backend/omp/step_device.c, cd_off_args): copies[0] of
  * its head (addresses, laws), copies[1] of its walls; both 0 on host
  * threads, where nothing is copied. */
 void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2]);

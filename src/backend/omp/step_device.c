@@ -1,0 +1,272 @@
+/* Residency of the omp backend's state on an offload device and the
+ * step's argument block (src/backend/omp/step_device.h): mapped once at
+ * start over the cd_fields table, kept on the device across steps, copied
+ * back only by sync (src/backend/omp/step_omp.c). */
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "backend/omp/step_device.h"
+#include "step_items.h"
+#include "broadphase.h"
+
+
+/* The state's device columns for the per-item functions of
+ * kernels/step_items.h. */
+cd_cols cd_sim_host_cols(cd_state *s)
+{
+    cd_cols c;
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = s->name;)
+#include "fields.def"
+#undef CD_FIELD
+    return c;
+}
+
+#if CD_OFFLOAD
+static void off_map(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target enter data map(to : c [0:bytes])
+    }
+}
+
+static void off_unmap(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target exit data map(delete : c [0:bytes])
+    }
+}
+
+void cd_off_from(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target update from(c [0:bytes])
+    }
+}
+
+static void *off_devptr(void *p)
+{
+    void *r = p;
+#pragma omp target data use_device_ptr(r)
+    {
+        p = r;
+    }
+    return p;
+}
+
+/* Rows of a group held in memory: the pair columns at their capacity. */
+static size_t alloc_rows(const cd_state *s, enum cd_field_group g)
+{
+    return cd_group_pair_rows(g) ? s->cap_pairs : cd_state_rows(s, g);
+}
+
+static void off_refresh_cols(cd_sim *sim, cd_off *o)
+{
+    cd_state d = sim->s;
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        void **slot = cd_field_ptr(&d, &cd_fields[f]);
+        if (o->host[f]) *slot = off_devptr(o->host[f]);
+    }
+    o->dev = cd_sim_host_cols(&d);
+}
+
+/* Maps field f at its current host address and size (none for the
+ * output-only columns, kernels/field_groups.h). */
+static void off_map_field(cd_sim *sim, cd_off *o, size_t f)
+{
+    void *p = cd_fields[f].on_device ? *cd_field_ptr(&sim->s, &cd_fields[f]) : NULL;
+    size_t bytes = alloc_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size;
+    o->host[f] = p && bytes ? p : NULL;
+    o->bytes[f] = o->host[f] ? bytes : 0;
+    off_map(o->host[f], o->bytes[f]);
+}
+
+void cd_off_release(cd_sim *sim)
+{
+    cd_off *o = sim->backend_data;
+    if (!o) return;
+    for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
+    off_unmap(o->part, o->part_n * sizeof(double));
+    cd_dev_free(o->args_dev);
+    free(o->part);
+    free(o->host);
+    free(o->bytes);
+    free(o);
+    sim->backend_data = NULL;
+}
+
+/* Is OMP_TARGET_OFFLOAD set to MANDATORY (any case)?  GCC 12's libgomp
+ * falls back to the host without a device even then, so the check is ours. */
+static int offload_mandatory(void)
+{
+    const char *v = getenv("OMP_TARGET_OFFLOAD"), *m = "MANDATORY";
+    if (!v) return 0;
+    for (; *v && *m; v++, m++)
+        if ((*v | 0x20) != (*m | 0x20)) return 0;
+    return !*v && !*m;
+}
+
+/* Copies every column of the host state to the device, once per run.  A
+ * build for offload that finds no device runs on the host, unless
+ * OMP_TARGET_OFFLOAD=MANDATORY: then the run fails rather than pass for a
+ * device run. */
+int cd_off_acquire(cd_sim *sim, char *err, size_t errlen)
+{
+    static int warned = 0;
+    if (omp_get_num_devices() == 0) {
+        if (offload_mandatory()) {
+            snprintf(err, errlen,
+                     "built for %s offload and OMP_TARGET_OFFLOAD=MANDATORY, but the OpenMP runtime "
+                     "finds no offload device (docs/offload.md)",
+                     CAPDEM_OFFLOAD_VARIANT);
+            return -1;
+        }
+        if (!warned)
+            fprintf(stderr, "capdem: built for %s offload but no offload device found: running on the host\n",
+                    CAPDEM_OFFLOAD_VARIANT);
+        warned = 1;
+    }
+    snprintf(err, errlen, "out of memory while mapping the state to the offload device");
+    cd_off *o = calloc(1, sizeof *o);
+    if (!o) return -1;
+    sim->backend_data = o;
+    o->host = calloc(cd_n_fields, sizeof *o->host);
+    o->bytes = calloc(cd_n_fields, sizeof *o->bytes);
+    o->part_n = sim->s.n_prims / CD_LOAD_CHUNK + 2; /* the chunks, then their total */
+    o->part = calloc(o->part_n, sizeof(double));
+    if (!o->host || !o->bytes || !o->part) {
+        cd_off_release(sim);
+        return -1;
+    }
+    for (size_t f = 0; f < cd_n_fields; f++) off_map_field(sim, o, f);
+    off_map(o->part, o->part_n * sizeof(double));
+    off_refresh_cols(sim, o);
+    return 0;
+}
+
+/* Room for n pair rows: the host columns grow, and when they moved the
+ * device copies are re-mapped (every old mapping goes before any new one:
+ * a new block may reuse an old address).  Their contents are not carried:
+ * the neighbour-list build keeps the history it needs before calling. */
+static int off_reserve_pairs(cd_sim *sim, size_t n)
+{
+    cd_state *s = &sim->s;
+    cd_off *o = sim->backend_data;
+    if (cd_state_reserve_pairs(s, n)) return -1;
+    int moved = 0;
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group != CD_GROUP_PAIR) continue;
+        void *p = *cd_field_ptr(s, &cd_fields[f]);
+        if (p != o->host[f] || s->cap_pairs * cd_fields[f].elem_size != o->bytes[f]) moved = 1;
+    }
+    if (!moved) return 0;
+    for (size_t f = 0; f < cd_n_fields; f++)
+        if (cd_fields[f].group == CD_GROUP_PAIR) {
+            off_unmap(o->host[f], o->bytes[f]);
+            o->host[f] = NULL;
+            o->bytes[f] = 0;
+        }
+    for (size_t f = 0; f < cd_n_fields; f++)
+        if (cd_fields[f].group == CD_GROUP_PAIR) off_map_field(sim, o, f);
+    off_refresh_cols(sim, o);
+    return 0;
+}
+#endif
+
+int cd_sim_reserve_step_pairs(cd_sim *sim, size_t n)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data) return off_reserve_pairs(sim, n);
+#endif
+    return cd_state_reserve_pairs(&sim->s, n);
+}
+
+void *cd_sim_step_field(cd_sim *sim, size_t f)
+{
+#if CD_OFFLOAD
+    cd_off *o = sim->backend_data;
+    if (o) return o->host[f] ? off_devptr(o->host[f]) : NULL;
+#endif
+    return *cd_field_ptr(&sim->s, &cd_fields[f]);
+}
+
+void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2])
+{
+    copies[0] = copies[1] = 0;
+#if CD_OFFLOAD
+    const cd_off *o = sim->backend_data;
+    if (o) memcpy(copies, o->args_copies, sizeof o->args_copies);
+#else
+    (void)sim;
+#endif
+}
+
+/* Columns the step loops work on: device addresses in the offload variant,
+ * the host columns otherwise. */
+cd_cols cd_sim_step_cols(cd_sim *sim)
+{
+#if CD_OFFLOAD
+    if (sim->backend_data) return ((cd_off *)sim->backend_data)->dev;
+#endif
+    return cd_sim_host_cols(&sim->s);
+}
+
+/* The block for the state as it is now, padding zeroed (blocks are
+ * compared byte by byte). */
+void cd_step_args_fill(cd_sim *sim, cd_step_args *a)
+{
+    memset(a, 0, sizeof *a);
+    a->c = cd_sim_step_cols(sim);
+    a->d = sim->nb.d;
+    a->law = sim->p.law;
+    a->wall_law = sim->p.wall_law;
+    a->gravity = sim->p.gravity;
+    a->dt = sim->p.dt;
+    a->sin_parallel = sim->p.sin_parallel;
+    a->limit2 = cd_bp_skin_limit2(sim->nb.skin);
+    a->blend = sim->p.parallel_blend;
+    a->dimension = sim->p.dimension;
+    a->n_walls = (cd_int)sim->s.n_walls;
+    memcpy(a->walls, sim->s.walls, sim->s.n_walls * sizeof(cd_wall));
+}
+
+#if CD_OFFLOAD
+/* The step's argument block on the device, brought up to date before a
+ * launch: what differs from the last block sent goes out (all of it after
+ * a start, the head after a build or re-map that moved a buffer or a
+ * change of the laws, the walls in use after they moved), nothing
+ * otherwise.  NULL when the device block could not be had. */
+static const cd_step_args *cd_off_args(cd_sim *sim)
+{
+    cd_off *o = sim->backend_data;
+    cd_step_args a;
+    cd_step_args_fill(sim, &a);
+    size_t head = offsetof(cd_step_args, walls), walls = sim->s.n_walls * sizeof(cd_wall);
+    if (!o->args_dev && !(o->args_dev = cd_dev_alloc(sizeof(cd_step_args)))) return NULL;
+    if (!o->args_sent || memcmp(&a, &o->args_host, head)) {
+        if (cd_dev_put(o->args_dev, &a, head)) return NULL;
+        o->args_copies[0]++;
+    }
+    if (walls && (!o->args_sent || memcmp(a.walls, o->args_host.walls, walls))) {
+        if (cd_dev_put(o->args_dev->walls, a.walls, walls)) return NULL;
+        o->args_copies[1]++;
+    }
+    o->args_host = a;
+    o->args_sent = 1;
+    return o->args_dev;
+}
+/* The loops have no error path: a device that cannot take 1.5 kB is
+ * gone, and the run stops here rather than compute with stale arguments. */
+const cd_step_args *cd_off_args_or_die(cd_sim *sim)
+{
+    const cd_step_args *a = cd_off_args(sim);
+    if (!a) {
+        fprintf(stderr, "capdem: the offload device refused the step's argument block (1.5 kB): stopping\n");
+        abort();
+    }
+    return a;
+}
+#endif

@@ -1,0 +1,60 @@
+/* The omp backend's step arguments and, in the offload variant, the
+ * state's residency on the device: the columns mapped once, their device
+ * addresses, the pair columns re-mapped when they grow, and the argument
+ * block every loop of a step reads (src/backend/omp/step_device.c; used by
+ * src/backend/omp/step_omp.c). */
+#ifndef CAPDEM_STEP_DEVICE_H
+#define CAPDEM_STEP_DEVICE_H
+
+#include "backend/omp/omp_loops.h"
+
+/* What every loop of a step takes besides its row count: the columns, the
+ * lists, the laws and the walls, as one block.  In the offload variant the
+ * block lives on the device (cd_off_args_or_die): the loops take its device address
+ * (is_device_ptr), so a launch copies and allocates nothing; a
+ * firstprivate struct was one packed host-to-device copy per launch
+ * (280-624 B; docs/offload.md, "Per-step copies").  The walls come last:
+ * they change every step while a protocol moves one, the rest only when a
+ * build or a re-map moves the buffers. */
+typedef struct {
+    cd_cols c;
+    cd_nb_lists d;
+    cd_law_params law, wall_law;
+    cd_vec3 gravity;                  /* [m/s^2] */
+    cd_real dt, sin_parallel, limit2; /* [s], [1], (skin/2)^2 [m^2] */
+    cd_int blend, dimension, n_walls; /* material.parallel_blend, 2 or 3, walls in use */
+    cd_int pad_;                      /* walls 8-byte aligned */
+    cd_wall walls[CD_MAX_WALLS];      /* the first n_walls are in use */
+} cd_step_args;
+
+#if CD_OFFLOAD
+/* What the offload variant keeps in sim->backend_data. */
+typedef struct {
+    void **host;   /* per field of cd_fields: host address mapped (NULL: none) */
+    size_t *bytes; /* per field: bytes mapped */
+    double *part;  /* per-chunk partial sums of the wall load (mapped) */
+    size_t part_n;
+    cd_cols dev;              /* device addresses of the columns */
+    cd_step_args *args_dev;   /* the loops' argument block on the device (cd_off_args_or_die) */
+    cd_step_args args_host;   /* what it holds */
+    int args_sent;            /* 0 until the first block went out */
+    long long args_copies[2]; /* copies of the block's head and of its walls since start */
+} cd_off;
+
+/* Maps every column of the host state to the device (once per run); 0 on
+ * success, -1 with err set. */
+int cd_off_acquire(cd_sim *sim, char *err, size_t errlen);
+/* Unmaps everything and frees sim->backend_data. */
+void cd_off_release(cd_sim *sim);
+/* Copies bytes at host address p back from the device. */
+void cd_off_from(void *p, size_t bytes);
+/* The step's argument block on the device, up to date; stops the run
+ * when the device cannot hold it. */
+const cd_step_args *cd_off_args_or_die(cd_sim *sim);
+#endif
+
+/* The block for the state as it is now, padding zeroed (blocks are
+ * compared byte by byte). */
+void cd_step_args_fill(cd_sim *sim, cd_step_args *a);
+
+#endif
