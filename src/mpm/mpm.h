@@ -67,7 +67,7 @@ typedef struct {
     long long *pair_keys; /* scratch: k * n_bodies + l of the pairs in contact */
     size_t cap_pairs;
     double contact_gap; /* two bodies' contact acts from this gap between them on [m] */
-    long n_contacts;    /* body pairs in contact (at a node within contact_gap) in the last step */
+    long n_contacts;    /* body pairs in contact (at a node within contact_gap) at the last cd_mpm_contact_count */
     double penetration; /* deepest overlap of two bodies in the last step, from the contact nodes [m]; 0 if none */
 
     int n_walls;
@@ -131,11 +131,17 @@ void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double
 
 /* Contact (src/mpm/mpm_contact.c, docs/mpm.md "Contact"): lists the common
  * nodes two or more bodies share; after the forces, detects the contacts
- * there, corrects the bodies' node velocities, sets the accelerations to
- * match and counts the body pairs.  -1 with a message when more bodies
- * than CD_MPM_NODE_BODIES (kernels/mpm_contact.h) meet at a node. */
+ * there, corrects the bodies' node velocities and sets the accelerations to
+ * match.  -1 with a message when more bodies than CD_MPM_NODE_BODIES
+ * (kernels/mpm_contact.h) meet at a node. */
 void cd_mpm_contact_nodes(cd_mpm *m);
 int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen);
+/* n_contacts from the last step's contact bits: called where the count is
+ * read (a series row, the progress line), not every step (on an offload
+ * device it copies the pair keys to the host and sorts them).  Before the
+ * first step, and with one body, n_contacts stays as it is (0).  0, or -1
+ * with a message (out of memory). */
+int cd_mpm_contact_count(cd_mpm *m, char *err, size_t errlen);
 /* The columns and mesh of m's own (host) memory (valid until the
  * body-node columns grow). */
 cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m);

@@ -111,11 +111,15 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
         int last_step = m.step == cfg->steps;
         double t = now_seconds();
         int show = !opt->quiet && t - last >= (tty ? 0.5 : 10.0);
+        int row = m.step % cfg->thermo_every == 0 || last_step;
         /* offload builds: the host columns the output and the progress line read, from the device */
-        if (m.step % cfg->thermo_every == 0 || m.step % cfg->snapshot_every == 0 || last_step || show)
-            cd_mpm_device_sync(&m);
-        if ((m.step % cfg->thermo_every == 0 || last_step) &&
-            cd_mpm_output_series(out, &m, cd_mpm_kinetic_energy(&m), err, sizeof err)) {
+        if (row || m.step % cfg->snapshot_every == 0 || show) cd_mpm_device_sync(&m);
+        /* the contact count Z, read by the series row and the progress line only */
+        if ((row || show) && cd_mpm_contact_count(&m, err, sizeof err)) {
+            fprintf(stderr, "\ncapdem: %s\n", err);
+            status = 1;
+        }
+        if (status == 0 && row && cd_mpm_output_series(out, &m, cd_mpm_kinetic_energy(&m), err, sizeof err)) {
             fprintf(stderr, "\ncapdem: %s\n", err);
             status = 1;
         }

@@ -67,6 +67,7 @@ static void step(cd_mpm *m)
     char err[512];
     if (cd_mpm_step(m, err, sizeof err)) fail_msg("step: %s", err);
     cd_mpm_device_sync(m); /* offload builds: the columns the test reads, from the device */
+    if (cd_mpm_contact_count(m, err, sizeof err)) fail_msg("count: %s", err); /* n_contacts, read below */
 }
 
 /* Overlap [m] of the two disks along the x axis: the rightmost reach of
