@@ -85,14 +85,14 @@ CD_INLINE void cd_mpm_contact_extent(cd_mpm_cols c, cd_int k, cd_int gi, cd_int 
                 cd_real dx = xi - c.x[p], dy = yi - c.y[p]; /* node - point [m] */
                 /* the lines that can cross the point: its parallelogram spans c_t +- w_t along t */
                 cd_real ct = -(dx * tx + dy * ty);
-                cd_real wt = cd_mpm_point_reach(c.half[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p], tx, ty);
+                cd_real wt = cd_mpm_point_reach(c.half_side[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p], tx, ty);
                 cd_int q0 = (cd_int)ceil((ct - wt) / step) + CD_MPM_CENTRAL_LINE,
                        q1 = (cd_int)floor((ct + wt) / step) + CD_MPM_CENTRAL_LINE;
                 if (q0 < 0) q0 = 0;
                 if (q1 > CD_MPM_CONTACT_LINES - 1) q1 = CD_MPM_CONTACT_LINES - 1;
                 for (cd_int q = q0; q <= q1; q++) {
                     cd_real o = (q - CD_MPM_CENTRAL_LINE) * step, s0, s1; /* offset [m], chord [m] */
-                    if (!cd_mpm_point_chord(c.half[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p], dx + o * tx,
+                    if (!cd_mpm_point_chord(c.half_side[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p], dx + o * tx,
                                             dy + o * ty, nx, ny, &s0, &s1))
                         continue;
                     if (s0 < lo[q]) lo[q] = s0;
@@ -131,7 +131,9 @@ CD_INLINE cd_int cd_mpm_item_contact(cd_mpm_cols c, cd_ulong ci, cd_real gap_max
             cd_ulong ta = c.cn_entry[first + a], tb = c.cn_entry[first + b];
             /* normal from body a towards body b: the difference of their outward normals (gn is
              * sum m_p grad_p N, the node's mass gradient with its sign turned) */
-            cd_real nx = c.gnx[ta] - c.gnx[tb], ny = c.gny[ta] - c.gny[tb], len = hypot(nx, ny);
+            /* (sqrt of the sum of squares, not hypot: sqrt, + and * round correctly on every OpenCL
+             * device and GPU, hypot may differ by ulps from the host's: the same bits everywhere) */
+            cd_real nx = c.gnx[ta] - c.gnx[tb], ny = c.gny[ta] - c.gny[tb], len = sqrt(nx * nx + ny * ny);
             if (!(len > 0)) continue;
             nx /= len;
             ny /= len;

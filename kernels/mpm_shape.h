@@ -48,7 +48,7 @@ CD_INLINE cd_real cd_mpm_bspline_dr(cd_real r)
 /* The four weights w[k] = N(r_k) and gradients dw[k] = dN/dx [1/m] of the
  * nodes base .. base+3 for a point at grid coordinate g = (x - origin) / h
  * [1] (h the cell size [m]).  Returns base = floor(g) - 1, the first node. */
-CD_INLINE cd_int cd_mpm_weights_1d(cd_real g, cd_real h, cd_real *w, cd_real *dw)
+CD_INLINE cd_int cd_mpm_weights_1d(cd_real g, cd_real h, CD_GLOBAL cd_real *w, CD_GLOBAL cd_real *dw)
 {
     cd_real c = floor(g);
     cd_int base = (cd_int)c - 1;

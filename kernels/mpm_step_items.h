@@ -23,8 +23,9 @@ CD_DEVICE_BEGIN
 /* The columns the items read and write, and the mesh they live on. */
 typedef struct {
     /* material points */
-    CD_GLOBAL cd_real *x, *y, *vx, *vy;           /* position [m], velocity [m/s] */
-    CD_GLOBAL cd_real *mass, *vol, *half;         /* [kg/m], [m^3/m], half the initial side [m] */
+    CD_GLOBAL cd_real *x, *y, *vx, *vy; /* position [m], velocity [m/s] */
+    CD_GLOBAL cd_real *mass, *vol,
+        *half_side; /* [kg/m], [m^3/m], half the initial side [m] ("half" is an OpenCL C type) */
     CD_GLOBAL cd_real *sxx, *syy, *sxy, *szz;     /* Cauchy stress [Pa] */
     CD_GLOBAL cd_real *eps_p;                     /* equivalent plastic strain [1] */
     CD_GLOBAL cd_real *f_xx, *f_xy, *f_yx, *f_yy; /* deformation gradient [1] */
@@ -64,7 +65,7 @@ typedef struct {
 /* Wall w's penalty overlap with point p [m] (<= 0: none). */
 CD_INLINE cd_real cd_mpm_item_wall_overlap(cd_mpm_cols c, cd_ulong p, cd_mpm_item_walls walls, cd_int w)
 {
-    return cd_mpm_wall_overlap(c.x[p], c.y[p], c.half[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p], walls.px[w],
+    return cd_mpm_wall_overlap(c.x[p], c.y[p], c.half_side[p], c.f_xx[p], c.f_xy[p], c.f_yx[p], c.f_yy[p], walls.px[w],
                                walls.py[w], walls.nx[w], walls.ny[w]);
 }
 
@@ -321,9 +322,9 @@ CD_INLINE void cd_mpm_item_mesh_kinetic(cd_mpm_cols c, cd_ulong nbn, CD_GLOBAL c
 CD_INLINE cd_ulong cd_mpm_common_node(cd_mpm_cols c, cd_ulong t)
 {
     cd_int k = c.bnode_body[t];
-    cd_ulong local = t - c.win_off[k];
-    cd_int i = c.win_i0[k] + (cd_int)(local % (cd_ulong)c.win_nx[k]);
-    cd_int j = c.win_j0[k] + (cd_int)(local / (cd_ulong)c.win_nx[k]);
+    cd_ulong loc = t - c.win_off[k];
+    cd_int i = c.win_i0[k] + (cd_int)(loc % (cd_ulong)c.win_nx[k]);
+    cd_int j = c.win_j0[k] + (cd_int)(loc / (cd_ulong)c.win_nx[k]);
     return (cd_ulong)j * (cd_ulong)c.nx + (cd_ulong)i;
 }
 

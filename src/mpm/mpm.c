@@ -43,6 +43,7 @@ int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, doubl
 
 void cd_mpm_free(cd_mpm *m)
 {
+    cd_mpm_cl_close(m);
     cd_mpm_device_stop(m);
     void *cols[] = {m->x,          m->y,        m->vx,       m->vy,       m->mass,      m->vol,      m->half,
                     m->sxx,        m->syy,      m->sxy,      m->szz,      m->eps_p,     m->f_xx,     m->f_xy,
@@ -143,7 +144,7 @@ cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m)
                      .vy = m->vy,
                      .mass = m->mass,
                      .vol = m->vol,
-                     .half = m->half,
+                     .half_side = m->half,
                      .sxx = m->sxx,
                      .syy = m->syy,
                      .sxy = m->sxy,
@@ -193,12 +194,8 @@ cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m)
     return c;
 }
 
-/* Stencil of every point, the wall forces on it, each body's window of
- * nodes, and the points sorted by body and cell.  -1 when a point's stencil leaves the mesh. */
-static int prepare(cd_mpm *m, char *err, size_t errlen)
+cd_mpm_item_walls cd_mpm_walls_items(const cd_mpm *m)
 {
-    size_t n = m->n;
-    long long bad = -1;
     cd_mpm_item_walls walls = {.n = m->n_walls, .k = m->wall_k};
     for (int w = 0; w < m->n_walls; w++) {
         walls.px[w] = m->walls[w].px;
@@ -206,21 +203,53 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
         walls.nx[w] = m->walls[w].nx;
         walls.ny[w] = m->walls[w].ny;
     }
+    return walls;
+}
+
+int cd_mpm_fail_left_mesh(cd_mpm *m, size_t p, char *err, size_t errlen)
+{
+    cd_mpm_device_sync(m);
+    snprintf(err, errlen,
+             "material point %zu at (%.6g, %.6g) m (t = %.9g s, step %lld) left the background mesh "
+             "[%.6g, %.6g] x [%.6g, %.6g] m: the run blew up, or the set-up leaves too little room",
+             p, m->x[p], m->y[p], m->time, m->step, m->ox, m->ox + (m->nx - 1) * m->h, m->oy,
+             m->oy + (m->ny - 1) * m->h);
+    return -1;
+}
+
+int cd_mpm_fail_blew_up(cd_mpm *m, long long p, char *err, size_t errlen)
+{
+    cd_mpm_device_sync(m);
+    snprintf(err, errlen,
+             "material point %lld is not finite or has a volume <= 0 at step %lld (t = %.9g s): the run "
+             "blew up; reduce run.dt (limit %.3g s) or check the material",
+             p, m->step + 1, m->time + m->dt, cd_mpm_dt_limit(m));
+    return -1;
+}
+
+void cd_mpm_step_done(cd_mpm *m)
+{
+    for (int w = 0; w < m->n_walls; w++) {
+        m->walls[w].px += m->dt * m->walls[w].vx;
+        m->walls[w].py += m->dt * m->walls[w].vy;
+    }
+    m->time += m->dt;
+    m->step++;
+}
+
+/* Stencil of every point, the wall forces on it, each body's window of
+ * nodes, and the points sorted by body and cell.  -1 when a point's stencil leaves the mesh. */
+static int prepare(cd_mpm *m, char *err, size_t errlen)
+{
+    size_t n = m->n;
+    long long bad = -1;
+    cd_mpm_item_walls walls = cd_mpm_walls_items(m);
     cd_mpm_cols c = cd_mpm_loop_cols(m);
     CD_WIDE_MIN
     CD_STEP_FOR(n, firstprivate(c, walls) reduction(max : bad) CD_DEV(map(tofrom : bad)))
     for (size_t p = 0; p < n; p++)
         if (cd_mpm_item_prepare(c, p, walls)) bad = (long long)p > bad ? (long long)p : bad;
-    if (bad >= 0) {
-        size_t p = (size_t)bad;
-        cd_mpm_device_sync(m);
-        snprintf(err, errlen,
-                 "material point %zu at (%.6g, %.6g) m (t = %.9g s, step %lld) left the background mesh "
-                 "[%.6g, %.6g] x [%.6g, %.6g] m: the run blew up, or the set-up leaves too little room",
-                 p, m->x[p], m->y[p], m->time, m->step, m->ox, m->ox + (m->nx - 1) * m->h, m->oy,
-                 m->oy + (m->ny - 1) * m->h);
-        return -1;
-    }
+    if (bad >= 0) return cd_mpm_fail_left_mesh(m, (size_t)bad, err, errlen);
     /* wall forces: the reaction of the points' penalty forces, summed in point order */
     double *wf = m->loop_wall_f, f[2 * CD_MPM_MAX_WALLS]; /* [N/m] */
     int nw = m->n_walls;
@@ -259,6 +288,7 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
 {
     double dt = m->dt;
     if (m->n_bodies == 0 && cd_mpm_bodies(m, err, errlen)) return -1;
+    if (m->cl) return cd_mpm_cl_step(m, err, errlen); /* the OpenCL backend (src/mpm/mpm_cl.c) */
     if (cd_mpm_device_start(m, err, errlen) || prepare(m, err, errlen)) return -1;
     cd_mpm_cols c = cd_mpm_loop_cols(m);
     size_t n = m->n, nbn = m->n_bnodes;
@@ -287,20 +317,8 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
     CD_STEP_FOR(n, firstprivate(c, dt, mat) reduction(max : bad) CD_DEV(map(tofrom : bad)))
     for (size_t p = 0; p < n; p++)
         if (cd_mpm_item_stress(c, p, dt, mat)) bad = (long long)p > bad ? (long long)p : bad;
-    if (bad >= 0) {
-        cd_mpm_device_sync(m);
-        snprintf(err, errlen,
-                 "material point %lld is not finite or has a volume <= 0 at step %lld (t = %.9g s): the run "
-                 "blew up; reduce run.dt (limit %.3g s) or check the material",
-                 bad, m->step + 1, m->time + dt, cd_mpm_dt_limit(m));
-        return -1;
-    }
-    for (int w = 0; w < m->n_walls; w++) {
-        m->walls[w].px += dt * m->walls[w].vx;
-        m->walls[w].py += dt * m->walls[w].vy;
-    }
-    m->time += dt;
-    m->step++;
+    if (bad >= 0) return cd_mpm_fail_blew_up(m, bad, err, errlen);
+    cd_mpm_step_done(m);
     return 0;
 }
 

@@ -89,6 +89,7 @@ typedef struct {
     double *loop_wall_f, *loop_real; /* where the loops run: wall forces [N/m], the mesh's kinetic energy */
     cd_ulong *loop_count;            /* where the loops run: counts the serial parts return */
     cd_long *loop_keys;              /* where the loops run: the contact pairs' keys */
+    struct cd_mpm_cl *cl;            /* the OpenCL backend's state (src/mpm/mpm_cl.c); NULL: the omp loops */
 } cd_mpm;
 
 /* Allocates n points and an nx x ny node mesh of cell size h [m] whose
@@ -142,6 +143,35 @@ int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen);
  * first step, and with one body, n_contacts stays as it is (0).  0, or -1
  * with a message (out of memory). */
 int cd_mpm_contact_count(cd_mpm *m, char *err, size_t errlen);
+/* Room for n keys in m->pair_keys (0, or -1 with a message). */
+int cd_mpm_pair_keys_room(cd_mpm *m, size_t n, char *err, size_t errlen);
+
+/* Shared by the omp loops and the OpenCL backend: the walls as the items
+ * see them; the messages of a step that stopped (the host columns synced
+ * first; they return -1): point p left the mesh, point p blew up, too many
+ * bodies at common node g; the end of a step (walls moved, time and step
+ * advanced). */
+cd_mpm_item_walls cd_mpm_walls_items(const cd_mpm *m);
+int cd_mpm_fail_left_mesh(cd_mpm *m, size_t p, char *err, size_t errlen);
+int cd_mpm_fail_blew_up(cd_mpm *m, long long p, char *err, size_t errlen);
+int cd_mpm_fail_crowded(cd_mpm *m, size_t g, char *err, size_t errlen);
+void cd_mpm_step_done(cd_mpm *m);
+
+/* The OpenCL backend (src/mpm/mpm_cl.c, docs/mpm.md "The OpenCL backend"):
+ * cd_mpm_cl_open opens the device (request cpu | gpu | auto, NULL: auto)
+ * and sets m->cl: from then on cd_mpm_step runs there (cd_mpm_cl_step), the
+ * state goes to the device at the first step and cd_mpm_device_sync /
+ * _stop bring it back / drop it; cd_mpm_free closes it.  0, or -1 with a
+ * message (no OpenCL in this build, no device, the kernels do not
+ * build). */
+int cd_mpm_cl_open(cd_mpm *m, const char *device, char *err, size_t errlen);
+int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen);
+void cd_mpm_cl_sync(cd_mpm *m);
+void cd_mpm_cl_close(cd_mpm *m);
+/* The device's name, for the run's first line. */
+const char *cd_mpm_cl_device(const cd_mpm *m);
+/* The last step's contact pair keys into m->pair_keys, their number into *n. */
+int cd_mpm_cl_pair_keys(cd_mpm *m, size_t *n, char *err, size_t errlen);
 /* The columns and mesh of m's own (host) memory (valid until the
  * body-node columns grow). */
 cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m);

@@ -40,11 +40,23 @@ static int cmp_key(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Body pairs in contact (exchanging force), each counted once, from the
- * contact bits of the last step (mpm.h). */
-int cd_mpm_contact_count(cd_mpm *m, char *err, size_t errlen)
+int cd_mpm_pair_keys_room(cd_mpm *m, size_t n, char *err, size_t errlen)
 {
-    if (!m->loop_on || m->n_bodies < 2) return 0; /* no step yet, or no contact: the count stays as it is */
+    if (n <= m->cap_pairs) return 0;
+    long long *q = realloc(m->pair_keys, (n + 64) * sizeof(long long));
+    if (!q) {
+        snprintf(err, errlen, "out of memory for %zu contact pairs", n);
+        return -1;
+    }
+    m->pair_keys = q;
+    m->cap_pairs = n + 64;
+    return 0;
+}
+
+/* The pair keys of the last step's contact bits into m->pair_keys, their
+ * number into *w, where the omp loops run. */
+static int loop_pair_keys(cd_mpm *m, size_t *w, char *err, size_t errlen)
+{
     cd_mpm_cols c = cd_mpm_loop_cols(m);
     cd_ulong *count = m->loop_count, n_cn = m->n_cn, n;
     cd_long *none = NULL;
@@ -52,15 +64,7 @@ int cd_mpm_contact_count(cd_mpm *m, char *err, size_t errlen)
     CD_STEP_FOR(1, firstprivate(c, n_cn, none) CD_DEV(is_device_ptr(count)))
     for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, none, count);
     cd_dev_get(&n, count, sizeof n);
-    if (n > m->cap_pairs) {
-        long long *q = realloc(m->pair_keys, (n + 64) * sizeof(long long));
-        if (!q) {
-            snprintf(err, errlen, "out of memory for %zu contact pairs", (size_t)n);
-            return -1;
-        }
-        m->pair_keys = q;
-        m->cap_pairs = n + 64;
-    }
+    if (cd_mpm_pair_keys_room(m, n, err, errlen)) return -1;
     if (cd_mpm_device_keys(m, n)) {
         snprintf(err, errlen, "out of device memory for %zu contact pairs", (size_t)n);
         return -1;
@@ -69,12 +73,33 @@ int cd_mpm_contact_count(cd_mpm *m, char *err, size_t errlen)
     CD_STEP_FOR(1, firstprivate(c, n_cn) CD_DEV(is_device_ptr(keys, count)))
     for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, keys, count);
     cd_dev_get(m->pair_keys, keys, n * sizeof(cd_long));
-    size_t w = (size_t)n;
+    *w = (size_t)n;
+    return 0;
+}
+
+/* Body pairs in contact (exchanging force), each counted once, from the
+ * contact bits of the last step (mpm.h). */
+int cd_mpm_contact_count(cd_mpm *m, char *err, size_t errlen)
+{
+    if (!m->loop_on || m->n_bodies < 2) return 0; /* no step yet, or no contact: the count stays as it is */
+    size_t w;
+    if (m->cl ? cd_mpm_cl_pair_keys(m, &w, err, errlen) : loop_pair_keys(m, &w, err, errlen)) return -1;
     if (w) qsort(m->pair_keys, w, sizeof(long long), cmp_key); /* (no keys: pair_keys may be NULL) */
     long distinct = 0;
     for (size_t i = 0; i < w; i++) distinct += i == 0 || m->pair_keys[i] != m->pair_keys[i - 1];
     m->n_contacts = distinct;
     return 0;
+}
+
+int cd_mpm_fail_crowded(cd_mpm *m, size_t g, char *err, size_t errlen)
+{
+    cd_mpm_device_sync(m); /* the common node's body count, for the message */
+    snprintf(err, errlen,
+             "common node (%zu, %zu) at step %lld: %zu bodies meet there, more than the %d the contact "
+             "handles: refine the mesh (mpm.cells_per_diameter)",
+             g % (size_t)m->nx, g / (size_t)m->nx, m->step + 1, (size_t)(m->cn_start[g + 1] - m->cn_start[g]),
+             CD_MPM_NODE_BODIES);
+    return -1;
 }
 
 int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen)
@@ -93,16 +118,7 @@ int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen)
             long long g = (long long)c.cn_list[ci];
             bad = g > bad ? g : bad;
         }
-    if (bad >= 0) {
-        size_t g = (size_t)bad;
-        cd_mpm_device_sync(m); /* the common node's body count, for the message */
-        snprintf(err, errlen,
-                 "common node (%zu, %zu) at step %lld: %zu bodies meet there, more than the %d the contact "
-                 "handles: refine the mesh (mpm.cells_per_diameter)",
-                 g % (size_t)m->nx, g / (size_t)m->nx, m->step + 1, m->cn_start[g + 1] - m->cn_start[g],
-                 CD_MPM_NODE_BODIES);
-        return -1;
-    }
+    if (bad >= 0) return cd_mpm_fail_crowded(m, (size_t)bad, err, errlen);
     CD_STEP_FOR(ncn, firstprivate(c, gap_max, dt) reduction(max : pen) CD_DEV(map(tofrom : pen)))
     for (long ci = 0; ci < ncn; ci++) {
         double over = pen;

@@ -106,8 +106,8 @@ int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen)
 #if CD_OFFLOAD
     map_all(m, MAP_ENTER);
     cd_mpm_cols c = cd_mpm_step_cols(m);
-    CD_GLOBAL cd_real **dcols[] = {&c.x,   &c.y,   &c.vx,  &c.vy,    &c.mass, &c.vol,  &c.half, &c.sxx,
-                                   &c.syy, &c.sxy, &c.szz, &c.eps_p, &c.f_xx, &c.f_xy, &c.f_yx, &c.f_yy,
+    CD_GLOBAL cd_real **dcols[] = {&c.x,   &c.y,   &c.vx,  &c.vy,    &c.mass, &c.vol,  &c.half_side, &c.sxx,
+                                   &c.syy, &c.sxy, &c.szz, &c.eps_p, &c.f_xx, &c.f_xy, &c.f_yx,      &c.f_yy,
                                    &c.ex,  &c.ey,  &c.wx,  &c.wy,    &c.dwx,  &c.dwy};
     for (size_t i = 0; i < sizeof dcols / sizeof dcols[0]; i++) *dcols[i] = devptr(*dcols[i]);
     CD_GLOBAL cd_int **icols[] = {&c.particle, &c.bx, &c.by, &c.win_i0, &c.win_j0, &c.win_nx, &c.win_ny};
@@ -173,6 +173,10 @@ cd_mpm_cols cd_mpm_loop_cols(const cd_mpm *m)
 
 void cd_mpm_device_sync(cd_mpm *m)
 {
+    if (m->cl) {
+        cd_mpm_cl_sync(m);
+        return;
+    }
 #if CD_OFFLOAD
     if (m->loop_on) map_all(m, MAP_UPDATE_FROM);
 #else
@@ -182,6 +186,10 @@ void cd_mpm_device_sync(cd_mpm *m)
 
 void cd_mpm_device_stop(cd_mpm *m)
 {
+    if (m->cl) { /* the OpenCL buffers stay; the next step uploads the host columns again */
+        m->loop_on = 0;
+        return;
+    }
 #if CD_OFFLOAD
     if (m->loop_on) {
         map_all(m, MAP_DELETE);

@@ -50,14 +50,19 @@ static void progress(const cd_mpm *m, const cd_config *c, double t0, long long s
 int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
 {
     char err[1024];
-    if (opt->backend && strcmp(opt->backend, "omp")) {
-        fprintf(stderr, "capdem: --backend %s: solver mpm runs on the omp backend only so far (docs/mpm.md)\n",
-                opt->backend);
+    int opencl = opt->backend && !strcmp(opt->backend, "opencl");
+    if (opt->backend && strcmp(opt->backend, "omp") && !opencl) {
+        fprintf(stderr, "capdem: --backend %s: expected omp or opencl\n", opt->backend);
         return 2;
     }
     static cd_mpm m;
     if (cd_mpm_setup(&m, cfg, err, sizeof err)) {
         fprintf(stderr, "capdem: %s\n", err);
+        return 2;
+    }
+    if (opencl && cd_mpm_cl_open(&m, opt->device, err, sizeof err)) { /* as the DEM runs: exit 2 */
+        fprintf(stderr, "capdem: %s\n", err);
+        cd_mpm_free(&m);
         return 2;
     }
     cd_mpm_output *out;
@@ -89,8 +94,9 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, m.step, m.time);
     fprintf(stderr,
             "capdem: mpm: %zu material points, mesh %d x %d nodes (h = %g m), dt = %g s (stability limit / %.1f), "
-            "output %s\n",
-            m.n, m.nx, m.ny, m.h, m.dt, cd_mpm_dt_limit(&m) / m.dt, cfg->output);
+            "backend %s on %s, output %s\n",
+            m.n, m.nx, m.ny, m.h, m.dt, cd_mpm_dt_limit(&m) / m.dt, opencl ? "opencl" : "omp",
+            opencl ? cd_mpm_cl_device(&m) : "host", cfg->output);
     int status = 0;
     /* the walls' forces of step 0 come from the first step's contact pass */
     if (!opt->resume_path && (cd_mpm_output_series(out, &m, cd_mpm_kinetic_energy(&m), err, sizeof err) ||
