@@ -128,9 +128,11 @@ CD_INLINE cd_ulong cd_mpm_stencil_base(cd_mpm_cols c, cd_ulong p)
 /* The points whose stencil holds body-node t lie in the body's cells
  * i-2 .. i+1 and j-2 .. j+1 (window coordinates): visited in that order,
  * each cell's points in index order.  a, b: the node's place in the
- * point's stencil. */
-#define CD_MPM_FOR_SUPPORT(c, t, p, a, b, ...)                                                                         \
-    do {                                                                                                               \
+ * point's stencil.  The loop's body goes between CD_MPM_SUPPORT_BEGIN and
+ * CD_MPM_SUPPORT_END (two macros, not one taking the body: OpenCL C 1.2
+ * has no variadic macros, and the body has commas). */
+#define CD_MPM_SUPPORT_BEGIN(c, t, p, a, b)                                                                            \
+    {                                                                                                                  \
         cd_int k_ = (c).bnode_body[t], wnx_ = (c).win_nx[k_], wny_ = (c).win_ny[k_];                                   \
         cd_ulong off_ = (c).win_off[k_], loc_ = (t)-off_;                                                              \
         cd_int li_ = (cd_int)(loc_ % (cd_ulong)wnx_), lj_ = (cd_int)(loc_ / (cd_ulong)wnx_);                           \
@@ -142,12 +144,12 @@ CD_INLINE cd_ulong cd_mpm_stencil_base(cd_mpm_cols c, cd_ulong p)
                 cd_ulong c_ = off_ + (cd_ulong)cy_ * (cd_ulong)wnx_ + (cd_ulong)cx_;                                   \
                 for (cd_ulong e_ = (c).cell_start[c_]; e_ < (c).cell_start[c_ + 1]; e_++) {                            \
                     cd_ulong p = (c).order[e_];                                                                        \
-                    cd_int a = gi_ - (c).bx[p], b = gj_ - (c).by[p];                                                   \
-                    __VA_ARGS__                                                                                        \
-                }                                                                                                      \
-            }                                                                                                          \
-        }                                                                                                              \
-    } while (0)
+                    cd_int a = gi_ - (c).bx[p], b = gj_ - (c).by[p];
+#define CD_MPM_SUPPORT_END                                                                                             \
+    }                                                                                                                  \
+    }                                                                                                                  \
+    }                                                                                                                  \
+    }
 
 /* Body-node t's mass, momentum and force from the points (the paper's eq.
  * (3): lumped mass, f_int = -sum V sigma grad N, f_ext = sum N f_p); with
@@ -155,22 +157,22 @@ CD_INLINE cd_ulong cd_mpm_stencil_base(cd_mpm_cols c, cd_ulong p)
 CD_INLINE void cd_mpm_item_to_grid(cd_mpm_cols c, cd_ulong t, cd_int normals)
 {
     cd_real gm = 0, px = 0, py = 0, fx = 0, fy = 0, nx = 0, ny = 0;
-    CD_MPM_FOR_SUPPORT(c, t, p, a, b, {
-        cd_real wa = c.wx[CD_MPM_STENCIL * p + a], wb = c.wy[CD_MPM_STENCIL * p + b];
-        cd_real N = wa * wb;                             /* [1] */
-        cd_real gx = c.dwx[CD_MPM_STENCIL * p + a] * wb; /* dN/dx [1/m] */
-        cd_real gy = wa * c.dwy[CD_MPM_STENCIL * p + b]; /* dN/dy [1/m] */
-        cd_real mN = N * c.mass[p];
-        gm += mN;
-        px += mN * c.vx[p];
-        py += mN * c.vy[p];
-        fx += N * c.ex[p] - c.vol[p] * (c.sxx[p] * gx + c.sxy[p] * gy);
-        fy += N * c.ey[p] - c.vol[p] * (c.sxy[p] * gx + c.syy[p] * gy);
-        if (normals) {
-            nx += c.mass[p] * gx;
-            ny += c.mass[p] * gy;
-        }
-    });
+    CD_MPM_SUPPORT_BEGIN(c, t, p, a, b)
+    cd_real wa = c.wx[CD_MPM_STENCIL * p + a], wb = c.wy[CD_MPM_STENCIL * p + b];
+    cd_real N = wa * wb;                             /* [1] */
+    cd_real gx = c.dwx[CD_MPM_STENCIL * p + a] * wb; /* dN/dx [1/m] */
+    cd_real gy = wa * c.dwy[CD_MPM_STENCIL * p + b]; /* dN/dy [1/m] */
+    cd_real mN = N * c.mass[p];
+    gm += mN;
+    px += mN * c.vx[p];
+    py += mN * c.vy[p];
+    fx += N * c.ex[p] - c.vol[p] * (c.sxx[p] * gx + c.sxy[p] * gy);
+    fy += N * c.ey[p] - c.vol[p] * (c.sxy[p] * gx + c.syy[p] * gy);
+    if (normals) {
+        nx += c.mass[p] * gx;
+        ny += c.mass[p] * gy;
+    }
+    CD_MPM_SUPPORT_END
     c.gm[t] = gm;
     c.gpx[t] = px;
     c.gpy[t] = py;
@@ -218,11 +220,11 @@ CD_INLINE void cd_mpm_item_point_update(cd_mpm_cols c, cd_ulong p, cd_real dt, c
 CD_INLINE void cd_mpm_item_remap(cd_mpm_cols c, cd_ulong t)
 {
     cd_real px = 0, py = 0;
-    CD_MPM_FOR_SUPPORT(c, t, p, a, b, {
-        cd_real mN = c.wx[CD_MPM_STENCIL * p + a] * c.wy[CD_MPM_STENCIL * p + b] * c.mass[p];
-        px += mN * c.vx[p];
-        py += mN * c.vy[p];
-    });
+    CD_MPM_SUPPORT_BEGIN(c, t, p, a, b)
+    cd_real mN = c.wx[CD_MPM_STENCIL * p + a] * c.wy[CD_MPM_STENCIL * p + b] * c.mass[p];
+    px += mN * c.vx[p];
+    py += mN * c.vy[p];
+    CD_MPM_SUPPORT_END
     cd_real gm = c.gm[t];
     c.gvx[t] = gm > 0 ? px / gm : 0;
     c.gvy[t] = gm > 0 ? py / gm : 0;
