@@ -5,6 +5,7 @@
 #include <mpi.h>
 #include "core/sim.h"
 #include "mpi/mpi_decomp.h"
+#include "io/io_h5.h"
 
 typedef struct {
     MPI_Comm comm;
@@ -53,6 +54,7 @@ typedef struct {
     /* the reductions (observables, wall loads: src/mpi/mpi_reduce.c) and
      * what this rank sent for them */
     long long reduces, reduce_msgs, reduce_bytes;
+    long long gathers; /* times sync gathered the whole state on every rank (protocols, diagnoses; no snapshot) */
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,
@@ -139,6 +141,14 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
  * (src/mpi/mpi_reduce.c).  Writes the moving columns of the blocks' rows
  * into global (which is the gathered state between syncs).  Collective. */
 int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total);
+/* This rank's part of a snapshot (io_h5.h cd_output_part) from its local
+ * state, the scalars from scal (the global state's): the place of each
+ * owned particle's first contact and wall-contact row among the
+ * snapshot's rows, from an exclusive prefix sum over the particles in
+ * global id order (src/mpi/mpi_output.c).  Returns the array that
+ * part->pair_at and wallc_at point into (the caller frees it).
+ * Collective; out of memory aborts the run. */
+long long *cd_mpi_output_part(cd_mpi_ctx *x, const cd_state *scal, cd_output_part *part);
 void cd_mpi_halo_free(cd_mpi_ctx *x);
 
 /* ---- records, shared by src/mpi/mpi_halo.c and src/mpi/mpi_migrate.c ------
