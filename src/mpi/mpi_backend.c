@@ -397,13 +397,13 @@ static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
  * of memory).  Collective. */
 static char *devices_of_ranks(cd_mpi_ctx *x, int node)
 {
-    enum { LEN = 128 };
+    enum { LEN = 256 };
     char mine[LEN] = "", name[MPI_MAX_PROCESSOR_NAME] = "", *all = x->rank == 0 ? calloc((size_t)x->size, LEN) : NULL;
     cd_mpi_dev_choose(x, mine, sizeof mine);
     int n = 0;
     if (node && MPI_Get_processor_name(name, &n) == MPI_SUCCESS && n > 0) {
         char with[LEN];
-        snprintf(with, sizeof with, "%.40s on %.*s", mine, LEN - 48, name);
+        snprintf(with, sizeof with, "%.150s on %.90s", mine, name);
         memcpy(mine, with, LEN);
     }
     MPI_Gather(mine, LEN, MPI_CHAR, all, LEN, MPI_CHAR, 0, x->comm);
