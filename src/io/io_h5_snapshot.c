@@ -327,14 +327,12 @@ static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g
     const cd_output_part *part = o->part;
     long long *map = part ? malloc((m ? m : 1) * sizeof *map) : NULL;
     if (part && !map) return FAIL("%s: out of memory", o->path);
-    for (size_t r = 0, k = 0; map && r < m; r++) {
+    size_t q_before = (size_t)-1, k = 0; /* k: the row's place among its particle's */
+    for (size_t r = 0; map && r < m; r++) {
         size_t prim = g == CD_GROUP_PAIR ? (size_t)s->pair_prim_i[idx[r]] : idx[r] / s->n_walls;
         size_t q = (size_t)s->prim_particle[prim];
-        size_t q_before =
-            r ? (size_t)
-                    s->prim_particle[g == CD_GROUP_PAIR ? (size_t)s->pair_prim_i[idx[r - 1]] : idx[r - 1] / s->n_walls]
-              : (size_t)-1;
-        k = q == q_before ? k + 1 : 0; /* the row's place among its particle's */
+        k = q == q_before ? k + 1 : 0;
+        q_before = q;
         map[r] = (g == CD_GROUP_PAIR ? part->pair_at[q] : part->wallc_at[q]) + (long long)k;
     }
     o->row_map = map;
