@@ -4,10 +4,11 @@
  * from it; step runs the serial step on the local state, with the
  * rebuild decided by all ranks together (the serial program's decision)
  * and the particles migrating to their new owners right before each
- * rebuild, then refreshes the ghosts; sync and observe gather the owned
- * rows on every rank, where output (rank 0), observables and protocols
- * use the serial functions, in the serial order; wall loads are summed
- * from the nonzero rows in the serial order. */
+ * rebuild, then refreshes the ghosts; a snapshot is written by every
+ * rank from its local state (cd_mpi_write_snapshot); observables and wall
+ * loads are reductions with the serial bits (src/mpi/mpi_reduce.c); sync
+ * gathers the owned rows on every rank, where a protocol reads particles
+ * (and rank 0 writes with mpi.output = rank0). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
