@@ -379,16 +379,27 @@ static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 }
 
 /* The load a protocol asks for at every control call: the nonzero wall
- * rows only, summed in the serial order (cd_mpi_wall_load).  The local
- * state's wall rows first from the inner backend (whose step keeps their
- * F_n per wall candidate, kernels/fields.def WALLC_OUT); every rank calls
+ * rows only, summed in the serial order (cd_mpi_wall_load).  The step
+ * keeps the rows' F_n per wall candidate (kernels/fields.def WALLC_OUT):
+ * on an offload device they are read there, one double per local
+ * primitive copied back (cd_mpi_dev_wall_fn); on the host the local
+ * state's wall rows come from the inner backend's sync.  Every rank calls
  * it, so a failure stops all. */
 static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    int rc = x->inner->sync(&x->loc, err, errlen);
-    if (agree_failure(x, rc, err, errlen)) return -1;
-    *load = cd_mpi_wall_load(x, w, sim->s.n_prims);
+    /* on an offload device the rows' F_n alone come back (every rank
+     * agrees either way: some ranks may hold their state on the host) */
+    double *fn = malloc((x->loc.s.n_prims + 1) * sizeof *fn); /* [N] */
+    int dev = fn ? cd_mpi_dev_wall_fn(x, w, fn) : -1;
+    int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
+    if (dev < 0) snprintf(err, errlen, "out of memory while summing the load on wall %d", w);
+    if (agree_failure(x, rc, err, errlen)) {
+        free(fn);
+        return -1;
+    }
+    *load = cd_mpi_wall_load(x, w, dev == 0 ? fn : NULL);
+    free(fn);
     return 0;
 }
 

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include "mpi/mpi_halo.h"
 #include "backend/omp/omp_loops.h"
+#include "step_items.h"
 
 #if CD_OFFLOAD
 /* Is the local state mapped on the device?  (The inner backend's data is
@@ -98,6 +99,29 @@ void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len)
                  local);
 }
 
+int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn)
+{
+    cd_sim *loc = &x->loc;
+    if (!on_device(x) || !loc->nb.wall_out_valid || cd_step_memory_is_host()) return 1;
+    size_t P = loc->s.n_prims;
+    cd_int W = (cd_int)loc->s.n_walls;
+    double *d = cd_dev_alloc((P + 1) * sizeof *d); /* [N] */
+    if (!d) return -1;
+    cd_cols c = cd_sim_step_cols(loc);
+    const cd_int *prim_at = cd_sim_step_order(loc).prim_at, *ws = loc->nb.d.wall_start, *wr = loc->nb.d.wall_rows;
+    const cd_wall_entry *wo = loc->nb.d.wall_out;
+    CD_WIDE_MIN
+    CD_STEP_FOR(P, firstprivate(c) is_device_ptr(d, prim_at, ws, wr, wo))
+    for (size_t i = 0; i < P; i++) {
+        /* what the serial load adds for the row (cd_item_wall_load_chunk) */
+        cd_long e = cd_wall_out_place(c, (cd_long)cd_map(prim_at, (cd_long)i) * W + w, W, ws, wr);
+        d[i] = e >= 0 && wo[e].active ? wo[e].fn : 0;
+    }
+    int rc = P && cd_dev_get(fn, d, P * sizeof *d) ? -1 : 0;
+    cd_dev_free(d);
+    return rc;
+}
+
 int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen)
 {
     if (!on_device(x)) return 0;
@@ -126,6 +150,14 @@ void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len)
 {
     (void)x;
     snprintf(desc, len, "host");
+}
+
+int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn)
+{
+    (void)x;
+    (void)w;
+    (void)fn;
+    return 1;
 }
 
 int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen)

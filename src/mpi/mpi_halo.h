@@ -92,6 +92,12 @@ void cd_mpi_dev_free(cd_mpi_ctx *x);
  * modulo the node's devices, made the default device before anything is
  * mapped; what it took, in words, into desc.  Collective. */
 void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len);
+/* F_n [N] on wall w of every local primitive (0 where it touches none)
+ * into fn, from the step's wall-candidate entries on the offload device:
+ * one double per primitive crosses instead of the local state (a wall
+ * load, at every step of a protocol).  1 when the state is on the host
+ * (the caller reads its columns), 0 done, -1 out of device memory. */
+int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn);
 /* Around a migration, which rebuilds the local state on the host: the
  * device's state copied back and let go (leave: 1, or 0 when the state is
  * on the host, -1 with err set), mapped again (return, after a leave that
@@ -129,11 +135,13 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
  * one process.  Collective.  0, or -1 (out of memory). */
 int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global);
 /* Normal load on wall w [N] with the serial program's bits (the sum of
- * kernels/step_items.h, CD_LOAD_CHUNK, over n_prims_global primitives),
- * from the nonzero rows alone: each chunk summed on rank chunk % R, the
- * chunks' sums merged in order on rank 0; the load on every rank
- * (src/mpi/mpi_reduce.c).  Collective. */
-double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
+ * kernels/step_items.h, CD_LOAD_CHUNK, over the primitives), from the
+ * nonzero rows alone: each chunk summed on rank chunk % R, the chunks'
+ * sums merged in order on rank 0; the load on every rank
+ * (src/mpi/mpi_reduce.c).  fn: F_n per local primitive
+ * (cd_mpi_dev_wall_fn), or NULL: the local state's wall rows.
+ * Collective. */
+double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn);
 /* The observables' slots (kernels/observe_items.h) with the serial
  * program's bits, without gathering the state: each block of rows summed
  * by the serial block function on rank block % R from its rows' owners'
