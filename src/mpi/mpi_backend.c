@@ -367,14 +367,18 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
     return agree_failure(x, rc, err, errlen);
 }
 
-/* The observables of the serial program: the state gathered in global
- * order on every rank and summed there as in one process
- * (kernels/observe_items.h): the run's decisions on them are every
- * rank's. */
+/* The observables of the serial program, reduced without gathering the
+ * state (src/mpi/mpi_reduce.c: the serial leaves of kernels/observe_items.h,
+ * merged in the serial order), on every rank: the run's decisions on them
+ * are every rank's. */
 static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    if (agree_failure(x, x->inner->sync(&x->loc, err, errlen), err, errlen)) return -1;
+    /* on an offload device the columns the sums read alone come back */
+    int dev = cd_mpi_dev_observe_cols(x);
+    int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
+    if (dev < 0) snprintf(err, errlen, "out of memory while summing the observables");
+    if (agree_failure(x, rc, err, errlen)) return -1;
     return cd_mpi_observe_slots(x, sim, slots);
 }
 

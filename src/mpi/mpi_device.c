@@ -8,6 +8,7 @@
  * the local state back, rebuilds it on the host (src/mpi/mpi_migrate.c) and
  * maps it again.  In a build without offload every function here says
  * "host" and the refresh packs on the host (src/mpi/mpi_halo.c). */
+#include <stddef.h>
 #include <stdio.h>
 #include "mpi/mpi_halo.h"
 #include "backend/omp/omp_loops.h"
@@ -122,6 +123,30 @@ int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn)
     return rc;
 }
 
+int cd_mpi_dev_observe_cols(cd_mpi_ctx *x)
+{
+    cd_sim *loc = &x->loc;
+    cd_state *s = &loc->s;
+    /* (the local state is never reordered: reorder is off under MPI) */
+    if (!on_device(x) || cd_step_memory_is_host() || loc->nb.reorder) return 1;
+    const size_t read[] = {
+        offsetof(cd_state, position),    offsetof(cd_state, velocity),     offsetof(cd_state, angmom),
+        offsetof(cd_state, orientation), offsetof(cd_state, pair_prim_i),  offsetof(cd_state, pair_prim_j),
+        offsetof(cd_state, pair_active), offsetof(cd_state, pair_overlap), offsetof(cd_state, pair_shear)};
+    for (size_t f = 0; f < cd_n_fields; f++)
+        for (size_t k = 0; k < sizeof read / sizeof read[0]; k++) {
+            const void *dev = cd_sim_step_field(loc, f);
+            size_t bytes = cd_state_rows(s, cd_fields[f].group) * cd_fields[f].elem_size;
+            if (cd_fields[f].offset == read[k] && dev && bytes &&
+                cd_dev_get(*cd_field_ptr(s, &cd_fields[f]), dev, bytes))
+                return -1;
+        }
+    /* the wall contacts kept per candidate into the host's rows, as the
+     * inner backend's sync expands them */
+    if (loc->nb.wall_out_valid) loc->nb.wall_out_pending = 1;
+    return cd_neighbors_wall_out_to_host(loc) ? -1 : 0;
+}
+
 int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen)
 {
     if (!on_device(x)) return 0;
@@ -157,6 +182,12 @@ int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn)
     (void)x;
     (void)w;
     (void)fn;
+    return 1;
+}
+
+int cd_mpi_dev_observe_cols(cd_mpi_ctx *x)
+{
+    (void)x;
     return 1;
 }
 

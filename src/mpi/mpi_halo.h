@@ -98,6 +98,13 @@ void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len);
  * load, at every step of a protocol).  1 when the state is on the host
  * (the caller reads its columns), 0 done, -1 out of device memory. */
 int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn);
+/* The columns of the local state that an observation reads
+ * (src/mpi/mpi_reduce.c: the particles' pose, velocity and angular
+ * momentum, the pair rows' primitives, flag, overlap and spring) and its
+ * wall rows (from the step's candidate entries) from the offload device
+ * to the host, instead of every column.  1 when the state is on the host
+ * (the caller syncs), 0 done, -1 out of memory. */
+int cd_mpi_dev_observe_cols(cd_mpi_ctx *x);
 /* Around a migration, which rebuilds the local state on the host: the
  * device's state copied back and let go (leave: 1, or 0 when the state is
  * on the host, -1 with err set), mapped again (return, after a leave that
