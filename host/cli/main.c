@@ -15,6 +15,7 @@
 #include "io/io_h5.h"
 #include "io/io_h5_guard.h"
 #include "io/io_h5_journal.h"
+#include "mpi/mpi_decomp.h"
 #include "capdem_commit.h" /* CAPDEM_COMMIT, generated at build time (src/git_commit.cmake) */
 #ifdef _OPENMP
 #include <omp.h>
@@ -168,7 +169,7 @@ static int cmd_run(int argc, char **argv)
 
 /* Exit status 1 when built for offload, no device is found and
  * OMP_TARGET_OFFLOAD=MANDATORY: a GPU machine's first check. */
-static int print_version(void)
+static int version_lines(void)
 {
     printf("capdem %s (commit %s)\n", CAPDEM_VERSION, CAPDEM_COMMIT);
 #if defined(__clang__)
@@ -195,6 +196,19 @@ static int print_version(void)
     printf(", built without OpenMP\n");
 #endif
     return 0;
+}
+
+/* Under an MPI launcher (an MPI build) rank 0 prints, with a line naming
+ * each rank's device (docs/mpi.md, "GPUs"). */
+static int print_version(void)
+{
+    if (cd_mpi_begin()) {
+        fprintf(stderr, "capdem: MPI did not start\n");
+        return 1;
+    }
+    int rc = cd_mpi_is_writer() ? version_lines() : 0;
+    cd_mpi_version();
+    return cd_mpi_end(rc);
 }
 
 /* `capdem recover RUN.h5`: replays the commit journal a killed writer left

@@ -151,10 +151,19 @@ static int write_thermo(cd_output *out, const cd_sim *sim, const cd_observables 
     return cd_mpi_agree(out ? cd_output_thermo(out, sim->s.step, sim->s.time, row) : 0);
 }
 
-static int write_snapshot(cd_output *out, const cd_state *s)
+static int write_snapshot(cd_output *out, cd_sim *sim)
 {
-    if (out) cd_output_set_owned(out, cd_mpi_owned_rows(s->n_particles));
-    return cd_mpi_agree(out ? cd_output_snapshot(out, s) : 0);
+    int rc = out ? cd_mpi_write_snapshot(out, sim) : 0; /* each rank its rows, from its local state */
+    if (rc == 1) rc = cd_output_snapshot(out, &sim->s);
+    return cd_mpi_agree(rc);
+}
+
+/* The state where a snapshot reads it: the backend's copy back, or under
+ * MPI with parallel output each rank's local state (no gather). */
+static int sync_for_snapshot(cd_sim *sim, char *err, size_t errlen)
+{
+    int rc = cd_mpi_sync_output(sim, err, errlen);
+    return rc == 1 ? cd_sim_sync(sim, err, errlen) : rc;
 }
 
 /* Whether paths a and b name the same file (device and inode; the same
@@ -393,13 +402,15 @@ static int run(const cd_run_options *opt)
     cd_observables o;
     long long last_snap = opt->resume_path ? sim.s.step : -1; /* step of the last snapshot committed */
     if (!opt->resume_path) {
-        if (cd_sim_sync(&sim, err, sizeof err)) {
+        /* (under MPI the observables are reductions: no state gathered) */
+        if (sync_for_snapshot(&sim, err, sizeof err) ||
+            (cd_mpi_decomposed() && cd_sim_observe_step(&sim, &o, err, sizeof err))) {
             fprintf(stderr, "capdem: %s\n", err);
             status = 1;
             goto done;
         }
-        cd_sim_observe(&sim, &o);
-        if (write_thermo(out, &sim, &o, row) || write_snapshot(out, &sim.s)) {
+        if (!cd_mpi_decomposed()) cd_sim_observe(&sim, &o);
+        if (write_thermo(out, &sim, &o, row) || write_snapshot(out, &sim)) {
             write_failed(opt, &cfg, -1);
             status = 1;
             goto done;
@@ -440,7 +451,7 @@ static int run(const cd_run_options *opt)
             /* A thermo line alone sums the observables where the steps run
              * (no state copy on an offload device); a snapshot brings the
              * state back first.  The same bits either way. */
-            if ((snap_due || last) && cd_sim_sync(&sim, err, sizeof err)) {
+            if ((snap_due || last) && sync_for_snapshot(&sim, err, sizeof err)) {
                 fprintf(stderr, "\ncapdem: %s\n", err);
                 status = 1;
                 break;
@@ -484,7 +495,7 @@ static int run(const cd_run_options *opt)
             }
         }
         if (snap_due || last) {
-            if (write_snapshot(out, &sim.s)) {
+            if (write_snapshot(out, &sim)) {
                 write_failed(opt, &cfg, last_snap);
                 status = 1;
                 break;

@@ -94,15 +94,29 @@ void cd_h5_no_atexit(void);
  * pointer to an MPI_Comm of more than one rank) shares the run files that
  * cd_output_create_mode and cd_output_reopen open from now on: they go
  * through HDF5's MPI-IO driver, every cd_output_* call on them is
- * collective (every rank calls it with the same state), and a snapshot's
- * rows are written by the ranks cd_output_set_owned names.  NULL: one
+ * collective (every rank calls it), and each rank writes its part of a
+ * snapshot (cd_output_snapshot_part).  NULL: one
  * writer again.  0, or -1 in a build without parallel HDF5. */
 int cd_output_use_mpi(const void *comm);
-/* Under cd_output_use_mpi: owned[p] != 0 for the particles (global ids)
- * whose rows, with those of their primitives, contacts (as particle i)
- * and wall contacts, this rank writes at the next snapshots (NULL: rank 0
- * writes them all).  The array must stay valid until then. */
-void cd_output_set_owned(cd_output *o, const unsigned char *owned);
+/* Under cd_output_use_mpi: one rank's part of a snapshot, written from its
+ * local state (docs/mpi.md, "One file"): the rows of the particles it
+ * owns, of their primitives, of the active contacts whose particle i it
+ * owns and of the active wall contacts of its primitives, each at its
+ * place in the serial layout; the scalars (step, time, walls, control)
+ * from scal, by rank 0.  s's particles are in ascending global id. */
+typedef struct {
+    const cd_state *s;                   /* the local state */
+    const cd_state *scal;                /* step, time, walls, control: every rank's alike */
+    size_t n_particles, n_prims;         /* of the whole run */
+    const long long *gid, *gprim;        /* per particle, per primitive of s: its global id */
+    const unsigned char *owned;          /* per particle of s: this rank writes its rows */
+    const long long *pair_at, *wallc_at; /* per owned particle of s: the snapshot's row of its first active
+                                          * contact (as particle i) and of its first active wall contact */
+    long long n_pair_rows, n_wallc_rows; /* the snapshot's active contact and wall-contact rows, every rank's */
+} cd_output_part;
+/* The snapshot of which every rank of cd_output_use_mpi's communicator
+ * gives its part (collective); as cd_output_snapshot. */
+int cd_output_snapshot_part(cd_output *o, const cd_output_part *part);
 /* Under cd_output_use_mpi: the bytes of data this rank has written into
  * run files (its rows, and on rank 0 the rest), for the closing report. */
 unsigned long long cd_output_bytes_written(void);

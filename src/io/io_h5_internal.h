@@ -78,12 +78,18 @@ struct cd_output {
     int own_lock;  /* descriptor holding capdem's mark on the file (cdh5_mark), or -1 */
     int io_failed; /* a write failed or found no room: nothing more is written */
     int writing;   /* inside a snapshot, past its checks */
-    /* parallel output (io_h5_mpi.c): per particle, whether this rank
-     * writes its rows (cd_output_set_owned; NULL: rank 0 writes all); the
-     * rows of the write under way this rank writes: row_mask[r] for row r
-     * along dimension mask_dim of the block written (NULL: rank 0 all) */
-    const unsigned char *owned, *row_mask;
+    /* parallel output (io_h5_mpi.c): the rows of the write under way that
+     * this rank writes, from its local state (cd_output_snapshot_part):
+     * memory row r (of map_rows along dimension mask_dim) into row
+     * row_map[r] of the block written, or nowhere (-1); NULL: rank 0
+     * writes all of the block */
+    const long long *row_map;
+    size_t map_rows;
     int mask_dim;
+    /* during cd_output_snapshot_part: the part, and the rows in the file
+     * of its particles and primitives (global ids, -1: not written here) */
+    const cd_output_part *part;
+    long long *map_particle, *map_prim;
 };
 
 /* Makes sure bytes more can be written at the end of the file (the space
@@ -134,9 +140,10 @@ void cdh5_par_bcast(void *buf, size_t bytes);
 /* Rank 0: the exclusive flock HDF5's serial driver would hold on fd's file. */
 void cdh5_par_lock(int fd);
 /* The collective H5Dwrite of the block start..start+cnt (rank dims; the
- * file selection fs, memory ms of shape cnt): this rank's rows of it
- * (o->row_mask) or, with no mask, all of it on rank 0 and none on the
- * others.  Not parallel: H5Dwrite as given. */
+ * file selection fs; memory ms of shape cnt, or with o->row_map of
+ * o->map_rows rows along o->mask_dim): this rank's rows of it (o->row_map)
+ * or, with no map, all of it on rank 0 and none on the others.  Not
+ * parallel: H5Dwrite as given. */
 herr_t cdh5_par_write(const cd_output *o, hid_t d, hid_t mtype, hid_t ms, hid_t fs, int rank, const hsize_t *start,
                       const hsize_t *cnt, const void *buf);
 
@@ -171,6 +178,10 @@ int cdh5_set_rows(cd_output *o, hid_t d, const char *what, hsize_t n);
 /* Writes count rows at row `at` of an extendible dataset, which then has
  * at + count rows. */
 int cdh5_append(cd_output *o, hid_t d, const char *what, hsize_t at, hsize_t count, hid_t mtype, const void *buf);
+/* The rows at..at+count of d (rank dims: the dataset's extent dims) from
+ * buf, as cdh5_append writes them, without changing the extent. */
+int cdh5_write_block(cd_output *o, hid_t d, const char *what, int rank, hsize_t at, hsize_t count, const hsize_t *dims,
+                     hid_t mtype, const void *buf);
 
 /* /h5md, /parameters (config, shapes), the empty groups, box, commit 0. */
 int cdh5_write_header(cd_output *o, const cd_config *cfg, const cd_shape *shapes, int n_shapes);

@@ -78,28 +78,28 @@ void cdh5_par_lock(int fd)
     if (par.on && par.rank == 0 && fd >= 0) (void)flock(fd, LOCK_EX | LOCK_NB);
 }
 
-/* Adds the runs of rows r (mask[r] != 0, r < n) along dimension dim of
- * the block start..start+cnt of the file and of 0..cnt of memory to the
- * selections fs and ms (both none before). */
+/* Adds the runs of memory rows r < n_map with map[r] >= 0 (memory row r
+ * to row map[r] of the block start..start+cnt of the file, both along
+ * dimension dim; map ascending where >= 0) to the selections fs and ms
+ * (both none before): one hyperslab per run of rows consecutive in both. */
 static herr_t select_runs(hid_t fs, hid_t ms, int rank, const hsize_t *start, const hsize_t *cnt, int dim,
-                          const unsigned char *mask)
+                          const long long *map, size_t n_map)
 {
     herr_t e = 0;
     int first = 1;
-    hsize_t n = cnt[dim];
-    for (hsize_t r = 0; r < n && e >= 0;) {
-        if (!mask[r]) {
+    for (size_t r = 0; r < n_map && e >= 0;) {
+        if (map[r] < 0) {
             r++;
             continue;
         }
-        hsize_t r0 = r;
-        while (r < n && mask[r]) r++;
+        size_t r0 = r;
+        for (r++; r < n_map && map[r] == map[r - 1] + 1;) r++;
         hsize_t fstart[3] = {0, 0, 0}, mstart[3] = {0, 0, 0}, c[3] = {1, 1, 1};
         for (int k = 0; k < rank; k++) {
             fstart[k] = start[k];
             c[k] = cnt[k];
         }
-        fstart[dim] += r0;
+        fstart[dim] += (hsize_t)map[r0];
         mstart[dim] = r0;
         c[dim] = r - r0;
         H5S_seloper_t op = first ? H5S_SELECT_SET : H5S_SELECT_OR;
@@ -115,8 +115,8 @@ herr_t cdh5_par_write(const cd_output *o, hid_t d, hid_t mtype, hid_t ms, hid_t 
 {
     herr_t e = H5Sselect_none(fs);
     if (e >= 0) e = H5Sselect_none(ms);
-    if (e >= 0 && o->row_mask && rank > o->mask_dim)
-        e = select_runs(fs, ms, rank, start, cnt, o->mask_dim, o->row_mask);
+    if (e >= 0 && o->row_map && rank > o->mask_dim)
+        e = select_runs(fs, ms, rank, start, cnt, o->mask_dim, o->row_map, o->map_rows);
     else if (e >= 0 && par.rank == 0 && rank > 0) {
         e = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL);
         if (e >= 0) e = H5Sselect_all(ms);
@@ -146,7 +146,8 @@ herr_t cdh5_par_write(const cd_output *o, hid_t d, hid_t mtype, hid_t ms, hid_t 
         free(bkg);
     }
     /* collective: every rank calls, those with nothing to write with none selected */
-    if (e >= 0) e = H5Dwrite(d, mtype, ms, fs, dxpl, buf);
+    static const double none[1]; /* (a rank without rows may have no column: HDF5 wants an address) */
+    if (e >= 0) e = H5Dwrite(d, mtype, ms, fs, dxpl, buf ? buf : none);
     hssize_t sel = e < 0 ? 0 : H5Sget_select_npoints(ms);
     if (sel > 0) par.bytes += (unsigned long long)sel * H5Tget_size(mtype);
     free(conv);
@@ -185,8 +186,3 @@ herr_t cdh5_par_write(const cd_output *o, hid_t d, hid_t mtype, hid_t ms, hid_t 
 }
 
 #endif
-
-void cd_output_set_owned(cd_output *o, const unsigned char *owned)
-{
-    if (o) o->owned = owned;
-}

@@ -5,6 +5,7 @@
 #include "io/io_h5_internal.h"
 #include "io/io_h5_check.h"
 #include "contact_law.h"
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,7 +41,47 @@ static int link_clock(cd_output *o, const char *group)
 
 static hsize_t clamp(hsize_t v, hsize_t lo, hsize_t hi) { return v < lo ? lo : v > hi ? hi : v; }
 
-/* Creates one column's dataset at the first snapshot. */
+/* Parallel output from a local state (o->part): the rows of a particle or
+ * primitive column this rank writes (its owned particles' rows, at their
+ * global ids), along dimension dim of the block written. */
+static void set_row_map(cd_output *o, enum cd_field_group g, int dim)
+{
+    int prim = g == CD_GROUP_PRIM;
+    o->row_map = prim ? o->map_prim : o->map_particle;
+    o->map_rows = prim ? o->part->s->n_prims : o->part->s->n_particles;
+    o->mask_dim = dim;
+}
+
+/* Under o->part: the columns that hold row numbers of the state (a
+ * particle's first primitive, a primitive's particle, a pair's
+ * primitives) hold them in the file as the serial state numbers them:
+ * the global ids.  The n entries at v (rows of f) translated in place. */
+static void to_global_ids(const cd_output *o, const cd_field_info *f, cd_int *v, size_t n)
+{
+    if (!o->part) return;
+    size_t at = f->offset;
+    const long long *id = at == offsetof(cd_state, prim_particle) ? o->part->gid
+                          : at == offsetof(cd_state, prim_first) || at == offsetof(cd_state, pair_prim_i) ||
+                                  at == offsetof(cd_state, pair_prim_j)
+                              ? o->part->gprim
+                              : NULL;
+    for (size_t r = 0; id && r < n; r++) v[r] = (cd_int)id[v[r]];
+}
+
+/* A column of n rows for the file: col, or under o->part a copy in *copy
+ * with the row numbers it holds as global ids (NULL: out of memory). */
+static const void *file_column(const cd_output *o, const cd_field_info *f, const void *col, size_t n, void **copy)
+{
+    *copy = NULL;
+    if (!o->part || f->kind != CD_KIND_INT) return col;
+    *copy = malloc(n * f->elem_size + 1);
+    if (*copy && n) memcpy(*copy, col, n * f->elem_size);
+    if (*copy) to_global_ids(o, f, *copy, n * (size_t)f->ncomp);
+    return *copy;
+}
+
+/* Creates one column's dataset at the first snapshot (s: the state whose
+ * rows it holds; under o->part the local state). */
 static int create_col(cd_output *o, const cd_state *s, size_t k)
 {
     const cd_field_info *f = &cd_fields[k];
@@ -58,7 +99,19 @@ static int create_col(cd_output *o, const cd_state *s, size_t k)
         hsize_t ch[2] = {clamp(rows ? rows : 1, 1, CDH5_LARGE_CHUNK / f->elem_size), nc};
         c->dset = cdh5_make_dset(o, p, ft, 1 + vec, d, NULL, ch, f->unit);
         const void *col = *cd_field_ptr((cd_state *)s, f);
-        if (c->dset < 0 || (rows && cdh5_write_all(o, c->dset, p, cdh5_mem_type(f), col))) return -1;
+        if (c->dset < 0) return -1;
+        if (o->part) { /* each rank its rows; no copy kept (a rank holds its rows only) */
+            set_row_map(o, f->group, 0);
+            void *copy;
+            const void *v = file_column(o, f, col, o->map_rows, &copy);
+            int rc = !v && col ? FAIL("%s: out of memory", o->path)
+                     : rows    ? cdh5_write_block(o, c->dset, p, 1 + vec, 0, rows, d, cdh5_mem_type(f), v)
+                               : 0;
+            o->row_map = NULL;
+            free(copy);
+            return rc;
+        }
+        if (rows && cdh5_write_all(o, c->dset, p, cdh5_mem_type(f), col)) return -1;
         c->fixed_bytes = rows * f->elem_size;
         c->fixed = malloc(c->fixed_bytes ? c->fixed_bytes : 1);
         if (!c->fixed) return FAIL("%s: out of memory", o->path);
@@ -97,8 +150,8 @@ int cdh5_layout_create(cd_output *o, const cd_state *s)
     hsize_t z = 0, unl = H5S_UNLIMITED, ch = CDH5_CLOCK_CHUNK;
     static const long long zero = 0;
     if (s->n_walls > CD_MAX_WALLS) return FAIL("%s: %zu walls, at most %d", o->path, s->n_walls, CD_MAX_WALLS);
-    o->n_particles = s->n_particles;
-    o->n_prims = s->n_prims;
+    o->n_particles = o->part ? o->part->n_particles : s->n_particles;
+    o->n_prims = o->part ? o->part->n_prims : s->n_prims;
     o->n_walls = s->n_walls;
     o->step = cdh5_make_clock(o, CDH5_SNAP_STEP, 0);
     o->time = cdh5_make_clock(o, CDH5_SNAP_TIME, 1);
@@ -218,7 +271,7 @@ int cdh5_layout_open(cd_output *o)
                 return FAIL("%s: %s has %lld rows, other columns of its group %lld", o->path, p, n, rows[f->group]);
             rows[f->group] = n;
         }
-        if (cdh5_store_of(f) == CDH5_FIXED) {
+        if (cdh5_store_of(f) == CDH5_FIXED && !cdh5_par_on()) { /* (parallel output keeps no copy) */
             if (cd_h5_mul(&c->fixed_bytes, (size_t)n, f->elem_size, 1))
                 return FAIL("%s: %s has %lld rows, too many to hold; the file is refused", o->path, p, n);
             c->fixed = malloc(c->fixed_bytes ? c->fixed_bytes : 1);
@@ -243,9 +296,10 @@ int cdh5_layout_open(cd_output *o)
 
 static int check_counts(cd_output *o, const cd_state *s)
 {
-    if (s->n_particles != o->n_particles || s->n_prims != o->n_prims || s->n_walls != o->n_walls)
+    size_t np = o->part ? o->part->n_particles : s->n_particles, nq = o->part ? o->part->n_prims : s->n_prims;
+    if (np != o->n_particles || nq != o->n_prims || s->n_walls != o->n_walls)
         return FAIL("%s: the file holds %zu particles, %zu primitives and %zu walls, the state %zu, %zu and %zu",
-                    o->path, o->n_particles, o->n_prims, o->n_walls, s->n_particles, s->n_prims, s->n_walls);
+                    o->path, o->n_particles, o->n_prims, o->n_walls, np, nq, s->n_walls);
     for (size_t k = 0; k < cd_n_fields; k++) {
         const cdh5_col *c = &o->cols[k];
         if (c->fixed && c->fixed_bytes && memcmp(c->fixed, *cd_field_ptr((cd_state *)s, &cd_fields[k]), c->fixed_bytes))
@@ -256,47 +310,56 @@ static int check_counts(cd_output *o, const cd_state *s)
     return 0;
 }
 
-/* The columns of write_contacts, at row `at`. */
+/* The columns of write_contacts, at row `at`: m rows of s (idx), of
+ * total rows of the snapshot. */
 static int write_contact_rows(cd_output *o, const cd_state *s, enum cd_field_group g, const size_t *idx, size_t m,
-                              void *tmp, hsize_t at);
+                              size_t total, void *tmp, hsize_t at);
 
 /* Appends the active rows of one contact group (PAIR, with its PAIR_OUT
- * columns, or WALLC). */
+ * columns, or WALLC): m rows of s (idx) of the snapshot's total. */
 static int write_contacts(cd_output *o, const cd_state *s, enum cd_field_group g, const size_t *idx, size_t m,
-                          void *tmp)
+                          size_t total, void *tmp)
 {
     hsize_t at = g == CD_GROUP_PAIR ? o->c_rows : o->w_rows;
-    /* parallel output: a row is written by the rank that owns its particle
-     * (a contact's particle i) */
-    const unsigned char *owned = cdh5_par_on() ? o->owned : NULL;
-    unsigned char *mine = owned ? malloc(m ? m : 1) : NULL;
-    if (owned && !mine) return FAIL("%s: out of memory", o->path);
-    for (size_t r = 0; mine && r < m; r++) {
-        long long prim = g == CD_GROUP_PAIR ? (long long)s->pair_prim_i[idx[r]] : (long long)(idx[r] / s->n_walls);
-        mine[r] = prim >= 0 && (size_t)prim < s->n_prims ? owned[s->prim_particle[prim]] : cdh5_par_root();
+    /* parallel output: a rank's rows are those of the particles it owns
+     * (a contact's particle i), each particle's at its place among the
+     * snapshot's rows (o->part's pair_at, wallc_at), in s's order */
+    const cd_output_part *part = o->part;
+    long long *map = part ? malloc((m ? m : 1) * sizeof *map) : NULL;
+    if (part && !map) return FAIL("%s: out of memory", o->path);
+    size_t q_before = (size_t)-1, k = 0; /* k: the row's place among its particle's */
+    for (size_t r = 0; map && r < m; r++) {
+        size_t prim = g == CD_GROUP_PAIR ? (size_t)s->pair_prim_i[idx[r]] : idx[r] / s->n_walls;
+        size_t q = (size_t)s->prim_particle[prim];
+        k = q == q_before ? k + 1 : 0;
+        q_before = q;
+        map[r] = (g == CD_GROUP_PAIR ? part->pair_at[q] : part->wallc_at[q]) + (long long)k;
     }
-    o->row_mask = mine;
+    o->row_map = map;
+    o->map_rows = m;
     o->mask_dim = 0;
-    int rc = write_contact_rows(o, s, g, idx, m, tmp, at);
-    o->row_mask = NULL;
-    free(mine);
+    int rc = write_contact_rows(o, s, g, idx, m, total, tmp, at);
+    o->row_map = NULL;
+    free(map);
     if (rc) return -1;
-    long long end = (long long)(at + m);
+    long long end = (long long)(at + total);
     hid_t off = g == CD_GROUP_PAIR ? o->c_offset : o->w_offset;
     return cdh5_append(o, off, g == CD_GROUP_PAIR ? CDH5_C_OFFSET : CDH5_W_OFFSET, o->n_snap + 1, 1, H5T_NATIVE_LLONG,
                        &end);
 }
 
 static int write_contact_rows(cd_output *o, const cd_state *s, enum cd_field_group g, const size_t *idx, size_t m,
-                              void *tmp, hsize_t at)
+                              size_t total, void *tmp, hsize_t at)
 {
+    const cd_output_part *part = o->part; /* (global ids of its particles and primitives) */
     for (size_t k = 0; k < cd_n_fields; k++) {
         const cd_field_info *f = &cd_fields[k];
         if (f->group != g && !(g == CD_GROUP_PAIR && f->group == CD_GROUP_PAIR_OUT)) continue;
         const char *col = *cd_field_ptr((cd_state *)s, f);
         for (size_t r = 0; r < m; r++)
             memcpy((char *)tmp + r * f->elem_size, col + idx[r] * f->elem_size, f->elem_size);
-        if (cdh5_append(o, o->cols[k].dset, f->name, at, m, cdh5_mem_type(f), tmp)) return -1;
+        if (f->kind == CD_KIND_INT) to_global_ids(o, f, tmp, m * (size_t)f->ncomp);
+        if (cdh5_append(o, o->cols[k].dset, f->name, at, total, cdh5_mem_type(f), tmp)) return -1;
     }
     if (g == CD_GROUP_PAIR) {
         const cd_int *side[2] = {s->pair_prim_i, s->pair_prim_j};
@@ -305,16 +368,20 @@ static int write_contact_rows(cd_output *o, const cd_state *s, enum cd_field_gro
             cd_int *p = tmp;
             for (size_t r = 0; r < m; r++) {
                 cd_int prim = side[e][idx[r]];
-                p[r] = prim >= 0 && (size_t)prim < s->n_prims ? s->prim_particle[prim] : -1;
+                p[r] = prim < 0 || (size_t)prim >= s->n_prims ? -1
+                       : part                                 ? (cd_int)part->gid[s->prim_particle[prim]]
+                                                              : s->prim_particle[prim];
             }
-            if (cdh5_append(o, ds[e], e ? CDH5_PATH(C_PARTICLE_J) : CDH5_PATH(C_PARTICLE_I), at, m, H5T_NATIVE_INT32,
-                            p))
+            if (cdh5_append(o, ds[e], e ? CDH5_PATH(C_PARTICLE_J) : CDH5_PATH(C_PARTICLE_I), at, total,
+                            H5T_NATIVE_INT32, p))
                 return -1;
         }
     } else {
         long long *p = tmp;
-        for (size_t r = 0; r < m; r++) p[r] = (long long)idx[r];
-        if (cdh5_append(o, o->w_index, CDH5_W_INDEX, at, m, H5T_NATIVE_LLONG, p)) return -1;
+        for (size_t r = 0; r < m; r++)
+            p[r] = part ? part->gprim[idx[r] / s->n_walls] * (long long)s->n_walls + (long long)(idx[r] % s->n_walls)
+                        : (long long)idx[r];
+        if (cdh5_append(o, o->w_index, CDH5_W_INDEX, at, total, H5T_NATIVE_LLONG, p)) return -1;
     }
     return 0;
 }
@@ -377,41 +444,53 @@ static unsigned long long first_snapshot_bytes(const cd_output *o, const cd_stat
 }
 
 /* The per-snapshot columns of particles and primitives, as row n; under
- * parallel output each rank writes the rows of the particles it owns
- * (o->owned) and of their primitives. */
+ * parallel output (o->part) each rank writes the rows of the particles it
+ * owns and of their primitives. */
 static int write_series(cd_output *o, const cd_state *s, hsize_t n)
 {
-    const unsigned char *owned = cdh5_par_on() ? o->owned : NULL;
-    unsigned char *prim_mine = owned ? malloc(s->n_prims ? s->n_prims : 1) : NULL;
-    if (owned && !prim_mine) return FAIL("%s: out of memory", o->path);
-    for (size_t p = 0; prim_mine && p < s->n_prims; p++) prim_mine[p] = owned[s->prim_particle[p]];
     int rc = 0;
     for (size_t k = 0; k < cd_n_fields && !rc; k++) {
         const cd_field_info *f = &cd_fields[k];
         if (cdh5_store_of(f) != CDH5_SERIES) continue;
-        o->row_mask = f->group == CD_GROUP_PARTICLE ? owned : f->group == CD_GROUP_PRIM ? prim_mine : NULL;
-        o->mask_dim = 1; /* (snapshots, rows[, ncomp]) */
-        rc = cdh5_append(o, o->cols[k].dset, f->name, n, 1, cdh5_mem_type(f), *cd_field_ptr((cd_state *)s, f));
+        if (o->part) set_row_map(o, f->group, 1); /* (snapshots, rows[, ncomp]) */
+        void *copy, *col = *cd_field_ptr((cd_state *)s, f);
+        const void *v = file_column(o, f, col, cd_state_rows(s, f->group), &copy);
+        rc = !v && col ? FAIL("%s: out of memory", o->path)
+                       : cdh5_append(o, o->cols[k].dset, f->name, n, 1, cdh5_mem_type(f), v);
+        free(copy);
     }
-    o->row_mask = NULL;
-    free(prim_mine);
+    o->row_map = NULL;
     return rc;
 }
 
+/* Whether row r of s's contact group g (PAIR or WALLC) is written here:
+ * active, and under parallel output of a particle this rank owns (a
+ * contact's particle i). */
+static int row_written(const cd_output *o, const cd_state *s, enum cd_field_group g, size_t r)
+{
+    if (!(g == CD_GROUP_PAIR ? s->pair_active[r] : s->wallc_active[r])) return 0;
+    size_t prim = g == CD_GROUP_PAIR ? (size_t)s->pair_prim_i[r] : r / s->n_walls;
+    return !o->part || (prim < s->n_prims && o->part->owned[s->prim_particle[prim]]);
+}
+
+/* s: the state whose rows are written (under o->part the local state;
+ * the scalars then come from o->part->scal). */
 static int snapshot(cd_output *o, const cd_state *s)
 {
+    const cd_state *sc = o->part ? o->part->scal : s;
     if (o->have_layout && check_counts(o, s)) return -1;
     hsize_t n = o->n_snap;
-    /* active contacts and wall contacts */
+    /* active contacts and wall contacts (written here; of the snapshot) */
     size_t nwc = s->n_prims * s->n_walls, cap = (s->n_pairs > nwc ? s->n_pairs : nwc) + 1;
     size_t m = 0, wm = 0;
-    for (size_t r = 0; r < s->n_pairs; r++) m += s->pair_active[r] != 0;
-    for (size_t r = 0; r < nwc; r++) wm += s->wallc_active[r] != 0;
+    for (size_t r = 0; r < s->n_pairs; r++) m += row_written(o, s, CD_GROUP_PAIR, r);
+    for (size_t r = 0; r < nwc; r++) wm += row_written(o, s, CD_GROUP_WALLC, r);
+    size_t m_all = o->part ? (size_t)o->part->n_pair_rows : m, wm_all = o->part ? (size_t)o->part->n_wallc_rows : wm;
     /* room for all of it first: a full disk or a file size limit stops the
      * run here, with the file as the last commit left it and nothing
      * unwritten in HDF5's cache */
     char what[64];
-    snprintf(what, sizeof what, "snapshot %llu (step %lld)", (unsigned long long)n, s->step);
+    snprintf(what, sizeof what, "snapshot %llu (step %lld)", (unsigned long long)n, sc->step);
     if (cdh5_check_linked(o) ||
         cdh5_reserve(o, o->have_layout ? snapshot_bytes(o, m, wm) : first_snapshot_bytes(o, s, m, wm), what))
         return -1;
@@ -424,22 +503,22 @@ static int snapshot(cd_output *o, const cd_state *s)
     if (!rc) {
         m = 0;
         for (size_t r = 0; r < s->n_pairs; r++)
-            if (s->pair_active[r]) idx[m++] = r;
-        rc = write_contacts(o, s, CD_GROUP_PAIR, idx, m, tmp);
+            if (row_written(o, s, CD_GROUP_PAIR, r)) idx[m++] = r;
+        rc = write_contacts(o, s, CD_GROUP_PAIR, idx, m, m_all, tmp);
     }
     if (!rc) {
         wm = 0;
         for (size_t r = 0; r < nwc; r++)
-            if (s->wallc_active[r]) idx[wm++] = r;
-        rc = write_contacts(o, s, CD_GROUP_WALLC, idx, wm, tmp);
+            if (row_written(o, s, CD_GROUP_WALLC, r)) idx[wm++] = r;
+        rc = write_contacts(o, s, CD_GROUP_WALLC, idx, wm, wm_all, tmp);
     }
     free(idx);
     free(tmp);
     if (rc) return -1;
-    if (cdh5_append(o, o->walls, CDH5_WALLS_VALUE, n, 1, o->wall_type, s->walls) ||
-        cdh5_append(o, o->control, CDH5_CONTROL_VALUE, n, 1, H5T_NATIVE_DOUBLE, s->control) ||
-        cdh5_append(o, o->time, CDH5_SNAP_TIME, n, 1, H5T_NATIVE_DOUBLE, &s->time) ||
-        cdh5_append(o, o->step, CDH5_SNAP_STEP, n, 1, H5T_NATIVE_LLONG, &s->step) || cdh5_obs_flush(o))
+    if (cdh5_append(o, o->walls, CDH5_WALLS_VALUE, n, 1, o->wall_type, sc->walls) ||
+        cdh5_append(o, o->control, CDH5_CONTROL_VALUE, n, 1, H5T_NATIVE_DOUBLE, sc->control) ||
+        cdh5_append(o, o->time, CDH5_SNAP_TIME, n, 1, H5T_NATIVE_DOUBLE, &sc->time) ||
+        cdh5_append(o, o->step, CDH5_SNAP_STEP, n, 1, H5T_NATIVE_LLONG, &sc->step) || cdh5_obs_flush(o))
         return -1;
     /* the snapshot and its count become the file's content in one atomic
      * commit; through MPI-IO (no journal, docs/mpi.md) the rows are flushed
@@ -447,8 +526,8 @@ static int snapshot(cd_output *o, const cd_state *s)
     if (cdh5_par_on() && cdh5_commit_output(o)) return -1;
     if (cdh5_write_commit(o, n + 1) || cdh5_commit_output(o)) return -1;
     o->n_snap = n + 1;
-    o->c_rows += m;
-    o->w_rows += wm;
+    o->c_rows += m_all;
+    o->w_rows += wm_all;
     /* CD_OUTPUT_REPLACE: the new file takes the old one's place now that it holds a snapshot */
     return o->tmp_path[0] ? cdh5_target_publish(o) : 0;
 }
@@ -463,5 +542,31 @@ int cd_output_snapshot(cd_output *o, const cd_state *s)
     if (rc && o->writing) o->io_failed = 1; /* a write failed: nothing more is written into this file */
     o->writing = 0;
     cdh5_quiet_end(&q);
+    return rc;
+}
+
+/* Each rank's rows from its local state: the maps of its particles and
+ * primitives to their rows in the file (their global ids; -1: a ghost,
+ * written by its owner), then the snapshot as above. */
+int cd_output_snapshot_part(cd_output *o, const cd_output_part *part)
+{
+    if (o->io_failed) return -1; /* (every rank learns it: the caller agrees on the status) */
+    const cd_state *s = part->s;
+    o->map_particle = malloc((s->n_particles + 1) * sizeof *o->map_particle);
+    o->map_prim = malloc((s->n_prims + 1) * sizeof *o->map_prim);
+    int rc = o->map_particle && o->map_prim ? 0 : FAIL("%s: out of memory", o->path);
+    for (size_t q = 0; !rc && q < s->n_particles; q++) {
+        o->map_particle[q] = part->owned[q] ? part->gid[q] : -1;
+        for (cd_int i = s->prim_first[q]; i < s->prim_first[q] + s->prim_count[q]; i++)
+            o->map_prim[i] = part->owned[q] ? part->gprim[i] : -1;
+    }
+    if (!rc) {
+        o->part = part;
+        rc = cd_output_snapshot(o, s);
+        o->part = NULL;
+    }
+    free(o->map_particle);
+    free(o->map_prim);
+    o->map_particle = o->map_prim = NULL;
     return rc;
 }

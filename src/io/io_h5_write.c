@@ -182,9 +182,18 @@ int cdh5_append(cd_output *o, hid_t d, const char *what, hsize_t at, hsize_t cou
     if (rank < 1) return FAIL("%s: cannot query %s", o->path, what);
     dims[0] = at + count;
     if (H5Dset_extent(d, dims) < 0) return FAIL("%s: cannot extend %s", o->path, what);
+    return cdh5_write_block(o, d, what, rank, at, count, dims, mtype, buf);
+}
+
+int cdh5_write_block(cd_output *o, hid_t d, const char *what, int rank, hsize_t at, hsize_t count, const hsize_t *dims,
+                     hid_t mtype, const void *buf)
+{
     hsize_t start[3] = {at, 0, 0}, cnt[3] = {count, rank > 1 ? dims[1] : 1, rank > 2 ? dims[2] : 1};
     if (cnt[0] * cnt[1] * cnt[2] == 0) return 0;
-    hid_t fs = H5Dget_space(d), ms = H5Screate_simple(rank, cnt, NULL);
+    /* parallel output from a local state: its map_rows rows in memory */
+    hsize_t mcnt[3] = {cnt[0], cnt[1], cnt[2]};
+    if (cdh5_par_on() && o->row_map && o->mask_dim < rank) mcnt[o->mask_dim] = o->map_rows ? o->map_rows : 1;
+    hid_t fs = H5Dget_space(d), ms = H5Screate_simple(rank, mcnt, NULL);
     herr_t e = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL);
     if (e >= 0)
         e = cdh5_par_on() ? cdh5_par_write(o, d, mtype, ms, fs, rank, start, cnt, buf)

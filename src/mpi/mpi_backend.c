@@ -4,10 +4,11 @@
  * from it; step runs the serial step on the local state, with the
  * rebuild decided by all ranks together (the serial program's decision)
  * and the particles migrating to their new owners right before each
- * rebuild, then refreshes the ghosts; sync and observe gather the owned
- * rows on every rank, where output (rank 0), observables and protocols
- * use the serial functions, in the serial order; wall loads are summed
- * from the nonzero rows in the serial order. */
+ * rebuild, then refreshes the ghosts; a snapshot is written by every
+ * rank from its local state (cd_mpi_write_snapshot); observables and wall
+ * loads are reductions with the serial bits (src/mpi/mpi_reduce.c); sync
+ * gathers the owned rows on every rank, where a protocol reads particles
+ * (and rank 0 writes with mpi.output = rank0). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,6 +25,7 @@ static int began_here; /* MPI_Init was called by cd_mpi_begin */
 static cd_mpi_ctx *the_ctx;
 static int parallel_output; /* every rank writes the run file (mpi.output = parallel) */
 static void report(const cd_mpi_ctx *x);
+static int agree_failure(cd_mpi_ctx *x, int rc, char *err, size_t errlen);
 
 static int world(int *rank)
 {
@@ -92,22 +94,24 @@ int cd_mpi_is_writer(void)
     return rank == 0;
 }
 
-const unsigned char *cd_mpi_owned_rows(size_t n_particles)
+int cd_mpi_sync_output(cd_sim *sim, char *err, size_t errlen)
 {
-    static unsigned char *mask;
-    static size_t cap;
-    const cd_mpi_ctx *x = the_ctx;
-    if (!x || !x->started) return NULL;
-    if (cap < n_particles) {
-        unsigned char *m = realloc(mask, n_particles);
-        if (!m) return NULL; /* (rank 0 then writes every row: the same file) */
-        mask = m;
-        cap = n_particles;
-    }
-    memset(mask, 0, n_particles);
-    for (size_t q = 0; q < x->loc.s.n_particles; q++)
-        if (x->owned[q] && (size_t)x->gid[q] < n_particles) mask[x->gid[q]] = 1;
-    return mask;
+    cd_mpi_ctx *x = the_ctx;
+    if (!x || !x->started || !parallel_output || sim->backend_data != x) return 1;
+    if (agree_failure(x, x->inner->sync(&x->loc, err, errlen), err, errlen)) return -1;
+    cd_sim_derive_pair_output(&x->loc); /* (as cd_sim_sync: the contacts' output columns) */
+    return 0;
+}
+
+int cd_mpi_write_snapshot(cd_output *out, cd_sim *sim)
+{
+    cd_mpi_ctx *x = the_ctx;
+    if (!x || !x->started || !parallel_output || sim->backend_data != x) return 1;
+    cd_output_part part;
+    long long *at = cd_mpi_output_part(x, &sim->s, &part);
+    int rc = cd_output_snapshot_part(out, &part);
+    free(at);
+    return rc;
 }
 
 int cd_mpi_opens_output(void) { return parallel_output || cd_mpi_is_writer(); }
@@ -241,8 +245,10 @@ static void report(const cd_mpi_ctx *x)
             csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
             cmax[3], csum[4] / x->size, cmax[4]);
         if (parallel_output)
-            fprintf(stderr, "capdem: MPI output: data bytes each rank wrote into the run file (MPI-IO): %.0f..%.0f\n",
-                    wmin, wmax);
+            fprintf(stderr,
+                    "capdem: MPI output: each rank wrote its rows from its local state; the whole state gathered %lld "
+                    "times; data bytes each rank wrote into the run file (MPI-IO): %.0f..%.0f\n",
+                    x->gathers, wmin, wmax);
         else fprintf(stderr, "capdem: MPI output: rank 0 wrote the run file (mpi.output = rank0)\n");
         fprintf(stderr,
                 "capdem: MPI reductions (observables, wall loads): %lld, sent per rank and reduction (mean, max) "
@@ -356,56 +362,105 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
     cd_mpi_ctx *x = sim->backend_data;
     int rc = x->inner->sync(&x->loc, err, errlen);
     if (!rc) rc = cd_mpi_gather(x, &sim->s);
+    x->gathers++;
     if (rc) snprintf(err, errlen, "out of memory while gathering the state on MPI rank 0");
     return agree_failure(x, rc, err, errlen);
 }
 
-/* The observables of the serial program: the state gathered in global
- * order on every rank and summed there as in one process
- * (kernels/observe_items.h): the run's decisions on them are every
- * rank's. */
+/* The observables of the serial program, reduced without gathering the
+ * state (src/mpi/mpi_reduce.c: the serial leaves of kernels/observe_items.h,
+ * merged in the serial order), on every rank: the run's decisions on them
+ * are every rank's. */
 static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    if (agree_failure(x, x->inner->sync(&x->loc, err, errlen), err, errlen)) return -1;
+    /* on an offload device the columns the sums read alone come back */
+    int dev = cd_mpi_dev_observe_cols(x);
+    int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
+    if (dev < 0) snprintf(err, errlen, "out of memory while summing the observables");
+    if (agree_failure(x, rc, err, errlen)) return -1;
     return cd_mpi_observe_slots(x, sim, slots);
 }
 
 /* The load a protocol asks for at every control call: the nonzero wall
- * rows only, summed in the serial order (cd_mpi_wall_load).  The local
- * state's wall rows first from the inner backend (whose step keeps their
- * F_n per wall candidate, kernels/fields.def WALLC_OUT); every rank calls
+ * rows only, summed in the serial order (cd_mpi_wall_load).  The step
+ * keeps the rows' F_n per wall candidate (kernels/fields.def WALLC_OUT):
+ * on an offload device they are read there, one double per local
+ * primitive copied back (cd_mpi_dev_wall_fn); on the host the local
+ * state's wall rows come from the inner backend's sync.  Every rank calls
  * it, so a failure stops all. */
 static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    int rc = x->inner->sync(&x->loc, err, errlen);
-    if (agree_failure(x, rc, err, errlen)) return -1;
-    *load = cd_mpi_wall_load(x, w, sim->s.n_prims);
+    /* on an offload device the rows' F_n alone come back (every rank
+     * agrees either way: some ranks may hold their state on the host) */
+    double *fn = malloc((x->loc.s.n_prims + 1) * sizeof *fn); /* [N] */
+    int dev = fn ? cd_mpi_dev_wall_fn(x, w, fn) : -1;
+    int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
+    if (dev < 0) snprintf(err, errlen, "out of memory while summing the load on wall %d", w);
+    if (agree_failure(x, rc, err, errlen)) {
+        free(fn);
+        return -1;
+    }
+    *load = cd_mpi_wall_load(x, w, dev == 0 ? fn : NULL);
+    free(fn);
     return 0;
 }
 
-/* The devices the ranks took (cd_mpi_dev_choose), on rank 0 in rank
- * order, for the run's first line; empty in a build without offload
- * (every rank: host threads). */
+/* Each rank's device (cd_mpi_dev_choose: made its default device), on
+ * rank 0 in rank order, "rank 0: ...; rank 1: ..." (with the node's name
+ * when node is set), into a new string (NULL on the other ranks, or out
+ * of memory).  Collective. */
+static char *devices_of_ranks(cd_mpi_ctx *x, int node)
+{
+    enum { LEN = 256 };
+    char mine[LEN] = "", name[MPI_MAX_PROCESSOR_NAME] = "", *all = x->rank == 0 ? calloc((size_t)x->size, LEN) : NULL;
+    cd_mpi_dev_choose(x, mine, sizeof mine);
+    int n = 0;
+    if (node && MPI_Get_processor_name(name, &n) == MPI_SUCCESS && n > 0) {
+        char with[LEN];
+        snprintf(with, sizeof with, "%.150s on %.90s", mine, name);
+        memcpy(mine, with, LEN);
+    }
+    MPI_Gather(mine, LEN, MPI_CHAR, all, LEN, MPI_CHAR, 0, x->comm);
+    size_t cap = (size_t)x->size * (LEN + 16) + 1, at = 0;
+    char *line = all ? malloc(cap) : NULL;
+    for (int r = 0; line && r < x->size; r++) {
+        int k = snprintf(line + at, cap - at, "%srank %d: %s", r ? "; " : "", r, all + (size_t)r * LEN);
+        at += k > 0 ? (size_t)k : 0;
+    }
+    free(all);
+    return line;
+}
+
+/* The devices the ranks took, for the run's first line; empty in a
+ * build without offload (every rank: host threads). */
 static char rank_devices[1024];
 
 static void devices_taken(cd_mpi_ctx *x)
 {
-    enum { LEN = 128 };
-    char mine[LEN] = "", *all = x->rank == 0 ? calloc((size_t)x->size, LEN) : NULL;
-    cd_mpi_dev_choose(x, mine, sizeof mine);
-    MPI_Gather(mine, LEN, MPI_CHAR, all, LEN, MPI_CHAR, 0, x->comm);
+    char *line = devices_of_ranks(x, 0); /* (every rank takes its device here, before anything is mapped) */
     rank_devices[0] = 0;
 #if defined(CAPDEM_OFFLOAD_TARGET)
-    size_t at = 0;
-    for (int r = 0; all && r < x->size && at < sizeof rank_devices; r++) {
-        int n = snprintf(rank_devices + at, sizeof rank_devices - at, "%srank %d: %s", r ? "; " : "", r,
-                         all + (size_t)r * LEN);
-        at += n > 0 ? (size_t)n : 0;
-    }
+    if (line) snprintf(rank_devices, sizeof rank_devices, "%s", line);
 #endif
-    free(all);
+    free(line);
+}
+
+int cd_mpi_version(void)
+{
+    int rank, size = world(&rank);
+    int on = 0;
+    MPI_Initialized(&on);
+    if (!on) return 0; /* not under an MPI launcher */
+    cd_mpi_ctx x = {.comm = MPI_COMM_WORLD, .rank = rank, .size = size};
+    fflush(stdout);
+    char *line = devices_of_ranks(&x, 1);
+    if (rank == 0)
+        printf("MPI: %d rank%s, each with the device it takes in a run: %s\n", size, size == 1 ? "" : "s",
+               line ? line : "(out of memory)");
+    free(line);
+    return 0;
 }
 
 static const char *mpi_device(const cd_sim *sim)

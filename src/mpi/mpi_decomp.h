@@ -6,9 +6,10 @@
  *
  * The run (src/core/run.c) sees one operation table, cd_backend_mpi, wrapping
  * the omp backend: start distributes the global state, step steps the
- * local one and refreshes the ghosts, sync and observe gather the owned
- * rows to rank 0 in global order, so that output, observables and wall
- * loads are computed there by the serial functions.
+ * local one and refreshes the ghosts; each rank writes its rows of the
+ * run file from its local state; observables and wall loads are
+ * reductions with the serial bits; sync gathers the owned rows on every
+ * rank, where a protocol reads particles.
  *
  * Without CAPDEM_MPI the hooks below are inline no-ops: one process, which
  * writes. */
@@ -18,6 +19,7 @@
 #include "config/config.h"
 
 struct cd_sim;
+struct cd_output;
 
 #if defined(CAPDEM_MPI) && CAPDEM_MPI
 /* Starts MPI (once per process; a no-op when already started).  On ranks
@@ -38,11 +40,21 @@ int cd_mpi_decomposed(void);
  * output (mpi.output = parallel, the default), else rank 0 (or the one
  * process).  Valid after cd_mpi_wrap. */
 int cd_mpi_opens_output(void);
-/* Decomposed: per global particle (n_particles of them), 1 when this rank
- * owns it (it writes the particle's rows of the run file, io_h5.h
- * cd_output_set_owned); NULL when not decomposed.  Valid until the next
- * call. */
-const unsigned char *cd_mpi_owned_rows(size_t n_particles);
+/* `capdem --version` under an MPI launcher: rank 0 prints one line naming
+ * each rank's node and the device it takes in a run (the node-local rank
+ * modulo the node's offload devices, docs/mpi.md "GPUs"); collective,
+ * after cd_mpi_begin.  Not under a launcher: nothing.  Returns 0. */
+int cd_mpi_version(void);
+/* Before a snapshot, decomposed with parallel output: each rank's local
+ * state synced where the writer reads it (its device's copy back), no
+ * gather; collective.  0, -1 (err set, every rank), or 1: not decomposed
+ * with parallel output (the caller syncs the state as in one process). */
+int cd_mpi_sync_output(struct cd_sim *sim, char *err, size_t errlen);
+/* A snapshot of the run, decomposed with parallel output: every rank
+ * writes its rows from its local state (io_h5.h cd_output_snapshot_part);
+ * collective.  0, -1 (the writer's message printed), or 1: not decomposed
+ * with parallel output (the caller writes sim's state as in one process). */
+int cd_mpi_write_snapshot(struct cd_output *out, struct cd_sim *sim);
 /* With more than one rank: checks that the config can run decomposed
  * (solver, protocol, backend) and puts cd_backend_mpi in front of the
  * chosen backend.  0, or -1 with a message naming the key (exit 2). */
@@ -54,10 +66,19 @@ static inline int cd_mpi_agree(int status) { return status; }
 static inline int cd_mpi_is_writer(void) { return 1; }
 static inline int cd_mpi_decomposed(void) { return 0; }
 static inline int cd_mpi_opens_output(void) { return 1; }
-static inline const unsigned char *cd_mpi_owned_rows(size_t n_particles)
+static inline int cd_mpi_version(void) { return 0; }
+static inline int cd_mpi_sync_output(struct cd_sim *sim, char *err, size_t errlen)
 {
-    (void)n_particles;
-    return NULL;
+    (void)sim;
+    (void)err;
+    (void)errlen;
+    return 1;
+}
+static inline int cd_mpi_write_snapshot(struct cd_output *out, struct cd_sim *sim)
+{
+    (void)out;
+    (void)sim;
+    return 1;
 }
 static inline int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err, size_t errlen)
 {

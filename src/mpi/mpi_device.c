@@ -8,9 +8,11 @@
  * the local state back, rebuilds it on the host (src/mpi/mpi_migrate.c) and
  * maps it again.  In a build without offload every function here says
  * "host" and the refresh packs on the host (src/mpi/mpi_halo.c). */
+#include <stddef.h>
 #include <stdio.h>
 #include "mpi/mpi_halo.h"
 #include "backend/omp/omp_loops.h"
+#include "step_items.h"
 
 #if CD_OFFLOAD
 /* Is the local state mapped on the device?  (The inner backend's data is
@@ -98,6 +100,53 @@ void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len)
                  local);
 }
 
+int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn)
+{
+    cd_sim *loc = &x->loc;
+    if (!on_device(x) || !loc->nb.wall_out_valid || cd_step_memory_is_host()) return 1;
+    size_t P = loc->s.n_prims;
+    cd_int W = (cd_int)loc->s.n_walls;
+    double *d = cd_dev_alloc((P + 1) * sizeof *d); /* [N] */
+    if (!d) return -1;
+    cd_cols c = cd_sim_step_cols(loc);
+    const cd_int *prim_at = cd_sim_step_order(loc).prim_at, *ws = loc->nb.d.wall_start, *wr = loc->nb.d.wall_rows;
+    const cd_wall_entry *wo = loc->nb.d.wall_out;
+    CD_WIDE_MIN
+    CD_STEP_FOR(P, firstprivate(c) is_device_ptr(d, prim_at, ws, wr, wo))
+    for (size_t i = 0; i < P; i++) {
+        /* what the serial load adds for the row (cd_item_wall_load_chunk) */
+        cd_long e = cd_wall_out_place(c, (cd_long)cd_map(prim_at, (cd_long)i) * W + w, W, ws, wr);
+        d[i] = e >= 0 && wo[e].active ? wo[e].fn : 0;
+    }
+    int rc = P && cd_dev_get(fn, d, P * sizeof *d) ? -1 : 0;
+    cd_dev_free(d);
+    return rc;
+}
+
+int cd_mpi_dev_observe_cols(cd_mpi_ctx *x)
+{
+    cd_sim *loc = &x->loc;
+    cd_state *s = &loc->s;
+    /* (the local state is never reordered: reorder is off under MPI) */
+    if (!on_device(x) || cd_step_memory_is_host() || loc->nb.reorder) return 1;
+    const size_t read[] = {
+        offsetof(cd_state, position),    offsetof(cd_state, velocity),     offsetof(cd_state, angmom),
+        offsetof(cd_state, orientation), offsetof(cd_state, pair_prim_i),  offsetof(cd_state, pair_prim_j),
+        offsetof(cd_state, pair_active), offsetof(cd_state, pair_overlap), offsetof(cd_state, pair_shear)};
+    for (size_t f = 0; f < cd_n_fields; f++)
+        for (size_t k = 0; k < sizeof read / sizeof read[0]; k++) {
+            const void *dev = cd_sim_step_field(loc, f);
+            size_t bytes = cd_state_rows(s, cd_fields[f].group) * cd_fields[f].elem_size;
+            if (cd_fields[f].offset == read[k] && dev && bytes &&
+                cd_dev_get(*cd_field_ptr(s, &cd_fields[f]), dev, bytes))
+                return -1;
+        }
+    /* the wall contacts kept per candidate into the host's rows, as the
+     * inner backend's sync expands them */
+    if (loc->nb.wall_out_valid) loc->nb.wall_out_pending = 1;
+    return cd_neighbors_wall_out_to_host(loc) ? -1 : 0;
+}
+
 int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen)
 {
     if (!on_device(x)) return 0;
@@ -126,6 +175,20 @@ void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len)
 {
     (void)x;
     snprintf(desc, len, "host");
+}
+
+int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn)
+{
+    (void)x;
+    (void)w;
+    (void)fn;
+    return 1;
+}
+
+int cd_mpi_dev_observe_cols(cd_mpi_ctx *x)
+{
+    (void)x;
+    return 1;
 }
 
 int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen)

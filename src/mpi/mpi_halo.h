@@ -5,6 +5,7 @@
 #include <mpi.h>
 #include "core/sim.h"
 #include "mpi/mpi_decomp.h"
+#include "io/io_h5.h"
 
 typedef struct {
     MPI_Comm comm;
@@ -53,6 +54,7 @@ typedef struct {
     /* the reductions (observables, wall loads: src/mpi/mpi_reduce.c) and
      * what this rank sent for them */
     long long reduces, reduce_msgs, reduce_bytes;
+    long long gathers; /* times sync gathered the whole state on every rank (protocols, diagnoses; no snapshot) */
 } cd_mpi_ctx;
 
 /* Doubles per particle of the ghost refresh: position 3, orientation 4,
@@ -90,6 +92,19 @@ void cd_mpi_dev_free(cd_mpi_ctx *x);
  * modulo the node's devices, made the default device before anything is
  * mapped; what it took, in words, into desc.  Collective. */
 void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len);
+/* F_n [N] on wall w of every local primitive (0 where it touches none)
+ * into fn, from the step's wall-candidate entries on the offload device:
+ * one double per primitive crosses instead of the local state (a wall
+ * load, at every step of a protocol).  1 when the state is on the host
+ * (the caller reads its columns), 0 done, -1 out of device memory. */
+int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn);
+/* The columns of the local state that an observation reads
+ * (src/mpi/mpi_reduce.c: the particles' pose, velocity and angular
+ * momentum, the pair rows' primitives, flag, overlap and spring) and its
+ * wall rows (from the step's candidate entries) from the offload device
+ * to the host, instead of every column.  1 when the state is on the host
+ * (the caller syncs), 0 done, -1 out of memory. */
+int cd_mpi_dev_observe_cols(cd_mpi_ctx *x);
 /* Around a migration, which rebuilds the local state on the host: the
  * device's state copied back and let go (leave: 1, or 0 when the state is
  * on the host, -1 with err set), mapped again (return, after a leave that
@@ -127,11 +142,13 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed);
  * one process.  Collective.  0, or -1 (out of memory). */
 int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global);
 /* Normal load on wall w [N] with the serial program's bits (the sum of
- * kernels/step_items.h, CD_LOAD_CHUNK, over n_prims_global primitives),
- * from the nonzero rows alone: each chunk summed on rank chunk % R, the
- * chunks' sums merged in order on rank 0; the load on every rank
- * (src/mpi/mpi_reduce.c).  Collective. */
-double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
+ * kernels/step_items.h, CD_LOAD_CHUNK, over the primitives), from the
+ * nonzero rows alone: each chunk summed on rank chunk % R, the chunks'
+ * sums merged in order on rank 0; the load on every rank
+ * (src/mpi/mpi_reduce.c).  fn: F_n per local primitive
+ * (cd_mpi_dev_wall_fn), or NULL: the local state's wall rows.
+ * Collective. */
+double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn);
 /* The observables' slots (kernels/observe_items.h) with the serial
  * program's bits, without gathering the state: each block of rows summed
  * by the serial block function on rank block % R from its rows' owners'
@@ -139,6 +156,14 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global);
  * (src/mpi/mpi_reduce.c).  Writes the moving columns of the blocks' rows
  * into global (which is the gathered state between syncs).  Collective. */
 int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total);
+/* This rank's part of a snapshot (io_h5.h cd_output_part) from its local
+ * state, the scalars from scal (the global state's): the place of each
+ * owned particle's first contact and wall-contact row among the
+ * snapshot's rows, from an exclusive prefix sum over the particles in
+ * global id order (src/mpi/mpi_output.c).  Returns the array that
+ * part->pair_at and wallc_at point into (the caller frees it).
+ * Collective; out of memory aborts the run. */
+long long *cd_mpi_output_part(cd_mpi_ctx *x, const cd_state *scal, cd_output_part *part);
 void cd_mpi_halo_free(cd_mpi_ctx *x);
 
 /* ---- records, shared by src/mpi/mpi_halo.c and src/mpi/mpi_migrate.c ------

@@ -129,9 +129,8 @@ static void merge_chunks(const char *all, size_t n, double *total)
     *total = load;
 }
 
-double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
+double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn)
 {
-    (void)n_prims_global;
     cd_state *s = &x->loc.s;
     size_t W = s->n_walls, n = 0;
     prim_load *mine = malloc((s->n_prims + 1) * sizeof *mine);
@@ -139,9 +138,9 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, size_t n_prims_global)
     if (!mine || !dest) MPI_Abort(x->comm, 1); /* the other ranks are about to wait in the exchange */
     for (size_t q = 0; q < s->n_particles; q++)
         for (cd_int i = s->prim_first[q]; x->owned[q] && i < s->prim_first[q] + s->prim_count[q]; i++)
-            if (s->wallc_fn[(size_t)i * W + (size_t)w] != 0) {
+            if ((fn ? fn[i] : s->wallc_fn[(size_t)i * W + (size_t)w]) != 0) {
                 /* the rows left out hold exact zeros: adding one changes no sum that starts at +0 */
-                mine[n] = (prim_load){x->gprim[i], s->wallc_fn[(size_t)i * W + (size_t)w]};
+                mine[n] = (prim_load){x->gprim[i], fn ? fn[i] : s->wallc_fn[(size_t)i * W + (size_t)w]};
                 dest[n++] = (int)((x->gprim[i] / CD_LOAD_CHUNK) % x->size);
             }
     char *got = NULL;

@@ -8,7 +8,9 @@
 # was, --overwrite replaces it (written aside, renamed, nothing left
 # beside it), a file an MPI run is writing is in use for another capdem
 # and for HDF5 readers, and a run file deleted during an MPI run stops
-# it with exit status 1 on every rank.
+# it with exit status 1 on every rank.  Every rank writes from its local
+# state: a run without a protocol gathers the state never.  `capdem
+# --version` under mpirun names each rank's device once.
 # usage: test_mpi_output.sh CAPDEM SOURCE_DIR
 set -u
 capdem=$1 src=$2
@@ -22,6 +24,9 @@ if mpi 3 run "$cfg" --output mpi3.h5 --quiet 2> err; then
   least=$(sed -n 's/^capdem: MPI output: .*(MPI-IO): \([0-9]*\)\.\.[0-9]*$/\1/p' err)
   if [ -n "$least" ] && [ "$least" -gt 0 ]; then ok; else bad "3 ranks: a rank wrote no data into the file ('$least')"; fi
   if same serial.h5 mpi3.h5; then ok; else bad "3 ranks: the file differs from the serial one"; cat diff.txt; fi
+  # from the local states: a run without a protocol never gathers the whole state
+  if grep -q 'MPI output: each rank wrote its rows from its local state; the whole state gathered 0 times;' err; then ok
+  else bad "3 ranks: the state was gathered for the snapshots ($(grep 'MPI output' err))"; fi
 else
   bad "3 ranks: the run failed"
 fi
@@ -71,6 +76,11 @@ wait "$writer"
 rc=$?
 if [ $rc -eq 1 ] && [ "$(grep -c 'gone.h5 was deleted during the run' err)" -eq 1 ]; then ok
 else bad "a file deleted under 3 ranks: exit $rc, expected 1 and one message"; fi
+
+# --version on 3 ranks: rank 0 prints, once, and names every rank's device
+if mpi 3 --version > out 2> err && [ "$(grep -c '^capdem ' out)" -eq 1 ] &&
+   grep -q '^MPI: 3 ranks, each with the device it takes in a run: rank 0: .*; rank 1: .*; rank 2: ' out; then ok
+else bad "--version on 3 ranks: expected one version line and one naming ranks 0-2"; cat out; fi
 
 echo "test_mpi_output: $pass passed, $fails failed"
 [ $fails -eq 0 ]

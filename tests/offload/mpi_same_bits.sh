@@ -6,8 +6,12 @@
 # device of its node-local rank (the run's first line names them), and the
 # run files must equal the serial program's of the default build
 # (REF_CAPDEM) bit for bit: the settling hexapod pile on 3 ranks
-# (sub-domains across x and z, migrations) and the sheared crosses on 4
-# (particles dragged across the sub-domains with their contacts).
+# (sub-domains across x and z, migrations), the sheared crosses on 4
+# (particles dragged across the sub-domains with their contacts) and the
+# 2D deposit on 3 (settling, piston, compression, hold: a wall load at
+# every step, read from the wall candidates on the devices, and the
+# observations of its relaxation checks, from the columns they read).
+# `capdem --version` on 3 ranks names each rank's device.
 #
 # usage: mpi_same_bits.sh REF_CAPDEM OFFLOAD_MPI_CAPDEM SOURCE_DIR
 set -u
@@ -19,7 +23,14 @@ fail=0
 devices=$("$off" --version | sed -n 's/.*, \([0-9]*\) offload device(s).*/\1/p')
 echo "offload devices of this build: ${devices:-none}"
 [ "${devices:-0}" -ge 1 ] || { echo "FAIL: no offload device (docs/offload.md)"; exit 1; }
-for c in hexapod_pile:3 crosses_shear:4; do
+# `capdem --version` under mpirun names the device each rank will take
+versions=$(timeout 120 mpirun --oversubscribe -np 3 "$off" --version 2> /dev/null)
+for ((r = 0; r < 3; r++)); do
+  want="rank $r: host offload device $((r % devices)) of $devices (node-local rank $r) on "
+  if [[ "$versions" != *"$want"* ]]; then echo "FAIL: --version on 3 ranks does not say '$want': $versions"; fail=1; fi
+done
+[ "$(grep -c '^capdem ' <<< "$versions")" = 1 ] || { echo "FAIL: --version on 3 ranks: not one version line"; fail=1; }
+for c in hexapod_pile:3 crosses_shear:4 deposit_2d:3; do
   IFS=: read -r name np <<< "$c"
   cfg="$src/tests/mpi/$name.yaml"
   "$ref" run "$cfg" --output "$work/$name-serial.h5" --quiet 2> "$work/$name-serial.log" ||
