@@ -249,10 +249,10 @@ cd_order cd_sim_step_order(const cd_sim *sim);
 cd_order cd_sim_host_order(const cd_sim *sim);
 /* At a rebuild, before the particles are binned: the particles, their
  * primitives and wall rows put in the order of their grid cells (the
- * grid of the build, d.grid), the maps updated; *moved = 1 when some
- * particle moved (then d.prim_src holds the primitives' old slots).
- * 0, or -1 out of memory. */
-int cd_reorder_build(cd_sim *sim, int *moved);
+ * grid of the build, d.grid, a host copy of which is g), the maps
+ * updated; *moved = 1 when some particle moved (then d.prim_src holds the
+ * primitives' old slots).  0, or -1 out of memory. */
+int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved);
 /* At the end of a build: d.pair_at for the new rows.  0, or -1. */
 int cd_reorder_pair_rows(cd_sim *sim);
 /* The host columns in user order (a sync; rows copied back from a device

@@ -35,17 +35,17 @@ static void test_arguments_copied_only_when_they_change(void **state)
     assert_int_equal(cd_sim_initial_forces(&sim), 0);
     long long c0[2], c1[2], c2[2];
     cdt_step(&sim, 2); /* the first steps allocate the skin flag: the head goes out again */
-    cd_sim_step_arg_copies(&sim, c0);
+    cd_sim_step_arg_copies(&sim, c0, NULL);
     long long builds = sim.nb.builds;
     cdt_step(&sim, 100); /* standing walls */
-    cd_sim_step_arg_copies(&sim, c1);
+    cd_sim_step_arg_copies(&sim, c1, NULL);
     assert_int_equal(sim.nb.builds, builds);
     assert_int_equal(c1[0] - c0[0], 0);
     assert_int_equal(c1[1] - c0[1], 0);
     /* a wall moving at 1 mm/s: 20 steps move it 0.2 um, far below half the skin */
     sim.s.walls[0].velocity = cd_v3_scale(sim.s.walls[0].normal, -1e-3);
     cdt_step(&sim, 20);
-    cd_sim_step_arg_copies(&sim, c2);
+    cd_sim_step_arg_copies(&sim, c2, NULL);
     assert_int_equal(sim.nb.builds, builds);
     assert_int_equal(c2[0] - c1[0], 0);
     /* one copy for the new velocity (the call's first advance), then one

@@ -19,6 +19,7 @@
 typedef struct {
     cd_cols c;
     cd_nb_lists d;
+    cd_order order; /* memory order maps where the loops run (cd_sim_step_order) */
     cd_law_params law, wall_law;
     cd_vec3 gravity;                  /* [m/s^2] */
     cd_real dt, sin_parallel, limit2; /* [s], [1], (skin/2)^2 [m^2] */
@@ -39,6 +40,7 @@ typedef struct {
     cd_step_args args_host;   /* what it holds */
     int args_sent;            /* 0 until the first block went out */
     long long args_copies[2]; /* copies of the block's head and of its walls since start */
+    long long args_bytes[2];  /* their bytes */
 } cd_off;
 
 /* Maps every column of the host state to the device (once per run); 0 on
@@ -56,5 +58,31 @@ const cd_step_args *cd_off_args_or_die(cd_sim *sim);
 /* The block for the state as it is now, padding zeroed (blocks are
  * compared byte by byte). */
 void cd_step_args_fill(cd_sim *sim, cd_step_args *a);
+
+/* A loop's arguments: `CD_ARGS(sim)` declares `a`, the block for the state
+ * as it is now, and `CD_ARGS_IN` hands it to a CD_STEP_FOR loop.  Offload:
+ * the device block, brought up to date (a launch copies nothing unless the
+ * block changed); host threads: a block on the stack, shared by the
+ * threads.  `CD_BUILD_ARGS(sim)`, for the passes of the neighbour-list
+ * build and the reorder, which read only the columns, lists, order and
+ * walls: on host threads only those are filled (their firstprivate
+ * structs were copied the same way). */
+#if CD_OFFLOAD
+#define CD_ARGS(sim)       const cd_step_args *a = cd_off_args_or_die(sim);
+#define CD_ARGS_IN         is_device_ptr(a)
+#define CD_BUILD_ARGS(sim) CD_ARGS(sim)
+#else
+#define CD_ARGS(sim)                                                                                                   \
+    cd_step_args a_;                                                                                                   \
+    cd_step_args_fill(sim, &a_);                                                                                       \
+    const cd_step_args *a = &a_;
+#define CD_ARGS_IN firstprivate(a)
+#define CD_BUILD_ARGS(sim)                                                                                             \
+    cd_step_args a_;                                                                                                   \
+    cd_build_args_fill(sim, &a_);                                                                                      \
+    const cd_step_args *a = &a_;
+/* Only the columns, lists, order and walls of the block (host threads). */
+void cd_build_args_fill(cd_sim *sim, cd_step_args *a);
+#endif
 
 #endif

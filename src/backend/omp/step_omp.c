@@ -34,9 +34,6 @@ long cd_parallel_min_rows = 4096;
 /* ---- the loops of a step ------------------------------------------------ */
 
 #if CD_OFFLOAD
-#define CD_ARGS(sim) const cd_step_args *a = cd_off_args_or_die(sim);
-#define CD_ARGS_IN   is_device_ptr(a)
-
 /* The device's skin flag (1: an end moved beyond half the skin since it
  * was cleared), allocated and cleared at its first use. */
 static cd_int *skin_flag(cd_sim *sim)
@@ -50,21 +47,15 @@ static cd_int *skin_flag(cd_sim *sim)
     return sim->nb.d.skin_flag;
 }
 
-/* The skin flag's one int back; cleared on the device only after a step
- * that set it. */
+/* The skin flag's one int back.  A step that set it is followed by a
+ * build, whose first pass over primitives clears it on the device
+ * (src/backend/omp/neighbors.c; it was a copy of its own). */
 static int skin_flag_read(cd_sim *sim)
 {
-    cd_int moved = 1, zero = 0;
+    cd_int moved = 1;
     if (cd_dev_get(&moved, sim->nb.d.skin_flag, sizeof moved)) return 1;
-    if (moved) cd_dev_put(sim->nb.d.skin_flag, &zero, sizeof zero);
     return moved != 0;
 }
-#else
-#define CD_ARGS(sim)                                                                                                   \
-    cd_step_args a_;                                                                                                   \
-    cd_step_args_fill(sim, &a_);                                                                                       \
-    const cd_step_args *a = &a_;
-#define CD_ARGS_IN firstprivate(a)
 #endif
 
 /* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
