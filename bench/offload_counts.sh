@@ -37,4 +37,10 @@ count() { # log -> launches h2d_copies h2d_bytes d2h_copies d2h_bytes builds
         }' "$1"
 }
 set -- $(count "$tmp/log$A" "$tmp/out$A") $(count "$tmp/log$B" "$tmp/out$B")
-echo "steps $((B - A)), builds $((${12} - $6)): launches $((${7} - $1)), to device $((${8} - $2)) copies $((${9} - $3)) B, from device $((${10} - $4)) copies $((${11} - $5)) B"
+steps=$((B - A)) builds=$((${12} - $6))
+launches=$((${7} - $1)) h2d=$((${8} - $2)) h2d_bytes=$((${9} - $3)) d2h=$((${10} - $4)) d2h_bytes=$((${11} - $5))
+echo "steps $steps, builds $builds: launches $launches, to device $h2d copies $h2d_bytes B, from device $d2h copies $d2h_bytes B"
+awk -v s=$steps -v b=$builds -v l=$launches -v h=$h2d -v hb=$h2d_bytes -v d=$d2h -v db=$d2h_bytes 'BEGIN {
+    printf "per step: %.2f launches, to device %.2f copies %.1f B, from device %.2f copies %.1f B\n", l / s, h / s, hb / s, d / s, db / s
+    if (b > 0) printf "per build: %.1f launches beyond 3 a step, to device %.2f copies %.1f B\n", (l - 3 * s) / b, h / b, hb / b
+}'

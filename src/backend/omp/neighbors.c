@@ -161,10 +161,10 @@ static int make_grid(cd_sim *sim, cd_grid *grid_out)
     cd_real skin = sim->nb.skin, *boxes = sim->nb.d.partial; /* [m] */
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
-    CD_STEP_FOR(N, CD_ARGS_IN)
-    for (cd_long p = 0; p < N; p++) cd_nb_item_bound(a->c, p, a->d.part_bound);
-    CD_STEP_FOR(n, CD_ARGS_IN)
-    for (cd_long q = 0; q < n; q++) cd_nb_item_box(a->c, q, N, a->d.part_bound, a->d.partial);
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_long p = 0; p < N; p++) cd_nb_item_bound(CD_B.c, p, CD_B.d.part_bound);
+    CD_STEP_FOR(n, CD_BUILD_IN)
+    for (cd_long q = 0; q < n; q++) cd_nb_item_box(CD_B.c, q, N, CD_B.d.part_bound, CD_B.d.partial);
     while (n > CD_BOX_CHUNK) {
         cd_long m = (n + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK, n_in = n;
         cd_real *up = boxes + 7 * n;
@@ -190,11 +190,12 @@ static void bin_particles(cd_sim *sim)
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
     zero_ints(dl->cell_count, (size_t)cell_cap);
-    CD_STEP_FOR(N, CD_ARGS_IN)
-    for (cd_int q = 0; q < N; q++) cd_nb_item_bin(a->c, q, a->d.grid, cell_cap, a->d.part_cell, a->d.cell_count);
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int q = 0; q < N; q++)
+        cd_nb_item_bin(CD_B.c, q, CD_B.d.grid, cell_cap, CD_B.d.part_cell, CD_B.d.cell_count);
     scan_copy(dl->cell_count, cell_cap, dl->cell_start, dl->chunk_sum, dl->cell_count);
-    CD_STEP_FOR(N, CD_ARGS_IN)
-    for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, a->d.part_cell, a->d.cell_count, a->d.cell_parts);
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, CD_B.d.part_cell, CD_B.d.cell_count, CD_B.d.cell_parts);
 }
 
 /* Pass 5 in slot mode (slot > 0; returns the longest row, which may exceed
@@ -206,16 +207,16 @@ static cd_int collect(cd_sim *sim, cd_int slot)
     cd_real skin = sim->nb.skin; /* [m] */
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
-    CD_STEP_FOR(N, CD_ARGS_IN reduction(max : longest) CD_DEV(map(tofrom : longest)))
+    CD_STEP_FOR(N, CD_BUILD_IN reduction(max : longest) CD_DEV(map(tofrom : longest)))
     for (cd_int p = 0; p < N; p++) {
         if (slot > 0)
-            cd_nb_item_collect(a->c, p, a->d.grid, a->d.cell_start, a->d.cell_parts, a->d.part_bound, skin, a->d.cand,
-                               slot, 0, a->d.pair_count, a->order);
+            cd_nb_item_collect(CD_B.c, p, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
+                               CD_B.d.cand, slot, 0, CD_B.d.pair_count, CD_B.order);
         else
-            cd_nb_item_collect(a->c, p, a->d.grid, a->d.cell_start, a->d.cell_parts, a->d.part_bound, skin,
-                               a->c.pair_prim_j, 0, a->d.pair_offset, a->d.pair_count, a->order);
-        for (cd_int i = a->c.prim_first[p]; i < a->c.prim_first[p] + a->c.prim_count[p]; i++)
-            if (a->d.pair_count[i] > longest) longest = a->d.pair_count[i];
+            cd_nb_item_collect(CD_B.c, p, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
+                               CD_B.c.pair_prim_j, 0, CD_B.d.pair_offset, CD_B.d.pair_count, CD_B.order);
+        for (cd_int i = CD_B.c.prim_first[p]; i < CD_B.c.prim_first[p] + CD_B.c.prim_count[p]; i++)
+            if (CD_B.d.pair_count[i] > longest) longest = CD_B.d.pair_count[i];
     }
     return longest;
 }
@@ -236,9 +237,9 @@ static int keep_history(cd_sim *sim)
     }
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
-    CD_STEP_FOR(n_old, CD_ARGS_IN)
+    CD_STEP_FOR(n_old, CD_BUILD_IN)
     for (size_t k = 0; k < n_old; k++)
-        cd_nb_item_keep(a->c, (cd_long)k, a->order, a->d.old_keys, a->d.old_active, a->d.old_shear);
+        cd_nb_item_keep(CD_B.c, (cd_long)k, CD_B.order, CD_B.d.old_keys, CD_B.d.old_active, CD_B.d.old_shear);
     return 0;
 }
 
@@ -329,12 +330,13 @@ static int particle_lists(cd_sim *sim, const cd_int *prim_src)
     {
         CD_BUILD_ARGS(sim)
         scan_copy(dl->count, N, dl->gather_start, dl->chunk_sum, dl->count);
-        CD_STEP_FOR(n_pairs, CD_ARGS_IN)
-        for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_fill(a->c, (cd_long)k, a->d.count, a->d.gather_rows);
-        CD_STEP_FOR(N, CD_ARGS_IN)
+        CD_STEP_FOR(n_pairs, CD_BUILD_IN)
+        for (size_t k = 0; k < n_pairs; k++)
+            cd_nb_item_gather_fill(CD_B.c, (cd_long)k, CD_B.d.count, CD_B.d.gather_rows);
+        CD_STEP_FOR(N, CD_BUILD_IN)
         for (cd_int q = 0; q < N; q++) {
-            cd_nb_item_gather_sort(a->c, a->order, q, a->d.gather_start, a->d.gather_rows);
-            a->d.count[q] = cd_item_wall_candidates(a->c, q, a->walls, W, skin, 0);
+            cd_nb_item_gather_sort(CD_B.c, CD_B.order, q, CD_B.d.gather_start, CD_B.d.gather_rows);
+            CD_B.d.count[q] = cd_item_wall_candidates(CD_B.c, q, CD_B.walls, W, skin, 0);
         }
     }
     cd_nb_scan(dl->count, N, dl->wall_start, dl->chunk_sum);
@@ -344,13 +346,13 @@ static int particle_lists(cd_sim *sim, const cd_int *prim_src)
     cd_long n_old = (cd_long)sim->nb.n_old_wall_rows;
     {
         CD_BUILD_ARGS(sim) /* the candidate lists may have moved */
-        CD_STEP_FOR(N, CD_ARGS_IN)
+        CD_STEP_FOR(N, CD_BUILD_IN)
         for (cd_int q = 0; q < N; q++)
-            cd_item_wall_candidates(a->c, q, a->walls, W, skin, a->d.wall_rows + a->d.wall_start[q]);
-        CD_STEP_FOR(n_rows, CD_ARGS_IN CD_DEV(is_device_ptr(prim_src)))
+            cd_item_wall_candidates(CD_B.c, q, CD_B.walls, W, skin, CD_B.d.wall_rows + CD_B.d.wall_start[q]);
+        CD_STEP_FOR(n_rows, CD_BUILD_IN CD_DEV(is_device_ptr(prim_src)))
         for (cd_int e = 0; e < n_rows; e++)
-            cd_item_wall_carry(e, a->d.wall_rows, a->d.wall_out, a->d.old_wall_rows, n_old, a->d.old_wall_out, prim_src,
-                               W);
+            cd_item_wall_carry(e, CD_B.d.wall_rows, CD_B.d.wall_out, CD_B.d.old_wall_rows, n_old, CD_B.d.old_wall_out,
+                               prim_src, W);
     }
     sim->nb.n_wall_rows = (size_t)n_rows;
     memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
@@ -409,23 +411,23 @@ int cd_neighbors_build(cd_sim *sim)
          * the particles' gather counts are cleared for the next launch, and
          * the skin flag (offload: set by the step that asked for this
          * build) is cleared; three launches and a copy before. */
-        CD_STEP_FOR(most, CD_ARGS_IN)
+        CD_STEP_FOR(most, CD_BUILD_IN)
         for (cd_int i = 0; i < most; i++) {
             if (i < P) {
-                cd_nb_item_place(a->c, i, a->d.pair_offset, a->d.cand, slot, a->d.keys, a->order);
-                a->c.prim_a_ref[i] = a->c.prim_a[i];
-                a->c.prim_b_ref[i] = a->c.prim_b[i];
+                cd_nb_item_place(CD_B.c, i, CD_B.d.pair_offset, CD_B.d.cand, slot, CD_B.d.keys, CD_B.order);
+                CD_B.c.prim_a_ref[i] = CD_B.c.prim_a[i];
+                CD_B.c.prim_b_ref[i] = CD_B.c.prim_b[i];
             }
-            if (i < N) a->d.count[i] = 0;
-            if (i == 0 && a->d.skin_flag) a->d.skin_flag[0] = 0;
+            if (i < N) CD_B.d.count[i] = 0;
+            if (i == 0 && CD_B.d.skin_flag) CD_B.d.skin_flag[0] = 0;
         }
         /* Passes 8 and 9a: each new row's history, and its count in its
          * two particles' gather lists. */
-        CD_STEP_FOR(n_new, CD_ARGS_IN CD_DEV(is_device_ptr(prim_src)))
+        CD_STEP_FOR(n_new, CD_BUILD_IN CD_DEV(is_device_ptr(prim_src)))
         for (cd_int k = 0; k < n_new; k++) {
-            cd_nb_item_carry(a->c, k, a->d.keys, a->d.old_keys, (cd_long)n_old, a->d.old_active, a->d.old_shear,
-                             prim_src);
-            cd_nb_item_gather_count(a->c, k, a->d.count);
+            cd_nb_item_carry(CD_B.c, k, CD_B.d.keys, CD_B.d.old_keys, (cd_long)n_old, CD_B.d.old_active,
+                             CD_B.d.old_shear, prim_src);
+            cd_nb_item_gather_count(CD_B.c, k, CD_B.d.count);
         }
     }
     if (particle_lists(sim, prim_src) || cd_reorder_pair_rows(sim)) return -1;

@@ -130,8 +130,8 @@ static long particle_keys(cd_sim *sim)
     long descents = 0;
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
-    CD_STEP_FOR(N, CD_ARGS_IN)
-    for (cd_int q = 0; q < N; q++) cd_reorder_item_key(a->c, q, a->d.grid, a->d.sort_keys, a->d.sort_vals);
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int q = 0; q < N; q++) cd_reorder_item_key(CD_B.c, q, CD_B.d.grid, CD_B.d.sort_keys, CD_B.d.sort_vals);
     CD_STEP_FOR(N, reduction(+ : descents) CD_DEV(is_device_ptr(keys) map(tofrom : descents)))
     for (cd_int m = 1; m < N; m++) descents += cd_reorder_item_descent(keys, m);
     return descents;
@@ -214,20 +214,20 @@ int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
     long excess = 0;
     size_t K = s->n_pairs;
     CD_BUILD_ARGS(sim)
-    CD_STEP_FOR(K, CD_ARGS_IN reduction(+ : excess) CD_DEV(is_device_ptr(slot_of) map(tofrom : excess)))
+    CD_STEP_FOR(K, CD_BUILD_IN reduction(+ : excess) CD_DEV(is_device_ptr(slot_of) map(tofrom : excess)))
     for (size_t k = 0; k < K; k++)
-        excess += 8L * cd_reorder_item_row_span(a->c, (cd_long)k, slot_of) -
-                  7L * cd_reorder_item_row_span(a->c, (cd_long)k, NULL);
+        excess += 8L * cd_reorder_item_row_span(CD_B.c, (cd_long)k, slot_of) -
+                  7L * cd_reorder_item_row_span(CD_B.c, (cd_long)k, NULL);
     if (excess >= 0 && !forced) return 0;
 
     /* the primitives follow their particles: new first primitives, and
      * the old slot of each new primitive (before prim_first moves) */
-    CD_STEP_FOR(N, CD_ARGS_IN)
-    for (cd_int m = 0; m < N; m++) a->d.count[m] = a->c.prim_count[a->d.part_src[m]];
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int m = 0; m < N; m++) CD_B.d.count[m] = CD_B.c.prim_count[CD_B.d.part_src[m]];
     cd_nb_scan(d.count, N, d.new_first, d.chunk_sum);
-    CD_STEP_FOR(N, CD_ARGS_IN)
+    CD_STEP_FOR(N, CD_BUILD_IN)
     for (cd_int m = 0; m < N; m++)
-        cd_reorder_item_prim_src(m, a->d.part_src, a->d.new_first, a->c.prim_first, a->d.prim_src);
+        cd_reorder_item_prim_src(m, CD_B.d.part_src, CD_B.d.new_first, CD_B.c.prim_first, CD_B.d.prim_src);
 
     const size_t word = sizeof(cd_int);
     for (size_t f = 0; f < cd_n_fields; f++) {
@@ -243,13 +243,13 @@ int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
     move_rows(sim, (cd_int *)d.part_bound, (size_t)N, sizeof(cd_real) / word, sizeof(cd_real) / word, d.part_src);
     move_rows(sim, d.part_uid, (size_t)N, 1, 1, d.part_src);
     move_rows(sim, d.prim_uid, (size_t)P, 1, 1, d.prim_src);
-    CD_STEP_FOR(N, CD_ARGS_IN)
+    CD_STEP_FOR(N, CD_BUILD_IN)
     for (cd_int m = 0; m < N; m++) {
-        cd_reorder_item_owner(a->c, m, a->d.new_first);
-        a->d.part_at[a->d.part_uid[m]] = m;
+        cd_reorder_item_owner(CD_B.c, m, CD_B.d.new_first);
+        CD_B.d.part_at[CD_B.d.part_uid[m]] = m;
     }
-    CD_STEP_FOR(P, CD_ARGS_IN)
-    for (cd_int i = 0; i < P; i++) a->d.prim_at[a->d.prim_uid[i]] = i;
+    CD_STEP_FOR(P, CD_BUILD_IN)
+    for (cd_int i = 0; i < P; i++) CD_B.d.prim_at[CD_B.d.prim_uid[i]] = i;
     sim->nb.reorders++;
     *moved = 1;
     return 0;
@@ -269,12 +269,13 @@ int cd_reorder_pair_rows(cd_sim *sim)
     cd_int P = (cd_int)sim->s.n_prims;
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
-    CD_STEP_FOR(P, CD_ARGS_IN)
-    for (cd_int u = 0; u < P; u++) a->d.pair_count[u] = cd_reorder_item_pair_count(a->d.prim_at, a->d.pair_offset, u);
-    cd_nb_scan(dl->pair_count, P, dl->pair_ustart, dl->chunk_sum);
-    CD_STEP_FOR(P, CD_ARGS_IN)
+    CD_STEP_FOR(P, CD_BUILD_IN)
     for (cd_int u = 0; u < P; u++)
-        cd_reorder_item_pair_at(a->d.prim_at, a->d.pair_offset, a->d.pair_ustart, u, a->d.pair_at);
+        CD_B.d.pair_count[u] = cd_reorder_item_pair_count(CD_B.d.prim_at, CD_B.d.pair_offset, u);
+    cd_nb_scan(dl->pair_count, P, dl->pair_ustart, dl->chunk_sum);
+    CD_STEP_FOR(P, CD_BUILD_IN)
+    for (cd_int u = 0; u < P; u++)
+        cd_reorder_item_pair_at(CD_B.d.prim_at, CD_B.d.pair_offset, CD_B.d.pair_ustart, u, CD_B.d.pair_at);
     return 0;
 }
 

@@ -236,17 +236,6 @@ void cd_step_args_fill(cd_sim *sim, cd_step_args *a)
     memcpy(a->walls, sim->s.walls, sim->s.n_walls * sizeof(cd_wall));
 }
 
-#if !CD_OFFLOAD
-void cd_build_args_fill(cd_sim *sim, cd_step_args *a)
-{
-    a->c = cd_sim_step_cols(sim);
-    a->d = sim->nb.d;
-    a->order = cd_sim_step_order(sim);
-    a->n_walls = (cd_int)sim->s.n_walls;
-    memcpy(a->walls, sim->s.walls, sim->s.n_walls * sizeof(cd_wall));
-}
-#endif
-
 #if CD_OFFLOAD
 /* [*first, *end): the bytes where x and y (n bytes) differ, in 8-byte
  * words; 0 when they are equal. */
