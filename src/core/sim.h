@@ -63,6 +63,7 @@ typedef struct {
     cd_int *count;                                            /* per particle: gather and wall counts, then cursors */
     cd_int *chunk_sum;                                        /* prefix sums' levels (cd_scan_scratch) */
     cd_int *skin_flag; /* offload: 1 when the last advance found an end beyond half the skin (step_omp.c) */
+    cd_real *ref_pose; /* CD_ENDS_FROM_POSE: each particle's pose at the build (cd_item_ref_pose; step_items.h) */
     /* memory order (kernels/reorder_items.h, src/backend/omp/reorder.c; allocated at
      * the first build with neighbor.reorder: cells) */
     cd_int *part_uid, *part_at;  /* particle: memory slot -> user id, user id -> memory slot */

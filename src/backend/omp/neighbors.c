@@ -44,7 +44,7 @@ void cd_neighbors_free(cd_neighbors *nb)
                    d->old_keys,   d->old_active,    d->old_shear,    d->count,        d->chunk_sum,   d->part_uid,
                    d->part_at,    d->prim_uid,      d->prim_at,      d->pair_at,      d->pair_ustart, d->part_src,
                    d->prim_src,   d->new_first,     d->sort_keys,    d->sort_vals,    d->hist,        d->move,
-                   d->skin_flag};
+                   d->skin_flag,  d->ref_pose};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -86,6 +86,8 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
             realloc_dev((void **)&d->gather_start, N + 1, sizeof(cd_int)) ||
             realloc_dev((void **)&d->wall_start, N + 1, sizeof(cd_int)))
             return -1;
+        /* the poses the skin test bounds the ends' motion from (step_items.h) */
+        if (CD_ENDS_FROM_POSE && realloc_dev((void **)&d->ref_pose, CD_REF_POSE * (N + 1), sizeof(cd_real))) return -1;
     }
     if (rows > nb->cap_rows || !d->keys) {
         size_t cap = rows + rows / 4 + 16;
@@ -161,8 +163,13 @@ static int make_grid(cd_sim *sim, cd_grid *grid_out)
     cd_real skin = sim->nb.skin, *boxes = sim->nb.d.partial; /* [m] */
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
+    /* (with CD_ENDS_FROM_POSE the world ends, which the steps do not
+     * store, first: the build bins and pairs them) */
     CD_STEP_FOR(N, CD_BUILD_IN)
-    for (cd_long p = 0; p < N; p++) cd_nb_item_bound(CD_B.c, p, CD_B.d.part_bound);
+    for (cd_long p = 0; p < N; p++) {
+        if (CD_ENDS_FROM_POSE) cd_item_particle_ends(CD_B.c, p);
+        cd_nb_item_bound(CD_B.c, p, CD_B.d.part_bound);
+    }
     CD_STEP_FOR(n, CD_BUILD_IN)
     for (cd_long q = 0; q < n; q++) cd_nb_item_box(CD_B.c, q, N, CD_B.d.part_bound, CD_B.d.partial);
     while (n > CD_BOX_CHUNK) {
@@ -407,10 +414,11 @@ int cd_neighbors_build(cd_sim *sim)
     {
         CD_BUILD_ARGS(sim)
         /* Pass 7, with in the same launch: the primitive ends become the
-         * skin test's reference (nothing later in the build moves them),
-         * the particles' gather counts are cleared for the next launch, and
-         * the skin flag (offload: set by the step that asked for this
-         * build) is cleared; three launches and a copy before. */
+         * skin test's reference (nothing later in the build moves them;
+         * with CD_ENDS_FROM_POSE the particles' poses too), the particles'
+         * gather counts are cleared for the next launch, and the skin flag
+         * (offload: set by the step that asked for this build) is cleared;
+         * three launches and a copy before. */
         CD_STEP_FOR(most, CD_BUILD_IN)
         for (cd_int i = 0; i < most; i++) {
             if (i < P) {
@@ -419,6 +427,7 @@ int cd_neighbors_build(cd_sim *sim)
                 CD_B.c.prim_b_ref[i] = CD_B.c.prim_b[i];
             }
             if (i < N) CD_B.d.count[i] = 0;
+            if (i < N && CD_B.d.ref_pose) cd_item_ref_pose(CD_B.c, i, CD_B.d.ref_pose);
             if (i == 0 && CD_B.d.skin_flag) CD_B.d.skin_flag[0] = 0;
         }
         /* Passes 8 and 9a: each new row's history, and its count in its
