@@ -112,19 +112,29 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
     c.prim_b[i] = b;
 }
 
-/* The world ends of particle q's primitives from its pose, stored (the
- * build and a sync when CD_ENDS_FROM_POSE). */
-CD_INLINE void cd_item_particle_ends(cd_cols c, cd_particle_id q)
+/* The world ends of particle q's primitives for the pose x [m], o,
+ * stored; with test = 1 also their skin test against the ends at the last
+ * build (limit2 = (skin/2)^2 [m^2]): 1 when one moved more than half the
+ * skin. */
+CD_INLINE int cd_store_ends(cd_cols c, cd_particle_id q, cd_vec3 x, cd_quat o, int test, cd_real limit2)
 {
-    cd_vec3 x = c.position[q];
-    cd_quat o = c.orientation[q];
+    int moved = 0;
     cd_int first = c.prim_first[q], last = first + c.prim_count[q];
     for (cd_int i = first; i < last; i++) {
         cd_vec3 a, b;
         cd_prim_ends_at(c, i, x, o, &a, &b);
         c.prim_a[i] = a;
         c.prim_b[i] = b;
+        if (test) moved |= cd_bp_moved(a, c.prim_a_ref[i], b, c.prim_b_ref[i], limit2);
     }
+    return moved;
+}
+
+/* The world ends of particle q's primitives from its pose, stored (the
+ * build and a sync when CD_ENDS_FROM_POSE). */
+CD_INLINE void cd_item_particle_ends(cd_cols c, cd_particle_id q)
+{
+    cd_store_ends(c, q, c.position[q], c.orientation[q], 0, 0);
 }
 
 /* World ends of primitive i as the step's passes use them: stored by the
@@ -223,16 +233,7 @@ CD_INLINE int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_vec3 L,
     return cd_pose_moved(c, q, x, o, ref_pose, limit2);
 #else
     (void)ref_pose;
-    int moved = 0;
-    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
-    for (cd_int i = first; i < last; i++) {
-        cd_vec3 a, b;
-        cd_prim_ends_at(c, i, x, o, &a, &b);
-        c.prim_a[i] = a;
-        c.prim_b[i] = b;
-        moved |= cd_bp_moved(a, c.prim_a_ref[i], b, c.prim_b_ref[i], limit2);
-    }
-    return moved;
+    return cd_store_ends(c, q, x, o, 1, limit2);
 #endif
 }
 
