@@ -35,18 +35,30 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * its particle (4), body-frame ends (48) and ends at the last build
      * (48); writes x, q, v, L, omega and the primitives' world ends (48). */
     cd_traffic advance = {"advance", N * 184 + P * 100, N * 128 + P * 48};
+    /* CD_ENDS_FROM_POSE (the offload variants, step_items.h): no world ends
+     * written and no primitive read by the skin test, which reads the pose
+     * at the last build (64 B a particle) and its primitives only when its
+     * bound does not settle it (near a rebuild: not counted); the passes
+     * that use the ends read the particle's orientation (32) besides the
+     * body-frame ends in place of the world ends. */
+    if (CD_ENDS_FROM_POSE) advance = (cd_traffic){"advance", N * (184 + 64), N * 128};
+    double pose = CD_ENDS_FROM_POSE ? 32 : 0; /* the orientation, per particle a pass reads */
     /* cd_item_pair_force: every row its primitives and flag (12); the
      * primitives' particle, ends and radius (60); an active row its history
      * (24) and its particles' x, v, omega, m (80 per particle, counted for
-     * every particle); writes flag, history, point, force (76), and the
-     * overlap and F_n (16) at the last step of a call only. */
-    out[0] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 76 + A * 16 / steps_per_call};
+     * every particle; with CD_ENDS_FROM_POSE the orientation too); writes
+     * flag, history, point, force (76; the flag only when it changes with
+     * CD_ENDS_FROM_POSE: 72), and the overlap and F_n (16) at the last step
+     * of a call only. */
+    out[0] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * (80 + pose),
+                          A * (CD_ENDS_FROM_POSE ? 72 : 76) + A * 16 / steps_per_call};
     /* cd_item_wall_row over the wall candidates: per candidate its row,
      * its entry's flag and its primitive (particle, ends, radius: 4 + 4 + 60, an upper
-     * bound when a primitive has several); an active row its history (24)
-     * and the particle's x, v, omega, m (80); writes flag, history, force,
-     * torque, overlap, F_n. */
-    out[1] = (cd_traffic){"wall_forces", C * 68 + Aw * (24 + 80), Aw * 92};
+     * bound when a primitive has several; with CD_ENDS_FROM_POSE body-frame
+     * ends, and the particle's x and q, 56, per candidate); an active row
+     * its history (24) and the particle's x, v, omega, m (80); writes flag,
+     * history, force, torque, overlap, F_n. */
+    out[1] = (cd_traffic){"wall_forces", C * (68 + (CD_ENDS_FROM_POSE ? 56 : 0)) + Aw * (24 + 80), Aw * 92};
     /* the gather's part: per wall candidate its entry and flag (8), per
      * active wall row force and torque (48); per pair row two entries (8)
      * and, active or not (an inactive row adds its zero force: no branch),
@@ -63,6 +75,9 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * F, T, v, L, x, omega (144), q (32) and the primitives' world ends
      * (48).  The advance of its own runs once per call of the step. */
     out[2] = (cd_traffic){"gather_kick_advance", N * 152 + P * 96 + gather_rows, N * 176 + P * 48};
+    /* with CD_ENDS_FROM_POSE: the pose at the build (64) instead of the
+     * primitive range and the primitives' ends (8 + 96), no ends written */
+    if (CD_ENDS_FROM_POSE) out[2] = (cd_traffic){"gather_kick_advance", N * (144 + 64) + gather_rows, N * 176};
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};

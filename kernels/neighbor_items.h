@@ -395,5 +395,17 @@ CD_INLINE void cd_scan_item_fill(const CD_GLOBAL cd_int *in, cd_long n, cd_long 
     if (end == n) out[n] = run;
 }
 
+/* After chunk g of out is filled (cd_scan_item_fill, or the top item for
+ * a single chunk): its entries, and the total after the last chunk, also
+ * into copy, in the same item -- the cursor of a counting fill, which was
+ * a launch of its own (copy may be the scan's input: the chunk has been
+ * read). */
+CD_INLINE void cd_scan_item_copy(const CD_GLOBAL cd_int *out, cd_long n, cd_long g, CD_GLOBAL cd_int *copy)
+{
+    cd_long end = cd_scan_chunk_end(g, n);
+    for (cd_long i = g * CD_SCAN_CHUNK; i < end; i++) copy[i] = out[i];
+    if (end == n) copy[n] = out[n];
+}
+
 CD_DEVICE_END
 #endif

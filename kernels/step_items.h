@@ -19,6 +19,31 @@
 
 CD_DEVICE_BEGIN
 
+/* CD_ENDS_FROM_POSE 1 (the offload variants, whose step is bound by memory
+ * traffic; docs/performance.md, "Ends from the pose"): the step does not
+ * store the primitives' world ends.  The pair and wall passes compute them
+ * where they use them, from the particle's pose and the body-frame ends
+ * (cd_prim_world_ends: the same function on the same numbers, so the same
+ * bits as the stored ones); the neighbour-list build stores them (it bins
+ * and pairs them, and they become the reference ends of the run file), and
+ * so does a sync; the skin test bounds the ends' motion from the pose at
+ * the last build (cd_pose_moved) and computes them only when the bound
+ * does not settle it, so it gives the per-end test's answer and the
+ * rebuilds come at the same steps.  0 on host threads and in OpenCL,
+ * where the stored ends cost fewer instructions. */
+#ifndef CD_ENDS_FROM_POSE
+#if defined(CAPDEM_OFFLOAD_TARGET) && CAPDEM_OFFLOAD_TARGET && !defined(__OPENCL_VERSION__)
+#define CD_ENDS_FROM_POSE 1
+#else
+#define CD_ENDS_FROM_POSE 0
+#endif
+#endif
+
+/* Reals per particle of the pose at the last neighbour-list build
+ * (cd_item_ref_pose): centre [m] (3), orientation (4), reach [m] (the
+ * largest distance of a body-frame end from the centre). */
+#define CD_REF_POSE 8
+
 /* Half kick of particle q over h = dt/2 [s] (docs/references.md, Motion), then its angular
  * velocity from the new angular momentum. */
 CD_INLINE void cd_item_kick(cd_cols c, cd_particle_id q, cd_real h)
@@ -87,6 +112,105 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
     c.prim_b[i] = b;
 }
 
+/* The world ends of particle q's primitives for the pose x [m], o,
+ * stored; with test = 1 also their skin test against the ends at the last
+ * build (limit2 = (skin/2)^2 [m^2]): 1 when one moved more than half the
+ * skin. */
+CD_INLINE int cd_store_ends(cd_cols c, cd_particle_id q, cd_vec3 x, cd_quat o, int test, cd_real limit2)
+{
+    int moved = 0;
+    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
+    for (cd_int i = first; i < last; i++) {
+        cd_vec3 a, b;
+        cd_prim_ends_at(c, i, x, o, &a, &b);
+        c.prim_a[i] = a;
+        c.prim_b[i] = b;
+        if (test) moved |= cd_bp_moved(a, c.prim_a_ref[i], b, c.prim_b_ref[i], limit2);
+    }
+    return moved;
+}
+
+/* The world ends of particle q's primitives from its pose, stored (the
+ * build and a sync when CD_ENDS_FROM_POSE). */
+CD_INLINE void cd_item_particle_ends(cd_cols c, cd_particle_id q)
+{
+    cd_store_ends(c, q, c.position[q], c.orientation[q], 0, 0);
+}
+
+/* World ends of primitive i as the step's passes use them: stored by the
+ * last advance, or (CD_ENDS_FROM_POSE) computed from the pose. */
+CD_INLINE void cd_prim_world_ends(cd_cols c, cd_prim_id i, cd_vec3 *a, cd_vec3 *b)
+{
+#if CD_ENDS_FROM_POSE
+    cd_particle_id p = c.prim_particle[i];
+    cd_prim_ends_at(c, i, c.position[p], c.orientation[p], a, b);
+#else
+    *a = c.prim_a[i];
+    *b = c.prim_b[i];
+#endif
+}
+
+/* At a build: particle q's pose and reach into ref_pose (CD_REF_POSE
+ * reals a particle), for cd_pose_moved. */
+CD_INLINE void cd_item_ref_pose(cd_cols c, cd_particle_id q, CD_GLOBAL cd_real *ref_pose)
+{
+    CD_GLOBAL cd_real *r = ref_pose + (cd_long)CD_REF_POSE * q;
+    cd_vec3 x = c.position[q];
+    cd_quat o = c.orientation[q];
+    cd_real reach = 0; /* [m] */
+    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
+    for (cd_int i = first; i < last; i++) {
+        cd_real ra = cd_v3_norm(c.prim_a_body[i]), rb = cd_v3_norm(c.prim_b_body[i]);
+        reach = ra > reach ? ra : reach;
+        reach = rb > reach ? rb : reach;
+    }
+    r[0] = x.x;
+    r[1] = x.y;
+    r[2] = x.z;
+    r[3] = o.w;
+    r[4] = o.x;
+    r[5] = o.y;
+    r[6] = o.z;
+    r[7] = reach;
+}
+
+/* The skin test of particle q (now at centre x, orientation o) against
+ * its pose at the last build (ref_pose; NULL before the first build: 1).
+ * An end at body-frame offset e moved by (x - x_ref) + (R(o) - R(o_ref)) e,
+ * and |R(o) - R(o_ref)| = 2 sin(theta/2) <= 2 |o -+ o_ref| for unit
+ * quaternions (theta: the angle between the two orientations; o and -o
+ * are one rotation), so no end moved more than |x - x_ref| + 2 min|o -+
+ * o_ref| reach.  When that bound, grown by far more than the roundings of
+ * the ends (1e-9 relative, 1e-12 of the coordinates' size), is within
+ * half the skin (limit2 = (skin/2)^2 [m^2]), no end moved beyond it: 0,
+ * without reading the primitives.  Otherwise the ends now and at the build
+ * are computed (as the advance and the build computed them: the same
+ * bits) and tested one by one, as the stored ends were. */
+CD_INLINE int cd_pose_moved(cd_cols c, cd_particle_id q, cd_vec3 x, cd_quat o, const CD_GLOBAL cd_real *ref_pose,
+                            cd_real limit2)
+{
+    if (!ref_pose) return 1;
+    const CD_GLOBAL cd_real *r = ref_pose + (cd_long)CD_REF_POSE * q;
+    cd_vec3 xr = cd_v3(r[0], r[1], r[2]);
+    cd_quat orf = cd_q(r[3], r[4], r[5], r[6]);
+    cd_real reach = r[7];
+    cd_real dw = o.w - orf.w, dx = o.x - orf.x, dy = o.y - orf.y, dz = o.z - orf.z;
+    cd_real sw = o.w + orf.w, sx = o.x + orf.x, sy = o.y + orf.y, sz = o.z + orf.z;
+    cd_real dm = dw * dw + dx * dx + dy * dy + dz * dz, dp = sw * sw + sx * sx + sy * sy + sz * sz;
+    cd_real bound = cd_v3_norm(cd_v3_sub(x, xr)) + CD_R(2) * sqrt(dm < dp ? dm : dp) * reach;
+    bound = bound * CD_R(1.000000001) + CD_R(1e-12) * (fabs(x.x) + fabs(x.y) + fabs(x.z) + reach);
+    if (bound * bound <= limit2) return 0;
+    int moved = 0;
+    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
+    for (cd_int i = first; i < last; i++) {
+        cd_vec3 a, b, ar, br;
+        cd_prim_ends_at(c, i, x, o, &a, &b);
+        cd_prim_ends_at(c, i, xr, orf, &ar, &br);
+        moved |= cd_bp_moved(a, ar, b, br, limit2);
+    }
+    return moved;
+}
+
 /* cd_item_advance for particle q whose velocity v [m/s], angular momentum
  * L [kg m^2/s], force F [N], torque T [N m] and mass m [kg] the caller has
  * already read (or just computed): the state is read once and written
@@ -94,7 +218,7 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
  * columns' stores (any column may alias any other for it).  The kick's own
  * angular velocity is not formed: the drift's replaces it. */
 CD_INLINE int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_vec3 L, cd_vec3 F, cd_vec3 T, cd_real m,
-                              cd_real dt, cd_real limit2)
+                              cd_real dt, cd_real limit2, const CD_GLOBAL cd_real *ref_pose)
 {
     cd_vec3 x = c.position[q], w;
     cd_quat o = c.orientation[q];
@@ -105,28 +229,27 @@ CD_INLINE int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_vec3 L,
     c.position[q] = x;
     c.orientation[q] = o;
     c.angvel[q] = w;
-    int moved = 0;
-    cd_int first = c.prim_first[q], last = first + c.prim_count[q];
-    for (cd_int i = first; i < last; i++) {
-        cd_vec3 a, b;
-        cd_prim_ends_at(c, i, x, o, &a, &b);
-        c.prim_a[i] = a;
-        c.prim_b[i] = b;
-        moved |= cd_bp_moved(a, c.prim_a_ref[i], b, c.prim_b_ref[i], limit2);
-    }
-    return moved;
+#if CD_ENDS_FROM_POSE
+    return cd_pose_moved(c, q, x, o, ref_pose, limit2);
+#else
+    (void)ref_pose;
+    return cd_store_ends(c, q, x, o, 1, limit2);
+#endif
 }
 
 /* Steps 1-4 of particle q in one pass over its data: the first half kick
  * over dt/2, the drift over dt [s], the world ends of its primitives, and
- * the skin test of those ends (limit2 = (skin/2)^2 [m^2], broadphase.h).
+ * the skin test of those ends (limit2 = (skin/2)^2 [m^2], broadphase.h;
+ * ref_pose: the poses at the last build when CD_ENDS_FROM_POSE, which
+ * stores no ends here, else unused).
  * Returns 1 when one of its primitives moved more than half the skin since
  * the last neighbour-list build.  The same arithmetic as the four items
  * one after the other: fused because each reads what the one before wrote
  * (docs/performance.md, "Bytes per step"). */
-CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real limit2)
+CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real limit2,
+                              const CD_GLOBAL cd_real *ref_pose)
 {
-    return cd_advance_from(c, q, c.velocity[q], c.angmom[q], c.force[q], c.torque[q], c.mass[q], dt, limit2);
+    return cd_advance_from(c, q, c.velocity[q], c.angmom[q], c.force[q], c.torque[q], c.mass[q], dt, limit2, ref_pose);
 }
 
 /* Contact geometry of pair row k (docs/references.md, Contacts): closest points of the two axes
@@ -164,7 +287,9 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
 {
     cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
     cd_particle_id pi = c.prim_particle[i], pj = c.prim_particle[j];
-    cd_vec3 ai = c.prim_a[i], bi = c.prim_b[i], aj = c.prim_a[j], bj = c.prim_b[j];
+    cd_vec3 ai, bi, aj, bj;
+    cd_prim_world_ends(c, i, &ai, &bi);
+    cd_prim_world_ends(c, j, &aj, &bj);
     cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
     cd_contact_geom g;
     int apart;
@@ -201,7 +326,10 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     cd_real m_eff = cd_law_effective_mass(c.mass[pi], c.mass[pj]);
     cd_vec3 shear = c.pair_shear[k];
     cd_contact_force f = cd_contact_law(law, m_eff, cd_law_pair_radius(ri, rj), &g, cd_v3_sub(vj, vi), dt, &shear);
-    c.pair_active[k] = 1;
+#if CD_ENDS_FROM_POSE
+    if (!c.pair_active[k]) /* memory-bound variants: written when it changes (4 B a contact-step) */
+#endif
+        c.pair_active[k] = 1;
     c.pair_shear[k] = shear;
     c.pair_point[k] = g.point;
     c.pair_force[k] = f.force_j;
@@ -237,9 +365,10 @@ CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_entry 
     cd_particle_id pi = c.prim_particle[i];
     cd_wall wall = walls[row % n_walls]; /* private copy: the wall functions take private pointers */
     cd_contact_geom g;
-    int apart = cd_wall_clearly_apart(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i]);
-    if (!apart)
-        cd_wall_contact_rule(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], sin_parallel, parallel_blend, &g);
+    cd_vec3 a, b;
+    cd_prim_world_ends(c, i, &a, &b);
+    int apart = cd_wall_clearly_apart(&wall, a, b, c.prim_radius[i]);
+    if (!apart) cd_wall_contact_rule(&wall, a, b, c.prim_radius[i], sin_parallel, parallel_blend, &g);
     if (apart || !(g.overlap > 0)) {
         /* the contact and its history end; written only when it changes,
          * to spare the bandwidth (the outputs are read only while active) */
@@ -416,7 +545,7 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
 CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                                           const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
                                           const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
-                                          cd_real dt, cd_real limit2, int next)
+                                          cd_real dt, cd_real limit2, const CD_GLOBAL cd_real *ref_pose, int next)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
@@ -424,7 +553,7 @@ CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_
     c.force[q] = F;
     c.torque[q] = T;
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
-    if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2);
+    if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2, ref_pose);
     c.velocity[q] = v;
     c.angmom[q] = L;
     c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, c.inertia[q]);

@@ -16,7 +16,7 @@ __kernel void cd_cl_advance(
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
-    if (q < n_particles && cd_item_advance(c, q, dt, limit2)) flags[0] = 1;
+    if (q < n_particles && cd_item_advance(c, q, dt, limit2, 0)) flags[0] = 1;
     if (q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
 }
 
@@ -67,7 +67,7 @@ __kernel void cd_cl_gather_kick(
         return;
     }
     if (cd_item_gather_kick_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, dt,
-                                    limit2, mode == 2))
+                                    limit2, 0, mode == 2))
         flags[0] = 1;
 }
 

@@ -63,6 +63,7 @@ typedef struct {
     cd_int *count;                                            /* per particle: gather and wall counts, then cursors */
     cd_int *chunk_sum;                                        /* prefix sums' levels (cd_scan_scratch) */
     cd_int *skin_flag; /* offload: 1 when the last advance found an end beyond half the skin (step_omp.c) */
+    cd_real *ref_pose; /* CD_ENDS_FROM_POSE: each particle's pose at the build (cd_item_ref_pose; step_items.h) */
     /* memory order (kernels/reorder_items.h, src/backend/omp/reorder.c; allocated at
      * the first build with neighbor.reorder: cells) */
     cd_int *part_uid, *part_at;  /* particle: memory slot -> user id, user id -> memory slot */
@@ -249,10 +250,10 @@ cd_order cd_sim_step_order(const cd_sim *sim);
 cd_order cd_sim_host_order(const cd_sim *sim);
 /* At a rebuild, before the particles are binned: the particles, their
  * primitives and wall rows put in the order of their grid cells (the
- * grid of the build, d.grid), the maps updated; *moved = 1 when some
- * particle moved (then d.prim_src holds the primitives' old slots).
- * 0, or -1 out of memory. */
-int cd_reorder_build(cd_sim *sim, int *moved);
+ * grid of the build, d.grid, a host copy of which is g), the maps
+ * updated; *moved = 1 when some particle moved (then d.prim_src holds the
+ * primitives' old slots).  0, or -1 out of memory. */
+int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved);
 /* At the end of a build: d.pair_at for the new rows.  0, or -1. */
 int cd_reorder_pair_rows(cd_sim *sim);
 /* The host columns in user order (a sync; rows copied back from a device

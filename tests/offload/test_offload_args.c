@@ -35,17 +35,17 @@ static void test_arguments_copied_only_when_they_change(void **state)
     assert_int_equal(cd_sim_initial_forces(&sim), 0);
     long long c0[2], c1[2], c2[2];
     cdt_step(&sim, 2); /* the first steps allocate the skin flag: the head goes out again */
-    cd_sim_step_arg_copies(&sim, c0);
+    cd_sim_step_arg_copies(&sim, c0, NULL);
     long long builds = sim.nb.builds;
     cdt_step(&sim, 100); /* standing walls */
-    cd_sim_step_arg_copies(&sim, c1);
+    cd_sim_step_arg_copies(&sim, c1, NULL);
     assert_int_equal(sim.nb.builds, builds);
     assert_int_equal(c1[0] - c0[0], 0);
     assert_int_equal(c1[1] - c0[1], 0);
     /* a wall moving at 1 mm/s: 20 steps move it 0.2 um, far below half the skin */
     sim.s.walls[0].velocity = cd_v3_scale(sim.s.walls[0].normal, -1e-3);
     cdt_step(&sim, 20);
-    cd_sim_step_arg_copies(&sim, c2);
+    cd_sim_step_arg_copies(&sim, c2, NULL);
     assert_int_equal(sim.nb.builds, builds);
     assert_int_equal(c2[0] - c1[0], 0);
     /* one copy for the new velocity (the call's first advance), then one
@@ -59,8 +59,38 @@ static void test_arguments_copied_only_when_they_change(void **state)
     cd_config_free(&cfg);
 }
 
+/* A build moves only the addresses of the wall-candidate lists (the new
+ * ones and the previous build's swap places): the block's head goes out
+ * once per build, as the span of words that changed (32 B), not whole
+ * (hundreds of bytes) and not once per launch of the build. */
+static void test_a_build_sends_the_changed_span_once(void **state)
+{
+    (void)state;
+    static cd_sim sim;
+    cd_config cfg;
+    cdt_setup(&sim, &cfg, resting);
+    assert_int_equal(cd_sim_initial_forces(&sim), 0);
+    cdt_step(&sim, 5);
+    long long c0[2], b0[2], c1[2], b1[2];
+    cd_sim_step_arg_copies(&sim, c0, b0);
+    long long builds = sim.nb.builds;
+    for (int k = 0; k < 10; k++) {
+        sim.nb.force_rebuild = 1;
+        cdt_step(&sim, 1);
+    }
+    cd_sim_step_arg_copies(&sim, c1, b1);
+    assert_int_equal(sim.nb.builds - builds, 10);
+    print_message("10 builds: +%lld copies of the head, %lld B\n", c1[0] - c0[0], b1[0] - b0[0]);
+    assert_int_equal(c1[0] - c0[0], OFFLOADED ? 10 : 0);
+    assert_true(b1[0] - b0[0] <= (OFFLOADED ? 10 * 64 : 0));
+    assert_int_equal(c1[1] - c0[1], 0); /* standing walls */
+    cd_sim_free(&sim);
+    cd_config_free(&cfg);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_arguments_copied_only_when_they_change)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_arguments_copied_only_when_they_change),
+                                       cmocka_unit_test(test_a_build_sends_the_changed_span_once)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

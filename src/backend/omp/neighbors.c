@@ -16,6 +16,7 @@
 #include <string.h>
 #include <math.h>
 #include "backend/omp/omp_loops.h"
+#include "backend/omp/step_device.h"
 #include "neighbor_items.h"
 #include "step_items.h"
 
@@ -43,7 +44,7 @@ void cd_neighbors_free(cd_neighbors *nb)
                    d->old_keys,   d->old_active,    d->old_shear,    d->count,        d->chunk_sum,   d->part_uid,
                    d->part_at,    d->prim_uid,      d->prim_at,      d->pair_at,      d->pair_ustart, d->part_src,
                    d->prim_src,   d->new_first,     d->sort_keys,    d->sort_vals,    d->hist,        d->move,
-                   d->skin_flag};
+                   d->skin_flag,  d->ref_pose};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -85,6 +86,8 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
             realloc_dev((void **)&d->gather_start, N + 1, sizeof(cd_int)) ||
             realloc_dev((void **)&d->wall_start, N + 1, sizeof(cd_int)))
             return -1;
+        /* the poses the skin test bounds the ends' motion from (step_items.h) */
+        if (CD_ENDS_FROM_POSE && realloc_dev((void **)&d->ref_pose, CD_REF_POSE * (N + 1), sizeof(cd_real))) return -1;
     }
     if (rows > nb->cap_rows || !d->keys) {
         size_t cap = rows + rows / 4 + 16;
@@ -98,8 +101,10 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
 
 /* out[0] = 0, out[k+1] = out[k] + in[k] for k < n: the tree of chunks of
  * kernels/neighbor_items.h, 2 L + 1 loops for L levels above the input
- * (one loop up to 64 entries, three up to 4,096, five up to 262,144). */
-void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *scratch)
+ * (one loop up to 64 entries, three up to 4,096, five up to 262,144);
+ * copy (or NULL): out[0 .. n] also into copy, in the loop that writes
+ * them (the cursor of a counting fill; it may be in). */
+static void scan_copy(const cd_int *in, cd_int n, cd_int *out, cd_int *scratch, cd_int *copy)
 {
     cd_int *level[8]; /* levels above 0 in scratch: 64^7 > 2^31 entries */
     cd_long len[8];
@@ -118,27 +123,27 @@ void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *scratch)
         level[L] = sums;
         len[L] = m;
     }
-    cd_int *top = L ? level[L] : out;
+    cd_int *top = L ? level[L] : out, *top_copy = L ? NULL : copy;
     const cd_int *top_in = L ? level[L] : in;
     cd_long n_top = len[L];
-    CD_STEP_FOR(1, CD_DEV(is_device_ptr(top_in, top)))
-    for (int one = 0; one < 1; one++) cd_scan_item_top(top_in, n_top, top);
+    CD_STEP_FOR(1, CD_DEV(is_device_ptr(top_in, top, top_copy)))
+    for (int one = 0; one < 1; one++) {
+        cd_scan_item_top(top_in, n_top, top);
+        if (top_copy) cd_scan_item_copy(top, n_top, 0, top_copy);
+    }
     for (int l = L - 1; l >= 0; l--) {
         const cd_int *src = l ? level[l] : in, *starts = level[l + 1];
-        cd_int *dst = l ? level[l] : out;
+        cd_int *dst = l ? level[l] : out, *dst_copy = l ? NULL : copy;
         cd_long n_src = len[l], m = len[l + 1];
-        CD_STEP_FOR(m, CD_DEV(is_device_ptr(src, starts, dst)))
-        for (cd_long g = 0; g < m; g++) cd_scan_item_fill(src, n_src, g, starts, dst);
+        CD_STEP_FOR(m, CD_DEV(is_device_ptr(src, starts, dst, dst_copy)))
+        for (cd_long g = 0; g < m; g++) {
+            cd_scan_item_fill(src, n_src, g, starts, dst);
+            if (dst_copy) cd_scan_item_copy(dst, n_src, g, dst_copy);
+        }
     }
 }
 
-/* dst[k] = src[k] (k < n): a scan's output becomes the cursor of a fill. */
-static void copy_ints(cd_int *dst, const cd_int *src, size_t n)
-{
-    CD_WIDE_MIN
-    CD_STEP_FOR(n, CD_DEV(is_device_ptr(dst, src)))
-    for (size_t k = 0; k < n; k++) dst[k] = src[k];
-}
+void cd_nb_scan(const cd_int *in, cd_int n, cd_int *out, cd_int *scratch) { scan_copy(in, n, out, scratch, NULL); }
 
 static void zero_ints(cd_int *dst, size_t n)
 {
@@ -148,74 +153,84 @@ static void zero_ints(cd_int *dst, size_t n)
 }
 
 /* Passes 1-2: bounds, the tree of boxes, and grid (2 + L loops for L
- * levels of boxes: 3 up to 4,096 particles, 4 up to 262,144).  Returns 1
- * when the grid says the run blew up (cd_nb_item_grid; the grid comes
- * back, 56 bytes), 0 otherwise. */
-static int make_grid(cd_sim *sim, cd_cols c, cd_nb_lists d)
+ * levels of boxes: 3 up to 4,096 particles, 4 up to 262,144), which comes
+ * back into *grid_out (56 bytes; the reorder reads it too).  Returns 1 when the
+ * grid says the run blew up (cd_nb_item_grid), -1 when it could not be
+ * read, 0 otherwise. */
+static int make_grid(cd_sim *sim, cd_grid *grid_out)
 {
     cd_long N = (cd_long)sim->s.n_particles, n = (N + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK;
-    cd_real skin = sim->nb.skin, *boxes = d.partial; /* [m] */
+    cd_real skin = sim->nb.skin, *boxes = sim->nb.d.partial; /* [m] */
     CD_WIDE_MIN
-    CD_STEP_FOR(N, firstprivate(c, d))
-    for (cd_long p = 0; p < N; p++) cd_nb_item_bound(c, p, d.part_bound);
-    CD_STEP_FOR(n, firstprivate(c, d))
-    for (cd_long g = 0; g < n; g++) cd_nb_item_box(c, g, N, d.part_bound, d.partial);
+    CD_BUILD_ARGS(sim)
+    /* (with CD_ENDS_FROM_POSE the world ends, which the steps do not
+     * store, first: the build bins and pairs them) */
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_long p = 0; p < N; p++) {
+        if (CD_ENDS_FROM_POSE) cd_item_particle_ends(CD_B.c, p);
+        cd_nb_item_bound(CD_B.c, p, CD_B.d.part_bound);
+    }
+    CD_STEP_FOR(n, CD_BUILD_IN)
+    for (cd_long q = 0; q < n; q++) cd_nb_item_box(CD_B.c, q, N, CD_B.d.part_bound, CD_B.d.partial);
     while (n > CD_BOX_CHUNK) {
         cd_long m = (n + CD_BOX_CHUNK - 1) / CD_BOX_CHUNK, n_in = n;
         cd_real *up = boxes + 7 * n;
         CD_STEP_FOR(m, CD_DEV(is_device_ptr(boxes, up)))
-        for (cd_long g = 0; g < m; g++) cd_nb_item_box_up(boxes, n_in, g, up);
+        for (cd_long q = 0; q < m; q++) cd_nb_item_box_up(boxes, n_in, q, up);
         boxes = up;
         n = m;
     }
     cd_int n_top = (cd_int)n;
-    cd_grid *grid = d.grid;
+    cd_grid *grid = sim->nb.d.grid;
     CD_STEP_FOR(1, CD_DEV(is_device_ptr(boxes, grid)))
     for (int one = 0; one < 1; one++) cd_nb_item_grid(boxes, n_top, skin, (cd_int)N, grid);
-    cd_grid g;
-    return cd_dev_get(&g, d.grid, sizeof g) == 0 && g.dim[0] < 0;
+    if (cd_dev_get(grid_out, grid, sizeof *grid_out)) return -1;
+    return grid_out->dim[0] < 0;
 }
 
-/* Passes 3-4: particles binned by cell (CSR). */
-static void bin_particles(cd_sim *sim, cd_cols c, cd_nb_lists d)
+/* Passes 3-4: particles binned by cell (CSR); the scan's last loop turns
+ * the counts into the fill's cursor. */
+static void bin_particles(cd_sim *sim)
 {
     cd_int N = (cd_int)sim->s.n_particles, cell_cap = (cd_int)sim->nb.cell_cap;
+    cd_nb_lists *dl = &sim->nb.d;
     CD_WIDE_MIN
-    zero_ints(d.cell_count, (size_t)cell_cap);
-    CD_STEP_FOR(N, firstprivate(c, d))
-    for (cd_int q = 0; q < N; q++) cd_nb_item_bin(c, q, d.grid, cell_cap, d.part_cell, d.cell_count);
-    cd_nb_scan(d.cell_count, cell_cap, d.cell_start, d.chunk_sum);
-    copy_ints(d.cell_count, d.cell_start, (size_t)cell_cap);
-    CD_STEP_FOR(N, firstprivate(d))
-    for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, d.part_cell, d.cell_count, d.cell_parts);
+    CD_BUILD_ARGS(sim)
+    zero_ints(dl->cell_count, (size_t)cell_cap);
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int q = 0; q < N; q++)
+        cd_nb_item_bin(CD_B.c, q, CD_B.d.grid, cell_cap, CD_B.d.part_cell, CD_B.d.cell_count);
+    scan_copy(dl->cell_count, cell_cap, dl->cell_start, dl->chunk_sum, dl->cell_count);
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, CD_B.d.part_cell, CD_B.d.cell_count, CD_B.d.cell_parts);
 }
 
 /* Pass 5 in slot mode (slot > 0; returns the longest row, which may exceed
  * the slot) or in fill mode (slot = 0: rows written in place into
  * pair_prim_j at pair_offset). */
-static cd_int collect(cd_sim *sim, cd_cols c, cd_nb_lists d, cd_int slot)
+static cd_int collect(cd_sim *sim, cd_int slot)
 {
     cd_int N = (cd_int)sim->s.n_particles, longest = 0;
     cd_real skin = sim->nb.skin; /* [m] */
-    cd_order o = cd_sim_step_order(sim);
     CD_WIDE_MIN
-    CD_STEP_FOR(N, firstprivate(c, d, o) reduction(max : longest) CD_DEV(map(tofrom : longest)))
+    CD_BUILD_ARGS(sim)
+    CD_STEP_FOR(N, CD_BUILD_IN reduction(max : longest) CD_DEV(map(tofrom : longest)))
     for (cd_int p = 0; p < N; p++) {
         if (slot > 0)
-            cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, d.cand, slot, 0,
-                               d.pair_count, o);
+            cd_nb_item_collect(CD_B.c, p, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
+                               CD_B.d.cand, slot, 0, CD_B.d.pair_count, CD_B.order);
         else
-            cd_nb_item_collect(c, p, d.grid, d.cell_start, d.cell_parts, d.part_bound, skin, c.pair_prim_j, 0,
-                               d.pair_offset, d.pair_count, o);
-        for (cd_int i = c.prim_first[p]; i < c.prim_first[p] + c.prim_count[p]; i++)
-            if (d.pair_count[i] > longest) longest = d.pair_count[i];
+            cd_nb_item_collect(CD_B.c, p, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
+                               CD_B.c.pair_prim_j, 0, CD_B.d.pair_offset, CD_B.d.pair_count, CD_B.order);
+        for (cd_int i = CD_B.c.prim_first[p]; i < CD_B.c.prim_first[p] + CD_B.c.prim_count[p]; i++)
+            if (CD_B.d.pair_count[i] > longest) longest = CD_B.d.pair_count[i];
     }
     return longest;
 }
 
 /* The old rows' keys and history, before the rows are replaced (pass 8
  * reads them). */
-static int keep_history(cd_sim *sim, cd_cols c)
+static int keep_history(cd_sim *sim)
 {
     cd_neighbors *nb = &sim->nb;
     size_t n_old = sim->s.n_pairs;
@@ -227,11 +242,11 @@ static int keep_history(cd_sim *sim, cd_cols c)
             return -1;
         nb->cap_old = cap;
     }
-    cd_nb_lists d = nb->d;
-    cd_order o = cd_sim_step_order(sim);
     CD_WIDE_MIN
-    CD_STEP_FOR(n_old, firstprivate(c, d, o))
-    for (size_t k = 0; k < n_old; k++) cd_nb_item_keep(c, (cd_long)k, o, d.old_keys, d.old_active, d.old_shear);
+    CD_BUILD_ARGS(sim)
+    CD_STEP_FOR(n_old, CD_BUILD_IN)
+    for (size_t k = 0; k < n_old; k++)
+        cd_nb_item_keep(CD_B.c, (cd_long)k, CD_B.order, CD_B.d.old_keys, CD_B.d.old_active, CD_B.d.old_shear);
     return 0;
 }
 
@@ -306,40 +321,46 @@ static int keep_wall_history(cd_sim *sim)
     return 0;
 }
 
-/* Passes 9 (gather lists) and 10 (wall candidates; their number comes
- * back, to size their lists; their history carried over from the old
- * ones, whose primitives had the slots prim_src names: null, the same). */
-static int particle_lists(cd_sim *sim, cd_cols c, cd_nb_lists d, const cd_int *prim_src)
+/* Passes 9 (gather lists: their counts came with the carry-over) and 10
+ * (wall candidates; their number comes back, to size their lists; their
+ * history carried over from the old ones, whose primitives had the slots
+ * prim_src names: null, the same).  The gather lists are sorted and the
+ * wall candidates counted in one launch (both per particle). */
+static int particle_lists(cd_sim *sim, const cd_int *prim_src)
 {
     cd_state *s = &sim->s;
     cd_int N = (cd_int)s->n_particles, W = (cd_int)s->n_walls;
     size_t n_pairs = s->n_pairs;
-    const cd_wall *walls = s->walls;
     cd_real skin = sim->nb.skin; /* [m] */
+    cd_nb_lists *dl = &sim->nb.d;
     CD_WIDE_MIN
-    zero_ints(d.count, (size_t)N);
-    CD_STEP_FOR(n_pairs, firstprivate(c, d))
-    for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_count(c, (cd_long)k, d.count);
-    cd_nb_scan(d.count, N, d.gather_start, d.chunk_sum);
-    copy_ints(d.count, d.gather_start, (size_t)N);
-    CD_STEP_FOR(n_pairs, firstprivate(c, d))
-    for (size_t k = 0; k < n_pairs; k++) cd_nb_item_gather_fill(c, (cd_long)k, d.count, d.gather_rows);
-    cd_order o = cd_sim_step_order(sim);
-    CD_STEP_FOR(N, firstprivate(c, d, o))
-    for (cd_int q = 0; q < N; q++) cd_nb_item_gather_sort(c, o, q, d.gather_start, d.gather_rows);
-
-    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
-    for (cd_int q = 0; q < N; q++) d.count[q] = cd_item_wall_candidates(c, q, walls, W, skin, 0);
-    cd_nb_scan(d.count, N, d.wall_start, d.chunk_sum);
+    {
+        CD_BUILD_ARGS(sim)
+        scan_copy(dl->count, N, dl->gather_start, dl->chunk_sum, dl->count);
+        CD_STEP_FOR(n_pairs, CD_BUILD_IN)
+        for (size_t k = 0; k < n_pairs; k++)
+            cd_nb_item_gather_fill(CD_B.c, (cd_long)k, CD_B.d.count, CD_B.d.gather_rows);
+        CD_STEP_FOR(N, CD_BUILD_IN)
+        for (cd_int q = 0; q < N; q++) {
+            cd_nb_item_gather_sort(CD_B.c, CD_B.order, q, CD_B.d.gather_start, CD_B.d.gather_rows);
+            CD_B.d.count[q] = cd_item_wall_candidates(CD_B.c, q, CD_B.walls, W, skin, 0);
+        }
+    }
+    cd_nb_scan(dl->count, N, dl->wall_start, dl->chunk_sum);
     cd_int n_rows = 0;
-    if (cd_dev_get(&n_rows, d.wall_start + N, sizeof n_rows) || reserve_wall_rows(&sim->nb, (size_t)n_rows)) return -1;
-    d = sim->nb.d; /* the candidate lists may have moved */
-    CD_STEP_FOR(N, firstprivate(c, d) CD_DEV(map(to : walls [0:CD_MAX_WALLS])))
-    for (cd_int q = 0; q < N; q++) cd_item_wall_candidates(c, q, walls, W, skin, d.wall_rows + d.wall_start[q]);
+    if (cd_dev_get(&n_rows, dl->wall_start + N, sizeof n_rows) || reserve_wall_rows(&sim->nb, (size_t)n_rows))
+        return -1;
     cd_long n_old = (cd_long)sim->nb.n_old_wall_rows;
-    CD_STEP_FOR(n_rows, firstprivate(d) CD_DEV(is_device_ptr(prim_src)))
-    for (cd_int e = 0; e < n_rows; e++)
-        cd_item_wall_carry(e, d.wall_rows, d.wall_out, d.old_wall_rows, n_old, d.old_wall_out, prim_src, W);
+    {
+        CD_BUILD_ARGS(sim) /* the candidate lists may have moved */
+        CD_STEP_FOR(N, CD_BUILD_IN)
+        for (cd_int q = 0; q < N; q++)
+            cd_item_wall_candidates(CD_B.c, q, CD_B.walls, W, skin, CD_B.d.wall_rows + CD_B.d.wall_start[q]);
+        CD_STEP_FOR(n_rows, CD_BUILD_IN CD_DEV(is_device_ptr(prim_src)))
+        for (cd_int e = 0; e < n_rows; e++)
+            cd_item_wall_carry(e, CD_B.d.wall_rows, CD_B.d.wall_out, CD_B.d.old_wall_rows, n_old, CD_B.d.old_wall_out,
+                               prim_src, W);
+    }
     sim->nb.n_wall_rows = (size_t)n_rows;
     memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
     return 0;
@@ -353,17 +374,18 @@ int cd_neighbors_build(cd_sim *sim)
 {
     cd_state *s = &sim->s;
     cd_neighbors *nb = &sim->nb;
-    cd_int P = (cd_int)s->n_prims;
+    cd_int P = (cd_int)s->n_prims, N = (cd_int)s->n_particles;
     /* host threads after a sync: the columns back in the lists' order */
     if (cd_reorder_to_memory(sim) || reserve(nb, s, s->n_pairs)) return -1;
-    cd_cols c = cd_sim_step_cols(sim);
     /* the old rows' history aside, keyed in the order they were made in */
-    if (keep_history(sim, c) || keep_wall_history(sim)) return -1;
-    if (make_grid(sim, c, nb->d)) return CD_NB_BLOWUP;
+    if (keep_history(sim) || keep_wall_history(sim)) return -1;
+    cd_grid grid;
+    int bad = make_grid(sim, &grid);
+    if (bad) return bad > 0 ? CD_NB_BLOWUP : -1;
     int moved = 0;
-    if (cd_reorder_build(sim, &moved)) return -1;
-    bin_particles(sim, c, nb->d);
-    cd_int longest = collect(sim, c, nb->d, nb->slot);
+    if (cd_reorder_build(sim, &grid, &moved)) return -1;
+    bin_particles(sim);
+    cd_int longest = collect(sim, nb->slot);
     cd_nb_scan(nb->d.pair_count, P, nb->d.pair_offset, nb->d.chunk_sum);
     cd_int n_new = 0;
     if (cd_dev_get(&n_new, nb->d.pair_offset + P, sizeof n_new)) return -1;
@@ -378,30 +400,46 @@ int cd_neighbors_build(cd_sim *sim)
     size_t n_old = s->n_pairs;
     if (cd_sim_reserve_step_pairs(sim, (size_t)n_new + (size_t)n_new / 4 + 16) || reserve(nb, s, (size_t)n_new))
         return -1;
-    c = cd_sim_step_cols(sim);
     s->n_pairs = (size_t)n_new;
     cd_int slot = nb->slot;
     if (longest > nb->slot) { /* some row is incomplete in its slot: write the rows in place */
-        collect(sim, c, nb->d, 0);
+        collect(sim, 0);
         slot = 0;
         while (nb->slot < longest) nb->slot *= 2;
         if (realloc_dev((void **)&nb->d.cand, (size_t)P * (size_t)nb->slot + 1, sizeof(cd_prim_id))) return -1;
     }
-    cd_nb_lists d = nb->d;
-    cd_order o = cd_sim_step_order(sim);
-    const cd_int *prim_src = moved ? d.prim_src : NULL; /* the slots the old rows' keys name */
+    const cd_int *prim_src = moved ? nb->d.prim_src : NULL; /* the slots the old rows' keys name */
+    cd_int most = P > N ? P : N;
     CD_WIDE_MIN
-    CD_STEP_FOR(P, firstprivate(c, d, o))
-    for (cd_int i = 0; i < P; i++) cd_nb_item_place(c, i, d.pair_offset, d.cand, slot, d.keys, o);
-    CD_STEP_FOR(n_new, firstprivate(c, d) CD_DEV(is_device_ptr(prim_src)))
-    for (cd_int k = 0; k < n_new; k++)
-        cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active, d.old_shear, prim_src);
-    if (particle_lists(sim, c, d, prim_src) || cd_reorder_pair_rows(sim)) return -1;
-    CD_STEP_FOR(P, firstprivate(c))
-    for (cd_int i = 0; i < P; i++) {
-        c.prim_a_ref[i] = c.prim_a[i];
-        c.prim_b_ref[i] = c.prim_b[i];
+    {
+        CD_BUILD_ARGS(sim)
+        /* Pass 7, with in the same launch: the primitive ends become the
+         * skin test's reference (nothing later in the build moves them;
+         * with CD_ENDS_FROM_POSE the particles' poses too), the particles'
+         * gather counts are cleared for the next launch, and the skin flag
+         * (offload: set by the step that asked for this build) is cleared;
+         * three launches and a copy before. */
+        CD_STEP_FOR(most, CD_BUILD_IN)
+        for (cd_int i = 0; i < most; i++) {
+            if (i < P) {
+                cd_nb_item_place(CD_B.c, i, CD_B.d.pair_offset, CD_B.d.cand, slot, CD_B.d.keys, CD_B.order);
+                CD_B.c.prim_a_ref[i] = CD_B.c.prim_a[i];
+                CD_B.c.prim_b_ref[i] = CD_B.c.prim_b[i];
+            }
+            if (i < N) CD_B.d.count[i] = 0;
+            if (i < N && CD_B.d.ref_pose) cd_item_ref_pose(CD_B.c, i, CD_B.d.ref_pose);
+            if (i == 0 && CD_B.d.skin_flag) CD_B.d.skin_flag[0] = 0;
+        }
+        /* Passes 8 and 9a: each new row's history, and its count in its
+         * two particles' gather lists. */
+        CD_STEP_FOR(n_new, CD_BUILD_IN CD_DEV(is_device_ptr(prim_src)))
+        for (cd_int k = 0; k < n_new; k++) {
+            cd_nb_item_carry(CD_B.c, k, CD_B.d.keys, CD_B.d.old_keys, (cd_long)n_old, CD_B.d.old_active,
+                             CD_B.d.old_shear, prim_src);
+            cd_nb_item_gather_count(CD_B.c, k, CD_B.d.count);
+        }
     }
+    if (particle_lists(sim, prim_src) || cd_reorder_pair_rows(sim)) return -1;
     nb->force_rebuild = 0;
     nb->builds++;
     return 0;

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <math.h>
 #include "backend/omp/omp_loops.h"
+#include "backend/omp/step_device.h"
 #include "observe_items.h"
 
 /* Leaves of the three reductions, in merge order. */
@@ -173,33 +174,31 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
         x->partial = cd_dev_alloc(x->cap_blocks * CD_OBS_SLOTS * sizeof(cd_real));
         if (!x->partial) return -1;
     }
-    cd_cols c = cd_sim_step_cols(sim);
     cd_long N = (cd_long)s->n_particles, K = (cd_long)s->n_pairs, R = (cd_long)(s->n_prims * s->n_walls),
             P = (cd_long)s->n_prims;
     cd_int W = (cd_int)s->n_walls;
-    cd_vec3 g = sim->p.gravity;
-    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
     cd_int *touch = x->touch;
     cd_real *part = x->partial, *total = x->total;
     cd_long pk = nb.particles * CD_OBS_SLOTS, pw = pk + nb.pairs * CD_OBS_SLOTS;
-    CD_WIDE_MIN
-    CD_STEP_FOR(N, firstprivate(c) is_device_ptr(touch))
-    for (cd_long q = 0; q < N; q++) touch[q] = 0;
-    CD_STEP_FOR(K, firstprivate(c) is_device_ptr(touch))
-    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(c, k, touch);
-    cd_nb_lists d = sim->nb.d;
     cd_long n_cand = W ? (cd_long)sim->nb.n_wall_rows : 0;
-    CD_STEP_FOR(n_cand, firstprivate(c, d) is_device_ptr(touch))
-    for (cd_long e = 0; e < n_cand; e++) cd_obs_item_touch_wall(c, e, W, d.wall_rows, d.wall_out, touch);
-    cd_order o = cd_sim_step_order(sim);
-    CD_STEP_FOR(N, firstprivate(c, g, o) is_device_ptr(touch, part))
-    for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, part + b * CD_OBS_SLOTS, o);
-    CD_STEP_FOR(P, firstprivate(c, law, o) is_device_ptr(part))
-    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, part + pk + b * CD_OBS_SLOTS, o);
-    CD_STEP_FOR(R, firstprivate(c, d, wall_law, o) is_device_ptr(part))
+    CD_WIDE_MIN
+    CD_ARGS(sim) /* the step's block: columns, lists, order, laws, gravity */
+    CD_STEP_FOR(N, is_device_ptr(touch))
+    for (cd_long q = 0; q < N; q++) touch[q] = 0;
+    CD_STEP_FOR(K, CD_ARGS_IN is_device_ptr(touch))
+    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(a->c, k, touch);
+    CD_STEP_FOR(n_cand, CD_ARGS_IN is_device_ptr(touch))
+    for (cd_long e = 0; e < n_cand; e++) cd_obs_item_touch_wall(a->c, e, W, a->d.wall_rows, a->d.wall_out, touch);
+    CD_STEP_FOR(N, CD_ARGS_IN is_device_ptr(touch, part))
+    for (cd_long b = 0; b < nb.particles; b++)
+        cd_obs_block_particles(a->c, b, N, a->gravity, touch, part + b * CD_OBS_SLOTS, a->order);
+    CD_STEP_FOR(P, CD_ARGS_IN is_device_ptr(part))
+    for (cd_long b = 0; b < nb.pairs; b++)
+        cd_obs_block_pairs(a->c, b, K, a->law, part + pk + b * CD_OBS_SLOTS, a->order);
+    CD_STEP_FOR(R, CD_ARGS_IN is_device_ptr(part))
     for (cd_long b = 0; b < nb.walls; b++)
-        cd_obs_block_walls(c, b, R, W, wall_law, part + pw + b * CD_OBS_SLOTS, o, d.wall_start, d.wall_rows,
-                           d.wall_out);
+        cd_obs_block_walls(a->c, b, R, W, a->wall_law, part + pw + b * CD_OBS_SLOTS, a->order, a->d.wall_start,
+                           a->d.wall_rows, a->d.wall_out);
     merge_tree(part, leaves(nb), total, 1);
     return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;
 }

@@ -7,7 +7,8 @@
  *   target teams distribute parallel for` over device memory: the state's
  *   columns mapped once at start, the neighbour lists and the build's
  *   scratch allocated on the device (cd_dev_alloc), handed to the loops as
- *   device addresses inside firstprivate structs.
+ *   device addresses inside one device-resident argument block
+ *   (src/backend/omp/step_device.h, CD_ARGS).
  * A function with a CD_STEP_FOR loop declares CD_WIDE_MIN first. */
 #ifndef CD_OMP_LOOPS_H
 #define CD_OMP_LOOPS_H
@@ -119,11 +120,12 @@ cd_cols cd_sim_step_cols(cd_sim *sim);
  * derived columns, which are current.  0, or -1 with err set. */
 int cd_sim_step_remap(cd_sim *sim, char *err, size_t errlen);
 
-/* Copies of the step loops' argument block to the device since the
- * backend started (src/backend/omp/step_device.c, cd_off_args): copies[0] of
- * its head (addresses, laws), copies[1] of its walls; both 0 on host
- * threads, where nothing is copied. */
-void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2]);
+/* Copies of the loops' argument block to the device since the backend
+ * started (src/backend/omp/step_device.c, cd_off_args): copies[0] of its
+ * head (addresses, laws, order: the span that changed), copies[1] of its
+ * walls, and their bytes (bytes may be NULL); all 0 on host threads,
+ * where nothing is copied. */
+void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2], long long bytes[2]);
 
 /* The column of field f (cd_fields) the loops work on (src/backend/omp/step_omp.c). */
 void *cd_sim_step_field(cd_sim *sim, size_t f);

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "backend/omp/omp_loops.h"
+#include "backend/omp/step_device.h"
 #include "reorder_items.h"
 
 /* A rebuild reorders when more than 1/CD_REORDER_DRIFT of the particle
@@ -122,15 +123,15 @@ static void move_rows(cd_sim *sim, cd_int *col, size_t groups, size_t n, size_t 
 
 /* The cell keys of the particles in d.sort_keys (values: their slots in
  * d.sort_vals), and how many slots hold a key below their predecessor's. */
-static long particle_keys(cd_sim *sim, cd_cols c)
+static long particle_keys(cd_sim *sim)
 {
-    cd_nb_lists d = sim->nb.d;
     cd_int N = (cd_int)sim->s.n_particles;
-    cd_ulong *keys = d.sort_keys;
+    cd_ulong *keys = sim->nb.d.sort_keys;
     long descents = 0;
     CD_WIDE_MIN
-    CD_STEP_FOR(N, firstprivate(c, d))
-    for (cd_int q = 0; q < N; q++) cd_reorder_item_key(c, q, d.grid, d.sort_keys, d.sort_vals);
+    CD_BUILD_ARGS(sim)
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int q = 0; q < N; q++) cd_reorder_item_key(CD_B.c, q, CD_B.d.grid, CD_B.d.sort_keys, CD_B.d.sort_vals);
     CD_STEP_FOR(N, reduction(+ : descents) CD_DEV(is_device_ptr(keys) map(tofrom : descents)))
     for (cd_int m = 1; m < N; m++) descents += cd_reorder_item_descent(keys, m);
     return descents;
@@ -175,27 +176,24 @@ static int moves(const cd_field_info *f)
     return f->on_device && strcmp(f->name, "prim_a_ref") && strcmp(f->name, "prim_b_ref");
 }
 
-int cd_reorder_build(cd_sim *sim, int *moved)
+int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
 {
     cd_state *s = &sim->s;
     *moved = 0;
     if (!sim->nb.reorder || s->n_particles < 2) return 0;
     if (!sim->nb.ordered && begin(sim)) return -1;
-    cd_nb_lists d = sim->nb.d;
-    cd_cols c = cd_sim_step_cols(sim);
-    cd_grid g;
-    if (cd_dev_get(&g, d.grid, sizeof g)) return -1;
+    cd_nb_lists d = sim->nb.d; /* host copies of device addresses (is_device_ptr) */
     cd_int N = (cd_int)s->n_particles, P = (cd_int)s->n_prims, W = (cd_int)s->n_walls;
     /* Sorting and moving the state costs a few passes over it: done only
      * when more than 1/CD_REORDER_DRIFT of the slots are out of cell
      * order (a settled packing keeps its order for many rebuilds). */
     int forced = sim->nb.reorder == CD_NB_REORDER_ALWAYS;
-    if (particle_keys(sim, c) * CD_REORDER_DRIFT <= (long)N && !forced) return 0;
+    if (particle_keys(sim) * CD_REORDER_DRIFT <= (long)N && !forced) return 0;
     /* No pair rows yet (a new run, a start from a file without contacts):
      * nothing tells whether the cells' order would beat the order at hand;
      * the next rebuild will. */
     if (s->n_pairs == 0 && !forced) return 0;
-    cd_int *sorted = sort_particles(sim, &g), *src = d.part_src, *slot_of = d.count;
+    cd_int *sorted = sort_particles(sim, g), *src = d.part_src, *slot_of = d.count;
     long changed = 0;
     CD_WIDE_MIN
     CD_STEP_FOR(N, reduction(+ : changed) CD_DEV(is_device_ptr(sorted, src, slot_of) map(tofrom : changed)))
@@ -215,19 +213,21 @@ int cd_reorder_build(cd_sim *sim, int *moved)
      * offload pack them into a 16-byte atomic it cannot link) */
     long excess = 0;
     size_t K = s->n_pairs;
-    CD_STEP_FOR(K, firstprivate(c) reduction(+ : excess) CD_DEV(is_device_ptr(slot_of) map(tofrom : excess)))
+    CD_BUILD_ARGS(sim)
+    CD_STEP_FOR(K, CD_BUILD_IN reduction(+ : excess) CD_DEV(is_device_ptr(slot_of) map(tofrom : excess)))
     for (size_t k = 0; k < K; k++)
-        excess +=
-            8L * cd_reorder_item_row_span(c, (cd_long)k, slot_of) - 7L * cd_reorder_item_row_span(c, (cd_long)k, NULL);
+        excess += 8L * cd_reorder_item_row_span(CD_B.c, (cd_long)k, slot_of) -
+                  7L * cd_reorder_item_row_span(CD_B.c, (cd_long)k, NULL);
     if (excess >= 0 && !forced) return 0;
 
     /* the primitives follow their particles: new first primitives, and
      * the old slot of each new primitive (before prim_first moves) */
-    CD_STEP_FOR(N, firstprivate(c, d))
-    for (cd_int m = 0; m < N; m++) d.count[m] = c.prim_count[d.part_src[m]];
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int m = 0; m < N; m++) CD_B.d.count[m] = CD_B.c.prim_count[CD_B.d.part_src[m]];
     cd_nb_scan(d.count, N, d.new_first, d.chunk_sum);
-    CD_STEP_FOR(N, firstprivate(c, d))
-    for (cd_int m = 0; m < N; m++) cd_reorder_item_prim_src(m, d.part_src, d.new_first, c.prim_first, d.prim_src);
+    CD_STEP_FOR(N, CD_BUILD_IN)
+    for (cd_int m = 0; m < N; m++)
+        cd_reorder_item_prim_src(m, CD_B.d.part_src, CD_B.d.new_first, CD_B.c.prim_first, CD_B.d.prim_src);
 
     const size_t word = sizeof(cd_int);
     for (size_t f = 0; f < cd_n_fields; f++) {
@@ -243,13 +243,13 @@ int cd_reorder_build(cd_sim *sim, int *moved)
     move_rows(sim, (cd_int *)d.part_bound, (size_t)N, sizeof(cd_real) / word, sizeof(cd_real) / word, d.part_src);
     move_rows(sim, d.part_uid, (size_t)N, 1, 1, d.part_src);
     move_rows(sim, d.prim_uid, (size_t)P, 1, 1, d.prim_src);
-    CD_STEP_FOR(N, firstprivate(c, d))
+    CD_STEP_FOR(N, CD_BUILD_IN)
     for (cd_int m = 0; m < N; m++) {
-        cd_reorder_item_owner(c, m, d.new_first);
-        d.part_at[d.part_uid[m]] = m;
+        cd_reorder_item_owner(CD_B.c, m, CD_B.d.new_first);
+        CD_B.d.part_at[CD_B.d.part_uid[m]] = m;
     }
-    CD_STEP_FOR(P, firstprivate(d))
-    for (cd_int i = 0; i < P; i++) d.prim_at[d.prim_uid[i]] = i;
+    CD_STEP_FOR(P, CD_BUILD_IN)
+    for (cd_int i = 0; i < P; i++) CD_B.d.prim_at[CD_B.d.prim_uid[i]] = i;
     sim->nb.reorders++;
     *moved = 1;
     return 0;
@@ -266,14 +266,16 @@ int cd_reorder_pair_rows(cd_sim *sim)
         if (alloc_ints(&dl->pair_at, cap)) return -1;
         sim->nb.pair_at_cap = cap;
     }
-    cd_nb_lists d = *dl;
     cd_int P = (cd_int)sim->s.n_prims;
     CD_WIDE_MIN
-    CD_STEP_FOR(P, firstprivate(d))
-    for (cd_int u = 0; u < P; u++) d.pair_count[u] = cd_reorder_item_pair_count(d.prim_at, d.pair_offset, u);
-    cd_nb_scan(d.pair_count, P, d.pair_ustart, d.chunk_sum);
-    CD_STEP_FOR(P, firstprivate(d))
-    for (cd_int u = 0; u < P; u++) cd_reorder_item_pair_at(d.prim_at, d.pair_offset, d.pair_ustart, u, d.pair_at);
+    CD_BUILD_ARGS(sim)
+    CD_STEP_FOR(P, CD_BUILD_IN)
+    for (cd_int u = 0; u < P; u++)
+        CD_B.d.pair_count[u] = cd_reorder_item_pair_count(CD_B.d.prim_at, CD_B.d.pair_offset, u);
+    cd_nb_scan(dl->pair_count, P, dl->pair_ustart, dl->chunk_sum);
+    CD_STEP_FOR(P, CD_BUILD_IN)
+    for (cd_int u = 0; u < P; u++)
+        cd_reorder_item_pair_at(CD_B.d.prim_at, CD_B.d.pair_offset, CD_B.d.pair_ustart, u, CD_B.d.pair_at);
     return 0;
 }
 

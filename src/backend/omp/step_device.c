@@ -193,12 +193,14 @@ void *cd_sim_step_field(cd_sim *sim, size_t f)
     return *cd_field_ptr(&sim->s, &cd_fields[f]);
 }
 
-void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2])
+void cd_sim_step_arg_copies(const cd_sim *sim, long long copies[2], long long bytes[2])
 {
     copies[0] = copies[1] = 0;
+    if (bytes) bytes[0] = bytes[1] = 0;
 #if CD_OFFLOAD
     const cd_off *o = sim->backend_data;
     if (o) memcpy(copies, o->args_copies, sizeof o->args_copies);
+    if (o && bytes) memcpy(bytes, o->args_bytes, sizeof o->args_bytes);
 #else
     (void)sim;
 #endif
@@ -221,6 +223,7 @@ void cd_step_args_fill(cd_sim *sim, cd_step_args *a)
     memset(a, 0, sizeof *a);
     a->c = cd_sim_step_cols(sim);
     a->d = sim->nb.d;
+    a->order = cd_sim_step_order(sim);
     a->law = sim->p.law;
     a->wall_law = sim->p.wall_law;
     a->gravity = sim->p.gravity;
@@ -234,25 +237,43 @@ void cd_step_args_fill(cd_sim *sim, cd_step_args *a)
 }
 
 #if CD_OFFLOAD
+/* [*first, *end): the bytes where x and y (n bytes) differ, in 8-byte
+ * words; 0 when they are equal. */
+static int differing_span(const void *x, const void *y, size_t n, size_t *first, size_t *end)
+{
+    const unsigned char *p = x, *q = y;
+    size_t lo = 0, hi = n;
+    while (lo < n && p[lo] == q[lo]) lo++;
+    if (lo == n) return 0;
+    while (hi > lo && p[hi - 1] == q[hi - 1]) hi--;
+    *first = lo / 8 * 8;
+    *end = (hi + 7) / 8 * 8 < n ? (hi + 7) / 8 * 8 : n;
+    return 1;
+}
+
 /* The step's argument block on the device, brought up to date before a
  * launch: what differs from the last block sent goes out (all of it after
- * a start, the head after a build or re-map that moved a buffer or a
- * change of the laws, the walls in use after they moved), nothing
- * otherwise.  NULL when the device block could not be had. */
+ * a start; otherwise the span of the head from its first to its last
+ * changed word: the addresses a build or re-map moved, the two swapped
+ * wall-candidate lists of every build, a change of the laws; the walls in
+ * use after they moved), nothing otherwise.  NULL when the device block
+ * could not be had. */
 static const cd_step_args *cd_off_args(cd_sim *sim)
 {
     cd_off *o = sim->backend_data;
     cd_step_args a;
     cd_step_args_fill(sim, &a);
-    size_t head = offsetof(cd_step_args, walls), walls = sim->s.n_walls * sizeof(cd_wall);
+    size_t head = offsetof(cd_step_args, walls), walls = sim->s.n_walls * sizeof(cd_wall), lo = 0, hi = head;
     if (!o->args_dev && !(o->args_dev = cd_dev_alloc(sizeof(cd_step_args)))) return NULL;
-    if (!o->args_sent || memcmp(&a, &o->args_host, head)) {
-        if (cd_dev_put(o->args_dev, &a, head)) return NULL;
+    if (!o->args_sent || differing_span(&a, &o->args_host, head, &lo, &hi)) {
+        if (cd_dev_put((char *)o->args_dev + lo, (const char *)&a + lo, hi - lo)) return NULL;
         o->args_copies[0]++;
+        o->args_bytes[0] += (long long)(hi - lo);
     }
     if (walls && (!o->args_sent || memcmp(a.walls, o->args_host.walls, walls))) {
         if (cd_dev_put(o->args_dev->walls, a.walls, walls)) return NULL;
         o->args_copies[1]++;
+        o->args_bytes[1] += (long long)walls;
     }
     o->args_host = a;
     o->args_sent = 1;

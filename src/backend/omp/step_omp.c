@@ -34,9 +34,6 @@ long cd_parallel_min_rows = 4096;
 /* ---- the loops of a step ------------------------------------------------ */
 
 #if CD_OFFLOAD
-#define CD_ARGS(sim) const cd_step_args *a = cd_off_args_or_die(sim);
-#define CD_ARGS_IN   is_device_ptr(a)
-
 /* The device's skin flag (1: an end moved beyond half the skin since it
  * was cleared), allocated and cleared at its first use. */
 static cd_int *skin_flag(cd_sim *sim)
@@ -50,21 +47,15 @@ static cd_int *skin_flag(cd_sim *sim)
     return sim->nb.d.skin_flag;
 }
 
-/* The skin flag's one int back; cleared on the device only after a step
- * that set it. */
+/* The skin flag's one int back.  A step that set it is followed by a
+ * build, whose first pass over primitives clears it on the device
+ * (src/backend/omp/neighbors.c; it was a copy of its own). */
 static int skin_flag_read(cd_sim *sim)
 {
-    cd_int moved = 1, zero = 0;
+    cd_int moved = 1;
     if (cd_dev_get(&moved, sim->nb.d.skin_flag, sizeof moved)) return 1;
-    if (moved) cd_dev_put(sim->nb.d.skin_flag, &zero, sizeof zero);
     return moved != 0;
 }
-#else
-#define CD_ARGS(sim)                                                                                                   \
-    cd_step_args a_;                                                                                                   \
-    cd_step_args_fill(sim, &a_);                                                                                       \
-    const cd_step_args *a = &a_;
-#define CD_ARGS_IN firstprivate(a)
 #endif
 
 /* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
@@ -86,7 +77,7 @@ static int advance_particles(cd_sim *sim)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
-        if (cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2)) {
+        if (cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2, a->d.ref_pose)) {
 #pragma omp atomic write
             a->d.skin_flag[0] = 1;
         }
@@ -94,7 +85,7 @@ static int advance_particles(cd_sim *sim)
 #else
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN reduction(| : moved))
-    for (size_t q = 0; q < n; q++) moved |= cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2);
+    for (size_t q = 0; q < n; q++) moved |= cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2, a->d.ref_pose);
 #endif
     return moved;
 }
@@ -191,7 +182,7 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
     for (size_t q = 0; q < n; q++)
         moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                             d.wall_out, g, dim, dt, limit2, next);
+                                             d.wall_out, g, dim, dt, limit2, d.ref_pose, next);
     return moved;
 }
 #endif
@@ -222,7 +213,8 @@ static int forces_and_advance(cd_sim *sim, int next)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
         if (cd_item_gather_kick_advance(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start,
-                                        a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2, next) &&
+                                        a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2, a->d.ref_pose,
+                                        next) &&
             flagged) {
 #pragma omp atomic write
             a->d.skin_flag[0] = 1;
@@ -308,6 +300,24 @@ static int check_step_state(cd_sim *sim, char *err, size_t errlen)
 #endif
 }
 
+/* CD_ENDS_FROM_POSE (offload): the steps do not store the primitives'
+ * world ends (kernels/step_items.h); before the state goes back to the
+ * host they are computed from the poses where the steps run, one launch
+ * (the values the steps used: the same function on the same numbers). */
+static void store_ends(cd_sim *sim)
+{
+#if CD_OFFLOAD && CD_ENDS_FROM_POSE
+    size_t n = sim->s.n_particles;
+    if (!sim->backend_data) return;
+    CD_WIDE_MIN
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN)
+    for (size_t q = 0; q < n; q++) cd_item_particle_ends(a->c, (cd_particle_id)q);
+#else
+    (void)sim;
+#endif
+}
+
 /* The backend lets go of the state: in host memory (host threads, or an
  * offload build's host fallback) the host columns go back to user order
  * (they are the current state); an offload device's state is dropped (the
@@ -315,6 +325,7 @@ static int check_step_state(cd_sim *sim, char *err, size_t errlen)
 static void omp_stop(cd_sim *sim)
 {
     /* the host keeps the step's wall-contact outputs too */
+    if (cd_step_memory_is_host()) store_ends(sim);
     if (cd_step_memory_is_host() && (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim)))
         fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
     cd_reorder_forget(sim);
@@ -398,6 +409,7 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen)
 {
+    store_ends(sim);
 #if CD_OFFLOAD
     /* The only full copy back: every device column, rows in use. */
     cd_off *o = sim->backend_data;
