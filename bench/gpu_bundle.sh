@@ -227,11 +227,12 @@ pack payload-lib.tar.xz lib lib.cxx
 pack payload-bin.tar.xz bin inputs
 
 # The part of the source tree the tests read through CAPDEM_SOURCE_DIR
-# (presets, example configs, kernels, and host/capdem_h5.py, which
-# test_runfile_layout checks against the C tables), unpacked: small, and
+# (presets, example configs, kernels, and host/capdem_h5.py and
+# docs/output.md, which test_runfile_layout checks against the C tables), unpacked: small, and
 # readable there.
 cp -r "$ROOT/configs" "$ROOT/kernels" "$OUT/src/"
 mkdir -p "$OUT/src/host" && cp "$ROOT/host/capdem_h5.py" "$OUT/src/host/"
+mkdir -p "$OUT/src/docs" && cp "$ROOT/docs/output.md" "$OUT/src/docs/" # test_runfile_layout checks its table too
 cp "$ROOT/bench/gpu/run_on_gpu.sh" "$OUT/"
 chmod +x "$OUT/run_on_gpu.sh"
 {

@@ -246,6 +246,9 @@ static void test_written_file_matches_table(void **state)
     char err[2048];
     const char *path = "test_runfile_layout.h5";
     cdt_setup(&sim, &cfg, small_run);
+    /* as `capdem run` does: a start before the first step (an offload
+     * device or OpenCL holds the state from there on) */
+    if (cd_sim_start(&sim, 1, err, sizeof err)) fail_msg("start: %s", err);
     cdt_step(&sim, 10);
     /* the time series `capdem run` writes, one row */
     cd_observable_info info[CD_OBSERVABLE_COUNT];

@@ -379,6 +379,14 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
+#if CD_OFFLOAD
+    /* the state is on the device only after a start (the OpenCL backend
+     * refuses the same way); host threads step the host's columns */
+    if (!sim->backend_data) {
+        snprintf(err, errlen, "the omp offload backend was not started (cd_sim_start)");
+        return -1;
+    }
+#endif
     /* host threads after a sync: the columns back in the lists' order */
     if (cd_reorder_to_memory(sim)) {
         snprintf(err, errlen, "out of memory putting the particles in memory order");
