@@ -39,6 +39,7 @@
 #   CAPDEM_BUNDLE_JOBS         tests run at once (default: the cores, at most 16;
 #                              4 with CAPDEM_BUNDLE_HOST)
 #   CAPDEM_BUNDLE_TESTS_CAP    seconds for one test part (default 240)
+#   CAPDEM_BUNDLE_ONLY         regular expression: only the test programs it matches
 #   CAPDEM_BUNDLE_LADDER       ladder entries (default "h1e4 h1e5 h1e6 s1e6")
 #   CAPDEM_BUNDLE_STEPS        timed steps per repeat (default 200; 100 at 1e6)
 #   CAPDEM_BUNDLE_TILES        "KX,KZ KX,KZ KX,KZ": the copies of the settled
@@ -283,7 +284,7 @@ run_tests() { # variant backend label tests...
     done
     note "-- $label took $((SECONDS - t0))s"
 }
-ALL_TESTS=$(cd "$BIN/$(echo "$VARIANTS" | head -1)" && ls test_* | grep -vE '^test_(parity|drift_bound)$')
+ALL_TESTS=$(cd "$BIN/$(echo "$VARIANTS" | head -1)" && ls test_* | grep -vE '^test_(parity|drift_bound)$' | grep -E "${CAPDEM_BUNDLE_ONLY:-.}")
 part_tests() { # variant
     # shellcheck disable=SC2086
     run_tests "$1" omp "tests-$1" $ALL_TESTS
