@@ -157,7 +157,7 @@ fi
 # find libcuda.so.1 through it (/usr/local/nvidia/lib64), not ldconfig.
 export LD_LIBRARY_PATH=$LIBPATH${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export CAPDEM_SOURCE_DIR=$B/src
-# no clang on GPU machines: test_segseg leaves its OpenCL C check to the
+# no clang on GPU machines: test_geometry_opencl_c leaves its OpenCL C check to the
 # device compiler (part opencl) instead of failing for want of clang
 command -v clang-14 >/dev/null || command -v clang >/dev/null || export CAPDEM_TEST_NO_CLANG=1
 export OMP_WAIT_POLICY=PASSIVE
