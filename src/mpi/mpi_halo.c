@@ -268,6 +268,8 @@ int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
         x->n_owned += owned[q];
     }
     rc = place_pairs(&s, cr, K, gprim);
+    /* the arms the step reads (kernels/cols.h), from the records' rows */
+    if (!rc) rc = cd_state_arms_derive(&s);
     free(pr);
     free(cr);
     if (rc) {

@@ -398,10 +398,7 @@ int cd_neighbors_build(cd_sim *sim)
         cd_nb_item_carry(c, k, d.keys, d.old_keys, (cd_long)n_old, d.old_active, d.old_shear, prim_src);
     if (particle_lists(sim, c, d, prim_src) || cd_reorder_pair_rows(sim)) return -1;
     CD_STEP_FOR(P, firstprivate(c))
-    for (cd_int i = 0; i < P; i++) {
-        c.prim_a_ref[i] = c.prim_a[i];
-        c.prim_b_ref[i] = c.prim_b[i];
-    }
+    for (cd_int i = 0; i < P; i++) cd_item_prim_refs(c, i);
     nb->force_rebuild = 0;
     nb->builds++;
     return 0;

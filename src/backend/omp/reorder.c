@@ -80,6 +80,7 @@ static size_t largest_column(const cd_state *s)
                                                                   : 0;
         if (rows * cd_fields[f].elem_size > most) most = rows * cd_fields[f].elem_size;
     }
+    if (s->n_arms * sizeof(cd_arm) > most) most = s->n_arms * sizeof(cd_arm);
     return most;
 }
 
@@ -171,8 +172,8 @@ static cd_int *sort_particles(cd_sim *sim, const cd_grid *g)
 static int moves(const cd_field_info *f)
 {
     /* not the host-only columns: a device does not hold them, and on host
-     * threads sync writes them anew (wallc_torque) */
-    return f->on_device && strcmp(f->name, "prim_a_ref") && strcmp(f->name, "prim_b_ref");
+     * threads sync writes them anew (wallc_torque, the arms' columns) */
+    return f->on_device && strcmp(f->name, "prim_a_ref");
 }
 
 int cd_reorder_build(cd_sim *sim, int *moved)
@@ -240,6 +241,12 @@ int cd_reorder_build(cd_sim *sim, int *moved)
         for (cd_int w = 0; grp == CD_GROUP_WALLC && w < W; w++) /* one wall's rows at a time */
             move_rows(sim, col + (size_t)w * words, (size_t)P, words, words * (size_t)W, d.prim_src);
     }
+    /* the arms (kernels/cols.h): where every primitive has one (prim_arm
+     * the identity since cd_state_arms_derive), the arms follow their
+     * primitives; otherwise each primitive takes its arm's row along */
+    if (s->n_arms == (size_t)P)
+        move_rows(sim, (cd_int *)c.arm, (size_t)P, sizeof(cd_arm) / word, sizeof(cd_arm) / word, d.prim_src);
+    else move_rows(sim, c.prim_arm, (size_t)P, 1, 1, d.prim_src);
     move_rows(sim, (cd_int *)d.part_bound, (size_t)N, sizeof(cd_real) / word, sizeof(cd_real) / word, d.part_src);
     move_rows(sim, d.part_uid, (size_t)N, 1, 1, d.part_src);
     move_rows(sim, d.prim_uid, (size_t)P, 1, 1, d.prim_src);
@@ -305,8 +312,8 @@ static void free_host_map(cd_int *h)
 #endif
 }
 
-/* Moves every step column of the host state (particles by part, primitives
- * and wall rows by prim, pair rows by pair, gather or scatter) through
+/* Moves every step column of the host state (particles by part, primitives,
+ * their arm indices and wall rows by prim, pair rows by pair, gather or scatter) through
  * scratch of `bytes`; the pair rows' primitive ids through prim_ids; then
  * each particle's primitive indices from the counts in the new order. */
 static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const cd_int *pair, int pair_scatter,
@@ -330,6 +337,12 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
         for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, n, col, n, map, (cd_long)g, n, scatter);
         memcpy(col, tmp, rows * cd_fields[f].elem_size);
     }
+    /* each primitive's arm row with it (the arms stay where they are) */
+    cd_int *arm_of = s->prim_arm;
+    size_t P = arm_of ? s->n_prims : 0;
+    CD_HOST_FOR(P, firstprivate(tmp, arm_of, prim))
+    for (size_t i = 0; i < P; i++) cd_reorder_item_move(tmp, 1, arm_of, 1, prim, (cd_long)i, 1, 0);
+    if (P) memcpy(arm_of, tmp, P * sizeof *arm_of);
     free(tmp);
     size_t K = s->n_pairs;
     CD_HOST_FOR(K, firstprivate(s, prim_ids))
