@@ -12,8 +12,9 @@
 #include "field_groups.h"
 
 /* The device columns only (field_groups.h), then the primitives' arms
- * (geom_types.h, cd_arm): prim_arm[i] is primitive i's row of arm, or -1
- * for a ball at its particle's centre (a sphere), whose two axis ends are
+ * (geom_types.h, cd_arm): prim_arm[i] is primitive i's row of arm, or
+ * negative for a ball at its particle's centre (a sphere; the value keeps
+ * the signs of its zero body ends for the host, src/core/state.c), whose two axis ends are
  * both prim_a[i] (and both prim_a_ref[i] at the last build). */
 typedef struct {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_GLOBAL ctype *name;)

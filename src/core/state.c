@@ -4,6 +4,7 @@
 #include "vec3.h"
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
 
 #define CD_GROUP_OF_PARTICLE CD_GROUP_PARTICLE
 #define CD_GROUP_OF_PRIM     CD_GROUP_PRIM
@@ -149,6 +150,23 @@ int cd_state_copy(cd_state *dst, const cd_state *src)
     return copy_arms(dst, src, keep.prim_arm, keep.arm);
 }
 
+/* A ball's body ends are zeros of either sign (a sphere's a = -0 in the
+ * shape catalogue): their six signs, bit k for component k of a then b,
+ * kept in its negative arm index -1 - signs, so that the host's columns
+ * come back with the bits they had (the run file stores them). */
+static cd_int zero_signs(cd_vec3 a, cd_vec3 b)
+{
+    const double v[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
+    cd_int bits = 0;
+    for (int k = 0; k < 6; k++) bits |= (cd_int)(signbit(v[k]) != 0) << k;
+    return bits;
+}
+
+static cd_vec3 signed_zeros(cd_int bits)
+{
+    return cd_v3(bits & 1 ? -0.0 : 0.0, bits & 2 ? -0.0 : 0.0, bits & 4 ? -0.0 : 0.0);
+}
+
 int cd_state_arms_derive(cd_state *s)
 {
     size_t P = s->n_prims, n = 0;
@@ -162,7 +180,7 @@ int cd_state_arms_derive(cd_state *s)
     n = 0;
     for (size_t i = 0; i < P; i++) {
         if (cd_ends_at_origin(s->prim_a_body[i], s->prim_b_body[i])) {
-            pa[i] = -1;
+            pa[i] = -1 - zero_signs(s->prim_a_body[i], s->prim_b_body[i]);
             continue;
         }
         pa[i] = (cd_int)n;
@@ -176,7 +194,8 @@ void cd_state_arms_expand(cd_state *s, const cd_int *prim_arm, const cd_arm *arm
     for (size_t i = 0; i < s->n_prims; i++) {
         cd_int r = prim_arm[i];
         if (r < 0) { /* a ball at the centre: both ends at the origin of the body */
-            s->prim_a_body[i] = s->prim_b_body[i] = cd_v3_zero();
+            s->prim_a_body[i] = signed_zeros(-1 - r);
+            s->prim_b_body[i] = signed_zeros((-1 - r) >> 3);
             s->prim_b[i] = s->prim_a[i];
             s->prim_b_ref[i] = s->prim_a_ref[i];
             continue;

@@ -29,7 +29,8 @@ typedef struct cd_state {
 #include "fields.def"
 #undef CD_FIELD
     /* The primitives' arms as a device holds them (kernels/cols.h, cd_arm):
-     * prim_arm per primitive (-1: a ball at its particle's centre), n_arms
+     * prim_arm per primitive (negative: a ball at its particle's centre,
+     * -1 - the signs of its zero body ends, src/core/state.c), n_arms
      * rows of arm; derived from the host's PRIM_ARM columns at a start
      * (cd_state_arms_derive), not written to files. */
     size_t n_arms;
@@ -81,8 +82,8 @@ int cd_state_copy(cd_state *dst, const cd_state *src);
 int cd_state_arms_derive(cd_state *s);
 /* The reverse, at sync: the host's PRIM_ARM columns (body ends, prim_b,
  * prim_b_ref) of every primitive i from its arm prim_arm[i] in arm (where
- * the step keeps them), or for a primitive without one, zero body ends and
- * its prim_a and prim_a_ref: every row is written, so that the rows follow
+ * the step keeps them), or for a primitive without one, its zero body ends
+ * (with the signs they had: prim_arm[i] = -1 - signs) and its prim_a and prim_a_ref: every row is written, so that the rows follow
  * the primitives' order where the step moved them (src/backend/omp/reorder.c). */
 void cd_state_arms_expand(cd_state *s, const cd_int *prim_arm, const cd_arm *arm);
 /* The host's wall-contact rows (fields.def, WALLC and WALLC_OUT) from the
