@@ -25,28 +25,43 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
     double A = 0, Aw = 0; /* active pair rows, active wall rows */
     for (size_t k = 0; k < s->n_pairs; k++) A += s->pair_active[k] != 0;
     for (size_t r = 0; r < s->n_prims * s->n_walls; r++) Aw += s->wallc_active[r] != 0;
-    /* wall candidates as the next build would choose them (cd_item_wall_candidates) */
-    double C = 0;
-    for (size_t i = 0; i < s->n_prims; i++)
-        for (size_t w = 0; w < s->n_walls; w++)
-            C += cd_bp_wall_candidate(&s->walls[w], s->prim_a[i], s->prim_b[i], s->prim_radius[i], sim->nb.skin);
+    /* wall candidates as the next build would choose them
+     * (cd_item_wall_candidates), Ca of them of primitives with an arm; the
+     * primitives with an arm (cd_arm, kernels/cols.h: all but a sphere's
+     * ball) */
+    double C = 0, Ca = 0, Arms = 0;
+    for (size_t i = 0; i < s->n_prims; i++) {
+        int arm = !cd_ends_at_origin(s->prim_a_body[i], s->prim_b_body[i]);
+        Arms += arm;
+        for (size_t w = 0; w < s->n_walls; w++) {
+            int cand = cd_bp_wall_candidate(&s->walls[w], s->prim_a[i], s->prim_b[i], s->prim_radius[i], sim->nb.skin);
+            C += cand;
+            Ca += cand && arm;
+        }
+    }
+    /* A primitive's ends in every loop that reads them: end a (24) and
+     * its arm index (4); an arm's end b (24) besides.  Its skin test reads
+     * end a at the last build (24), an arm's b too (24); its world ends from
+     * the pose: an arm's body-frame ends (48). */
+    double ends = P * 28 + Arms * 24, advance_prims = P * (4 + 24) + Arms * (48 + 24);
+    double advance_writes = P * 24 + Arms * 24;
     /* advance (cd_item_advance: kick, drift, primitive ends, skin test):
      * reads v, L, F, T, x (24 each), m (8), q (32), I (24) and per primitive
-     * its particle (4), body-frame ends (48) and ends at the last build
-     * (48); writes x, q, v, L, omega and the primitives' world ends (48). */
-    cd_traffic advance = {"advance", N * 184 + P * 100, N * 128 + P * 48};
+     * advance_prims; writes x, q, v, L, omega and the primitives' world
+     * ends (advance_writes). */
+    cd_traffic advance = {"advance", N * 184 + advance_prims, N * 128 + advance_writes};
     /* cd_item_pair_force: every row its primitives and flag (12); the
-     * primitives' particle, ends and radius (60); an active row its history
-     * (24) and its particles' x, v, omega, m (80 per particle, counted for
-     * every particle); writes flag, history, point, force (76), and the
-     * overlap and F_n (16) at the last step of a call only. */
-    out[0] = (cd_traffic){"pair_forces", R * 12 + P * 60 + A * 24 + N * 80, A * 76 + A * 16 / steps_per_call};
+     * primitives' particle (4), ends and radius (8); an active row its
+     * history (24) and its particles' x, v, omega, m (80 per particle,
+     * counted for every particle); writes flag, history, point, force (76),
+     * and the overlap and F_n (16) at the last step of a call only. */
+    out[0] = (cd_traffic){"pair_forces", R * 12 + P * 12 + ends + A * 24 + N * 80, A * 76 + A * 16 / steps_per_call};
     /* cd_item_wall_row over the wall candidates: per candidate its row,
-     * its entry's flag and its primitive (particle, ends, radius: 4 + 4 + 60, an upper
-     * bound when a primitive has several); an active row its history (24)
-     * and the particle's x, v, omega, m (80); writes flag, history, force,
-     * torque, overlap, F_n. */
-    out[1] = (cd_traffic){"wall_forces", C * 68 + Aw * (24 + 80), Aw * 92};
+     * its entry's flag and its primitive (particle, radius, end a, arm
+     * index: 4 + 4 + 40; an arm's b: 24; an upper bound when a primitive
+     * has several); an active row its history (24) and the particle's x,
+     * v, omega, m (80); writes flag, history, force, torque, overlap, F_n. */
+    out[1] = (cd_traffic){"wall_forces", C * 48 + Ca * 24 + Aw * (24 + 80), Aw * 92};
     /* the gather's part: per wall candidate its entry and flag (8), per
      * active wall row force and torque (48); per pair row two entries (8)
      * and, active or not (an inactive row adds its zero force: no branch),
@@ -59,10 +74,11 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * (cd_item_gather_kick_advance; omp on host threads and offload, and
      * OpenCL's cd_cl_gather_kick in mode 2) reading the particle once: m,
      * x, the two CSR starts (40), v, L, q, I (104), its primitive range
-     * (8), per primitive the body-frame and last-build ends (96); writes
-     * F, T, v, L, x, omega (144), q (32) and the primitives' world ends
-     * (48).  The advance of its own runs once per call of the step. */
-    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + P * 96 + gather_rows, N * 176 + P * 48};
+     * (8), its primitives' as the advance (advance_prims); writes F, T, v,
+     * L, x, omega (144), q (32) and the primitives' world ends
+     * (advance_writes).  The advance of its own runs once per call of the
+     * step. */
+    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + advance_prims + gather_rows, N * 176 + advance_writes};
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};

@@ -35,19 +35,25 @@ CD_INLINE int cd_ends_at_origin(cd_vec3 a, cd_vec3 b)
     return fabs(a.x) + fabs(a.y) + fabs(a.z) + fabs(b.x) + fabs(b.y) + fabs(b.z) == CD_R(0);
 }
 
+/* Primitive i's row of arm (negative: none).  A null prim_arm says that
+ * every primitive has an arm, its own row (hexapods, crosses: the index
+ * column is neither held nor read; the test is the same for every item,
+ * so it does not diverge on a GPU). */
+CD_INLINE cd_int cd_prim_arm_of(cd_cols c, cd_prim_id i) { return c.prim_arm ? c.prim_arm[i] : i; }
+
 /* World axis end b of primitive i [m]: its arm's, or prim_a[i] for a ball
  * without one (both ends at the particle's centre: the same value the
  * step wrote into both ends when every primitive had an arm). */
 CD_INLINE cd_vec3 cd_prim_b(cd_cols c, cd_prim_id i)
 {
-    cd_int r = c.prim_arm[i];
+    cd_int r = cd_prim_arm_of(c, i);
     return r < 0 ? c.prim_a[i] : c.arm[r].b;
 }
 
 /* End b of primitive i at the last neighbour-list build [m]. */
 CD_INLINE cd_vec3 cd_prim_b_ref(cd_cols c, cd_prim_id i)
 {
-    cd_int r = c.prim_arm[i];
+    cd_int r = cd_prim_arm_of(c, i);
     return r < 0 ? c.prim_a_ref[i] : c.arm[r].b_ref;
 }
 

@@ -58,7 +58,7 @@ CD_INLINE cd_wall cd_wall_advanced(cd_wall w, cd_real dt)
  * (docs/performance.md, "The sphere step"). */
 CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd_vec3 *a, cd_vec3 *b)
 {
-    cd_int r = c.prim_arm[i];
+    cd_int r = cd_prim_arm_of(c, i);
     if (r < 0) {
         *a = x;
         *b = x;
@@ -72,7 +72,7 @@ CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd
  * it has one; a ball's b is its a, cd_prim_b). */
 CD_INLINE void cd_prim_ends_store(cd_cols c, cd_prim_id i, cd_vec3 a, cd_vec3 b)
 {
-    cd_int r = c.prim_arm[i];
+    cd_int r = cd_prim_arm_of(c, i);
     c.prim_a[i] = a;
     if (r >= 0) c.arm[r].b = b;
 }
@@ -90,7 +90,7 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
  * neighbour-list build. */
 CD_INLINE void cd_item_prim_refs(cd_cols c, cd_prim_id i)
 {
-    cd_int r = c.prim_arm[i];
+    cd_int r = cd_prim_arm_of(c, i);
     c.prim_a_ref[i] = c.prim_a[i];
     if (r >= 0) c.arm[r].b_ref = c.arm[r].b;
 }

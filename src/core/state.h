@@ -80,6 +80,9 @@ int cd_state_copy(cd_state *dst, const cd_state *src);
  * unless both its body-frame ends are the body origin (cd_ends_at_origin),
  * in primitive order.  Returns 0, or -1 (out of memory). */
 int cd_state_arms_derive(cd_state *s);
+/* Has every primitive of s an arm, its own row (prim_arm the identity)?
+ * Then a device neither holds nor reads prim_arm (kernels/cols.h). */
+static inline int cd_state_arms_all(const cd_state *s) { return s->n_arms == s->n_prims; }
 /* The reverse, at sync: the host's PRIM_ARM columns (body ends, prim_b,
  * prim_b_ref) of every primitive i from its arm prim_arm[i] in arm (where
  * the step keeps them), or for a primitive without one, its zero body ends

@@ -244,7 +244,7 @@ int cd_reorder_build(cd_sim *sim, int *moved)
     /* the arms (kernels/cols.h): where every primitive has one (prim_arm
      * the identity since cd_state_arms_derive), the arms follow their
      * primitives; otherwise each primitive takes its arm's row along */
-    if (s->n_arms == (size_t)P)
+    if (cd_state_arms_all(s))
         move_rows(sim, (cd_int *)c.arm, (size_t)P, sizeof(cd_arm) / word, sizeof(cd_arm) / word, d.prim_src);
     else move_rows(sim, c.prim_arm, (size_t)P, 1, 1, d.prim_src);
     move_rows(sim, (cd_int *)d.part_bound, (size_t)N, sizeof(cd_real) / word, sizeof(cd_real) / word, d.part_src);
@@ -337,12 +337,16 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
         for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, n, col, n, map, (cd_long)g, n, scatter);
         memcpy(col, tmp, rows * cd_fields[f].elem_size);
     }
-    /* each primitive's arm row with it (the arms stay where they are) */
-    cd_int *arm_of = s->prim_arm;
-    size_t P = arm_of ? s->n_prims : 0;
-    CD_HOST_FOR(P, firstprivate(tmp, arm_of, prim))
-    for (size_t i = 0; i < P; i++) cd_reorder_item_move(tmp, 1, arm_of, 1, prim, (cd_long)i, 1, 0);
-    if (P) memcpy(arm_of, tmp, P * sizeof *arm_of);
+    /* the arms as at the reorder's build (cd_reorder_build): where every
+     * primitive has one (prim_arm the identity), the arms with their
+     * primitives; otherwise each primitive's arm index with it */
+    int all = cd_state_arms_all(s);
+    cd_int *col = all ? (cd_int *)s->arm : s->prim_arm;
+    cd_long nw = all ? (cd_long)(sizeof(cd_arm) / sizeof(cd_int)) : 1;
+    size_t P = col ? s->n_prims : 0;
+    CD_HOST_FOR(P, firstprivate(tmp, col, prim, nw))
+    for (size_t i = 0; i < P; i++) cd_reorder_item_move(tmp, nw, col, nw, prim, (cd_long)i, nw, 0);
+    if (P) memcpy(col, tmp, P * (size_t)nw * sizeof(cd_int));
     free(tmp);
     size_t K = s->n_pairs;
     CD_HOST_FOR(K, firstprivate(s, prim_ids))

@@ -89,6 +89,7 @@ typedef struct cd_cl {
      * and pair_shear, which are those of hist[cur] (cd_cl_col) */
     cl_mem col[CD_CL_N_FIELDS];
     cl_mem prim_arm, arm; /* the primitives' arms (kernels/cols.h; no reorder: the host's rows) */
+    int arms_all;         /* every primitive has an arm: prim_arm is bound as null (cd_prim_arm_of) */
     size_t cap_pairs;
     cd_cl_pairset hist[2];
     int cur;

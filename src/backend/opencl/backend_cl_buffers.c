@@ -82,7 +82,9 @@ int cd_cl_bind_cols(cd_cl *cl)
             cl_mem m = cd_cl_col(cl, f);
             if (cd_cl_arg(cl, (enum cd_cl_kernel)k, (cl_uint)f, sizeof m, &m)) return -1;
         }
-        if (cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS, sizeof cl->prim_arm, &cl->prim_arm) ||
+        /* a null prim_arm where every primitive has an arm (kernels/cols.h) */
+        cl_mem arm_of = cl->arms_all ? NULL : cl->prim_arm;
+        if (cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS, sizeof arm_of, &arm_of) ||
             cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 1, sizeof cl->arm, &cl->arm))
             return -1;
     }
@@ -175,7 +177,8 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
         if (cd_fields[f].group == CD_GROUP_PAIR) continue;
         cl->col[f] = cd_cl_buffer(cl, rows_of(cl, s, &cd_fields[f]) * cd_fields[f].elem_size, "allocating the state");
     }
-    cl->prim_arm = cd_cl_buffer(cl, (P + 1) * sizeof(cd_int), "allocating the state");
+    cl->arms_all = cd_state_arms_all(s);
+    cl->prim_arm = cd_cl_buffer(cl, (cl->arms_all ? 1 : P + 1) * sizeof(cd_int), "allocating the state");
     cl->arm = cd_cl_buffer(cl, (s->n_arms + 1) * sizeof(cd_arm), "allocating the state");
     cl->walls = cd_cl_buffer(cl, (W > 0 ? W : 1) * sizeof(cd_wall), "allocating the walls");
     cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
@@ -236,7 +239,7 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
         void *host = *cd_field_ptr(s, &cd_fields[f]);
         write(cl, cd_cl_col(cl, f), rows * cd_fields[f].elem_size, host, "uploading the state");
     }
-    write(cl, cl->prim_arm, s->n_prims * sizeof(cd_int), s->prim_arm, "uploading the state");
+    if (!cl->arms_all) write(cl, cl->prim_arm, s->n_prims * sizeof(cd_int), s->prim_arm, "uploading the state");
     write(cl, cl->arm, s->n_arms * sizeof(cd_arm), s->arm, "uploading the state");
     write(cl, cl->walls, s->n_walls * sizeof(cd_wall), s->walls, "uploading the walls");
     cd_int flags[3] = {0, -1, 0};
