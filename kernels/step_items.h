@@ -136,19 +136,19 @@ CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real l
     return cd_advance_from(c, q, c.velocity[q], c.angmom[q], c.force[q], c.torque[q], c.mass[q], dt, limit2);
 }
 
-/* Contact geometry of pair row k (docs/references.md, Contacts): closest points of the two axes
- * and, from them, the contact point, normal and overlap.  Fills g always
- * (the host's output pass, src/io/pair_output.c, needs the normal of every
- * active row). */
-CD_INLINE void cd_pair_geometry(cd_cols c, cd_pair_id k, cd_real sin_parallel, cd_int parallel_blend,
-                                cd_contact_geom *g)
+/* Contact geometry of two primitives (axis ends ai, bi and aj, bj, radii
+ * ri, rj [m]; docs/references.md, Contacts): closest points of the two
+ * axes and, from them, the contact point, normal and overlap.  Fills g
+ * always (the host's output pass, src/io/pair_output.c, needs the normal of
+ * every active row, from the host's columns). */
+CD_INLINE void cd_pair_geometry_of(cd_vec3 ai, cd_vec3 bi, cd_real ri, cd_vec3 aj, cd_vec3 bj, cd_real rj,
+                                   cd_real sin_parallel, cd_int parallel_blend, cd_contact_geom *g)
 {
-    cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
-    cd_vec3 ai = c.prim_a[i], bi = cd_prim_b(c, i), aj = c.prim_a[j], bj = cd_prim_b(c, j);
     cd_real s, t;
     cd_segseg_closest(ai, bi, aj, bj, &s, &t);
-    cd_segseg_contact_at(ai, bi, c.prim_radius[i], aj, bj, c.prim_radius[j], s, t, sin_parallel, parallel_blend, g);
+    cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, g);
 }
+
 
 /* Torque about a body's centre [m] of a force [N] acting at a point [m]. */
 CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force)
