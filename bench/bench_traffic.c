@@ -40,10 +40,12 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
         }
     }
     /* A primitive's ends in every loop that reads them: end a (24) and
-     * its arm index (4); an arm's end b (24) besides.  Its skin test reads
+     * its arm index (4; none where every primitive has an arm:
+     * cd_prim_arm_of); an arm's end b (24) besides.  Its skin test reads
      * end a at the last build (24), an arm's b too (24); its world ends from
      * the pose: an arm's body-frame ends (48). */
-    double ends = P * 28 + Arms * 24, advance_prims = P * (4 + 24) + Arms * (48 + 24);
+    double idx = cd_state_arms_all(s) ? 0 : 4;
+    double ends = P * (24 + idx) + Arms * 24, advance_prims = P * (idx + 24) + Arms * (48 + 24);
     double advance_writes = P * 24 + Arms * 24;
     /* advance (cd_item_advance: kick, drift, primitive ends, skin test):
      * reads v, L, F, T, x (24 each), m (8), q (32), I (24) and per primitive
@@ -61,7 +63,7 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * index: 4 + 4 + 40; an arm's b: 24; an upper bound when a primitive
      * has several); an active row its history (24) and the particle's x,
      * v, omega, m (80); writes flag, history, force, torque, overlap, F_n. */
-    out[1] = (cd_traffic){"wall_forces", C * 48 + Ca * 24 + Aw * (24 + 80), Aw * 92};
+    out[1] = (cd_traffic){"wall_forces", C * (44 + idx) + Ca * 24 + Aw * (24 + 80), Aw * 92};
     /* the gather's part: per wall candidate its entry and flag (8), per
      * active wall row force and torque (48); per pair row two entries (8)
      * and, active or not (an inactive row adds its zero force: no branch),
@@ -82,4 +84,22 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};
+}
+
+void cd_bench_row_kinds(const cd_sim *sim, double kinds[3], double *mixed, double *groups)
+{
+    const cd_state *s = &sim->s;
+    kinds[0] = kinds[1] = kinds[2] = *mixed = *groups = 0;
+    int seen = 0; /* bit k: kind k in the current group */
+    for (size_t k = 0; k < s->n_pairs; k++) {
+        cd_prim_id i = s->pair_prim_i[k], j = s->pair_prim_j[k];
+        int kind = 2 - cd_segseg_is_point(s->prim_a[i], s->prim_b[i]) - cd_segseg_is_point(s->prim_a[j], s->prim_b[j]);
+        kinds[kind]++;
+        seen |= 1 << kind;
+        if ((k + 1) % CD_BENCH_WARP == 0 || k + 1 == s->n_pairs) {
+            *groups += 1;
+            *mixed += (seen & (seen - 1)) != 0; /* more than one bit */
+            seen = 0;
+        }
+    }
 }
