@@ -268,6 +268,8 @@ int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
         x->n_owned += owned[q];
     }
     rc = place_pairs(&s, cr, K, gprim);
+    /* the arms the step reads (kernels/cols.h), from the records' rows */
+    if (!rc) rc = cd_state_arms_derive(&s);
     free(pr);
     free(cr);
     if (rc) {
@@ -515,6 +517,7 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
             unpack_particle(global, (size_t)h.gid, (size_t)h.gprim_first, pr[q].at);
         }
         if (!rc) rc = place_serial_rows(global, (const long long *)nall, nlen / (2 * sizeof(long long)), cr, K);
+        if (!rc) rc = cd_state_arms_derive(global); /* its arms of these rows (kernels/cols.h) */
         free(pr);
         free(cr);
     }
