@@ -153,9 +153,9 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn);
  * program's bits, without gathering the state: each block of rows summed
  * by the serial block function on rank block % R from its rows' owners'
  * records, the blocks merged in order on rank 0, the total on every rank
- * (src/mpi/mpi_reduce.c).  Writes the moving columns of the blocks' rows
- * into global (which is the gathered state between syncs).  Collective. */
-int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total);
+ * (src/mpi/mpi_reduce.c).  Reads of global its counts and laws only (each
+ * leaf is summed on columns of its own rows).  Collective. */
+int cd_mpi_observe_slots(cd_mpi_ctx *x, const cd_sim *global, double *total);
 /* This rank's part of a snapshot (io_h5.h cd_output_part) from its local
  * state, the scalars from scal (the global state's): the place of each
  * owned particle's first contact and wall-contact row among the
