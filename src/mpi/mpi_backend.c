@@ -272,6 +272,26 @@ static void mpi_stop(cd_sim *sim)
     x->started = 0;
 }
 
+/* The whole run's columns on this rank (every particle, primitive, wall
+ * row and pair row): the set-up builds them (or a resume reads them), and
+ * the start cuts the local state from them and lets them go (with
+ * parallel output; cd_mpi_distribute).  After that a rank needs them only
+ * where the whole state is gathered (sync: a protocol that reads
+ * particles, a diagnosis; rank 0's writer with mpi.output = rank0 keeps
+ * them): they come back, empty, for the gather.  The counts and scalars
+ * (step, time, walls, protocol slots) stay throughout. */
+static int global_columns(cd_sim *sim)
+{
+    if (sim->s.position) return 0;
+    cd_state keep = sim->s;
+    if (cd_state_alloc(&sim->s, keep.n_particles, keep.n_prims, keep.n_walls, keep.cap_pairs)) {
+        sim->s = keep;
+        return -1;
+    }
+    scalars_back(sim, &keep);
+    return 0;
+}
+
 static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
@@ -322,7 +342,7 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     x->recv_count = calloc(R, sizeof(int));
     x->recv_displ = calloc(R, sizeof(int));
     int rc = x->send_count && x->send_displ && x->recv_count && x->recv_displ ? 0 : -1;
-    if (!rc) rc = cd_mpi_distribute(x, &sim->s);
+    if (!rc) rc = cd_mpi_distribute(x, &sim->s, parallel_output);
     if (rc) snprintf(err, errlen, "out of memory while distributing the particles over %d MPI ranks", x->size);
     /* (a rank without particles has no list to build and no forces) */
     if (!rc) rc = x->inner->start(loc, compute && loc->s.n_particles > 0, err, errlen);
@@ -361,6 +381,7 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
     int rc = x->inner->sync(&x->loc, err, errlen);
+    if (!rc) rc = global_columns(sim);
     if (!rc) rc = cd_mpi_gather(x, &sim->s);
     x->gathers++;
     if (rc) snprintf(err, errlen, "out of memory while gathering the state on MPI rank 0");

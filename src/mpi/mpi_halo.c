@@ -305,7 +305,7 @@ static int find_neighbors(cd_mpi_ctx *x)
     return x->requests ? 0 : -1;
 }
 
-int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, int release)
 {
     size_t W = global->n_walls, pb = 0, cb = 0;
     int *ranks = malloc((size_t)x->size * sizeof *ranks);
@@ -329,6 +329,7 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
     for (size_t k = 0; !rc && k < global->n_pairs; k++)
         if (global->pair_active[k])
             at = cd_mpi_pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
+    if (!rc && release) cd_state_free(global); /* (the counts and scalars stay: copy_scalars) */
     if (!rc) rc = cd_mpi_assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
     free(ranks);
     free(pbuf);

@@ -114,9 +114,11 @@ int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen);
 
 /* The local state of this rank cut from a global state (every rank holds
  * the same one at start): owned particles, ghosts, the active pair rows
- * among them; the neighbours and the ghost refresh planned.  0, or -1 (out
- * of memory). */
-int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global);
+ * among them; the neighbours and the ghost refresh planned.  release: the
+ * global state's columns freed as soon as this rank's records are packed,
+ * before the local state is assembled (its counts and scalars kept), so
+ * that a rank never holds both.  0, or -1 (out of memory). */
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, int release);
 /* Every particle to the ranks that hold it by its centre now (its owner,
  * and as a ghost the ranks within the interaction range): a rank keeps
  * the copies it has and gets, from the particle's owner, only the ones
