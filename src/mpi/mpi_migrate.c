@@ -268,6 +268,11 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
         size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
         if (keeps(x, &d, a) && keeps(x, &d, b)) ck = cd_mpi_pack_pair(s, k, gi, gj, 0, ck);
     }
+    /* everything of the local state is in the records now: its columns go
+     * before the new state is assembled, so that a rank holds the old
+     * state, the kept records and the new state two at a time, never all
+     * three (the counts and scalars stay, for scal below) */
+    if (!rc) cd_state_free(s);
     /* a particle beyond the neighbours (it moved far, or is not finite):
      * this migration goes through all ranks, which all must know */
     int any_far = 0;
