@@ -298,7 +298,8 @@ static void mpi_stop(cd_sim *sim)
  * where the whole state is gathered (sync: a protocol that reads
  * particles, a diagnosis; rank 0's writer with mpi.output = rank0 keeps
  * them): they come back, empty, for the gather.  The counts and scalars
- * (step, time, walls, protocol slots) stay throughout. */
+ * (step, time, walls, protocol slots) stay throughout; a gathered state
+ * goes at the next step (a protocol reads it right after its sync). */
 static int global_columns(cd_sim *sim)
 {
     if (sim->s.position) return 0;
@@ -377,6 +378,10 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
 static int mpi_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
+    if (parallel_output && sim->s.position) { /* gathered for a protocol: read by now */
+        cd_state_free(&sim->s);
+        give_back_memory();
+    }
     /* the walls and protocol slots as the protocol left them (the same on
      * every rank: it decides from the same loads and observables) */
     memcpy(x->loc.s.walls, sim->s.walls, sizeof x->loc.s.walls);

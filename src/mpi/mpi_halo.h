@@ -180,11 +180,20 @@ size_t cd_mpi_pair_bytes(void);
  * b; returns the end of the record. */
 char *cd_mpi_pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b);
 char *cd_mpi_pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b);
-/* The local state from particle records (pbuf) and pair records (cbuf),
- * in ascending global id, a key given twice taken once, the scalars of
- * scal; ownership by the centre, the ghost refresh planned, the list to
- * be rebuilt.  0, or -1 (out of memory). */
-int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal);
+/* The local state, in ascending global id, from the particles of `from`
+ * marked in keep (a state in ascending global id: from_gid and from_gprim
+ * its particles' and primitives' global ids, NULL for a global state,
+ * whose rows are its ids) and the particle records of pbuf (a record
+ * replaces a kept row of its id), the pair records of cbuf (a key given
+ * twice taken once; from's own pair rows are not read), the scalars of
+ * scal; ownership by the centre, the ghost refresh planned, the list to be
+ * rebuilt.  Column by column; with release each column of from is let go
+ * as soon as its rows are copied (its pair columns first), so that a rank
+ * never holds both states whole.  0, or -1 (out of memory; from then
+ * partly let go when release). */
+int cd_mpi_assemble(cd_mpi_ctx *x, cd_state *from, const long long *from_gid, const long long *from_gprim,
+                    const unsigned char *keep, int release, const char *pbuf, size_t plen, const char *cbuf,
+                    size_t clen, const cd_state *scal);
 /* MPI_Alltoallv of bytes over all ranks: sc[r] bytes to rank r (in rank
  * order in send) into a new buffer *recv of *rlen bytes.  0, or -1. */
 int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen);
