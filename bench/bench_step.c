@@ -76,6 +76,8 @@ static size_t state_bytes(const cd_sim *sim)
             cd_fields[f].group == CD_GROUP_PAIR ? sim->s.cap_pairs : cd_state_rows(&sim->s, cd_fields[f].group);
         b += rows * cd_fields[f].elem_size;
     }
+    /* the primitives' arm indices and arms (kernels/cols.h) */
+    b += (cd_state_arms_all(&sim->s) ? 0 : sim->s.n_prims * sizeof(cd_int)) + sim->s.n_arms * sizeof(cd_arm);
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
     /* the wall candidates: CSR starts, rows and their entries (cd_wall_entry:
      * history and outputs), and the build before's, kept for the carry-over */
@@ -314,6 +316,8 @@ int main(int argc, char **argv)
             cd_sim_observe(&sim, &after);
             cd_traffic tr[CD_TRAFFIC_KERNELS];
             cd_bench_traffic(&sim, (double)steps, tr);
+            double kinds[3], mixed, warps;
+            cd_bench_row_kinds(&sim, kinds, &mixed, &warps);
             double moved = 0;
             char kernels[768];
             int at = 0;
@@ -329,14 +333,15 @@ int main(int argc, char **argv)
                    "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"neighbor_builds_timed\": %lld, \"dt\": %g, "
                    "\"reorder\": \"%s\", \"reorders\": %lld, "
                    "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}, "
-                   "\"rows\": {\"prims\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, \"walls\": %zu, "
-                   "\"wall_contacts\": %.0f}}\n",
+                   "\"rows\": {\"prims\": %zu, \"arms\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, "
+                   "\"walls\": %zu, \"wall_contacts\": %.0f, \"pair_rows_by_kind\": [%.0f, %.0f, %.0f], "
+                   "\"mixed_warps\": [%.0f, %.0f]}}\n",
                    case_label, n, sim.backend->name, sim.backend->device(&sim), round_threads[k], steps, wall, cpu,
                    (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n, sim.s.n_pairs,
                    (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
                    sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
-                   moved / (double)n, kernels, sim.s.n_prims, sim.s.n_pairs, after.n_contacts, sim.s.n_walls,
-                   after.n_wall_contacts);
+                   moved / (double)n, kernels, sim.s.n_prims, sim.s.n_arms, sim.s.n_pairs, after.n_contacts,
+                   sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps);
             fflush(stdout);
         }
     }

@@ -18,4 +18,16 @@ typedef struct {
  * Fills out[CD_TRAFFIC_KERNELS]. */
 void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[CD_TRAFFIC_KERNELS]);
 
+/* Width of the groups of consecutive pair rows counted by cd_bench_row_kinds
+ * (a warp of an NVIDIA GPU). */
+enum { CD_BENCH_WARP = 32 };
+
+/* The pair rows by the narrow phase their end points choose in
+ * cd_item_pair_force (kernels/step_items.h; sim->s synced): kinds[0] two
+ * points (sphere-sphere), kinds[1] a point and a segment, kinds[2] two
+ * segments; and how many groups of CD_BENCH_WARP consecutive rows in the
+ * row order at hand hold more than one kind (*mixed of *groups): the
+ * groups whose items would diverge on a GPU (issue 21 item 5). */
+void cd_bench_row_kinds(const cd_sim *sim, double kinds[3], double *mixed, double *groups);
+
 #endif

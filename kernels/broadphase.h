@@ -28,21 +28,31 @@ CD_INLINE cd_vec3 cd_bp_centre(cd_vec3 a, cd_vec3 b) { return cd_v3_scale(cd_v3_
 /* Radius of a primitive's bounding sphere about cd_bp_centre [m]. */
 CD_INLINE cd_real cd_bp_bound(cd_vec3 a, cd_vec3 b, cd_real r) { return CD_R(0.5) * cd_v3_norm(cd_v3_sub(b, a)) + r; }
 
-/* Bounding radius of a particle about its centre of mass x [m]: the
- * largest reach |centre_i - x| + bound_i of its primitives first ..
- * first + count - 1, widened by 1e-9 of itself so that it holds every
+/* Reach of a primitive (axis ends a, b, radius r [m]) from a particle's
+ * centre x [m]: |centre - x| + its bound. */
+CD_INLINE cd_real cd_bp_reach(cd_vec3 a, cd_vec3 b, cd_real r, cd_vec3 x)
+{
+    return cd_v3_norm(cd_v3_sub(cd_bp_centre(a, b), x)) + cd_bp_bound(a, b, r);
+}
+
+/* A particle's bounding radius from the largest reach r of its primitives
+ * (cd_bp_reach), widened by 1e-9 of itself so that it holds every
  * primitive's sphere despite rounding (the particle test must never drop a
  * pair that the primitive test keeps). */
+CD_INLINE cd_real cd_bp_widened(cd_real r) { return r * CD_R(1.000000001); }
+
+/* Bounding radius of a particle about its centre of mass x [m]: the
+ * largest reach of its primitives first .. first + count - 1, widened
+ * (cd_bp_widened). */
 CD_INLINE cd_real cd_bp_particle_bound(const CD_GLOBAL cd_vec3 *prim_a, const CD_GLOBAL cd_vec3 *prim_b,
                                        const CD_GLOBAL cd_real *prim_radius, cd_int first, cd_int count, cd_vec3 x)
 {
     cd_real r = 0;
     for (cd_int i = first; i < first + count; i++) {
-        cd_real reach = cd_v3_norm(cd_v3_sub(cd_bp_centre(prim_a[i], prim_b[i]), x)) +
-                        cd_bp_bound(prim_a[i], prim_b[i], prim_radius[i]);
+        cd_real reach = cd_bp_reach(prim_a[i], prim_b[i], prim_radius[i], x);
         if (reach > r) r = reach;
     }
-    return r * CD_R(1.000000001);
+    return cd_bp_widened(r);
 }
 
 /* Adds a particle (centre x [m], bounding radius bound [m]) to the running

@@ -11,11 +11,52 @@
 #include "geom_types.h"
 #include "field_groups.h"
 
-/* The device columns only (field_groups.h). */
+/* The device columns only (field_groups.h), then the primitives' arms
+ * (geom_types.h, cd_arm): prim_arm[i] is primitive i's row of arm, or
+ * negative for a ball at its particle's centre (a sphere; the value keeps
+ * the signs of its zero body ends for the host, src/core/state.c), whose two axis ends are
+ * both prim_a[i] (and both prim_a_ref[i] at the last build). */
 typedef struct {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_GLOBAL ctype *name;)
 #include "fields.def"
 #undef CD_FIELD
+    CD_GLOBAL cd_int *prim_arm;
+    CD_GLOBAL cd_arm *arm;
 } cd_cols;
+
+CD_DEVICE_BEGIN
+
+/* Are both body-frame ends a, b the body origin (every component a zero
+ * of either sign)?  Such a primitive has no arm.  One test of a sum of
+ * magnitudes, which is zero only when every term is (a sum of non-negative
+ * numbers does not underflow to zero). */
+CD_INLINE int cd_ends_at_origin(cd_vec3 a, cd_vec3 b)
+{
+    return fabs(a.x) + fabs(a.y) + fabs(a.z) + fabs(b.x) + fabs(b.y) + fabs(b.z) == CD_R(0);
+}
+
+/* Primitive i's row of arm (negative: none).  A null prim_arm says that
+ * every primitive has an arm, its own row (hexapods, crosses: the index
+ * column is neither held nor read; the test is the same for every item,
+ * so it does not diverge on a GPU). */
+CD_INLINE cd_int cd_prim_arm_of(cd_cols c, cd_prim_id i) { return c.prim_arm ? c.prim_arm[i] : i; }
+
+/* World axis end b of primitive i [m]: its arm's, or prim_a[i] for a ball
+ * without one (both ends at the particle's centre: the same value the
+ * step wrote into both ends when every primitive had an arm). */
+CD_INLINE cd_vec3 cd_prim_b(cd_cols c, cd_prim_id i)
+{
+    cd_int r = cd_prim_arm_of(c, i);
+    return r < 0 ? c.prim_a[i] : c.arm[r].b;
+}
+
+/* End b of primitive i at the last neighbour-list build [m]. */
+CD_INLINE cd_vec3 cd_prim_b_ref(cd_cols c, cd_prim_id i)
+{
+    cd_int r = cd_prim_arm_of(c, i);
+    return r < 0 ? c.prim_a_ref[i] : c.arm[r].b_ref;
+}
+
+CD_DEVICE_END
 
 #endif

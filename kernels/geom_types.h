@@ -52,6 +52,21 @@ typedef struct {
     cd_int pad_;     /* keeps the size a multiple of 8 bytes on every backend */
 } cd_wall_entry;
 
+/* The arm of a primitive whose axis is not a point at the body origin (a
+ * spherocylinder's segment, an off-centre ball): what a sphere's ball does
+ * not need, kept apart so that a sphere holds its centre, radius and owner
+ * only (cd_cols.prim_arm, kernels/cols.h; docs/performance.md, "Sphere
+ * primitives without arm columns").  The host keeps the same values per
+ * primitive in fields.def (group PRIM_ARM), derived into arms at a start
+ * and expanded back at sync (src/core/state.c).  96 B of 8-byte members:
+ * the same layout in C and OpenCL. */
+typedef struct {
+    cd_vec3 a_body; /* axis end a, principal body frame, scaled [m] */
+    cd_vec3 b_body; /* axis end b, principal body frame, scaled [m] */
+    cd_vec3 b;      /* axis end b, world frame [m] (end a: cd_cols.prim_a) */
+    cd_vec3 b_ref;  /* end b at the last neighbour-list build [m] */
+} cd_arm;
+
 /* Walls a simulation may have (the state's table, the observables' slots). */
 #define CD_MAX_WALLS 8
 

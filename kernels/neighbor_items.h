@@ -56,10 +56,17 @@ CD_INLINE cd_long cd_nb_box_scratch(cd_long n)
     return s;
 }
 
+/* Bounding radius of particle p about its centre [m] (cd_bp_particle_bound,
+ * with end b of a ball without an arm its end a). */
 CD_INLINE void cd_nb_item_bound(cd_cols c, cd_particle_id p, CD_GLOBAL cd_real *part_bound)
 {
-    part_bound[p] =
-        cd_bp_particle_bound(c.prim_a, c.prim_b, c.prim_radius, c.prim_first[p], c.prim_count[p], c.position[p]);
+    cd_real r = 0;
+    cd_vec3 x = c.position[p];
+    for (cd_prim_id i = c.prim_first[p]; i < c.prim_first[p] + c.prim_count[p]; i++) {
+        cd_real reach = cd_bp_reach(c.prim_a[i], cd_prim_b(c, i), c.prim_radius[i], x);
+        if (reach > r) r = reach;
+    }
+    part_bound[p] = cd_bp_widened(r);
 }
 
 CD_INLINE void cd_nb_box_clear(cd_real *lo, cd_real *hi, cd_real *rmax)
@@ -199,10 +206,10 @@ CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL c
                     if (cd_v3_norm2(cd_v3_sub(c.position[q], x)) > reach * reach) continue;
                     for (cd_int i = first; i < last; i++) {
                         CD_GLOBAL cd_prim_id *row = out + (offset ? (cd_long)offset[i] : (cd_long)i * slot);
-                        cd_vec3 ai = c.prim_a[i], bi = c.prim_b[i];
+                        cd_vec3 ai = c.prim_a[i], bi = cd_prim_b(c, i);
                         cd_real ri = c.prim_radius[i];
                         for (cd_prim_id j = c.prim_first[q]; j < c.prim_first[q] + c.prim_count[q]; j++) {
-                            if (!cd_bp_is_candidate(ai, bi, ri, c.prim_a[j], c.prim_b[j], c.prim_radius[j], skin))
+                            if (!cd_bp_is_candidate(ai, bi, ri, c.prim_a[j], cd_prim_b(c, j), c.prim_radius[j], skin))
                                 continue;
                             cd_int n = count[i];
                             if (n < cap) { /* insertion keeps the row sorted by the user id of j */

@@ -75,31 +75,31 @@ CD_INLINE cd_wall cd_wall_advanced(cd_wall w, cd_real dt)
     return w;
 }
 
-/* Are both body-frame ends a, b the body origin (every component a zero
- * of either sign)?  One test of a sum of magnitudes, which is zero only
- * when every term is (a sum of non-negative numbers does not underflow to
- * zero): fewer instructions than six compared components. */
-CD_INLINE int cd_ends_at_origin(cd_vec3 a, cd_vec3 b)
-{
-    return fabs(a.x) + fabs(a.y) + fabs(a.z) + fabs(b.x) + fabs(b.y) + fabs(b.z) == CD_R(0);
-}
-
 /* World axis ends *a, *b of primitive i for its particle's pose (centre x
- * [m], orientation o).  A primitive whose body-frame ends are both the
- * body origin (a sphere's ball) has both ends at x: the rotation of a zero
- * vector is a zero, and x plus a zero is x (but for the sign of a zero
- * coordinate of x), so the two rotations are skipped (docs/performance.md,
- * "The sphere step"). */
+ * [m], orientation o).  A primitive without an arm (a sphere's ball, both
+ * body-frame ends at the body origin) has both ends at x: the rotation of
+ * a zero vector is a zero, and x plus a zero is x (but for the sign of a
+ * zero coordinate of x), so the two rotations are skipped
+ * (docs/performance.md, "The sphere step"). */
 CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd_vec3 *a, cd_vec3 *b)
 {
-    cd_vec3 a_body = c.prim_a_body[i], b_body = c.prim_b_body[i];
-    if (cd_ends_at_origin(a_body, b_body)) {
+    cd_int r = cd_prim_arm_of(c, i);
+    if (r < 0) {
         *a = x;
         *b = x;
         return;
     }
-    *a = cd_rigid_to_world(x, o, a_body);
-    *b = cd_rigid_to_world(x, o, b_body);
+    *a = cd_rigid_to_world(x, o, c.arm[r].a_body);
+    *b = cd_rigid_to_world(x, o, c.arm[r].b_body);
+}
+
+/* Primitive i's world ends a, b into its columns (end b: its arm's, where
+ * it has one; a ball's b is its a, cd_prim_b). */
+CD_INLINE void cd_prim_ends_store(cd_cols c, cd_prim_id i, cd_vec3 a, cd_vec3 b)
+{
+    cd_int r = cd_prim_arm_of(c, i);
+    c.prim_a[i] = a;
+    if (r >= 0) c.arm[r].b = b;
 }
 
 /* World axis ends of primitive i from its particle's pose. */
@@ -108,8 +108,16 @@ CD_INLINE void cd_item_prim_ends(cd_cols c, cd_prim_id i)
     cd_particle_id p = c.prim_particle[i];
     cd_vec3 a, b;
     cd_prim_ends_at(c, i, c.position[p], c.orientation[p], &a, &b);
-    c.prim_a[i] = a;
-    c.prim_b[i] = b;
+    cd_prim_ends_store(c, i, a, b);
+}
+
+/* Primitive i's ends become the reference of the skin test at a
+ * neighbour-list build. */
+CD_INLINE void cd_item_prim_refs(cd_cols c, cd_prim_id i)
+{
+    cd_int r = cd_prim_arm_of(c, i);
+    c.prim_a_ref[i] = c.prim_a[i];
+    if (r >= 0) c.arm[r].b_ref = c.arm[r].b;
 }
 
 /* The world ends of particle q's primitives for the pose x [m], o,
@@ -123,9 +131,8 @@ CD_INLINE int cd_store_ends(cd_cols c, cd_particle_id q, cd_vec3 x, cd_quat o, i
     for (cd_int i = first; i < last; i++) {
         cd_vec3 a, b;
         cd_prim_ends_at(c, i, x, o, &a, &b);
-        c.prim_a[i] = a;
-        c.prim_b[i] = b;
-        if (test) moved |= cd_bp_moved(a, c.prim_a_ref[i], b, c.prim_b_ref[i], limit2);
+        cd_prim_ends_store(c, i, a, b);
+        if (test) moved |= cd_bp_moved(a, c.prim_a_ref[i], b, cd_prim_b_ref(c, i), limit2);
     }
     return moved;
 }
@@ -146,7 +153,7 @@ CD_INLINE void cd_prim_world_ends(cd_cols c, cd_prim_id i, cd_vec3 *a, cd_vec3 *
     cd_prim_ends_at(c, i, c.position[p], c.orientation[p], a, b);
 #else
     *a = c.prim_a[i];
-    *b = c.prim_b[i];
+    *b = cd_prim_b(c, i);
 #endif
 }
 
@@ -160,7 +167,9 @@ CD_INLINE void cd_item_ref_pose(cd_cols c, cd_particle_id q, CD_GLOBAL cd_real *
     cd_real reach = 0; /* [m] */
     cd_int first = c.prim_first[q], last = first + c.prim_count[q];
     for (cd_int i = first; i < last; i++) {
-        cd_real ra = cd_v3_norm(c.prim_a_body[i]), rb = cd_v3_norm(c.prim_b_body[i]);
+        cd_int arm = cd_prim_arm_of(c, i);
+        if (arm < 0) continue; /* a ball at the centre: its ends move with x only */
+        cd_real ra = cd_v3_norm(c.arm[arm].a_body), rb = cd_v3_norm(c.arm[arm].b_body);
         reach = ra > reach ? ra : reach;
         reach = rb > reach ? rb : reach;
     }
@@ -252,18 +261,17 @@ CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real l
     return cd_advance_from(c, q, c.velocity[q], c.angmom[q], c.force[q], c.torque[q], c.mass[q], dt, limit2, ref_pose);
 }
 
-/* Contact geometry of pair row k (docs/references.md, Contacts): closest points of the two axes
- * and, from them, the contact point, normal and overlap.  Fills g always
- * (the host's output pass, src/io/pair_output.c, needs the normal of every
- * active row). */
-CD_INLINE void cd_pair_geometry(cd_cols c, cd_pair_id k, cd_real sin_parallel, cd_int parallel_blend,
-                                cd_contact_geom *g)
+/* Contact geometry of two primitives (axis ends ai, bi and aj, bj, radii
+ * ri, rj [m]; docs/references.md, Contacts): closest points of the two
+ * axes and, from them, the contact point, normal and overlap.  Fills g
+ * always (the host's output pass, src/io/pair_output.c, needs the normal of
+ * every active row, from the host's columns). */
+CD_INLINE void cd_pair_geometry_of(cd_vec3 ai, cd_vec3 bi, cd_real ri, cd_vec3 aj, cd_vec3 bj, cd_real rj,
+                                   cd_real sin_parallel, cd_int parallel_blend, cd_contact_geom *g)
 {
-    cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
-    cd_vec3 ai = c.prim_a[i], bi = c.prim_b[i], aj = c.prim_a[j], bj = c.prim_b[j];
     cd_real s, t;
     cd_segseg_closest(ai, bi, aj, bj, &s, &t);
-    cd_segseg_contact_at(ai, bi, c.prim_radius[i], aj, bj, c.prim_radius[j], s, t, sin_parallel, parallel_blend, g);
+    cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, g);
 }
 
 /* Torque about a body's centre [m] of a force [N] acting at a point [m]. */
@@ -409,7 +417,7 @@ CD_INLINE cd_int cd_item_wall_candidates(cd_cols c, cd_particle_id q, const CD_G
         for (cd_int w = 0; w < n_walls; w++) {
             cd_long row = (cd_long)i * n_walls + w;
             cd_wall wall = walls[w];
-            if (cd_bp_wall_candidate(&wall, c.prim_a[i], c.prim_b[i], c.prim_radius[i], skin)) {
+            if (cd_bp_wall_candidate(&wall, c.prim_a[i], cd_prim_b(c, i), c.prim_radius[i], skin)) {
                 if (out) out[n] = (cd_int)row;
                 n++;
             }

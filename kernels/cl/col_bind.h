@@ -4,3 +4,5 @@ cd_cols c;
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = name;)
 #include "../fields.def"
 #undef CD_FIELD
+c.prim_arm = prim_arm;
+c.arm = arm;

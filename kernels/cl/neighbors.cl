@@ -18,6 +18,17 @@ __kernel void cd_cl_bounds(
     if (p < n_particles) cd_nb_item_bound(c, p, part_bound);
 }
 
+/* The build's last pass: primitive i's ends become the skin test's
+ * reference (cd_item_prim_refs). */
+__kernel void cd_cl_prim_refs(
+#include "col_params.h"
+    cd_int n_prims)
+{
+#include "col_bind.h"
+    cd_int i = (cd_int)get_global_id(0);
+    if (i < n_prims) cd_item_prim_refs(c, i);
+}
+
 /* Pass 1b: box of the particles of chunk g. */
 __kernel void cd_cl_box(
 #include "col_params.h"

@@ -518,6 +518,11 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
     }
     if (place_particles(sim, &rng, err, errlen)) return -1;
     if (check_time_step(sim, err, errlen)) return -1;
+    /* the arms the step reads (kernels/cols.h); a start derives them anew */
+    if (cd_state_arms_derive(s)) {
+        snprintf(err, errlen, "out of memory while setting up the primitives' arms");
+        return -1;
+    }
 
     cd_step_params *sp = &sim->p;
     sp->dt = c->dt;

@@ -1,11 +1,17 @@
 #include "core/state.h"
 #include "field_groups.h"
+#include "cols.h"
+#include "vec3.h"
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
 
 #define CD_GROUP_OF_PARTICLE CD_GROUP_PARTICLE
 #define CD_GROUP_OF_PRIM     CD_GROUP_PRIM
 #define CD_GROUP_OF_PAIR     CD_GROUP_PAIR
+/* PRIM_ARM: rows of PRIM on the host; a device holds them per arm (cd_arm,
+ * cd_state_arms_derive below). */
+#define CD_GROUP_OF_PRIM_ARM CD_GROUP_PRIM
 #define CD_GROUP_OF_WALLC    CD_GROUP_WALLC
 #define CD_GROUP_OF_PAIR_OUT CD_GROUP_PAIR_OUT
 /* WALLC_OUT: the rows of WALLC on the host (I/O, reorder, copies); only
@@ -95,6 +101,34 @@ void cd_state_free(cd_state *s)
         free(*slot);
         *slot = NULL;
     }
+    free(s->prim_arm);
+    free(s->arm);
+    s->prim_arm = NULL;
+    s->arm = NULL;
+    s->n_arms = 0;
+}
+
+/* dst's arms the size of src's, holding src's (dst's own arrays). */
+static int copy_arms(cd_state *dst, const cd_state *src, cd_int *prim_arm, cd_arm *arm)
+{
+    dst->prim_arm = prim_arm;
+    dst->arm = arm;
+    if (!src->prim_arm) { /* src has none yet (derived at a start) */
+        free(prim_arm);
+        free(arm);
+        dst->prim_arm = NULL;
+        dst->arm = NULL;
+        dst->n_arms = 0;
+        return 0;
+    }
+    cd_int *pa = realloc(prim_arm, (src->n_prims + 1) * sizeof *pa);
+    if (pa) dst->prim_arm = pa;
+    cd_arm *ar = pa ? realloc(arm, (src->n_arms + 1) * sizeof *ar) : NULL;
+    if (ar) dst->arm = ar;
+    if (!pa || !ar) return -1;
+    memcpy(pa, src->prim_arm, src->n_prims * sizeof *pa);
+    memcpy(ar, src->arm, src->n_arms * sizeof *ar);
+    return 0;
 }
 
 int cd_state_copy(cd_state *dst, const cd_state *src)
@@ -113,7 +147,64 @@ int cd_state_copy(cd_state *dst, const cd_state *src)
         memcpy(*slot, *cd_field_ptr((cd_state *)src, &cd_fields[k]),
                cd_state_rows(src, cd_fields[k].group) * cd_fields[k].elem_size);
     }
+    return copy_arms(dst, src, keep.prim_arm, keep.arm);
+}
+
+/* A ball's body ends are zeros of either sign (a sphere's a = -0 in the
+ * shape catalogue): their six signs, bit k for component k of a then b,
+ * kept in its negative arm index -1 - signs, so that the host's columns
+ * come back with the bits they had (the run file stores them). */
+static cd_int zero_signs(cd_vec3 a, cd_vec3 b)
+{
+    const double v[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
+    cd_int bits = 0;
+    for (int k = 0; k < 6; k++) bits |= (cd_int)(signbit(v[k]) != 0) << k;
+    return bits;
+}
+
+static cd_vec3 signed_zeros(cd_int bits)
+{
+    return cd_v3(bits & 1 ? -0.0 : 0.0, bits & 2 ? -0.0 : 0.0, bits & 4 ? -0.0 : 0.0);
+}
+
+int cd_state_arms_derive(cd_state *s)
+{
+    size_t P = s->n_prims, n = 0;
+    cd_int *pa = realloc(s->prim_arm, (P + 1) * sizeof *pa);
+    if (pa) s->prim_arm = pa;
+    for (size_t i = 0; pa && i < P; i++) n += !cd_ends_at_origin(s->prim_a_body[i], s->prim_b_body[i]);
+    cd_arm *arm = pa ? realloc(s->arm, (n + 1) * sizeof *arm) : NULL;
+    if (arm) s->arm = arm;
+    if (!pa || !arm) return -1;
+    s->n_arms = n;
+    n = 0;
+    for (size_t i = 0; i < P; i++) {
+        if (cd_ends_at_origin(s->prim_a_body[i], s->prim_b_body[i])) {
+            pa[i] = -1 - zero_signs(s->prim_a_body[i], s->prim_b_body[i]);
+            continue;
+        }
+        pa[i] = (cd_int)n;
+        arm[n++] = (cd_arm){s->prim_a_body[i], s->prim_b_body[i], s->prim_b[i], s->prim_b_ref[i]};
+    }
     return 0;
+}
+
+void cd_state_arms_expand(cd_state *s, const cd_int *prim_arm, const cd_arm *arm)
+{
+    for (size_t i = 0; i < s->n_prims; i++) {
+        cd_int r = prim_arm[i];
+        if (r < 0) { /* a ball at the centre: both ends at the origin of the body */
+            s->prim_a_body[i] = signed_zeros(-1 - r);
+            s->prim_b_body[i] = signed_zeros((-1 - r) >> 3);
+            s->prim_b[i] = s->prim_a[i];
+            s->prim_b_ref[i] = s->prim_a_ref[i];
+            continue;
+        }
+        s->prim_a_body[i] = arm[r].a_body;
+        s->prim_b_body[i] = arm[r].b_body;
+        s->prim_b[i] = arm[r].b;
+        s->prim_b_ref[i] = arm[r].b_ref;
+    }
 }
 
 void cd_state_expand_wall_entries(cd_state *s, const cd_int *rows, const cd_wall_entry *ent, size_t n)

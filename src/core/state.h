@@ -28,6 +28,14 @@ typedef struct cd_state {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) ctype *name;
 #include "fields.def"
 #undef CD_FIELD
+    /* The primitives' arms as a device holds them (kernels/cols.h, cd_arm):
+     * prim_arm per primitive (negative: a ball at its particle's centre,
+     * -1 - the signs of its zero body ends, src/core/state.c), n_arms
+     * rows of arm; derived from the host's PRIM_ARM columns at a start
+     * (cd_state_arms_derive), not written to files. */
+    size_t n_arms;
+    cd_int *prim_arm;
+    cd_arm *arm;
     cd_wall walls[CD_MAX_WALLS]; /* current wall positions and motion */
     /* State of the protocol driving the run (phase, wall dynamics,
      * convergence checks): doubles saved with every snapshot, so that a
@@ -67,6 +75,20 @@ void cd_state_free(cd_state *s);
  * allocated for the same particles, primitives and walls (its pair columns
  * grow as needed).  Returns 0, or -1 (out of memory, or other sizes). */
 int cd_state_copy(cd_state *dst, const cd_state *src);
+/* The arms of s (n_arms, prim_arm, arm) anew from its host columns
+ * prim_a_body, prim_b_body, prim_b, prim_b_ref: a primitive has an arm
+ * unless both its body-frame ends are the body origin (cd_ends_at_origin),
+ * in primitive order.  Returns 0, or -1 (out of memory). */
+int cd_state_arms_derive(cd_state *s);
+/* Has every primitive of s an arm, its own row (prim_arm the identity)?
+ * Then a device neither holds nor reads prim_arm (kernels/cols.h). */
+static inline int cd_state_arms_all(const cd_state *s) { return s->n_arms == s->n_prims; }
+/* The reverse, at sync: the host's PRIM_ARM columns (body ends, prim_b,
+ * prim_b_ref) of every primitive i from its arm prim_arm[i] in arm (where
+ * the step keeps them), or for a primitive without one, its zero body ends
+ * (with the signs they had: prim_arm[i] = -1 - signs) and its prim_a and prim_a_ref: every row is written, so that the rows follow
+ * the primitives' order where the step moved them (src/backend/omp/reorder.c). */
+void cd_state_arms_expand(cd_state *s, const cd_int *prim_arm, const cd_arm *arm);
 /* The host's wall-contact rows (fields.def, WALLC and WALLC_OUT) from the
  * entries the step keeps per wall candidate: ent[e] for the candidate row
  * rows[e] (e < n) while it is in contact (active), 0 elsewhere. */

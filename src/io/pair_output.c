@@ -5,8 +5,8 @@
  * torques, which output and analysis read, are rebuilt here when the state
  * is synced to the host:
  *   normal  : the same contact geometry the step computed (kernels/
- *             step_items.h, cd_pair_geometry: same function, same
- *             primitive ends, so the same bits on the host backend);
+ *             step_items.h, cd_pair_geometry_of: same function, same
+ *             primitive ends from the host's columns, so the same bits on the host backend);
  *   F_t     : F_j - F_n n, the law's tangential force up to one rounding
  *             of F_n n (relative 1e-16 of F_n);
  *   torques : the expressions the gather sums (cd_contact_torque), so the
@@ -17,7 +17,6 @@
 void cd_sim_derive_pair_output(cd_sim *sim)
 {
     cd_state *s = &sim->s;
-    cd_cols c = cd_sim_host_cols(s);
     cd_real sin_parallel = sim->p.sin_parallel;
     cd_int blend = sim->p.parallel_blend;
     size_t n = s->n_pairs;
@@ -28,8 +27,12 @@ void cd_sim_derive_pair_output(cd_sim *sim)
             s->pair_normal[k] = s->pair_ft[k] = s->pair_torque_i[k] = s->pair_torque_j[k] = cd_v3_zero();
             continue;
         }
+        /* from the host's columns (synced; the arms of a backend's step
+         * may be elsewhere, or of another state: an MPI gather's) */
+        cd_prim_id i = s->pair_prim_i[k], j = s->pair_prim_j[k];
         cd_contact_geom g;
-        cd_pair_geometry(c, k, sin_parallel, blend, &g);
+        cd_pair_geometry_of(s->prim_a[i], s->prim_b[i], s->prim_radius[i], s->prim_a[j], s->prim_b[j],
+                            s->prim_radius[j], sin_parallel, blend, &g);
         cd_vec3 f = s->pair_force[k], point = s->pair_point[k];
         s->pair_normal[k] = g.normal;
         s->pair_ft[k] = cd_contact_tangential(f, s->pair_fn[k], g.normal);

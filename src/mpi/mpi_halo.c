@@ -341,6 +341,7 @@ int cd_mpi_assemble(cd_mpi_ctx *x, cd_state *from, const long long *from_gid, co
             *cd_field_ptr(from, f) = NULL;
         }
     }
+    if (!rc && release && from) cd_state_free(from); /* (its arms; the columns are gone already) */
     /* the index columns in the new numbering, the global ids, ownership */
     x->n_owned = 0;
     for (long long l = 0; !rc && l < N; l++) {
@@ -362,6 +363,8 @@ int cd_mpi_assemble(cd_mpi_ctx *x, cd_state *from, const long long *from_gid, co
         x->n_owned += owned[l];
     }
     if (!rc) rc = place_pairs(&s, cr, K, gprim);
+    /* the arms the step reads (kernels/cols.h), from the rows */
+    if (!rc) rc = cd_state_arms_derive(&s);
     free(pr);
     free(cr);
     free(src);
@@ -612,6 +615,7 @@ int cd_mpi_gather(cd_mpi_ctx *x, cd_state *global)
             unpack_particle(global, (size_t)h.gid, (size_t)h.gprim_first, pr[q].at);
         }
         if (!rc) rc = place_serial_rows(global, (const long long *)nall, nlen / (2 * sizeof(long long)), cr, K);
+        if (!rc) rc = cd_state_arms_derive(global); /* its arms of these rows (kernels/cols.h) */
         free(pr);
         free(cr);
     }

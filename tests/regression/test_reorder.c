@@ -33,6 +33,18 @@ static const char *pile_frictional_walls =
     "domain: {type: box, width: 0.06, thickness: 0.06, height: 0.3}\n"
     "init: {placement: random, exclusion: shape, speed: 0.2}\n";
 
+/* Spheres and hexapods in one pile: some primitives have an arm and some
+ * do not, so each primitive's arm index moves with it at a reorder and at
+ * a sync (kernels/cols.h, src/backend/omp/reorder.c), where a pile of one
+ * shape moves the arms themselves (hexapods) or has none (spheres). */
+static const char *pile_mixed =
+    "run: {dt: 8.5e-6, steps: 0, seed: 7}\n"
+    "physics: {gravity: [0, -490.5, 0]}\n"
+    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 150, polydispersity: 0.2},\n"
+    "            {shape: sphere, diameter: 0.005, count: 300, polydispersity: 0.2}]\n"
+    "domain: {type: box, width: 0.06, thickness: 0.06, height: 0.3}\n"
+    "init: {placement: random, exclusion: shape, speed: 0.2}\n";
+
 /* Is column f one a pair row keeps while inactive?  (The point, force,
  * overlap and F_n of an inactive row are whatever its memory row last
  * held, in either order: nobody reads them, kernels/step_items.h.) */
@@ -121,6 +133,7 @@ static void check_reorder(int reorder, const char *cfg)
     assert_true(contacts > 1000 && wall_contacts > 300);
     if (cfg == pile_frictional_walls) assert_true(springs > 300);
     assert_int_equal(b.nb.reorders, 0);
+    if (cfg == pile_mixed) assert_true(a.s.n_arms > 0 && a.s.n_arms < a.s.n_prims);
     /* the particles did move in memory: once for the default (the random
      * placement's order, then the cells', which the pile keeps), at
      * every rebuild that changes the cells' order when forced */
@@ -153,12 +166,21 @@ static void test_reorder_with_frictional_walls_changes_no_bit(void **state)
     check_reorder(CD_NB_REORDER_ALWAYS, pile_frictional_walls);
 }
 
+/* The same with spheres among the hexapods (primitives with and without
+ * an arm). */
+static void test_reorder_of_spheres_and_hexapods_changes_no_bit(void **state)
+{
+    (void)state;
+    check_reorder(CD_NB_REORDER_ALWAYS, pile_mixed);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reorder_changes_no_bit),
         cmocka_unit_test(test_reorder_at_every_rebuild_changes_no_bit),
         cmocka_unit_test(test_reorder_with_frictional_walls_changes_no_bit),
+        cmocka_unit_test(test_reorder_of_spheres_and_hexapods_changes_no_bit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -423,8 +423,7 @@ int cd_neighbors_build(cd_sim *sim)
         for (cd_int i = 0; i < most; i++) {
             if (i < P) {
                 cd_nb_item_place(CD_B.c, i, CD_B.d.pair_offset, CD_B.d.cand, slot, CD_B.d.keys, CD_B.order);
-                CD_B.c.prim_a_ref[i] = CD_B.c.prim_a[i];
-                CD_B.c.prim_b_ref[i] = CD_B.c.prim_b[i];
+                cd_item_prim_refs(CD_B.c, i);
             }
             if (i < N) CD_B.d.count[i] = 0;
             if (i < N && CD_B.d.ref_pose) cd_item_ref_pose(CD_B.c, i, CD_B.d.ref_pose);

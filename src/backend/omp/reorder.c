@@ -81,6 +81,7 @@ static size_t largest_column(const cd_state *s)
                                                                   : 0;
         if (rows * cd_fields[f].elem_size > most) most = rows * cd_fields[f].elem_size;
     }
+    if (s->n_arms * sizeof(cd_arm) > most) most = s->n_arms * sizeof(cd_arm);
     return most;
 }
 
@@ -172,8 +173,8 @@ static cd_int *sort_particles(cd_sim *sim, const cd_grid *g)
 static int moves(const cd_field_info *f)
 {
     /* not the host-only columns: a device does not hold them, and on host
-     * threads sync writes them anew (wallc_torque) */
-    return f->on_device && strcmp(f->name, "prim_a_ref") && strcmp(f->name, "prim_b_ref");
+     * threads sync writes them anew (wallc_torque, the arms' columns) */
+    return f->on_device && strcmp(f->name, "prim_a_ref");
 }
 
 int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
@@ -240,6 +241,13 @@ int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
         for (cd_int w = 0; grp == CD_GROUP_WALLC && w < W; w++) /* one wall's rows at a time */
             move_rows(sim, col + (size_t)w * words, (size_t)P, words, words * (size_t)W, d.prim_src);
     }
+    /* the arms (kernels/cols.h): where every primitive has one (prim_arm
+     * the identity since cd_state_arms_derive), the arms follow their
+     * primitives; otherwise each primitive takes its arm's row along */
+    cd_cols c = cd_sim_step_cols(sim); /* where the step's columns are (host copies of device addresses) */
+    if (cd_state_arms_all(s))
+        move_rows(sim, (cd_int *)c.arm, (size_t)P, sizeof(cd_arm) / word, sizeof(cd_arm) / word, d.prim_src);
+    else move_rows(sim, c.prim_arm, (size_t)P, 1, 1, d.prim_src);
     move_rows(sim, (cd_int *)d.part_bound, (size_t)N, sizeof(cd_real) / word, sizeof(cd_real) / word, d.part_src);
     move_rows(sim, d.part_uid, (size_t)N, 1, 1, d.part_src);
     move_rows(sim, d.prim_uid, (size_t)P, 1, 1, d.prim_src);
@@ -307,8 +315,8 @@ static void free_host_map(cd_int *h)
 #endif
 }
 
-/* Moves every step column of the host state (particles by part, primitives
- * and wall rows by prim, pair rows by pair, gather or scatter) through
+/* Moves every step column of the host state (particles by part, primitives,
+ * their arm indices and wall rows by prim, pair rows by pair, gather or scatter) through
  * scratch of `bytes`; the pair rows' primitive ids through prim_ids; then
  * each particle's primitive indices from the counts in the new order. */
 static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const cd_int *pair, int pair_scatter,
@@ -332,6 +340,16 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
         for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, n, col, n, map, (cd_long)g, n, scatter);
         memcpy(col, tmp, rows * cd_fields[f].elem_size);
     }
+    /* the arms as at the reorder's build (cd_reorder_build): where every
+     * primitive has one (prim_arm the identity), the arms with their
+     * primitives; otherwise each primitive's arm index with it */
+    int all = cd_state_arms_all(s);
+    cd_int *col = all ? (cd_int *)s->arm : s->prim_arm;
+    cd_long nw = all ? (cd_long)(sizeof(cd_arm) / sizeof(cd_int)) : 1;
+    size_t P = col ? s->n_prims : 0;
+    CD_HOST_FOR(P, firstprivate(tmp, col, prim, nw))
+    for (size_t i = 0; i < P; i++) cd_reorder_item_move(tmp, nw, col, nw, prim, (cd_long)i, nw, 0);
+    if (P) memcpy(col, tmp, P * (size_t)nw * sizeof(cd_int));
     free(tmp);
     size_t K = s->n_pairs;
     CD_HOST_FOR(K, firstprivate(s, prim_ids))

@@ -19,6 +19,8 @@ cd_cols cd_sim_host_cols(cd_state *s)
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(c.name = s->name;)
 #include "fields.def"
 #undef CD_FIELD
+    c.prim_arm = cd_state_arms_all(s) ? NULL : s->prim_arm; /* kernels/cols.h, cd_prim_arm_of */
+    c.arm = s->arm;
     return c;
 }
 
@@ -70,6 +72,8 @@ static void off_refresh_cols(cd_sim *sim, cd_off *o)
         void **slot = cd_field_ptr(&d, &cd_fields[f]);
         if (o->host[f]) *slot = off_devptr(o->host[f]);
     }
+    d.prim_arm = o->arm_host[0] ? off_devptr(o->arm_host[0]) : NULL;
+    d.arm = off_devptr(o->arm_host[1]);
     o->dev = cd_sim_host_cols(&d);
 }
 
@@ -89,6 +93,7 @@ void cd_off_release(cd_sim *sim)
     cd_off *o = sim->backend_data;
     if (!o) return;
     for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
+    for (int k = 0; k < 2; k++) off_unmap(o->arm_host[k], o->arm_bytes[k]);
     off_unmap(o->part, o->part_n * sizeof(double));
     cd_dev_free(o->args_dev);
     free(o->part);
@@ -142,6 +147,14 @@ int cd_off_acquire(cd_sim *sim, char *err, size_t errlen)
         return -1;
     }
     for (size_t f = 0; f < cd_n_fields; f++) off_map_field(sim, o, f);
+    /* the arms (cd_state_arms_derive), one spare row each: mapped even
+     * when a state has none */
+    int all = cd_state_arms_all(&sim->s); /* then no index column (kernels/cols.h) */
+    o->arm_host[0] = all ? NULL : sim->s.prim_arm;
+    o->arm_bytes[0] = all ? 0 : (sim->s.n_prims + 1) * sizeof(cd_int);
+    o->arm_host[1] = sim->s.arm;
+    o->arm_bytes[1] = (sim->s.n_arms + 1) * sizeof(cd_arm);
+    for (int k = 0; k < 2; k++) off_map(o->arm_host[k], o->arm_bytes[k]);
     off_map(o->part, o->part_n * sizeof(double));
     off_refresh_cols(sim, o);
     return 0;

@@ -31,9 +31,11 @@ typedef struct {
 #if CD_OFFLOAD
 /* What the offload variant keeps in sim->backend_data. */
 typedef struct {
-    void **host;   /* per field of cd_fields: host address mapped (NULL: none) */
-    size_t *bytes; /* per field: bytes mapped */
-    double *part;  /* per-chunk partial sums of the wall load (mapped) */
+    void **host;         /* per field of cd_fields: host address mapped (NULL: none) */
+    size_t *bytes;       /* per field: bytes mapped */
+    void *arm_host[2];   /* the state's prim_arm and arm, mapped (kernels/cols.h) */
+    size_t arm_bytes[2]; /* their bytes mapped */
+    double *part;        /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;              /* device addresses of the columns */
     cd_step_args *args_dev;   /* the loops' argument block on the device (cd_off_args_or_die) */

@@ -252,6 +252,7 @@ void cd_sim_refresh(cd_sim *sim)
     size_t n = s->n_prims;
     CD_HOST_FOR(n, firstprivate(c))
     for (size_t i = 0; i < n; i++) cd_item_prim_ends(c, (cd_prim_id)i);
+    cd_state_arms_expand(s, s->prim_arm, s->arm); /* the host's prim_b current too */
     sim->nb.force_rebuild = 1;
 }
 
@@ -318,14 +319,35 @@ static void store_ends(cd_sim *sim)
 #endif
 }
 
+/* The primitives' arms into the host's PRIM_ARM rows (cd_state_arms_expand)
+ * while the host columns are in the step's order: before
+ * cd_reorder_to_user moves them; a second sync without a step between
+ * finds them in user order (host_user) and the rows already written. */
+static void arms_to_host(cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    if (s->prim_arm && !sim->nb.host_user) cd_state_arms_expand(s, s->prim_arm, s->arm);
+}
+
+/* The arms anew from the host's columns (in user order: after omp_stop). */
+static int arms_from_host(cd_sim *sim, char *err, size_t errlen)
+{
+    if (!cd_state_arms_derive(&sim->s)) return 0;
+    snprintf(err, errlen, "out of memory while setting up the primitives' arms");
+    return -1;
+}
+
 /* The backend lets go of the state: in host memory (host threads, or an
  * offload build's host fallback) the host columns go back to user order
  * (they are the current state); an offload device's state is dropped (the
  * host keeps what the last sync brought). */
 static void omp_stop(cd_sim *sim)
 {
-    /* the host keeps the step's wall-contact outputs too */
-    if (cd_step_memory_is_host()) store_ends(sim);
+    /* the host keeps the step's wall-contact outputs and arms too */
+    if (cd_step_memory_is_host()) {
+        store_ends(sim);
+        arms_to_host(sim);
+    }
     if (cd_step_memory_is_host() && (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim)))
         fprintf(stderr, "capdem: out of memory putting the particles in user order\n");
     cd_reorder_forget(sim);
@@ -341,6 +363,7 @@ int cd_sim_step_remap(cd_sim *sim, char *err, size_t errlen)
 {
 #if CD_OFFLOAD
     omp_stop(sim);
+    if (arms_from_host(sim, err, errlen)) return -1;
     return cd_off_acquire(sim, err, errlen);
 #else
     (void)sim;
@@ -353,6 +376,7 @@ int cd_sim_step_remap(cd_sim *sim, char *err, size_t errlen)
 static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
 {
     omp_stop(sim);
+    if (arms_from_host(sim, err, errlen)) return -1;
     cd_sim_refresh(sim);
     /* the host's wall rows hold the contacts to carry on (a resumed run, a
      * state put back): the first build turns them into candidate entries */
@@ -387,6 +411,8 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
         return -1;
     }
 #endif
+    /* a state stepped without a start (tests): its arms from its columns */
+    if (!s->prim_arm && arms_from_host(sim, err, errlen)) return -1;
     /* host threads after a sync: the columns back in the lists' order */
     if (cd_reorder_to_memory(sim)) {
         snprintf(err, errlen, "out of memory putting the particles in memory order");
@@ -433,6 +459,8 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
                 cd_off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
                             cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
         }
+    if (o) /* the arms in the step's order: expanded below (arms_to_host) */
+        for (int k = 0; k < 2; k++) cd_off_from(o->arm_host[k], o->arm_bytes[k]);
     /* The host's wall rows anew as well, whenever the step has entries:
      * cd_reorder_to_user below moves every host column from memory order
      * at every sync, so rows not written again (a second sync without a
@@ -441,8 +469,9 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
      * user order and moves nothing, as on host threads. */
     if (sim->nb.wall_out_valid && !cd_step_memory_is_host()) sim->nb.wall_out_pending = 1;
 #endif
-    /* the wall contacts kept per candidate into the host's rows, then the
-     * host columns in user order (src/backend/omp/reorder.c) */
+    /* the wall contacts kept per candidate and the arms into the host's
+     * rows, then the host columns in user order (src/backend/omp/reorder.c) */
+    arms_to_host(sim);
     if (cd_neighbors_wall_out_to_host(sim) || cd_reorder_to_user(sim)) {
         snprintf(err, errlen, "out of memory putting the particles in user order");
         return -1;

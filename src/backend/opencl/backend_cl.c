@@ -12,7 +12,7 @@
 #include "broadphase.h"
 #include "step_items.h"
 
-#define F CD_CL_N_FIELDS /* first kernel argument after the columns */
+#define F CD_CL_N_COLS /* first kernel argument after the columns */
 
 /* Arguments that change only with sim->p or the buffers: set at every call
  * of step (sim->p may change between calls, e.g. gravity in capdem-bench). */
@@ -121,6 +121,11 @@ static int cl_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
     }
     /* As the omp backend: angular velocities and primitive ends from the
      * poses on the host, and a rebuild before the first forces. */
+    if (cd_state_arms_derive(&sim->s)) {
+        snprintf(err, errlen, "out of memory while setting up the primitives' arms");
+        cl_stop(sim);
+        return -1;
+    }
     cd_sim_refresh(sim);
     if (cd_cl_buffers_create(cl, sim) || cd_cl_buffers_upload(cl, sim)) return fail(sim, err, errlen);
     set_step_args(cl, sim);

@@ -12,7 +12,7 @@
 #include "field_groups.h"
 
 /* Kernels of the .cl files in kernels/cl.  Those marked "cols" in backend_cl_device.c
- * take the state's columns as their first CD_CL_N_FIELDS arguments. */
+ * take the state's columns as their first CD_CL_N_COLS arguments. */
 enum cd_cl_kernel {
     CD_CLK_ADVANCE,
     CD_CLK_PAIR_FORCES,
@@ -41,6 +41,7 @@ enum cd_cl_kernel {
     CD_CLK_WALL_CAND_COUNT,
     CD_CLK_WALL_CAND_FILL,
     CD_CLK_WALL_CARRY,
+    CD_CLK_PRIM_REFS,
     CD_CLK_OBS_TOUCH_PAIRS,
     CD_CLK_OBS_TOUCH_WALLS,
     CD_CLK_OBS_PARTICLES,
@@ -59,6 +60,9 @@ enum {
 #undef CD_FIELD
     CD_CL_N_FIELDS
 };
+/* Kernel arguments taken by the columns: the fields', then the
+ * primitives' arms (prim_arm, arm: kernels/cl/col_params.h). */
+#define CD_CL_N_COLS (CD_CL_N_FIELDS + 2)
 
 /* The pair columns that carry history across a rebuild exist twice: the
  * new list is filled from the old one.  One such set, with its keys. */
@@ -84,6 +88,8 @@ typedef struct cd_cl {
     /* state columns; pair columns have cap_pairs rows, except pair_active
      * and pair_shear, which are those of hist[cur] (cd_cl_col) */
     cl_mem col[CD_CL_N_FIELDS];
+    cl_mem prim_arm, arm; /* the primitives' arms (kernels/cols.h; no reorder: the host's rows) */
+    int arms_all;         /* every primitive has an arm: prim_arm is bound as null (cd_prim_arm_of) */
     size_t cap_pairs;
     cd_cl_pairset hist[2];
     int cur;

@@ -82,6 +82,11 @@ int cd_cl_bind_cols(cd_cl *cl)
             cl_mem m = cd_cl_col(cl, f);
             if (cd_cl_arg(cl, (enum cd_cl_kernel)k, (cl_uint)f, sizeof m, &m)) return -1;
         }
+        /* a null prim_arm where every primitive has an arm (kernels/cols.h) */
+        cl_mem arm_of = cl->arms_all ? NULL : cl->prim_arm;
+        if (cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS, sizeof arm_of, &arm_of) ||
+            cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 1, sizeof cl->arm, &cl->arm))
+            return -1;
     }
     cl->cols_dirty = 0;
     return 0;
@@ -172,6 +177,9 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
         if (cd_fields[f].group == CD_GROUP_PAIR) continue;
         cl->col[f] = cd_cl_buffer(cl, rows_of(cl, s, &cd_fields[f]) * cd_fields[f].elem_size, "allocating the state");
     }
+    cl->arms_all = cd_state_arms_all(s);
+    cl->prim_arm = cd_cl_buffer(cl, (cl->arms_all ? 1 : P + 1) * sizeof(cd_int), "allocating the state");
+    cl->arm = cd_cl_buffer(cl, (s->n_arms + 1) * sizeof(cd_arm), "allocating the state");
     cl->walls = cd_cl_buffer(cl, (W > 0 ? W : 1) * sizeof(cd_wall), "allocating the walls");
     cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
     cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
@@ -231,6 +239,8 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
         void *host = *cd_field_ptr(s, &cd_fields[f]);
         write(cl, cd_cl_col(cl, f), rows * cd_fields[f].elem_size, host, "uploading the state");
     }
+    if (!cl->arms_all) write(cl, cl->prim_arm, s->n_prims * sizeof(cd_int), s->prim_arm, "uploading the state");
+    write(cl, cl->arm, s->n_arms * sizeof(cd_arm), s->arm, "uploading the state");
     write(cl, cl->walls, s->n_walls * sizeof(cd_wall), s->walls, "uploading the walls");
     cd_int flags[3] = {0, -1, 0};
     write(cl, cl->flags, sizeof flags, flags, "uploading the flags");
@@ -239,8 +249,8 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
      * so that the first rebuild finds their history. */
     cd_int n = (cd_int)cl->n_pairs;
     cl_mem keys = cl->hist[cl->cur].keys;
-    cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_FIELDS, sizeof n, &n);
-    cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_FIELDS + 1, sizeof keys, &keys);
+    cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_COLS, sizeof n, &n);
+    cd_cl_arg(cl, CD_CLK_PAIR_KEYS, CD_CL_N_COLS + 1, sizeof keys, &keys);
     cd_cl_run(cl, CD_CLK_PAIR_KEYS, cl->n_pairs);
     /* The wall rows in contact as the candidates of a build before, so
      * that the first rebuild carries their history over. */
@@ -275,10 +285,15 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
         cl_int rc = clEnqueueReadBuffer(cl->queue, cd_cl_col(cl, f), CL_FALSE, 0, bytes, host, 0, NULL, NULL);
         cd_cl_check(cl, rc, "downloading the state");
     }
+    if (!cl->status && s->n_arms) /* the arms, expanded into the host's rows below */
+        cd_cl_check(
+            cl, clEnqueueReadBuffer(cl->queue, cl->arm, CL_FALSE, 0, s->n_arms * sizeof(cd_arm), s->arm, 0, NULL, NULL),
+            "downloading the state");
     /* Not the walls: the host's copy is current after every call of step
      * and may since have been changed by a protocol (docs/opencl.md). */
     if (!cl->status) cd_cl_check(cl, clFinish(cl->queue), "downloading the state");
     if (cl->status) return -1;
+    cd_state_arms_expand(s, s->prim_arm, s->arm);
     /* the wall contacts the step keeps per candidate, into the host's rows */
     size_t n = (size_t)cl->n_wall_rows;
     if (!cl->wall_out_pending || !s->n_walls) return 0;
@@ -306,6 +321,8 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
 void cd_cl_buffers_release(cd_cl *cl)
 {
     for (int f = 0; f < CD_CL_N_FIELDS; f++) release(&cl->col[f]);
+    release(&cl->prim_arm);
+    release(&cl->arm);
     for (int h = 0; h < 2; h++) {
         release(&cl->hist[h].active);
         release(&cl->hist[h].shear);

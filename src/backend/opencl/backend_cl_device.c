@@ -44,6 +44,7 @@ static const struct {
     {"cd_cl_wall_cand_count", 1},
     {"cd_cl_wall_cand_fill", 1},
     {"cd_cl_wall_carry", 0},
+    {"cd_cl_prim_refs", 1},
     {"cd_cl_obs_touch_pairs", 1},
     {"cd_cl_obs_touch_walls", 1},
     {"cd_cl_obs_particles", 1},

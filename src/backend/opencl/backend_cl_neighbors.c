@@ -12,7 +12,7 @@
 #include "broadphase.h"
 #include "neighbor_items.h"
 
-#define F CD_CL_N_FIELDS /* first kernel argument after the columns */
+#define F CD_CL_N_COLS /* first kernel argument after the columns */
 
 static int copy(cd_cl *cl, cl_mem src, cl_mem dst, size_t bytes)
 {
@@ -221,8 +221,8 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
     wall_lists(cl, sim, N);
 
     /* Reference ends for the skin criterion (its flag was cleared above). */
-    copy(cl, cl->col[CD_CL_F_prim_a], cl->col[CD_CL_F_prim_a_ref], (size_t)P * sizeof(cd_vec3));
-    copy(cl, cl->col[CD_CL_F_prim_b], cl->col[CD_CL_F_prim_b_ref], (size_t)P * sizeof(cd_vec3));
+    cd_cl_arg(cl, CD_CLK_PRIM_REFS, F, sizeof P, &P);
+    cd_cl_run(cl, CD_CLK_PRIM_REFS, (size_t)P);
     if (cl->status) return -1;
     cl->n_pairs = (size_t)n_new;
     sim->nb.force_rebuild = 0;
