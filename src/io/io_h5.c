@@ -417,8 +417,10 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
     int rc = 0;
     /* parallel output: a journal a killed writer left (io_h5_journal.h) is
      * replayed in place by rank 0 before the ranks open the file through
-     * MPI-IO (which knows no journal); the serial driver does it on open */
-    if (cdh5_par_on() && cdh5_par_max(cdh5_par_root() && cdh5_recover(path, o->err, sizeof o->err) < 0)) {
+     * MPI-IO (which knows no journal; the serial driver does it on open),
+     * and a file of the serial writer is refused (cdh5_par_appendable) */
+    if (cdh5_par_on() && cdh5_par_max(cdh5_par_root() && (cdh5_recover(path, o->err, sizeof o->err) < 0 ||
+                                                          cdh5_par_appendable(path, o->err, sizeof o->err) < 0))) {
         if (cdh5_par_root()) cdh5_report(o);
         rc = -1;
     }

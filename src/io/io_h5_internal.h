@@ -139,6 +139,11 @@ int cdh5_par_max(int v);
 void cdh5_par_bcast(void *buf, size_t bytes);
 /* Rank 0: the exclusive flock HDF5's serial driver would hold on fd's file. */
 void cdh5_par_lock(int fd);
+/* Rank 0, before the ranks open a run file to append to it (a resume):
+ * 0 when every chunked dataset got its chunks when it was extended (a
+ * file written through MPI-IO), else -1 with err set (written by the
+ * serial writer: HDF5 1.10 cannot append to it from several ranks). */
+int cdh5_par_appendable(const char *path, char *err, size_t errlen);
 /* The collective H5Dwrite of the block start..start+cnt (rank dims; the
  * file selection fs; memory ms of shape cnt, or with o->row_map of
  * o->map_rows rows along o->mask_dim): this rank's rows of it (o->row_map)

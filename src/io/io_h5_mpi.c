@@ -17,6 +17,49 @@
 #include <string.h>
 #include <sys/file.h>
 
+/* Datasets that HDF5 gives their chunks as they are written (the serial
+ * writer's: allocation time "incremental") cannot be appended to from
+ * several ranks by HDF5 1.10: its collective write of checksummed chunks
+ * reads a chunk that a rank fills only in part, and a chunk not yet
+ * written has no address (H5D__filtered_collective_chunk_entry_io: "addr
+ * overflow"), so one rank fails while the others wait in the collective
+ * (a resume of a serially written file on 2 ranks hung).  Files created
+ * through MPI-IO get every chunk when a dataset is extended (allocation
+ * time "early", HDF5's rule for parallel files) and are not affected. */
+static herr_t incremental_one(hid_t loc, const char *name, const H5O_info_t *info, void *data)
+{
+    int *found = data;
+    if (info->type != H5O_TYPE_DATASET) return 0;
+    hid_t d = H5Dopen2(loc, name, H5P_DEFAULT), dcpl = d < 0 ? -1 : H5Dget_create_plist(d);
+    H5D_alloc_time_t at = H5D_ALLOC_TIME_EARLY;
+    if (dcpl < 0 || H5Pget_alloc_time(dcpl, &at) < 0) *found = -1;
+    else if (H5Pget_layout(dcpl) == H5D_CHUNKED && at == H5D_ALLOC_TIME_INCR) *found = 1;
+    if (dcpl >= 0) H5Pclose(dcpl);
+    if (d >= 0) H5Dclose(d);
+    return *found ? 1 : 0;
+}
+
+int cdh5_par_appendable(const char *path, char *err, size_t errlen)
+{
+    cdh5_quiet q;
+    cdh5_quiet_begin(&q);
+    int found = 0;
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0 || H5Ovisit2(f, H5_INDEX_NAME, H5_ITER_NATIVE, incremental_one, &found, H5O_INFO_BASIC) < 0)
+        found = found ? found : -1;
+    if (f >= 0) H5Fclose(f);
+    cdh5_quiet_end(&q);
+    if (found < 0) snprintf(err, errlen, "%s: cannot read its datasets' layout", path);
+    else if (found)
+        snprintf(err, errlen,
+                 "%s was written by one process (the serial writer: one process, or mpi.output = rank0), whose "
+                 "datasets get their chunks as they are written; several MPI ranks cannot append to it with this "
+                 "HDF5 (1.10): resume it with mpi.output: rank0 in the config (it may change on --resume), or "
+                 "with one process (docs/mpi.md, \"Resume\")",
+                 path);
+    return found ? -1 : 0;
+}
+
 #if defined(CAPDEM_MPI) && CAPDEM_MPI && defined(H5_HAVE_PARALLEL)
 
 static struct {

@@ -225,53 +225,150 @@ static int plan_refresh(cd_mpi_ctx *x)
     return 0;
 }
 
-/* The local state from received records (particles: pbuf, pair rows:
- * cbuf), the scalars of scal; the neighbour list to be rebuilt. */
-int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal)
+/* Where column f of a particle record (n primitives, W walls) starts:
+ * the order of cd_mpi_pack_particle (rows_io over the groups). */
+static size_t record_field_at(const cd_field_info *f, long long n, size_t W)
 {
-    size_t W = scal->n_walls, N = 0, K = 0, P = 0;
-    rec_ref *pr = parse(pbuf, plen, 0, W, &N), *cr = parse(cbuf, clen, 1, W, &K);
+    static const enum cd_field_group order[3] = {CD_GROUP_PARTICLE, CD_GROUP_PRIM, CD_GROUP_WALLC};
+    size_t at = sizeof(rec_head);
+    for (int g = 0; g < 3; g++) {
+        size_t rows = g == 0 ? 1 : g == 1 ? (size_t)n : (size_t)n * W;
+        for (size_t k = 0; k < cd_n_fields; k++) {
+            if (cd_fields[k].group != order[g]) continue;
+            if (&cd_fields[k] == f) return at;
+            at += rows * cd_fields[k].elem_size;
+        }
+    }
+    return at;
+}
+
+/* A row of the new local state: row q of the state it is cut from, or a
+ * received record. */
+typedef struct {
+    long long gid, q, n_prims, first; /* q < 0: rec; first: its first primitive in the new state */
+    const char *rec;
+} source;
+
+/* The rows of from that stay (keep, ascending global id) and the records
+ * (ascending global id; a record replaces a kept row of the same id) in
+ * ascending global id into *out; their count, or -1 (out of memory). */
+static long long merge_sources(const cd_state *from, const long long *from_gid, const unsigned char *keep,
+                               const rec_ref *pr, size_t nr, source **out)
+{
+    size_t nf = from ? from->n_particles : 0, n = 0, a = 0, b = 0;
+    source *v = malloc((nf + nr + 1) * sizeof *v);
+    if (!(*out = v)) return -1;
+    while (a < nf || b < nr) {
+        if (a < nf && !keep[a]) {
+            a++;
+            continue;
+        }
+        long long ga = a < nf ? (from_gid ? from_gid[a] : (long long)a) : 0;
+        if (b < nr && (a >= nf || pr[b].a <= ga)) {
+            rec_head h;
+            memcpy(&h, pr[b].at, sizeof h);
+            v[n++] = (source){h.gid, -1, h.n_prims, 0, pr[b].at};
+            if (a < nf && pr[b].a == ga) a++; /* (the record's bits lead) */
+            b++;
+        } else {
+            v[n++] = (source){ga, (long long)a, from->prim_count[a], 0, NULL};
+            a++;
+        }
+    }
+    return (long long)n;
+}
+
+int cd_mpi_assemble(cd_mpi_ctx *x, cd_state *from, const long long *from_gid, const long long *from_gprim,
+                    const unsigned char *keep, int release, const char *pbuf, size_t plen, const char *cbuf,
+                    size_t clen, const cd_state *scal)
+{
+    size_t W = scal->n_walls, nr = 0, K = 0, P = 0, nf = from ? from->n_particles : 0;
+    rec_ref *pr = parse(pbuf, plen, 0, W, &nr), *cr = parse(cbuf, clen, 1, W, &K);
+    source *src = NULL;
+    long long N = pr && cr ? merge_sources(from, from_gid, keep, pr, nr, &src) : -1;
+    /* the first primitive of every row of from (its prim_first goes with
+     * the other columns) */
+    cd_int *old_first = malloc((nf + 1) * sizeof *old_first);
+    int rc = N >= 0 && old_first ? 0 : -1;
+    for (size_t q = 0; !rc && q < nf; q++) old_first[q] = from->prim_first[q];
+    for (long long l = 0; !rc && l < N; l++) {
+        src[l].first = (long long)P;
+        P += (size_t)src[l].n_prims;
+    }
     cd_state s;
-    int rc = pr && cr ? 0 : -1;
-    for (size_t q = 0; !rc && q < N; q++) {
-        rec_head h;
-        memcpy(&h, pr[q].at, sizeof h);
-        P += (size_t)h.n_prims;
-    }
-    if (!rc) rc = cd_state_alloc(&s, N, P, W, K + 16);
-    long long *gid = rc ? NULL : malloc((N + 1) * sizeof *gid), *gprim = rc ? NULL : malloc((P + 1) * sizeof *gprim);
-    unsigned char *owned = rc ? NULL : malloc(N + 1);
-    if (!rc && (!gid || !gprim || !owned)) {
-        cd_state_free(&s);
-        rc = -1;
-    }
-    if (rc) {
-        free(pr);
-        free(cr);
-        free(gid);
-        free(gprim);
-        free(owned);
-        return -1;
-    }
+    memset(&s, 0, sizeof s);
+    s.n_particles = rc ? 0 : (size_t)N;
+    s.n_prims = P;
     copy_scalars(&s, scal);
-    size_t pl = 0;
-    x->n_owned = 0;
-    for (size_t q = 0; q < N; q++) {
-        rec_head h;
-        memcpy(&h, pr[q].at, sizeof h);
-        unpack_particle(&s, q, pl, pr[q].at);
-        gid[q] = h.gid;
-        for (long long k = 0; k < h.n_prims; k++) gprim[pl + (size_t)k] = h.gprim_first + k;
-        pl += (size_t)h.n_prims;
-        double p[3];
-        owned[q] = cd_decomp_owner(&x->grid, cd_mpi_pos3(&s, q, p)) == x->rank;
-        x->n_owned += owned[q];
+    long long *gid = rc ? NULL : malloc(((size_t)N + 1) * sizeof *gid),
+              *gprim = rc ? NULL : malloc((P + 1) * sizeof *gprim);
+    unsigned char *owned = rc ? NULL : malloc((size_t)N + 1);
+    if (!gid || !gprim || !owned) rc = -1;
+    if (!rc && release) /* (the kept pair rows are among cbuf's records) */
+        for (size_t k = 0; k < cd_n_fields; k++)
+            if (cd_group_pair_rows(cd_fields[k].group)) {
+                void **slot = cd_field_ptr(from, &cd_fields[k]);
+                free(*slot);
+                *slot = NULL;
+            }
+    /* column by column: each new column filled from its rows of from and
+     * from the records, the old one let go at once (release), so that a
+     * rank holds one column of both at a time */
+    for (size_t k = 0; !rc && k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        if (cd_group_pair_rows(f->group)) continue;
+        /* rows per primitive (W for wall-contact rows), or a particle's one */
+        int by_prim = f->group != CD_GROUP_PARTICLE;
+        size_t e = f->elem_size, per = f->group == CD_GROUP_WALLC ? W : 1;
+        char *col = calloc(cd_state_rows(&s, f->group) + 1, e), *old = from ? *cd_field_ptr(from, f) : NULL;
+        if (!col) {
+            rc = -1;
+            break;
+        }
+        for (long long l = 0; l < N; l++) {
+            const source *v = &src[l];
+            size_t rows = by_prim ? (size_t)v->n_prims * per : 1, to = by_prim ? (size_t)v->first * per : (size_t)l;
+            if (v->q >= 0) {
+                size_t fr = by_prim ? (size_t)old_first[v->q] * per : (size_t)v->q;
+                memcpy(col + to * e, old + fr * e, rows * e);
+            } else {
+                memcpy(col + to * e, v->rec + record_field_at(f, v->n_prims, W), rows * e);
+            }
+        }
+        *cd_field_ptr(&s, f) = col;
+        if (release && from) {
+            free(old);
+            *cd_field_ptr(from, f) = NULL;
+        }
     }
-    rc = place_pairs(&s, cr, K, gprim);
-    /* the arms the step reads (kernels/cols.h), from the records' rows */
+    if (!rc && release && from) cd_state_free(from); /* (its arms; the columns are gone already) */
+    /* the index columns in the new numbering, the global ids, ownership */
+    x->n_owned = 0;
+    for (long long l = 0; !rc && l < N; l++) {
+        const source *v = &src[l];
+        long long g0 = v->q < 0 ? 0 : from_gprim ? from_gprim[old_first[v->q]] : (long long)old_first[v->q];
+        if (v->q < 0) {
+            rec_head h;
+            memcpy(&h, v->rec, sizeof h);
+            g0 = h.gprim_first;
+        }
+        s.prim_first[l] = (cd_int)v->first;
+        for (long long k = 0; k < v->n_prims; k++) {
+            s.prim_particle[v->first + k] = (cd_int)l;
+            gprim[v->first + k] = g0 + k;
+        }
+        gid[l] = v->gid;
+        double p[3];
+        owned[l] = cd_decomp_owner(&x->grid, cd_mpi_pos3(&s, (size_t)l, p)) == x->rank;
+        x->n_owned += owned[l];
+    }
+    if (!rc) rc = place_pairs(&s, cr, K, gprim);
+    /* the arms the step reads (kernels/cols.h), from the rows */
     if (!rc) rc = cd_state_arms_derive(&s);
     free(pr);
     free(cr);
+    free(src);
+    free(old_first);
     if (rc) {
         cd_state_free(&s);
         free(gid);
@@ -279,7 +376,7 @@ int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cb
         free(owned);
         return -1;
     }
-    cd_state_free(&x->loc.s);
+    cd_state_free(&x->loc.s); /* (from, when it is the local state: let go already with release) */
     x->loc.s = s;
     free(x->gid);
     free(x->gprim);
@@ -307,33 +404,34 @@ static int find_neighbors(cd_mpi_ctx *x)
     return x->requests ? 0 : -1;
 }
 
-int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global)
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, int release)
 {
-    size_t W = global->n_walls, pb = 0, cb = 0;
+    size_t cb = 0, N = global->n_particles;
     int *ranks = malloc((size_t)x->size * sizeof *ranks);
+    unsigned char *here = malloc(N + 1);
     double p[3];
-    if (find_neighbors(x)) {
+    if (find_neighbors(x) || !ranks || !here) {
         free(ranks);
+        free(here);
         return -1;
     }
-    for (size_t q = 0; q < global->n_particles; q++) pb += cd_mpi_particle_bytes(global->prim_count[q], W);
     for (size_t k = 0; k < global->n_pairs; k++) cb += global->pair_active[k] ? cd_mpi_pair_bytes() : 0;
-    char *pbuf = malloc(pb + 1), *cbuf = malloc(cb + 1), *at = pbuf;
-    int rc = ranks && pbuf && cbuf ? 0 : -1;
-    for (size_t q = 0; !rc && q < global->n_particles; q++) {
-        int o = cd_decomp_owner(&x->grid, cd_mpi_pos3(global, q, p)), here = o == x->rank;
+    char *cbuf = malloc(cb + 1), *at = cbuf;
+    int rc = cbuf ? 0 : -1;
+    for (size_t q = 0; !rc && q < N; q++) { /* this rank's particles: owned, and ghosts */
+        int o = cd_decomp_owner(&x->grid, cd_mpi_pos3(global, q, p));
+        here[q] = o == x->rank;
         int n = cd_decomp_ghost_ranks(&x->grid, p, o, ranks);
-        for (int k = 0; k < n && !here; k++) here = ranks[k] == x->rank;
-        if (here) at = cd_mpi_pack_particle(global, q, (long long)q, global->prim_first[q], at);
+        for (int k = 0; k < n && !here[q]; k++) here[q] = ranks[k] == x->rank;
     }
-    size_t plen = rc ? 0 : (size_t)(at - pbuf);
-    at = cbuf;
     for (size_t k = 0; !rc && k < global->n_pairs; k++)
         if (global->pair_active[k])
             at = cd_mpi_pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
-    if (!rc) rc = cd_mpi_assemble(x, pbuf, plen, cbuf, (size_t)(at - cbuf), global);
+    /* the particles' rows straight from the global columns (global ids:
+     * their rows), which go as they are copied when release is set */
+    if (!rc) rc = cd_mpi_assemble(x, global, NULL, NULL, here, release, NULL, 0, cbuf, (size_t)(at - cbuf), global);
     free(ranks);
-    free(pbuf);
+    free(here);
     free(cbuf);
     return rc;
 }

@@ -114,9 +114,11 @@ int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen);
 
 /* The local state of this rank cut from a global state (every rank holds
  * the same one at start): owned particles, ghosts, the active pair rows
- * among them; the neighbours and the ghost refresh planned.  0, or -1 (out
- * of memory). */
-int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global);
+ * among them; the neighbours and the ghost refresh planned.  release: the
+ * global state's columns freed as soon as this rank's records are packed,
+ * before the local state is assembled (its counts and scalars kept), so
+ * that a rank never holds both.  0, or -1 (out of memory). */
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, int release);
 /* Every particle to the ranks that hold it by its centre now (its owner,
  * and as a ghost the ranks within the interaction range): a rank keeps
  * the copies it has and gets, from the particle's owner, only the ones
@@ -153,9 +155,9 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn);
  * program's bits, without gathering the state: each block of rows summed
  * by the serial block function on rank block % R from its rows' owners'
  * records, the blocks merged in order on rank 0, the total on every rank
- * (src/mpi/mpi_reduce.c).  Writes the moving columns of the blocks' rows
- * into global (which is the gathered state between syncs).  Collective. */
-int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total);
+ * (src/mpi/mpi_reduce.c).  Reads of global its counts and laws only (each
+ * leaf is summed on columns of its own rows).  Collective. */
+int cd_mpi_observe_slots(cd_mpi_ctx *x, const cd_sim *global, double *total);
 /* This rank's part of a snapshot (io_h5.h cd_output_part) from its local
  * state, the scalars from scal (the global state's): the place of each
  * owned particle's first contact and wall-contact row among the
@@ -178,11 +180,20 @@ size_t cd_mpi_pair_bytes(void);
  * b; returns the end of the record. */
 char *cd_mpi_pack_particle(cd_state *s, size_t q, long long gid, long long gp, char *b);
 char *cd_mpi_pack_pair(cd_state *s, size_t k, long long gi, long long gj, long long rank_in_row, char *b);
-/* The local state from particle records (pbuf) and pair records (cbuf),
- * in ascending global id, a key given twice taken once, the scalars of
- * scal; ownership by the centre, the ghost refresh planned, the list to
- * be rebuilt.  0, or -1 (out of memory). */
-int cd_mpi_assemble(cd_mpi_ctx *x, const char *pbuf, size_t plen, const char *cbuf, size_t clen, const cd_state *scal);
+/* The local state, in ascending global id, from the particles of `from`
+ * marked in keep (a state in ascending global id: from_gid and from_gprim
+ * its particles' and primitives' global ids, NULL for a global state,
+ * whose rows are its ids) and the particle records of pbuf (a record
+ * replaces a kept row of its id), the pair records of cbuf (a key given
+ * twice taken once; from's own pair rows are not read), the scalars of
+ * scal; ownership by the centre, the ghost refresh planned, the list to be
+ * rebuilt.  Column by column; with release each column of from is let go
+ * as soon as its rows are copied (its pair columns first), so that a rank
+ * never holds both states whole.  0, or -1 (out of memory; from then
+ * partly let go when release). */
+int cd_mpi_assemble(cd_mpi_ctx *x, cd_state *from, const long long *from_gid, const long long *from_gprim,
+                    const unsigned char *keep, int release, const char *pbuf, size_t plen, const char *cbuf,
+                    size_t clen, const cd_state *scal);
 /* MPI_Alltoallv of bytes over all ranks: sc[r] bytes to rank r (in rank
  * order in send) into a new buffer *recv of *rlen bytes.  0, or -1. */
 int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char **recv, size_t *rlen);

@@ -205,21 +205,22 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
     int *rd = malloc((2 * (size_t)R + 1) * sizeof(int));
     size_t *pl = calloc((size_t)R + 1, sizeof(size_t));
     char **out = calloc((size_t)R + 1, sizeof(char *)), *in = NULL, *pbuf = NULL, *cbuf = NULL;
-    size_t inlen = 0, plen = 0, clen = 0, kept_p = 0, kept_c = 0;
-    int rc = len && rows && rd && pl && out ? dests_of_local(x, &d) : -1;
+    unsigned char *keep = malloc(N + 1); /* the copies this rank keeps: copied into the new state, not packed */
+    size_t inlen = 0, plen = 0, clen = 0, kept_c = 0;
+    int rc = len && rows && rd && pl && out && keep ? dests_of_local(x, &d) : -1;
     /* what goes where: particle records, then the pair rows */
     for (size_t q = 0; !rc && q < N; q++) {
         for (int e = 0; x->owned[q] && e < d.count[q]; e++)
             if (sends(x, &d, q, d.ranks[d.first[q] + e]))
                 pl[d.ranks[d.first[q] + e]] += cd_mpi_particle_bytes(s->prim_count[q], W);
-        if (keeps(x, &d, q)) kept_p += cd_mpi_particle_bytes(s->prim_count[q], W);
+        keep[q] = (unsigned char)keeps(x, &d, q);
     }
     for (size_t k = 0; !rc && k < s->n_pairs; k++) {
         if (!s->pair_active[k]) continue;
         int n = row_dests(x, &d, k, rd);
         for (int e = 0; e < n; e++) rows[rd[e]]++;
         size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
-        if (keeps(x, &d, a) && keeps(x, &d, b)) kept_c += cd_mpi_pair_bytes();
+        if (keep[a] && keep[b]) kept_c += cd_mpi_pair_bytes();
     }
     int far = 0;
     for (int r = 0; !rc && r < R; r++) {
@@ -241,11 +242,10 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
         pl[r] = sizeof(move_head); /* now: where the next particle record goes */
         rows[r] = 0;               /* and how many pair records are in */
     }
-    pbuf = rc ? NULL : malloc(kept_p + 1);
     cbuf = rc ? NULL : malloc(kept_c + 1);
-    if (!rc && (!pbuf || !cbuf)) rc = -1;
-    /* pack: the records sent, the copies kept (the local ones, no message) */
-    char *pk = pbuf, *ck = cbuf;
+    if (!rc && !cbuf) rc = -1;
+    /* pack: the records sent, the pair rows kept (the local ones, no message) */
+    char *ck = cbuf;
     for (size_t q = 0; !rc && q < N; q++) {
         long long gp = x->gprim[s->prim_first[q]];
         for (int e = 0; x->owned[q] && e < d.count[q]; e++) {
@@ -254,7 +254,6 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
             pl[r] = (size_t)(cd_mpi_pack_particle(s, q, x->gid[q], gp, out[r] + pl[r]) - out[r]);
             x->migrate_records++;
         }
-        if (keeps(x, &d, q)) pk = cd_mpi_pack_particle(s, q, x->gid[q], gp, pk);
     }
     for (size_t k = 0; !rc && k < s->n_pairs; k++) {
         if (!s->pair_active[k]) continue;
@@ -266,7 +265,7 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
             cd_mpi_pack_pair(s, k, gi, gj, 0, out[r] + at);
         }
         size_t a = (size_t)s->prim_particle[s->pair_prim_i[k]], b = (size_t)s->prim_particle[s->pair_prim_j[k]];
-        if (keeps(x, &d, a) && keeps(x, &d, b)) ck = cd_mpi_pack_pair(s, k, gi, gj, 0, ck);
+        if (keep[a] && keep[b]) ck = cd_mpi_pack_pair(s, k, gi, gj, 0, ck);
     }
     /* a particle beyond the neighbours (it moved far, or is not finite):
      * this migration goes through all ranks, which all must know */
@@ -274,11 +273,12 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
     far |= x->all_ranks;
     if (!rc) MPI_Allreduce(&far, &any_far, 1, MPI_INT, MPI_LOR, x->comm);
     if (!rc) rc = move_bytes(x, out, len, any_far, &in, &inlen);
-    plen = rc ? 0 : (size_t)(pk - pbuf);
     clen = rc ? 0 : (size_t)(ck - cbuf);
     if (!rc) rc = split_moved(in, inlen, &pbuf, &plen, &cbuf, &clen);
+    /* the kept rows copied column by column from the local state, which
+     * goes as they are (a rank never holds the old and the new state whole) */
     cd_state scal = *s; /* the scalars only: assemble replaces s */
-    if (!rc) rc = cd_mpi_assemble(x, pbuf, plen, cbuf, clen, &scal);
+    if (!rc) rc = cd_mpi_assemble(x, s, x->gid, x->gprim, keep, 1, pbuf, plen, cbuf, clen, &scal);
     if (!rc) x->migrations++;
     dests_free(&d);
     for (int r = 0; out && r < R; r++) free(out[r]);
@@ -290,5 +290,6 @@ int cd_mpi_migrate(cd_mpi_ctx *x)
     free(in);
     free(pbuf);
     free(cbuf);
+    free(keep);
     return rc;
 }

@@ -13,7 +13,8 @@
  * global ids only (the pair rows' of their primitive i), dealt to the
  * ranks by groups of CD_OBS_FANIN^k leaves, so that each rank makes the
  * tree's first k levels of merges of its groups and rank 0 the rest.  Every exchange
- * moves each row once (no rank receives the whole state). */
+ * moves each row once (no rank receives the whole state), and a leaf's
+ * rank keeps the rows of its leaves only (no column of the whole run). */
 #include <stdlib.h>
 #include <string.h>
 #include "mpi/mpi_halo.h"
@@ -172,25 +173,31 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn)
 /* ---- observables ------------------------------------------------------------ */
 
 /* What a leaf of each kind reads of a row (kernels/observe_items.h): a
- * particle's moving columns (its mass and inertia are the set-up's, on
- * every rank) and whether it touches; an active wall row; an active pair
- * row with its global primitives. */
+ * particle's moving columns, its mass and inertia, and whether it
+ * touches; an active wall row with its primitive's radius; an active pair
+ * row with its global primitives and their radii.  A leaf's rank holds
+ * these rows only (no column of the whole run): each leaf is summed on
+ * columns of its own rows, in a frame of row numbers where the serial leaf
+ * function visits exactly its rows, in its order ("Reductions",
+ * docs/mpi.md). */
 typedef struct {
     long long gid;
-    cd_vec3 position, velocity, angmom;
+    cd_vec3 position, velocity, angmom, inertia;
     cd_quat orientation;
+    double mass; /* [kg] */
     long long touch;
 } obs_particle;
 
 typedef struct {
     long long row;     /* global primitive x walls + wall */
     cd_wall_entry out; /* the row's history and outputs (kernels/geom_types.h) */
+    double radius;     /* [m] the primitive's */
 } obs_wall;
 
 typedef struct {
     long long key, gi, gj; /* gi x (global primitives) + gj: the serial list's order; global primitives */
     cd_vec3 shear;
-    double overlap;
+    double overlap, ri, rj; /* [m] */
     long long active;
 } obs_pair;
 
@@ -289,58 +296,92 @@ static void merge_groups(const char *all, size_t n, double *total)
     free(flat);
 }
 
-/* The particle leaves of this rank, summed on the global state's columns
- * (their rows written from the owners' records; mass and inertia are the
- * set-up's) with the touch flags of the owners. */
-static int particle_leaves(cd_mpi_ctx *x, cd_sim *g, const cd_int *touch_loc, leaf_plan lp, partials *out)
+/* The particle leaves of this rank: each on columns of its own rows
+ * (rows b CD_OBS_BLOCK .. of the run, put at 0 ..), which the serial leaf
+ * function sums as leaf 0 of a state of that many particles: the same
+ * rows in the same order, so the same bits. */
+static int particle_leaves(cd_mpi_ctx *x, const cd_sim *g, const cd_int *touch_loc, leaf_plan lp, partials *out)
 {
-    cd_state *s = &x->loc.s, *gs = &g->s;
-    size_t n = 0, N = gs->n_particles;
+    cd_state *s = &x->loc.s;
+    size_t n = 0, N = g->s.n_particles;
     obs_particle *mine = malloc((s->n_particles + 1) * sizeof *mine);
     int *dest = malloc((s->n_particles + 1) * sizeof *dest);
-    cd_int *touch = calloc(N + 1, sizeof *touch);
-    if (!mine || !dest || !touch) return -1;
+    if (!mine || !dest) return -1;
     for (size_t q = 0; q < s->n_particles; q++)
         if (x->owned[q]) {
-            mine[n] = (obs_particle){x->gid[q],    s->position[q],    s->velocity[q],
-                                     s->angmom[q], s->orientation[q], touch_loc[q] != 0};
+            mine[n] = (obs_particle){x->gid[q],     s->position[q],    s->velocity[q], s->angmom[q],
+                                     s->inertia[q], s->orientation[q], s->mass[q],     touch_loc[q] != 0};
             dest[n++] = leaf_rank(x, &lp, lp.particles + x->gid[q] / CD_OBS_BLOCK);
         }
     char *got = NULL;
     size_t len = 0;
     int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
-    for (size_t k = 0; !rc && k < len / sizeof(obs_particle); k++) {
-        obs_particle r;
-        memcpy(&r, got + k * sizeof r, sizeof r);
-        gs->position[r.gid] = r.position;
-        gs->velocity[r.gid] = r.velocity;
-        gs->angmom[r.gid] = r.angmom;
-        gs->orientation[r.gid] = r.orientation;
-        touch[r.gid] = (cd_int)r.touch;
-    }
-    cd_cols c = cd_sim_host_cols(gs);
+    size_t m = len / sizeof(obs_particle);
+    obs_particle *e = (obs_particle *)got;
+    if (!rc) qsort(e, m, sizeof *e, by_key); /* each leaf's rows together, ascending */
+    cd_vec3 position[CD_OBS_BLOCK], velocity[CD_OBS_BLOCK], angmom[CD_OBS_BLOCK], inertia[CD_OBS_BLOCK];
+    cd_quat orientation[CD_OBS_BLOCK];
+    cd_real mass[CD_OBS_BLOCK];
+    cd_int touch[CD_OBS_BLOCK];
+    cd_cols c;
+    memset(&c, 0, sizeof c);
+    c.position = position;
+    c.velocity = velocity;
+    c.angmom = angmom;
+    c.inertia = inertia;
+    c.orientation = orientation;
+    c.mass = mass;
+    size_t k = 0;
     for (cd_long b = 0; !rc && b < lp.pairs - lp.particles; b++) {
         if (leaf_rank(x, &lp, lp.particles + b) != x->rank) continue;
-        double *acc = push(out, lp.particles + b);
+        cd_long rows = cd_obs_block_end(b, (cd_long)N) - b * CD_OBS_BLOCK;
+        for (cd_long u = 0; u < rows; u++, k++) {
+            if (k >= m || e[k].gid != b * CD_OBS_BLOCK + u) { /* (every particle has one owner: cannot happen) */
+                rc = -1;
+                break;
+            }
+            position[u] = e[k].position;
+            velocity[u] = e[k].velocity;
+            angmom[u] = e[k].angmom;
+            inertia[u] = e[k].inertia;
+            orientation[u] = e[k].orientation;
+            mass[u] = e[k].mass;
+            touch[u] = (cd_int)e[k].touch;
+        }
+        double *acc = rc ? NULL : push(out, lp.particles + b);
         if (!acc) rc = -1;
-        else cd_obs_block_particles(c, b, (cd_long)N, g->p.gravity, touch, acc, cd_order_identity());
+        else cd_obs_block_particles(c, 0, rows, g->p.gravity, touch, acc, cd_order_identity());
     }
     free(mine);
     free(dest);
-    free(touch);
     free(got);
     return rc;
 }
 
-/* The wall-row leaves of this rank, summed on the global state's wall
- * columns (this rank's leaves cleared, then the active rows written from
- * the owners' records) with the rows' outputs in the form of the step's
- * candidate lists (kernels/step_items.h, cd_wall_out_place): per particle
- * its rows in contact, ascending. */
-static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
+/* Greatest common divisor of a, b > 0. */
+static long long gcd(long long a, long long b)
 {
-    cd_state *s = &x->loc.s, *gs = &g->s;
-    size_t W = s->n_walls, n = 0, rows = gs->n_prims * W, N = gs->n_particles;
+    while (b) {
+        long long t = a % b;
+        a = b;
+        b = t;
+    }
+    return a;
+}
+
+/* The wall-row leaves of this rank.  Leaf b is rows b CD_OBS_BLOCK .. of
+ * the primitive x wall rows (W a primitive), and the serial leaf function
+ * takes a row's wall from the row number (row % W): so each leaf is
+ * summed in a frame whose rows are the run's less a shift that is a
+ * multiple of both CD_OBS_BLOCK and W, as leaf b' = b mod (W / gcd(64, W))
+ * of it: the same rows, walls and order, on columns of at most 64 / gcd +
+ * 1 primitives (their radius; each its own particle, with its rows in
+ * contact as the step's candidate entries, cd_wall_out_place). */
+static int wall_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *out)
+{
+    cd_state *s = &x->loc.s;
+    size_t W = s->n_walls, n = 0;
+    long long rows = (long long)(g->s.n_prims * W);
     obs_wall *mine = malloc((s->n_prims * W + 1) * sizeof *mine);
     int *dest = malloc((s->n_prims * W + 1) * sizeof *dest);
     if (!mine || !dest) return -1;
@@ -350,57 +391,62 @@ static int wall_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
                 size_t r = (size_t)i * W + w;
                 if (!s->wallc_active[r]) continue; /* (an inactive row adds nothing) */
                 long long row = x->gprim[i] * (long long)W + (long long)w;
-                cd_wall_entry o = cd_state_wall_entry(s, r);
-                mine[n] = (obs_wall){row, o};
+                mine[n] = (obs_wall){row, cd_state_wall_entry(s, r), s->prim_radius[i]};
                 dest[n++] = leaf_rank(x, &lp, lp.walls + row / CD_OBS_BLOCK);
             }
     char *got = NULL;
-    size_t len = 0, m = 0;
+    size_t len = 0;
     int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
-    m = len / sizeof(obs_wall);
+    size_t m = len / sizeof(obs_wall);
     obs_wall *e = (obs_wall *)got;
-    cd_int *start = calloc(N + 2, sizeof *start), *wrows = malloc((m + 1) * sizeof *wrows);
-    cd_wall_entry *outs = malloc((m + 1) * sizeof *outs);
-    if (!start || !wrows || !outs) rc = -1;
-    cd_long nb = lp.n - lp.walls;
-    for (cd_long b = 0; !rc && b < nb; b++)
-        for (cd_long r = b * CD_OBS_BLOCK;
-             leaf_rank(x, &lp, lp.walls + b) == x->rank && r < cd_obs_block_end(b, (cd_long)rows); r++)
-            gs->wallc_active[r] = 0;
-    if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: particles ascending */
-    for (size_t k = 0; !rc && k < m; k++) {
-        gs->wallc_active[e[k].row] = e[k].out.active;
-        gs->wallc_shear[e[k].row] = e[k].out.shear;
-        start[gs->prim_particle[e[k].row / (long long)W] + 1]++;
-        wrows[k] = (cd_int)e[k].row;
-        outs[k] = e[k].out;
-    }
-    for (size_t q = 0; !rc && q < N; q++) start[q + 1] += start[q];
-    cd_cols c = cd_sim_host_cols(gs);
-    for (cd_long b = 0; !rc && b < nb; b++) {
+    if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: each leaf's together */
+    enum { PRIMS = CD_OBS_BLOCK + 2 };       /* a frame's primitives: at most 64 / gcd(64, W) + 1 */
+    cd_int prim_particle[PRIMS], start[PRIMS + 1], wrows[CD_OBS_BLOCK];
+    cd_real radius[PRIMS];
+    cd_wall_entry outs[CD_OBS_BLOCK];
+    cd_cols c;
+    memset(&c, 0, sizeof c);
+    c.prim_particle = prim_particle;
+    c.prim_radius = radius;
+    for (int i = 0; i < PRIMS; i++) prim_particle[i] = i;
+    long long period = W ? (long long)W / gcd(CD_OBS_BLOCK, (long long)W) : 1; /* leaves */
+    size_t k = 0;
+    for (cd_long b = 0; !rc && b < lp.n - lp.walls; b++) {
         if (leaf_rank(x, &lp, lp.walls + b) != x->rank) continue;
+        long long bf = b % period, shift = (b - bf) * CD_OBS_BLOCK; /* frame's leaf; rows before it */
+        long long end = cd_obs_block_end(b, rows);
+        memset(start, 0, sizeof start);
+        memset(radius, 0, sizeof radius);
+        cd_int ne = 0;
+        for (; k < m && e[k].row < end; k++, ne++) { /* the leaf's rows, ascending */
+            long long r = e[k].row - shift, i = r / (long long)W;
+            wrows[ne] = (cd_int)r;
+            outs[ne] = e[k].out;
+            radius[i] = e[k].radius;
+            start[i + 1]++;
+        }
+        for (int i = 0; i < PRIMS; i++) start[i + 1] += start[i];
         double *acc = push(out, lp.walls + b);
         if (!acc) rc = -1;
         else
-            cd_obs_block_walls(c, b, (cd_long)rows, (cd_int)W, g->p.wall_law, acc, cd_order_identity(), start, wrows,
-                               outs);
+            cd_obs_block_walls(c, bf, (cd_long)(rows - shift), (cd_int)W, g->p.wall_law, acc, cd_order_identity(),
+                               start, wrows, outs);
     }
     free(mine);
     free(dest);
     free(got);
-    free(start);
-    free(wrows);
-    free(outs);
     return rc;
 }
 
 /* The pair-row leaves of this rank: the active rows, each sent by the
  * owner of its particle i to the rank of its primitive i's leaf, put in
  * the serial list's order (by global primitive i, then j: the order of the
- * rows of the serial list, inactive rows aside, which add nothing) into
- * columns of their own, summed by the serial leaf function, which finds
- * each leaf's rows by their primitive i; prim_radius is the set-up's. */
-static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
+ * rows of the serial list, inactive rows aside, which add nothing).  The
+ * serial leaf function finds a leaf's rows by their primitive i, so each
+ * leaf is summed as leaf 0 of its own rows: primitive i numbered from the
+ * leaf's first (0 .. 63), primitive j of row k as 64 + k, each with the
+ * radius the owner sent. */
+static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *out)
 {
     cd_state *s = &x->loc.s;
     long long P = (long long)g->s.n_prims;
@@ -409,10 +455,12 @@ static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     int *dest = malloc((s->n_pairs + 1) * sizeof *dest);
     if (!mine || !dest) return -1;
     for (size_t k = 0; k < s->n_pairs; k++) {
-        cd_int i = s->pair_prim_i[k];
+        cd_int i = s->pair_prim_i[k], j = s->pair_prim_j[k];
         if (!s->pair_active[k] || !x->owned[s->prim_particle[i]]) continue;
-        long long gi = x->gprim[i], gj = x->gprim[s->pair_prim_j[k]];
-        mine[n] = (obs_pair){gi * P + gj, gi, gj, s->pair_shear[k], s->pair_overlap[k], s->pair_active[k]};
+        long long gi = x->gprim[i], gj = x->gprim[j];
+        mine[n] = (obs_pair){
+            gi * P + gj,      gi, gj, s->pair_shear[k], s->pair_overlap[k], s->prim_radius[i], s->prim_radius[j],
+            s->pair_active[k]};
         dest[n++] = leaf_rank(x, &lp, lp.pairs + gi / CD_OBS_BLOCK);
     }
     char *got = NULL;
@@ -422,17 +470,10 @@ static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     obs_pair *e = (obs_pair *)got;
     cd_int *active = malloc((m + 1) * sizeof *active), *pi = malloc((m + 1) * sizeof *pi),
            *pj = malloc((m + 1) * sizeof *pj);
-    double *overlap = malloc((m + 1) * sizeof *overlap);
+    double *overlap = malloc((m + 1) * sizeof *overlap), *radius = malloc((m + CD_OBS_BLOCK + 1) * sizeof *radius);
     cd_vec3 *shear = malloc((m + 1) * sizeof *shear);
-    if (!active || !pi || !pj || !overlap || !shear) rc = -1;
+    if (!active || !pi || !pj || !overlap || !shear || !radius) rc = -1;
     if (!rc) qsort(e, m, sizeof *e, by_key);
-    for (size_t k = 0; !rc && k < m; k++) {
-        active[k] = (cd_int)e[k].active;
-        pi[k] = (cd_int)e[k].gi;
-        pj[k] = (cd_int)e[k].gj;
-        overlap[k] = e[k].overlap;
-        shear[k] = e[k].shear;
-    }
     cd_cols c;
     memset(&c, 0, sizeof c);
     c.pair_active = active;
@@ -440,12 +481,23 @@ static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     c.pair_prim_j = pj;
     c.pair_overlap = overlap;
     c.pair_shear = shear;
-    c.prim_radius = g->s.prim_radius;
+    c.prim_radius = radius;
+    size_t k = 0;
     for (cd_long b = 0; !rc && b < lp.walls - lp.pairs; b++) {
         if (leaf_rank(x, &lp, lp.pairs + b) != x->rank) continue;
+        cd_long nb = 0; /* the leaf's rows */
+        for (; k < m && e[k].gi < (b + 1) * CD_OBS_BLOCK; k++, nb++) {
+            active[nb] = (cd_int)e[k].active;
+            pi[nb] = (cd_int)(e[k].gi - b * CD_OBS_BLOCK);
+            pj[nb] = (cd_int)(CD_OBS_BLOCK + nb);
+            overlap[nb] = e[k].overlap;
+            shear[nb] = e[k].shear;
+            radius[pi[nb]] = e[k].ri;
+            radius[pj[nb]] = e[k].rj;
+        }
         double *acc = push(out, lp.pairs + b);
         if (!acc) rc = -1;
-        else cd_obs_block_pairs(c, b, (cd_long)m, g->p.law, acc, cd_order_identity());
+        else cd_obs_block_pairs(c, 0, nb, g->p.law, acc, cd_order_identity());
     }
     free(mine);
     free(dest);
@@ -455,6 +507,7 @@ static int pair_leaves(cd_mpi_ctx *x, cd_sim *g, leaf_plan lp, partials *out)
     free(pj);
     free(overlap);
     free(shear);
+    free(radius);
     return rc;
 }
 
@@ -489,7 +542,7 @@ static int merge_own_groups(const partials *leaves, leaf_plan lp, partials *grou
     return rc;
 }
 
-int cd_mpi_observe_slots(cd_mpi_ctx *x, cd_sim *global, double *total)
+int cd_mpi_observe_slots(cd_mpi_ctx *x, const cd_sim *global, double *total)
 {
     cd_state *s = &x->loc.s;
     const cd_state *gs = &global->s;

@@ -181,7 +181,10 @@ static int resume(cd_sim *sim, const char *path, char *err, size_t errlen)
 {
     if (cd_proto_phase(sim) != CD_PHASE_PROBE || sim->probe_base.position) return 0;
     long long base_step = (long long)sim->s.control[CTL_BASE_STEP];
-    if (cd_state_copy(&sim->probe_base, &sim->s)) {
+    /* (every column comes from the file; under MPI the run's whole columns
+     * are not held after the start: docs/mpi.md) */
+    const cd_state *s = &sim->s;
+    if (cd_state_alloc(&sim->probe_base, s->n_particles, s->n_prims, s->n_walls, 1)) {
         snprintf(err, errlen, "out of memory reading the base state of the bulk probe");
         return -1;
     }
