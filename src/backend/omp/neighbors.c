@@ -90,7 +90,7 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
         if (CD_ENDS_FROM_POSE && realloc_dev((void **)&d->ref_pose, CD_REF_POSE * (N + 1), sizeof(cd_real))) return -1;
     }
     if (rows > nb->cap_rows || !d->keys) {
-        size_t cap = rows + rows / 4 + 16;
+        size_t cap = (size_t)cd_nb_room((cd_long)rows);
         if (realloc_dev((void **)&d->keys, cap, sizeof(cd_ulong)) ||
             realloc_dev((void **)&d->gather_rows, 2 * cap, sizeof(cd_pair_id)))
             return -1;
@@ -235,7 +235,7 @@ static int keep_history(cd_sim *sim)
     cd_neighbors *nb = &sim->nb;
     size_t n_old = sim->s.n_pairs;
     if (n_old > nb->cap_old || !nb->d.old_keys) {
-        size_t cap = n_old + n_old / 4 + 16;
+        size_t cap = (size_t)cd_nb_room((cd_long)n_old);
         if (realloc_dev((void **)&nb->d.old_keys, cap, sizeof(cd_ulong)) ||
             realloc_dev((void **)&nb->d.old_active, cap, sizeof(cd_int)) ||
             realloc_dev((void **)&nb->d.old_shear, cap, sizeof(cd_vec3)))
@@ -250,12 +250,12 @@ static int keep_history(cd_sim *sim)
     return 0;
 }
 
-/* Room for n wall candidates (their rows and outputs), with a quarter to
- * spare: sized by the candidates, not by primitives x walls. */
+/* Room for n wall candidates (their rows and outputs), with a 64th to
+ * spare (cd_nb_room): sized by the candidates, not by primitives x walls. */
 static int reserve_wall_rows(cd_neighbors *nb, size_t n)
 {
     if (n <= nb->cap_wall_rows && nb->d.wall_rows) return 0;
-    size_t cap = n + n / 4 + 16;
+    size_t cap = (size_t)cd_nb_room((cd_long)n);
     if (realloc_dev((void **)&nb->d.wall_rows, cap, sizeof(cd_int)) ||
         realloc_dev((void **)&nb->d.wall_out, cap, sizeof(cd_wall_entry)))
         return -1;
@@ -361,6 +361,14 @@ static int particle_lists(cd_sim *sim, const cd_int *prim_src)
             cd_item_wall_carry(e, CD_B.d.wall_rows, CD_B.d.wall_out, CD_B.d.old_wall_rows, n_old, CD_B.d.old_wall_out,
                                prim_src, W);
     }
+    /* The old candidates have served the carry-over: the steps hold the
+     * new ones only (the next build allocates its lists anew, sized by its
+     * candidates). */
+    cd_dev_free(dl->old_wall_rows);
+    cd_dev_free(dl->old_wall_out);
+    dl->old_wall_rows = NULL;
+    dl->old_wall_out = NULL;
+    sim->nb.cap_old_wall_rows = 0;
     sim->nb.n_wall_rows = (size_t)n_rows;
     memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
     return 0;
@@ -398,8 +406,8 @@ int cd_neighbors_build(cd_sim *sim)
 
     /* Replace the rows: room for the new rows. */
     size_t n_old = s->n_pairs;
-    if (cd_sim_reserve_step_pairs(sim, (size_t)n_new + (size_t)n_new / 4 + 16) || reserve(nb, s, (size_t)n_new))
-        return -1;
+    size_t room = (size_t)n_new <= s->cap_pairs ? s->cap_pairs : (size_t)cd_nb_room(n_new);
+    if (cd_sim_reserve_step_pairs(sim, room) || reserve(nb, s, (size_t)n_new)) return -1;
     s->n_pairs = (size_t)n_new;
     cd_int slot = nb->slot;
     if (longest > nb->slot) { /* some row is incomplete in its slot: write the rows in place */
