@@ -311,13 +311,15 @@ CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd
     cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
     cd_contact_geom g;
     int apart;
-    if (cd_prim_arm_of(c, i) < 0 && cd_prim_arm_of(c, j) < 0) {
-        /* Two balls without an arm (spheres): their centres' distance
-         * only, chosen by the arm indices (no end b read, no point test of
-         * the ends: 0.85x the instructions of a sphere row; rows of one kind
-         * take one path, docs/performance.md, "Fewer bytes per sphere").
-         * The same call on the same values as the point test below makes
-         * for them (a ball's two ends are its centre), so the same bits. */
+    if (c.prim_arm && c.prim_arm[i] < 0 && c.prim_arm[j] < 0) {
+        /* Two balls without an arm (spheres: cd_prim_arm_of < 0; where
+         * every primitive has an arm, prim_arm is null and one test decides
+         * for every row): their centres' distance only, chosen by the arm
+         * indices (no end b read, no point test of the ends: 0.86x the
+         * instructions of a sphere row; rows of one kind take one path,
+         * docs/performance.md, "Fewer bytes per sphere").  The same call on
+         * the same values as the point test below makes for them (a ball's
+         * two ends are its centre), so the same bits. */
         apart = cd_segseg_point_contact(cd_ball_world_point(c, i), ri, cd_ball_world_point(c, j), rj, &g);
     } else {
         cd_vec3 ai, bi, aj, bj;
