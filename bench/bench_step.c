@@ -81,9 +81,8 @@ static size_t state_bytes(const cd_sim *sim)
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
     /* the wall candidates: CSR starts, rows and their entries (cd_wall_entry:
      * history and outputs); the build before's, which only a build's
-     * carry-over reads, are released after it (none between builds) */
-    b += (sim->s.n_particles + 1) * sizeof(cd_int) +
-         (sim->nb.cap_wall_rows + sim->nb.cap_old_wall_rows) * (sizeof(cd_int) + sizeof(cd_wall_entry));
+     * carry-over reads, are freed after it (neighbors.c, particle_lists) */
+    b += (sim->s.n_particles + 1) * sizeof(cd_int) + sim->nb.cap_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_entry));
     return b;
 }
 
