@@ -80,9 +80,9 @@ static size_t state_bytes(const cd_sim *sim)
     b += (cd_state_arms_all(&sim->s) ? 0 : sim->s.n_prims * sizeof(cd_int)) + sim->s.n_arms * sizeof(cd_arm);
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
     /* the wall candidates: CSR starts, rows and their entries (cd_wall_entry:
-     * history and outputs), and the build before's, kept for the carry-over */
-    b += (sim->s.n_particles + 1) * sizeof(cd_int) +
-         (sim->nb.cap_wall_rows + sim->nb.cap_old_wall_rows) * (sizeof(cd_int) + sizeof(cd_wall_entry));
+     * history and outputs); the build before's, which only a build's
+     * carry-over reads, are freed after it (neighbors.c, particle_lists) */
+    b += (sim->s.n_particles + 1) * sizeof(cd_int) + sim->nb.cap_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_entry));
     return b;
 }
 

@@ -32,6 +32,14 @@
 
 CD_DEVICE_BEGIN
 
+/* Rows to allocate for n rows of a list that the builds size (the pair
+ * rows, their keys, gather entries and kept history; the wall
+ * candidates): n and a 64th of it, so that a list at rest holds 1.6 %
+ * spare rows instead of a quarter, and a growing list reallocates once per
+ * 1.6 % of growth, not at every build (docs/performance.md, "Fewer bytes
+ * per sphere").  Host code of both backends calls it. */
+CD_INLINE cd_long cd_nb_room(cd_long n) { return n + n / 64 + 16; }
+
 /* Pass 1, in three steps shaped for a GPU (one item per particle, then
  * a tree of boxes; a 256-particle chunk per item left a GPU a few hundred
  * threads, 4.8 ms at 1e5 hexapods on an H100):

@@ -46,10 +46,6 @@ typedef struct {
     cd_int *wall_start;      /* n_particles + 1 */
     cd_int *wall_rows;       /* wall_start[n_particles] (cap_wall_rows) */
     cd_wall_entry *wall_out; /* per candidate: history and outputs of its wall contact (fields.def, WALLC*) */
-    /* the candidates of the build before (or the host's rows in contact
-     * after a start), whose history the build carries over (ascending rows) */
-    cd_int *old_wall_rows;       /* n_old_wall_rows (cap_old_wall_rows) */
-    cd_wall_entry *old_wall_out; /* their entries */
     /* scratch of the build */
     cd_grid *grid;       /* 1 */
     cd_real *part_bound; /* bounding radius per particle [m] */
@@ -88,8 +84,6 @@ typedef struct {
     cd_wall walls_ref[CD_MAX_WALLS]; /* the walls at the last build (cd_bp_wall_moved) */
     size_t n_wall_rows;              /* entries of d.wall_rows (wall_start[n_particles]) */
     size_t cap_wall_rows;            /* entries d.wall_rows and d.wall_out hold */
-    size_t n_old_wall_rows;          /* entries of d.old_wall_rows (the build's carry-over) */
-    size_t cap_old_wall_rows;        /* entries d.old_wall_rows and d.old_wall_out hold */
     int walls_from_host;             /* the next build takes the wall history from the host's rows (a start) */
     int wall_out_valid;              /* d.wall_out holds the step's wall-contact outputs (forces since start) */
     int wall_out_pending;            /* ... newer than the host's columns (expanded at sync) */

@@ -38,13 +38,12 @@ void cd_neighbors_init(cd_neighbors *nb, double skin, int reorder)
 void cd_neighbors_free(cd_neighbors *nb)
 {
     cd_nb_lists *d = &nb->d;
-    void *all[] = {d->wall_out,   d->old_wall_rows, d->old_wall_out, d->gather_start, d->gather_rows, d->wall_start,
-                   d->wall_rows,  d->grid,          d->part_bound,   d->partial,      d->part_cell,   d->cell_count,
-                   d->cell_start, d->cell_parts,    d->pair_count,   d->pair_offset,  d->cand,        d->keys,
-                   d->old_keys,   d->old_active,    d->old_shear,    d->count,        d->chunk_sum,   d->part_uid,
-                   d->part_at,    d->prim_uid,      d->prim_at,      d->pair_at,      d->pair_ustart, d->part_src,
-                   d->prim_src,   d->new_first,     d->sort_keys,    d->sort_vals,    d->hist,        d->move,
-                   d->skin_flag,  d->ref_pose};
+    void *all[] = {d->wall_out,   d->gather_start, d->gather_rows, d->wall_start, d->wall_rows,  d->grid,
+                   d->part_bound, d->partial,      d->part_cell,   d->cell_count, d->cell_start, d->cell_parts,
+                   d->pair_count, d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active,
+                   d->old_shear,  d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,
+                   d->prim_at,    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
+                   d->sort_keys,  d->sort_vals,    d->hist,        d->move,       d->skin_flag,  d->ref_pose};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
     memset(nb, 0, sizeof(*nb));
 }
@@ -90,7 +89,7 @@ static int reserve(cd_neighbors *nb, const cd_state *s, size_t rows)
         if (CD_ENDS_FROM_POSE && realloc_dev((void **)&d->ref_pose, CD_REF_POSE * (N + 1), sizeof(cd_real))) return -1;
     }
     if (rows > nb->cap_rows || !d->keys) {
-        size_t cap = rows + rows / 4 + 16;
+        size_t cap = (size_t)cd_nb_room((cd_long)rows);
         if (realloc_dev((void **)&d->keys, cap, sizeof(cd_ulong)) ||
             realloc_dev((void **)&d->gather_rows, 2 * cap, sizeof(cd_pair_id)))
             return -1;
@@ -235,7 +234,7 @@ static int keep_history(cd_sim *sim)
     cd_neighbors *nb = &sim->nb;
     size_t n_old = sim->s.n_pairs;
     if (n_old > nb->cap_old || !nb->d.old_keys) {
-        size_t cap = n_old + n_old / 4 + 16;
+        size_t cap = (size_t)cd_nb_room((cd_long)n_old);
         if (realloc_dev((void **)&nb->d.old_keys, cap, sizeof(cd_ulong)) ||
             realloc_dev((void **)&nb->d.old_active, cap, sizeof(cd_int)) ||
             realloc_dev((void **)&nb->d.old_shear, cap, sizeof(cd_vec3)))
@@ -250,12 +249,12 @@ static int keep_history(cd_sim *sim)
     return 0;
 }
 
-/* Room for n wall candidates (their rows and outputs), with a quarter to
- * spare: sized by the candidates, not by primitives x walls. */
+/* Room for n wall candidates (their rows and outputs), with a 64th to
+ * spare (cd_nb_room): sized by the candidates, not by primitives x walls. */
 static int reserve_wall_rows(cd_neighbors *nb, size_t n)
 {
     if (n <= nb->cap_wall_rows && nb->d.wall_rows) return 0;
-    size_t cap = n + n / 4 + 16;
+    size_t cap = (size_t)cd_nb_room((cd_long)n);
     if (realloc_dev((void **)&nb->d.wall_rows, cap, sizeof(cd_int)) ||
         realloc_dev((void **)&nb->d.wall_out, cap, sizeof(cd_wall_entry)))
         return -1;
@@ -282,42 +281,28 @@ int cd_neighbors_wall_out_to_host(cd_sim *sim)
     return rc ? -1 : 0;
 }
 
-/* Before the candidates are replaced: they become the old ones, whose
- * history the build carries over (cd_item_wall_carry).  After a start the
- * host's rows in contact take their place (cd_state_wall_entries), in the
- * slots the step columns have before this build's reorder. */
+/* Before the candidates are replaced: after a start the host's rows in
+ * contact become the candidates of a build before (cd_state_wall_entries),
+ * in the slots the step columns have before this build's reorder, whose
+ * history the build carries over (particle_lists). */
 static int keep_wall_history(cd_sim *sim)
 {
     cd_neighbors *nb = &sim->nb;
-    if (nb->walls_from_host) {
-        size_t n = cd_state_wall_entries(&sim->s, NULL, NULL);
-        cd_int *rows = malloc((n + 1) * sizeof *rows);
-        cd_wall_entry *ent = malloc((n + 1) * sizeof *ent);
-        int rc = rows && ent ? reserve_wall_rows(nb, n) : -1;
-        if (!rc) {
-            cd_state_wall_entries(&sim->s, rows, ent);
-            rc = n ? cd_dev_put(nb->d.wall_rows, rows, n * sizeof *rows) ||
-                         cd_dev_put(nb->d.wall_out, ent, n * sizeof *ent)
-                   : 0;
-        }
-        free(rows);
-        free(ent);
-        if (rc) return -1;
-        nb->n_wall_rows = n;
-        nb->walls_from_host = 0;
+    if (!nb->walls_from_host) return 0;
+    size_t n = cd_state_wall_entries(&sim->s, NULL, NULL);
+    cd_int *rows = malloc((n + 1) * sizeof *rows);
+    cd_wall_entry *ent = malloc((n + 1) * sizeof *ent);
+    int rc = rows && ent ? reserve_wall_rows(nb, n) : -1;
+    if (!rc) {
+        cd_state_wall_entries(&sim->s, rows, ent);
+        rc = n ? cd_dev_put(nb->d.wall_rows, rows, n * sizeof *rows) || cd_dev_put(nb->d.wall_out, ent, n * sizeof *ent)
+               : 0;
     }
-    cd_nb_lists *d = &nb->d;
-    cd_int *rows = d->wall_rows;
-    cd_wall_entry *ent = d->wall_out;
-    size_t cap = nb->cap_wall_rows;
-    d->wall_rows = d->old_wall_rows;
-    d->wall_out = d->old_wall_out;
-    nb->cap_wall_rows = nb->cap_old_wall_rows;
-    d->old_wall_rows = rows;
-    d->old_wall_out = ent;
-    nb->cap_old_wall_rows = cap;
-    nb->n_old_wall_rows = nb->n_wall_rows;
-    nb->n_wall_rows = 0;
+    free(rows);
+    free(ent);
+    if (rc) return -1;
+    nb->n_wall_rows = n;
+    nb->walls_from_host = 0;
     return 0;
 }
 
@@ -348,19 +333,30 @@ static int particle_lists(cd_sim *sim, const cd_int *prim_src)
     }
     cd_nb_scan(dl->count, N, dl->wall_start, dl->chunk_sum);
     cd_int n_rows = 0;
-    if (cd_dev_get(&n_rows, dl->wall_start + N, sizeof n_rows) || reserve_wall_rows(&sim->nb, (size_t)n_rows))
-        return -1;
-    cd_long n_old = (cd_long)sim->nb.n_old_wall_rows;
-    {
-        CD_BUILD_ARGS(sim) /* the candidate lists may have moved */
+    if (cd_dev_get(&n_rows, dl->wall_start + N, sizeof n_rows)) return -1;
+    /* The candidates of the build before: only the carry-over below reads
+     * them, then they are freed, so that the steps hold one set of
+     * candidates, sized by this build's (the lists' addresses change once
+     * a build, as when two sets swapped places). */
+    cd_int *old_rows = dl->wall_rows;
+    cd_wall_entry *old_out = dl->wall_out;
+    cd_long n_old = (cd_long)sim->nb.n_wall_rows;
+    dl->wall_rows = NULL;
+    dl->wall_out = NULL;
+    sim->nb.cap_wall_rows = 0;
+    int rc = reserve_wall_rows(&sim->nb, (size_t)n_rows);
+    if (!rc) {
+        CD_BUILD_ARGS(sim) /* the candidate lists have moved */
         CD_STEP_FOR(N, CD_BUILD_IN)
         for (cd_int q = 0; q < N; q++)
             cd_item_wall_candidates(CD_B.c, q, CD_B.walls, W, skin, CD_B.d.wall_rows + CD_B.d.wall_start[q]);
-        CD_STEP_FOR(n_rows, CD_BUILD_IN CD_DEV(is_device_ptr(prim_src)))
+        CD_STEP_FOR(n_rows, CD_BUILD_IN CD_DEV(is_device_ptr(prim_src, old_rows, old_out)))
         for (cd_int e = 0; e < n_rows; e++)
-            cd_item_wall_carry(e, CD_B.d.wall_rows, CD_B.d.wall_out, CD_B.d.old_wall_rows, n_old, CD_B.d.old_wall_out,
-                               prim_src, W);
+            cd_item_wall_carry(e, CD_B.d.wall_rows, CD_B.d.wall_out, old_rows, n_old, old_out, prim_src, W);
     }
+    cd_dev_free(old_rows);
+    cd_dev_free(old_out);
+    if (rc) return -1;
     sim->nb.n_wall_rows = (size_t)n_rows;
     memcpy(sim->nb.walls_ref, s->walls, sizeof sim->nb.walls_ref);
     return 0;
@@ -398,8 +394,8 @@ int cd_neighbors_build(cd_sim *sim)
 
     /* Replace the rows: room for the new rows. */
     size_t n_old = s->n_pairs;
-    if (cd_sim_reserve_step_pairs(sim, (size_t)n_new + (size_t)n_new / 4 + 16) || reserve(nb, s, (size_t)n_new))
-        return -1;
+    size_t room = (size_t)n_new <= s->cap_pairs ? s->cap_pairs : (size_t)cd_nb_room(n_new);
+    if (cd_sim_reserve_step_pairs(sim, room) || reserve(nb, s, (size_t)n_new)) return -1;
     s->n_pairs = (size_t)n_new;
     cd_int slot = nb->slot;
     if (longest > nb->slot) { /* some row is incomplete in its slot: write the rows in place */

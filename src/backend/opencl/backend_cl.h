@@ -171,8 +171,12 @@ int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which);
 /* Room for n wall candidates in wall_rows and wall_out (contents dropped). */
 int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n);
 /* The wall candidates become the old ones (their history for the build's
- * carry-over); the old buffers become the new, empty candidates'. */
+ * carry-over); the old buffers (none after a build: released by
+ * cd_cl_release_old_wall_rows) become the new, empty candidates'. */
 void cd_cl_keep_wall_rows(cd_cl *cl);
+/* After the carry-over: the old candidates' buffers released, so that the
+ * steps hold the new candidates only. */
+void cd_cl_release_old_wall_rows(cd_cl *cl);
 /* The buffer bound as column f (the current history set for pair_active
  * and pair_shear). */
 cl_mem cd_cl_col(const cd_cl *cl, int f);

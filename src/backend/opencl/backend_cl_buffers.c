@@ -10,8 +10,8 @@
 #include "step_items.h"
 
 /* Rows above need, so that a slowly growing list does not reallocate at
- * every rebuild (as the host list, neighbors.c). */
-static size_t with_headroom(size_t n) { return n + n / 4 + 16; }
+ * every rebuild (as the host list, neighbors.c: a 64th, cd_nb_room). */
+static size_t with_headroom(size_t n) { return (size_t)cd_nb_room((cd_long)n); }
 
 cl_mem cd_cl_buffer(cd_cl *cl, size_t bytes, const char *what)
 {
@@ -142,14 +142,21 @@ int cd_cl_scan(cd_cl *cl, cl_mem in, size_t n, cl_mem out)
 
 int cd_cl_reserve_wall_rows(cd_cl *cl, size_t n)
 {
-    if (n <= cl->cap_wall_rows) return cl->status ? -1 : 0;
-    size_t want = n + n / 4 + 16;
+    if (n <= cl->cap_wall_rows && cl->wall_rows) return cl->status ? -1 : 0;
+    size_t want = with_headroom(n);
     release(&cl->wall_rows);
     release(&cl->wall_out);
     cl->wall_rows = cd_cl_buffer(cl, want * sizeof(cd_int), "allocating the wall lists");
     cl->wall_out = cd_cl_buffer(cl, want * sizeof(cd_wall_entry), "allocating the wall lists");
     cl->cap_wall_rows = want;
     return cl->status ? -1 : 0;
+}
+
+void cd_cl_release_old_wall_rows(cd_cl *cl)
+{
+    release(&cl->old_wall_rows);
+    release(&cl->old_wall_out);
+    cl->cap_old_wall_rows = 0;
 }
 
 void cd_cl_keep_wall_rows(cd_cl *cl)

@@ -148,6 +148,9 @@ static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
     cd_cl_arg(cl, CD_CLK_WALL_CARRY, 5, sizeof cl->old_wall_out, &cl->old_wall_out);
     cd_cl_arg(cl, CD_CLK_WALL_CARRY, 6, sizeof W, &W);
     cd_cl_run(cl, CD_CLK_WALL_CARRY, (size_t)cl->n_wall_rows);
+    /* The old candidates have served the carry-over (released once the
+     * queued carry has run): the steps hold the new ones only. */
+    cd_cl_release_old_wall_rows(cl);
     memcpy(sim->nb.walls_ref, cl->host_walls, sizeof sim->nb.walls_ref);
 }
 
