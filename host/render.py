@@ -2,7 +2,7 @@
 """Draws one snapshot of a capdem run file as a PNG (docs/visualization.md).
 
     capdem render RUN.h5 [--snapshot N] -o PICTURE.png [--mode arms|forces]
-                  [--color particle|height|shape|speed] [--view ELEV,AZIM]
+                  [--color particle|height|shape|speed|plastic] [--view ELEV,AZIM]
                   [--width INCHES] [--dpi D] [--title TEXT]
 
 mode arms    every arm as a shaded capsule (spherocylinder), coloured by
@@ -10,6 +10,10 @@ mode arms    every arm as a shaded capsule (spherocylinder), coloured by
 mode forces  the contact network: a line between the centres of every pair
              of touching particles, width and colour by the normal force,
              over faint arms.
+
+A run file of the material point method (solver mpm) is drawn by
+host/render_mpm.py: every material point as its deformed square, coloured
+by particle, plastic (equivalent plastic strain) or speed, and the walls.
 
 Runs with Debian's python3-matplotlib, python3-h5py and python3-numpy.  A 2D
 run (every arm end at one z) is drawn in the x-y plane; a 3D run with an
@@ -35,6 +39,7 @@ try:
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib import colors as mcolors
     from mpl_toolkits.axes_grid1 import make_axes_locatable
+    import render_mpm
 except ImportError as e:  # the caller maps 2 to "install the Debian packages"
     sys.stderr.write("capdem render: %s (needs python3-matplotlib, python3-h5py and "
                      "python3-numpy: apt-get install python3-matplotlib python3-h5py "
@@ -50,7 +55,8 @@ class BadInput(Exception):
 
 def render_read(path, snapshot):
     """Everything one picture needs, from snapshot `snapshot` (negative:
-    counted from the end) of the run file."""
+    counted from the end) of the run file.  A run file of the material
+    point method (root attribute solver = "mpm") is read by render_mpm."""
     try:
         f = capdem_h5.open_run(path)
     except capdem_h5.LayoutError as e:
@@ -58,6 +64,12 @@ def render_read(path, snapshot):
     except OSError as e:
         raise BadInput("%s: cannot open (%s)" % (path, e))
     with f:
+        solver = f.attrs.get("solver", b"")
+        if (solver.decode() if isinstance(solver, bytes) else str(solver)) == "mpm":
+            try:
+                return dict(render_mpm.read(f, path, snapshot), solver="mpm")
+            except render_mpm.BadInput as e:
+                raise BadInput(str(e))
         H = capdem_h5
         need = [H.COLUMN[c][0] for c in ("prim_a", "prim_b", "prim_radius", "prim_particle", "position")]
         need += [H.PATH[p] for p in ("snap_step", "snap_time", "c_offset", "w_offset")]
@@ -465,8 +477,9 @@ def render_parse(argv):
     p.add_argument("-o", "--output", required=True, help="PNG to write")
     p.add_argument("--snapshot", type=int, default=-1, help="snapshot index; negative counts from the end (default -1: last)")
     p.add_argument("--mode", choices=("arms", "forces"), default="arms")
-    p.add_argument("--color", choices=("particle", "height", "shape", "speed"), default="particle",
-                   help="arm colours in mode arms (default particle)")
+    p.add_argument("--color", choices=("particle", "height", "shape", "speed", "plastic"), default="particle",
+                   help="arm colours in mode arms (default particle); material point runs: particle, "
+                   "plastic (equivalent plastic strain) or speed")
     p.add_argument("--view", default="22,-35", help="3D camera elevation,azimuth in degrees (default 22,-35)")
     p.add_argument("--width", type=float, default=7.0, help="picture width in inches (default 7; height follows)")
     p.add_argument("--dpi", type=int, default=110)
@@ -491,7 +504,15 @@ def main(argv):
         sys.stderr.write("capdem render: %s\n" % e)
         return 2
     try:
-        render_picture(d, args)
+        if d.get("solver") == "mpm":
+            render_mpm.draw(d, args)
+        elif args.color == "plastic":
+            raise BadInput("--color plastic: only material point runs (solver mpm) have a plastic strain")
+        else:
+            render_picture(d, args)
+    except (BadInput, render_mpm.BadInput) as e:
+        sys.stderr.write("capdem render: %s: %s\n" % (args.run, e))
+        return 2
     except OSError as e:
         sys.stderr.write("capdem render: %s: cannot write (%s)\n" % (args.output, e))
         return 1
