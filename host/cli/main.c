@@ -21,24 +21,24 @@
 
 static void usage(FILE *f)
 {
-    fprintf(
-        f,
-        "usage: capdem <command> [options]\n"
-        "commands:\n"
-        "  run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--overwrite] [--steps N] [--threads N]\n"
-        "                  [--allow-change KEY]... [--quiet] [--backend omp|opencl] [--device cpu|gpu|auto]\n"
-        "                  run a simulation; `capdem run --help` lists every config key\n"
-        "  shape KIND [--aspect A] [--diameter D] [--density RHO] [--json]\n"
-        "                  mass properties of a sphere, rod, cross or hexapod (SI units)\n"
-        "  analyze RUN.h5 [--snapshot last|N] [--json]\n"
-        "                  microstructure of a packing (docs/analysis.md)\n"
-        "  export RUN.h5 [-o OUT.xmf]\n"
-        "                  ParaView-ready XDMF description of a run (docs/visualization.md)\n"
-        "  render RUN.h5 [--snapshot N] -o PIC.png [--mode arms|forces] [--color particle|height|shape|speed|plastic]\n"
-        "                [--view ELEV,AZIM]   picture of a packing (matplotlib)\n"
-        "  recover RUN.h5  brings a run file left by a killed run to its last commit in place, so that\n"
-        "                  programs other than capdem (h5py, h5dump) read it (docs/output.md, \"Crash safety\")\n"
-        "  --version       version, build variant and OpenMP devices\n");
+    fprintf(f,
+            "usage: capdem <command> [options]\n"
+            "commands:\n"
+            "  run CONFIG.yaml [--resume RUN.h5] [--output RUN.h5] [--overwrite] [--steps N] [--threads N]\n"
+            "                  [--allow-change KEY]... [--quiet] [--backend omp|opencl] [--device cpu|gpu|auto]\n"
+            "                  run a simulation; `capdem run --help` lists every config key\n"
+            "  shape KIND [--aspect A] [--diameter D] [--density RHO] [--json]\n"
+            "                  mass properties of a sphere, rod, cross or hexapod (SI units)\n"
+            "  analyze RUN.h5 [--snapshot last|N] [--json]\n"
+            "                  microstructure of a packing (docs/analysis.md)\n"
+            "  export RUN.h5 [-o OUT.xmf]\n"
+            "                  ParaView-ready XDMF description of a run (docs/visualization.md)\n"
+            "  render RUN.h5 [--snapshot N] -o PIC.png [--mode arms|forces] [--view ELEV,AZIM]\n"
+            "                [--color particle|height|shape|speed|plastic]   picture of a packing or of\n"
+            "                material points (matplotlib)\n"
+            "  recover RUN.h5  brings a run file left by a killed run to its last commit in place, so that\n"
+            "                  programs other than capdem (h5py, h5dump) read it (docs/output.md, \"Crash safety\")\n"
+            "  --version       version, build variant and OpenMP devices\n");
 }
 
 static int parse_double(const char *opt, const char *s, double *out)
