@@ -299,17 +299,31 @@ CD_INLINE void cd_mpm_item_bnode_body(cd_mpm_cols c, cd_int k)
     for (cd_ulong t = c.win_off[k]; t < c.win_off[k + 1]; t++) c.bnode_body[t] = k;
 }
 
-/* The n points sorted by (body, cell) into order, stably (a counting sort
- * over the nbn body-cells), and each cell's first entry in cell_start. */
-CD_INLINE void cd_mpm_item_sort_points(cd_mpm_cols c, cd_ulong n, cd_ulong nbn)
+/* Body k's points sorted by cell into order, stably (a counting sort over
+ * the body's cells), and the first entry of each of its cells in
+ * cell_start; the last body also ends the list (cell_start[nbn] = n).  A
+ * body's points come after those of the bodies before it and its cells
+ * after theirs, so the bodies sort independently and together give the one
+ * stable sort of all points by (body, cell): the same order whatever runs
+ * them (every count an integer). */
+CD_INLINE void cd_mpm_item_sort_body(cd_mpm_cols c, cd_int k)
 {
     CD_GLOBAL cd_ulong *cs = c.cell_start;
-    for (cd_ulong q = 0; q <= nbn; q++) cs[q] = 0;
-    for (cd_ulong p = 0; p < n; p++) cs[cd_mpm_point_cell(c, p) + 1]++;
-    for (cd_ulong q = 0; q < nbn; q++) cs[q + 1] += cs[q];
-    for (cd_ulong p = 0; p < n; p++) c.order[cs[cd_mpm_point_cell(c, p)]++] = p;
-    for (cd_ulong q = nbn; q > 0; q--) cs[q] = cs[q - 1];
-    cs[0] = 0;
+    cd_ulong q0 = c.win_off[k], q1 = c.win_off[k + 1], p0 = c.pfirst[k], p1 = c.pfirst[k + 1];
+    for (cd_ulong q = q0; q < q1; q++) cs[q] = 0;
+    for (cd_ulong p = p0; p < p1; p++) cs[cd_mpm_point_cell(c, p)]++;
+    cd_ulong start = p0; /* each cell's first entry: the exclusive prefix sum of the counts */
+    for (cd_ulong q = q0; q < q1; q++) {
+        cd_ulong count = cs[q];
+        cs[q] = start;
+        start += count;
+    }
+    for (cd_ulong p = p0; p < p1; p++) c.order[cs[cd_mpm_point_cell(c, p)]++] = p;
+    if (q1 > q0) { /* each cell's entry was moved to its end: shifted back by one cell */
+        for (cd_ulong q = q1 - 1; q > q0; q--) cs[q] = cs[q - 1];
+        cs[q0] = p0;
+    }
+    if (k == c.n_bodies - 1) cs[q1] = p1;
 }
 
 /* Sum of m_i v_i^2 / 2 over the nbn body-nodes, in their order [J/m]. */
