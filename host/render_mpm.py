@@ -5,16 +5,17 @@ host/render.py calls draw() when the run file's root attribute `solver` is
 Each material point is drawn as its deformed square, x_p + F_p [-l/2, l/2]^2
 with l its initial side sqrt(V_p / det F_p) (the square the export's and the
 analysis' outlines are the convex hull of), filled in its colour over a
-darker, slightly wider pass of the same squares: the dark shows only on the
-outside of each particle's area, so the particles' boundaries read as lines.
-The walls are drawn as thick lines, across the box (the packings) or across
-the points' extent plus a tenth (the diametral test's two walls).
+darker, slightly wider pass of the same squares (RGB 31): the dark shows only
+on the outside of each particle's area, so the particles' boundaries read as
+lines.  The walls are lines 2 points wide in RGB 64, across the box (the
+packings) or across the points' extent plus a tenth (the diametral test's
+two walls).
 
 Colours (--color): particle (default, as the DEM render's palette), plastic
 (the equivalent plastic strain on a log scale; points that never yielded,
-plastic strain exactly 0, light grey RGB 204, 204, 204), speed.  Both passes
-are drawn without antialiasing, so every pixel of a point's square has its
-point's colour exactly (tests/mpm/check_mpm_render.py reads them back).  The
+plastic strain exactly 0, light grey RGB 204, 204, 204), speed.  Squares and
+walls are drawn without antialiasing, so every pixel of a point's square has
+its point's colour exactly (tests/mpm/check_mpm_render.py reads them back).  The
 PNG's text chunk `capdem:axes` holds the axes' pixel box in the written
 image and their data limits, `x0 y0 x1 y1 xmin xmax ymin ymax` (pixels from
 the top-left corner, metres), so that a reader can find the point at a
@@ -171,7 +172,7 @@ def draw(d, args):
     ax.add_collection(PolyCollection(quads, facecolors=rgb, edgecolors=rgb, linewidths=0.25, antialiaseds=False,
                                      zorder=2))
     for seg in walls:
-        ax.plot(seg[:, 0], seg[:, 1], color="0.25", lw=2.0, solid_capstyle="butt", zorder=3)
+        ax.plot(seg[:, 0], seg[:, 1], color="0.25", lw=2.0, solid_capstyle="butt", antialiased=False, zorder=3)
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_xlabel("x [m]")

@@ -14,8 +14,9 @@ usage: /usr/bin/python3 check_mpm_render.py PICTURE.png RUN.h5 SNAPSHOT particle
   it, the documented scale; each within 3 of 255 per channel;
 - plastic: the plastic-coloured pixels (channels spread by more than 40)
   inside the axes number none when no point has yielded;
-- each wall's line is drawn (the pixel at its middle between the box's
-  corners, or at its point for the diametral walls, is dark grey).
+- each wall's line is drawn: one of the 3 x 3 pixels at its middle between
+  the box's corners (or at its point, the diametral walls) has the walls'
+  grey, RGB 64, 64, 64 (the particles' dark edge is 31).
 Prints one line per failure and exits 1 if any."""
 import sys
 
@@ -90,9 +91,10 @@ for w in range(len(wall_n)):
             if v != w and abs(wall_n[v] @ t) > 1e-9]
     mid = wall_p[w] + (0.5 * (min(cuts) + max(cuts)) if len(cuts) >= 2 else 0.0) * t
     rr, cc = pixel(mid[None, :])
-    v = rgb[rr[0], cc[0]]
-    if v.max() > 110 or v.max() - v.min() > 10:
-        fails.append("wall %d: pixel (%d, %d) at its middle is %s, not its dark grey" % (w, rr[0], cc[0], v))
+    near = rgb[max(rr[0] - 1, 0):rr[0] + 2, max(cc[0] - 1, 0):cc[0] + 2].reshape(-1, 3)  # a line 2 points wide
+    if not (np.abs(near - 64).max(axis=1) <= 3).any():
+        fails.append("wall %d: none of the pixels next to (%d, %d), its middle, has its grey 64: %s"
+                     % (w, rr[0], cc[0], near.tolist()))
 
 for m in fails:
     print("FAIL", m)
