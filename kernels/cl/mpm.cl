@@ -2,10 +2,11 @@
  * OpenCL backend"): one work-item per point, body, body-node or listed
  * common node, each a thin wrapper around the items of
  * kernels/mpm_step_items.h and kernels/mpm_contact.h that the omp loops of
- * src/mpm/mpm.c run too; the serial parts that remain (the common nodes'
- * sort, and at observed steps only the walls' forces, the mesh's kinetic
- * energy and the deepest overlap) are one-item kernels or one item per
- * wall.  src/mpm/mpm_cl.c launches them without reading anything back
+ * src/mpm/mpm.c run too.  What the omp loops do in one item is parallel
+ * here where the result is a count (the points' sort, one item per body;
+ * the common nodes' lists, in six kernels); the sums in a fixed order (the
+ * walls' forces, the mesh's kinetic energy) and the deepest overlap stay
+ * one item (per wall) and run only at the steps the host reads them.  src/mpm/mpm_cl.c launches them without reading anything back
  * between steps.
  *
  * Every kernel takes the columns of kernels/cl/mpm_col_list.h first, then
@@ -128,11 +129,49 @@ __kernel void cd_mpm_cl_node_update(CD_MPM_CL_PARAMS, cd_real dt)
     if (t < counts[0] && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_node_update(c, t, dt);
 }
 
-/* One item: the common nodes' body lists; the listed nodes' count into counts[1]. */
-__kernel void cd_mpm_cl_contact_nodes(CD_MPM_CL_PARAMS)
+/* The common nodes' body lists in six steps (kernels/mpm_step_items.h,
+ * cd_mpm_item_cn_*: the lists of the omp loops' one-item sort, bit for
+ * bit); the listed nodes' count into counts[1]. */
+__kernel void cd_mpm_cl_cn_rows(CD_MPM_CL_PARAMS, __global cd_int *row_n, __global cd_int *rows)
 {
     CD_MPM_CL_BIND;
-    if (get_global_id(0) == 0 && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_contact_nodes(c, counts[0], counts + 1);
+    cd_int row = (cd_int)get_global_id(0);
+    if (row < ny && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_rows(c, row, row_n, rows);
+}
+
+__kernel void cd_mpm_cl_cn_count(CD_MPM_CL_PARAMS, __global const cd_int *row_n, __global const cd_int *rows)
+{
+    CD_MPM_CL_BIND;
+    cd_ulong g = (cd_ulong)get_global_id(0);
+    if (g < (cd_ulong)nx * (cd_ulong)ny && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_count(c, g, row_n, rows);
+}
+
+__kernel void cd_mpm_cl_cn_block_sums(CD_MPM_CL_PARAMS, __global cd_ulong *blocks, cd_ulong n_blocks)
+{
+    CD_MPM_CL_BIND;
+    cd_ulong b = (cd_ulong)get_global_id(0);
+    if (b < n_blocks && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_block_sums(c, b, blocks);
+}
+
+/* One item over the nn / CD_MPM_CN_BLOCK blocks' sums. */
+__kernel void cd_mpm_cl_cn_block_scan(CD_MPM_CL_PARAMS, __global cd_ulong *blocks, cd_ulong n_blocks)
+{
+    if (get_global_id(0) == 0 && !cd_mpm_cl_stopped(flags, j, 2))
+        cd_mpm_item_cn_block_scan(n_blocks, blocks, counts + 1);
+}
+
+__kernel void cd_mpm_cl_cn_block_starts(CD_MPM_CL_PARAMS, __global const cd_ulong *blocks, cd_ulong n_blocks)
+{
+    CD_MPM_CL_BIND;
+    cd_ulong b = (cd_ulong)get_global_id(0);
+    if (b < n_blocks && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_block_starts(c, b, blocks);
+}
+
+__kernel void cd_mpm_cl_cn_entries(CD_MPM_CL_PARAMS, __global const cd_int *row_n, __global const cd_int *rows)
+{
+    CD_MPM_CL_BIND;
+    cd_ulong g = (cd_ulong)get_global_id(0);
+    if (g < (cd_ulong)nx * (cd_ulong)ny && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_entries(c, g, row_n, rows);
 }
 
 /* Stage 2 (the listed-node kernels run over a bound; those past counts[1]

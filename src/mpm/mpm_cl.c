@@ -43,7 +43,12 @@ enum {
     K_SORT_BODY,
     K_TO_GRID,
     K_NODE_UPDATE,
-    K_CONTACT_NODES,
+    K_CN_ROWS,
+    K_CN_COUNT,
+    K_CN_BLOCK_SUMS,
+    K_CN_BLOCK_SCAN,
+    K_CN_BLOCK_STARTS,
+    K_CN_ENTRIES,
     K_CONTACT_CROWDED,
     K_CONTACT,
     K_MAX_OVER,
@@ -58,12 +63,14 @@ static const struct {
     const char *name;
     int one_item; /* the serial parts: one work-item */
 } kernel_table[K_COUNT] = {
-    {"cd_mpm_cl_prepare", 0},         {"cd_mpm_cl_wall_force", 0},  {"cd_mpm_cl_window", 0},
-    {"cd_mpm_cl_window_offsets", 1},  {"cd_mpm_cl_bnode_body", 0},  {"cd_mpm_cl_sort_body", 0},
-    {"cd_mpm_cl_to_grid", 0},         {"cd_mpm_cl_node_update", 0}, {"cd_mpm_cl_contact_nodes", 1},
-    {"cd_mpm_cl_contact_crowded", 0}, {"cd_mpm_cl_contact", 0},     {"cd_mpm_cl_max_over", 1},
-    {"cd_mpm_cl_point_update", 0},    {"cd_mpm_cl_remap", 0},       {"cd_mpm_cl_mesh_kinetic", 1},
-    {"cd_mpm_cl_stress", 0},          {"cd_mpm_cl_pair_keys", 1},
+    {"cd_mpm_cl_prepare", 0},         {"cd_mpm_cl_wall_force", 0},    {"cd_mpm_cl_window", 0},
+    {"cd_mpm_cl_window_offsets", 1},  {"cd_mpm_cl_bnode_body", 0},    {"cd_mpm_cl_sort_body", 0},
+    {"cd_mpm_cl_to_grid", 0},         {"cd_mpm_cl_node_update", 0},   {"cd_mpm_cl_cn_rows", 0},
+    {"cd_mpm_cl_cn_count", 0},        {"cd_mpm_cl_cn_block_sums", 0}, {"cd_mpm_cl_cn_block_scan", 1},
+    {"cd_mpm_cl_cn_block_starts", 0}, {"cd_mpm_cl_cn_entries", 0},    {"cd_mpm_cl_contact_crowded", 0},
+    {"cd_mpm_cl_contact", 0},         {"cd_mpm_cl_max_over", 1},      {"cd_mpm_cl_point_update", 0},
+    {"cd_mpm_cl_remap", 0},           {"cd_mpm_cl_mesh_kinetic", 1},  {"cd_mpm_cl_stress", 0},
+    {"cd_mpm_cl_pair_keys", 1},
 };
 
 /* Columns, in the kernels' parameter order; and what their rows are. */
@@ -115,6 +122,8 @@ struct cd_mpm_cl {
     cl_mem over;         /* cd_real per common node: the contact's overlaps */
     cl_mem keys;         /* cd_long: the contact pairs' keys */
     size_t cap_keys;
+    cl_mem row_n, rows;       /* the common nodes' lists: bodies per mesh row (cd_int ny, ny x n_bodies) */
+    cl_mem blocks;            /* cd_ulong 2 per CD_MPM_CN_BLOCK common nodes */
     int sized;                /* the body-node buffers sized from the first step's count */
     cd_int j;                 /* steps enqueued since the host last looked */
     struct step_start *since; /* where each of them began */
@@ -218,6 +227,14 @@ static int reserve_bnodes(cd_mpm *m, size_t nbn)
     return 0;
 }
 
+/* The contact's row lists hold a row per mesh row, each room for every body. */
+static size_t nb_rows(const cd_mpm *m) { return m->n_bodies > 0 ? (size_t)m->n_bodies : 1; }
+/* Blocks of CD_MPM_CN_BLOCK common nodes. */
+static size_t n_blocks(const cd_mpm *m)
+{
+    return ((size_t)m->nx * (size_t)m->ny + CD_MPM_CN_BLOCK - 1) / CD_MPM_CN_BLOCK;
+}
+
 /* The checks as they are before any step: no failure, never seen. */
 static int reset_flags(struct cd_mpm_cl *d)
 {
@@ -249,7 +266,10 @@ static int start(cd_mpm *m)
         d->reals = cd_cl_buffer(cl, N_REALS * sizeof(cd_real), "allocating the step's sums");
         d->count = cd_cl_buffer(cl, N_COUNTS * sizeof(cd_ulong), "allocating the step's counts");
         d->over = cd_cl_buffer(cl, nn * sizeof(cd_real), "allocating the contact's overlaps");
-        if (!d->flags || !d->reals || !d->count || !d->over) return -1;
+        d->row_n = cd_cl_buffer(cl, (size_t)m->ny * sizeof(cd_int), "allocating the contact's row lists");
+        d->rows = cd_cl_buffer(cl, (size_t)m->ny * nb_rows(m) * sizeof(cd_int), "allocating the contact's row lists");
+        d->blocks = cd_cl_buffer(cl, 2 * n_blocks(m) * sizeof(cd_ulong), "allocating the contact's block sums");
+        if (!d->flags || !d->reals || !d->count || !d->over || !d->row_n || !d->rows || !d->blocks) return -1;
         cl_int nx = m->nx, ny = m->ny, nb = m->n_bodies;
         double mesh[3] = {m->h, m->ox, m->oy}; /* [m] */
         for (int k = 0; k < K_COUNT; k++)
@@ -347,7 +367,13 @@ int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen)
     LAUNCH_WITH(K_TO_GRID, rows, A_ANY(K_TO_GRID, normals));
     LAUNCH_WITH(K_NODE_UPDATE, rows, A_REAL(K_NODE_UPDATE, dt));
     if (m->n_bodies > 1) {
-        LAUNCH_WITH(K_CONTACT_NODES, 1, );
+        size_t nblk = n_blocks(m);
+        LAUNCH_WITH(K_CN_ROWS, (size_t)m->ny, A_MEM(K_CN_ROWS, d->row_n); A_MEM(K_CN_ROWS, d->rows));
+        LAUNCH_WITH(K_CN_COUNT, nn, A_MEM(K_CN_COUNT, d->row_n); A_MEM(K_CN_COUNT, d->rows));
+        LAUNCH_WITH(K_CN_BLOCK_SUMS, nblk, A_MEM(K_CN_BLOCK_SUMS, d->blocks); A_ULONG(K_CN_BLOCK_SUMS, nblk));
+        LAUNCH_WITH(K_CN_BLOCK_SCAN, 1, A_MEM(K_CN_BLOCK_SCAN, d->blocks); A_ULONG(K_CN_BLOCK_SCAN, nblk));
+        LAUNCH_WITH(K_CN_BLOCK_STARTS, nblk, A_MEM(K_CN_BLOCK_STARTS, d->blocks); A_ULONG(K_CN_BLOCK_STARTS, nblk));
+        LAUNCH_WITH(K_CN_ENTRIES, nn, A_MEM(K_CN_ENTRIES, d->row_n); A_MEM(K_CN_ENTRIES, d->rows));
         LAUNCH_WITH(K_CONTACT_CROWDED, listed, );
         LAUNCH_WITH(K_CONTACT, listed, A_REAL(K_CONTACT, m->contact_gap); A_REAL(K_CONTACT, dt);
                     A_MEM(K_CONTACT, d->over));
@@ -501,7 +527,7 @@ void cd_mpm_cl_close(cd_mpm *m)
     if (!d) return;
     for (int f = 0; f < N_COLS; f++)
         if (d->col[f]) clReleaseMemObject(d->col[f]);
-    cl_mem scratch[] = {d->flags, d->reals, d->count, d->over, d->keys};
+    cl_mem scratch[] = {d->flags, d->reals, d->count, d->over, d->keys, d->row_n, d->rows, d->blocks};
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++)
         if (scratch[i]) clReleaseMemObject(scratch[i]);
     for (int k = 0; k < K_COUNT; k++)
