@@ -47,8 +47,7 @@ except ImportError as e:  # the caller maps 2 to "install the Debian packages"
     sys.exit(2)
 
 
-class BadInput(Exception):
-    pass
+BadInput = render_mpm.BadInput  # one kind of bad input for both readers
 
 
 # ---------------------------------------------------------------- reading
@@ -66,10 +65,7 @@ def render_read(path, snapshot):
     with f:
         solver = f.attrs.get("solver", b"")
         if (solver.decode() if isinstance(solver, bytes) else str(solver)) == "mpm":
-            try:
-                return dict(render_mpm.read(f, path, snapshot), solver="mpm")
-            except render_mpm.BadInput as e:
-                raise BadInput(str(e))
+            return dict(render_mpm.read(f, path, snapshot), solver="mpm")
         H = capdem_h5
         need = [H.COLUMN[c][0] for c in ("prim_a", "prim_b", "prim_radius", "prim_particle", "position")]
         need += [H.PATH[p] for p in ("snap_step", "snap_time", "c_offset", "w_offset")]
@@ -78,12 +74,7 @@ def render_read(path, snapshot):
                 raise BadInput("%s: not a capdem run file (no %s)" % (path, name))
         # docs/output.md: the committed count, never rows beyond it.
         n = min(H.snapshot_count(f), H.column_dataset(f, "prim_a").shape[0], H.column_dataset(f, "position").shape[0])
-        if n <= 0:
-            raise BadInput("%s: the run file holds no complete snapshot" % path)
-        k = snapshot if snapshot >= 0 else n + snapshot
-        if not 0 <= k < n:
-            raise BadInput("%s: --snapshot %d: the file holds snapshots 0..%d (or -1..-%d from the end)"
-                           % (path, snapshot, n - 1, n))
+        k = render_mpm.snapshot_index(path, snapshot, n)
         d = {"k": k, "n": n, "path": path}
         d["a"] = H.column(f, "prim_a", k)
         d["b"] = H.column(f, "prim_b", k)
@@ -419,14 +410,7 @@ def render_picture(d, args):
     # saving takes them in.
     if network is not None:
         cbar = ("normal force [N]",) + network
-    aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
-    frac = 0.94 if cbar else 1.0
-    fig.set_size_inches(args.width, min(max(args.width * frac * aspect, 1.5), 2.0 * args.width))
-    fig.subplots_adjust(left=0, right=1, bottom=0, top=1)
-    if cbar:
-        label, norm, cmap = cbar
-        cax = make_axes_locatable(ax).append_axes("right", size="2.5%", pad=0.1)
-        fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax, label=label)
+    render_fit_figure(fig, ax, args.width, lo, hi, cbar)
 
     nc = len(d["fn"])
     title = args.title or ("%s  snapshot %d of %d  t = %.4g s  %d particles, %d arms, %d contacts"
@@ -435,6 +419,19 @@ def render_picture(d, args):
     # tight: the equal-aspect axes leave margins that depend on the picture
     fig.savefig(args.output, dpi=args.dpi, bbox_inches="tight", pad_inches=0.08)
     plt.close(fig)
+
+
+def render_fit_figure(fig, ax, width, lo, hi, cbar):
+    """The figure's height from the picture's aspect (the axes fill it) and
+    the colour bar (label, norm, colormap) at the right, if any."""
+    aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
+    frac = 0.94 if cbar else 1.0
+    fig.set_size_inches(width, min(max(width * frac * aspect, 1.5), 2.0 * width))
+    fig.subplots_adjust(left=0, right=1, bottom=0, top=1)
+    if cbar:
+        label, norm, cmap = cbar
+        cax = make_axes_locatable(ax).append_axes("right", size="2.5%", pad=0.1)
+        fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax, label=label)
 
 
 def _shift_walls(walls, centre):
@@ -505,12 +502,12 @@ def main(argv):
         return 2
     try:
         if d.get("solver") == "mpm":
-            render_mpm.draw(d, args)
+            render_mpm.draw(d, args, render_fit_figure)
         elif args.color == "plastic":
             raise BadInput("--color plastic: only material point runs (solver mpm) have a plastic strain")
         else:
             render_picture(d, args)
-    except (BadInput, render_mpm.BadInput) as e:
+    except BadInput as e:
         sys.stderr.write("capdem render: %s: %s\n" % (args.run, e))
         return 2
     except OSError as e:

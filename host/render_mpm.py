@@ -27,7 +27,6 @@ import numpy as np
 import matplotlib.pyplot as plt
 from matplotlib.collections import PolyCollection
 from matplotlib import colors as mcolors
-from mpl_toolkits.axes_grid1 import make_axes_locatable
 
 ELASTIC_GREY = 0.8  # RGB of points whose plastic strain is 0 (204 of 255)
 EDGE_GREY = 0.12  # the dark pass under the particles
@@ -36,7 +35,19 @@ PLASTIC_DECADES = 3  # the log scale spans max / 10^3 .. max; less is its lowest
 
 
 class BadInput(Exception):
-    pass
+    """Bad input (file, snapshot, option): exit status 2 (host/render.py)."""
+
+
+def snapshot_index(path, snapshot, n):
+    """The index of --snapshot `snapshot` (negative: from the end) among n
+    committed snapshots (host/render.py's DEM reader uses it too)."""
+    if n <= 0:
+        raise BadInput("%s: the run file holds no complete snapshot" % path)
+    k = snapshot if snapshot >= 0 else n + snapshot
+    if not 0 <= k < n:
+        raise BadInput("%s: --snapshot %d: the file holds snapshots 0..%d (or -1..-%d from the end)"
+                       % (path, snapshot, n - 1, n))
+    return k
 
 
 def read(f, path, snapshot):
@@ -51,12 +62,7 @@ def read(f, path, snapshot):
     n = min(len(f[name]) for name in need[2:])
     if "n_snapshots" in f.attrs:
         n = min(n, int(f.attrs["n_snapshots"]))
-    if n <= 0:
-        raise BadInput("%s: the run file holds no complete snapshot" % path)
-    k = snapshot if snapshot >= 0 else n + snapshot
-    if not 0 <= k < n:
-        raise BadInput("%s: --snapshot %d: the file holds snapshots 0..%d (or -1..-%d from the end)"
-                       % (path, snapshot, n - 1, n))
+    k = snapshot_index(path, snapshot, n)
     S = "/mpm/snapshots/"
     d = {"k": k, "n": n, "path": path, "name": os.path.splitext(os.path.basename(path))[0]}
     d["particle"] = f["/mpm/points/particle"][()].astype(np.int64)
@@ -143,8 +149,9 @@ def wall_segments(d, lo, hi):
     return np.array(segs).reshape(-1, 2, 2)
 
 
-def draw(d, args):
-    """The picture of snapshot d["k"] as args.output (PNG)."""
+def draw(d, args, fit_figure):
+    """The picture of snapshot d["k"] as args.output (PNG); fit_figure is
+    host/render.py's (the figure's height from the aspect, the colour bar)."""
     if args.mode != "arms":
         raise BadInput("--mode %s: a material point run file holds no contact network; "
                        "draw its points (the default mode)" % args.mode)
@@ -177,14 +184,7 @@ def draw(d, args):
     ax.set_ylim(lo[1], hi[1])
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
-    frac = 0.94 if cbar else 1.0
-    fig.set_size_inches(args.width, min(max(args.width * frac * aspect, 1.5), 2.0 * args.width))
-    fig.subplots_adjust(left=0, right=1, bottom=0, top=1)
-    if cbar:
-        label, norm, cmap = cbar
-        cax = make_axes_locatable(ax).append_axes("right", size="2.5%", pad=0.1)
-        fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax, label=label)
+    fit_figure(fig, ax, args.width, lo, hi, cbar)
     npart = len(np.unique(d["particle"]))
     title = args.title or ("%s  snapshot %d of %d  step %d  t = %.4g s  %d material points, %d particle%s"
                            % (d["name"], d["k"], d["n"], d["step"], d["time"], len(quads), npart,
