@@ -39,8 +39,8 @@ rows, cols = rgb.shape[:2]
 aspect_px = (x1 - x0) / (y1 - y0)
 aspect_data = (xmax - xmin) / (ymax - ymin)
 if abs(aspect_px / aspect_data - 1) > 0.01:
-    fails.append("axes box %.1f x %.1f px for %.4g x %.4g m: not equal axes" % (x1 - x0, y1 - y0, xmax - xmin,
-                                                                             ymax - ymin))
+    fails.append("axes box %.1f x %.1f px for %.4g x %.4g m: not equal axes"
+                 % (x1 - x0, y1 - y0, xmax - xmin, ymax - ymin))
 
 
 def pixel(xy):
@@ -74,8 +74,8 @@ else:
 match = np.abs(got - want).max(axis=1) <= 3
 for name, sel in groups.items():
     if sel.sum() and match[sel].mean() < 0.9:
-        fails.append("%s: %d of %d have their colour at their pixel (want 90 %%)" % (name, match[sel].sum(),
-                                                                                    sel.sum()))
+        fails.append("%s: %d of %d have their colour at their pixel (want 90 %%)"
+                     % (name, match[sel].sum(), sel.sum()))
 print("%s: %s" % (png, ", ".join("%s %d/%d" % (n, match[s].sum(), s.sum()) for n, s in groups.items())))
 
 if how == "plastic" and not (eps > 0).any():
