@@ -17,7 +17,7 @@ names() { for f in "$@"; do [ -e "$f" ] && basename "${f%.*}"; done; }
   names configs/protocols/ci/*.yaml | grep -vxE 'deposit_2d_crosses|radial_hexapods_a3|radial_spheres|bulk_modulus_hexapods_a3' |
     sed 's/^/preset_/'
   echo preset_twins_exist; echo validation_study1_smoke; echo validation_deposit_driver
-  echo mpm_opencl_same_bits # tests/mpm/opencl_same_bits.sh, in OpenCL builds
+  echo mpm_opencl_same_bits mpm_opencl_failures | tr " " "\n" # tests/mpm/opencl_{same_bits,failures}.sh, in OpenCL builds
 } | sort > "$build/tests-expected.txt"
 ctest --test-dir "$build" -N | sed -n 's/^ *Test *#[0-9]*: //p' | sort > "$build/tests-registered.txt"
 if ! diff "$build/tests-expected.txt" "$build/tests-registered.txt" > "$build/tests-diff.txt"; then

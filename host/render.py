@@ -2,7 +2,7 @@
 """Draws one snapshot of a capdem run file as a PNG (docs/visualization.md).
 
     capdem render RUN.h5 [--snapshot N] -o PICTURE.png [--mode arms|forces]
-                  [--color particle|height|shape|speed] [--view ELEV,AZIM]
+                  [--color particle|height|shape|speed|plastic] [--view ELEV,AZIM]
                   [--width INCHES] [--dpi D] [--title TEXT]
 
 mode arms    every arm as a shaded capsule (spherocylinder), coloured by
@@ -10,6 +10,10 @@ mode arms    every arm as a shaded capsule (spherocylinder), coloured by
 mode forces  the contact network: a line between the centres of every pair
              of touching particles, width and colour by the normal force,
              over faint arms.
+
+A run file of the material point method (solver mpm) is drawn by
+host/render_mpm.py: every material point as its deformed square, coloured
+by particle, plastic (equivalent plastic strain) or speed, and the walls.
 
 Runs with Debian's python3-matplotlib, python3-h5py and python3-numpy.  A 2D
 run (every arm end at one z) is drawn in the x-y plane; a 3D run with an
@@ -35,6 +39,7 @@ try:
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib import colors as mcolors
     from mpl_toolkits.axes_grid1 import make_axes_locatable
+    import render_mpm
 except ImportError as e:  # the caller maps 2 to "install the Debian packages"
     sys.stderr.write("capdem render: %s (needs python3-matplotlib, python3-h5py and "
                      "python3-numpy: apt-get install python3-matplotlib python3-h5py "
@@ -42,15 +47,15 @@ except ImportError as e:  # the caller maps 2 to "install the Debian packages"
     sys.exit(2)
 
 
-class BadInput(Exception):
-    pass
+BadInput = render_mpm.BadInput  # one kind of bad input for both readers
 
 
 # ---------------------------------------------------------------- reading
 
 def render_read(path, snapshot):
     """Everything one picture needs, from snapshot `snapshot` (negative:
-    counted from the end) of the run file."""
+    counted from the end) of the run file.  A run file of the material
+    point method (root attribute solver = "mpm") is read by render_mpm."""
     try:
         f = capdem_h5.open_run(path)
     except capdem_h5.LayoutError as e:
@@ -58,6 +63,9 @@ def render_read(path, snapshot):
     except OSError as e:
         raise BadInput("%s: cannot open (%s)" % (path, e))
     with f:
+        solver = f.attrs.get("solver", b"")
+        if (solver.decode() if isinstance(solver, bytes) else str(solver)) == "mpm":
+            return dict(render_mpm.read(f, path, snapshot), solver="mpm")
         H = capdem_h5
         need = [H.COLUMN[c][0] for c in ("prim_a", "prim_b", "prim_radius", "prim_particle", "position")]
         need += [H.PATH[p] for p in ("snap_step", "snap_time", "c_offset", "w_offset")]
@@ -66,12 +74,7 @@ def render_read(path, snapshot):
                 raise BadInput("%s: not a capdem run file (no %s)" % (path, name))
         # docs/output.md: the committed count, never rows beyond it.
         n = min(H.snapshot_count(f), H.column_dataset(f, "prim_a").shape[0], H.column_dataset(f, "position").shape[0])
-        if n <= 0:
-            raise BadInput("%s: the run file holds no complete snapshot" % path)
-        k = snapshot if snapshot >= 0 else n + snapshot
-        if not 0 <= k < n:
-            raise BadInput("%s: --snapshot %d: the file holds snapshots 0..%d (or -1..-%d from the end)"
-                           % (path, snapshot, n - 1, n))
+        k = render_mpm.snapshot_index(path, snapshot, n)
         d = {"k": k, "n": n, "path": path}
         d["a"] = H.column(f, "prim_a", k)
         d["b"] = H.column(f, "prim_b", k)
@@ -407,14 +410,7 @@ def render_picture(d, args):
     # saving takes them in.
     if network is not None:
         cbar = ("normal force [N]",) + network
-    aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
-    frac = 0.94 if cbar else 1.0
-    fig.set_size_inches(args.width, min(max(args.width * frac * aspect, 1.5), 2.0 * args.width))
-    fig.subplots_adjust(left=0, right=1, bottom=0, top=1)
-    if cbar:
-        label, norm, cmap = cbar
-        cax = make_axes_locatable(ax).append_axes("right", size="2.5%", pad=0.1)
-        fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax, label=label)
+    render_fit_figure(fig, ax, args.width, lo, hi, cbar)
 
     nc = len(d["fn"])
     title = args.title or ("%s  snapshot %d of %d  t = %.4g s  %d particles, %d arms, %d contacts"
@@ -423,6 +419,19 @@ def render_picture(d, args):
     # tight: the equal-aspect axes leave margins that depend on the picture
     fig.savefig(args.output, dpi=args.dpi, bbox_inches="tight", pad_inches=0.08)
     plt.close(fig)
+
+
+def render_fit_figure(fig, ax, width, lo, hi, cbar):
+    """The figure's height from the picture's aspect (the axes fill it) and
+    the colour bar (label, norm, colormap) at the right, if any."""
+    aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
+    frac = 0.94 if cbar else 1.0
+    fig.set_size_inches(width, min(max(width * frac * aspect, 1.5), 2.0 * width))
+    fig.subplots_adjust(left=0, right=1, bottom=0, top=1)
+    if cbar:
+        label, norm, cmap = cbar
+        cax = make_axes_locatable(ax).append_axes("right", size="2.5%", pad=0.1)
+        fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax, label=label)
 
 
 def _shift_walls(walls, centre):
@@ -465,8 +474,9 @@ def render_parse(argv):
     p.add_argument("-o", "--output", required=True, help="PNG to write")
     p.add_argument("--snapshot", type=int, default=-1, help="snapshot index; negative counts from the end (default -1: last)")
     p.add_argument("--mode", choices=("arms", "forces"), default="arms")
-    p.add_argument("--color", choices=("particle", "height", "shape", "speed"), default="particle",
-                   help="arm colours in mode arms (default particle)")
+    p.add_argument("--color", choices=("particle", "height", "shape", "speed", "plastic"), default="particle",
+                   help="arm colours in mode arms (default particle); material point runs: particle, "
+                   "plastic (equivalent plastic strain) or speed")
     p.add_argument("--view", default="22,-35", help="3D camera elevation,azimuth in degrees (default 22,-35)")
     p.add_argument("--width", type=float, default=7.0, help="picture width in inches (default 7; height follows)")
     p.add_argument("--dpi", type=int, default=110)
@@ -491,7 +501,15 @@ def main(argv):
         sys.stderr.write("capdem render: %s\n" % e)
         return 2
     try:
-        render_picture(d, args)
+        if d.get("solver") == "mpm":
+            render_mpm.draw(d, args, render_fit_figure)
+        elif args.color == "plastic":
+            raise BadInput("--color plastic: only material point runs (solver mpm) have a plastic strain")
+        else:
+            render_picture(d, args)
+    except BadInput as e:
+        sys.stderr.write("capdem render: %s: %s\n" % (args.run, e))
+        return 2
     except OSError as e:
         sys.stderr.write("capdem render: %s: cannot write (%s)\n" % (args.output, e))
         return 1

@@ -299,17 +299,31 @@ CD_INLINE void cd_mpm_item_bnode_body(cd_mpm_cols c, cd_int k)
     for (cd_ulong t = c.win_off[k]; t < c.win_off[k + 1]; t++) c.bnode_body[t] = k;
 }
 
-/* The n points sorted by (body, cell) into order, stably (a counting sort
- * over the nbn body-cells), and each cell's first entry in cell_start. */
-CD_INLINE void cd_mpm_item_sort_points(cd_mpm_cols c, cd_ulong n, cd_ulong nbn)
+/* Body k's points sorted by cell into order, stably (a counting sort over
+ * the body's cells), and the first entry of each of its cells in
+ * cell_start; the last body also ends the list (cell_start[nbn] = n).  A
+ * body's points come after those of the bodies before it and its cells
+ * after theirs, so the bodies sort independently and together give the one
+ * stable sort of all points by (body, cell): the same order whatever runs
+ * them (every count an integer). */
+CD_INLINE void cd_mpm_item_sort_body(cd_mpm_cols c, cd_int k)
 {
     CD_GLOBAL cd_ulong *cs = c.cell_start;
-    for (cd_ulong q = 0; q <= nbn; q++) cs[q] = 0;
-    for (cd_ulong p = 0; p < n; p++) cs[cd_mpm_point_cell(c, p) + 1]++;
-    for (cd_ulong q = 0; q < nbn; q++) cs[q + 1] += cs[q];
-    for (cd_ulong p = 0; p < n; p++) c.order[cs[cd_mpm_point_cell(c, p)]++] = p;
-    for (cd_ulong q = nbn; q > 0; q--) cs[q] = cs[q - 1];
-    cs[0] = 0;
+    cd_ulong q0 = c.win_off[k], q1 = c.win_off[k + 1], p0 = c.pfirst[k], p1 = c.pfirst[k + 1];
+    for (cd_ulong q = q0; q < q1; q++) cs[q] = 0;
+    for (cd_ulong p = p0; p < p1; p++) cs[cd_mpm_point_cell(c, p)]++;
+    cd_ulong start = p0; /* each cell's first entry: the exclusive prefix sum of the counts */
+    for (cd_ulong q = q0; q < q1; q++) {
+        cd_ulong count = cs[q];
+        cs[q] = start;
+        start += count;
+    }
+    for (cd_ulong p = p0; p < p1; p++) c.order[cs[cd_mpm_point_cell(c, p)]++] = p;
+    if (q1 > q0) { /* each cell's entry was moved to its end: shifted back by one cell */
+        for (cd_ulong q = q1 - 1; q > q0; q--) cs[q] = cs[q - 1];
+        cs[q0] = p0;
+    }
+    if (k == c.n_bodies - 1) cs[q1] = p1;
 }
 
 /* Sum of m_i v_i^2 / 2 over the nbn body-nodes, in their order [J/m]. */
@@ -349,6 +363,97 @@ CD_INLINE void cd_mpm_item_contact_nodes(cd_mpm_cols c, cd_ulong nbn, CD_GLOBAL 
     for (cd_ulong g = 0; g < nn; g++)
         if (cs[g + 1] - cs[g] >= 2) c.cn_list[n_cn++] = g;
     *listed = n_cn;
+}
+
+/* The same lists in parallel (the OpenCL backend; every count an integer,
+ * so the lists are those of cd_mpm_item_contact_nodes bit for bit):
+ *   1. per mesh row j, the bodies whose window holds it, ascending, into
+ *      rows[j * n_bodies ...], their number into row_n[j];
+ *   2. per common node g, its body-nodes with mass into cn_start[g + 1];
+ *   3. per block of CD_MPM_CN_BLOCK nodes, their entries and listed nodes
+ *      into blocks[2 b], blocks[2 b + 1];
+ *   4. one item: the blocks' running totals (nn / CD_MPM_CN_BLOCK of them),
+ *      the listed nodes' count into *listed;
+ *   5. per block, cn_start as the running count and cn_list;
+ *   6. per common node, its body-nodes into cn_entry, bodies ascending. */
+#define CD_MPM_CN_BLOCK 256
+
+CD_INLINE void cd_mpm_item_cn_rows(cd_mpm_cols c, cd_int j, CD_GLOBAL cd_int *row_n, CD_GLOBAL cd_int *rows)
+{
+    cd_int m = 0;
+    for (cd_int k = 0; k < c.n_bodies; k++)
+        if (j >= c.win_j0[k] && j < c.win_j0[k] + c.win_ny[k]) rows[(cd_ulong)j * (cd_ulong)c.n_bodies + m++] = k;
+    row_n[j] = m;
+}
+
+/* Body k's body-node at common node (i, j), or -1 when its window does not
+ * hold it or the node has no mass there. */
+CD_INLINE cd_long cd_mpm_cn_bnode(cd_mpm_cols c, cd_int k, cd_int i, cd_int j)
+{
+    if (i < c.win_i0[k] || i >= c.win_i0[k] + c.win_nx[k]) return -1;
+    cd_ulong t = c.win_off[k] + (cd_ulong)(j - c.win_j0[k]) * (cd_ulong)c.win_nx[k] + (cd_ulong)(i - c.win_i0[k]);
+    return c.gm[t] > 0 ? (cd_long)t : -1;
+}
+
+CD_INLINE void cd_mpm_item_cn_count(cd_mpm_cols c, cd_ulong g, CD_GLOBAL const cd_int *row_n,
+                                    CD_GLOBAL const cd_int *rows)
+{
+    cd_int i = (cd_int)(g % (cd_ulong)c.nx), j = (cd_int)(g / (cd_ulong)c.nx);
+    cd_ulong count = 0;
+    for (cd_int m = 0; m < row_n[j]; m++)
+        count += cd_mpm_cn_bnode(c, rows[(cd_ulong)j * (cd_ulong)c.n_bodies + m], i, j) >= 0;
+    c.cn_start[g + 1] = count;
+}
+
+CD_INLINE void cd_mpm_item_cn_block_sums(cd_mpm_cols c, cd_ulong b, CD_GLOBAL cd_ulong *blocks)
+{
+    cd_ulong nn = (cd_ulong)c.nx * (cd_ulong)c.ny,
+             end = (b + 1) * CD_MPM_CN_BLOCK < nn ? (b + 1) * CD_MPM_CN_BLOCK : nn;
+    cd_ulong entries = 0, listed = 0;
+    for (cd_ulong g = b * CD_MPM_CN_BLOCK; g < end; g++) {
+        entries += c.cn_start[g + 1];
+        listed += c.cn_start[g + 1] >= 2;
+    }
+    blocks[2 * b] = entries;
+    blocks[2 * b + 1] = listed;
+}
+
+CD_INLINE void cd_mpm_item_cn_block_scan(cd_ulong n_blocks, CD_GLOBAL cd_ulong *blocks, CD_GLOBAL cd_ulong *listed)
+{
+    cd_ulong entries = 0, lists = 0;
+    for (cd_ulong b = 0; b < n_blocks; b++) {
+        cd_ulong e = blocks[2 * b], l = blocks[2 * b + 1];
+        blocks[2 * b] = entries;
+        blocks[2 * b + 1] = lists;
+        entries += e;
+        lists += l;
+    }
+    *listed = lists;
+}
+
+CD_INLINE void cd_mpm_item_cn_block_starts(cd_mpm_cols c, cd_ulong b, CD_GLOBAL const cd_ulong *blocks)
+{
+    cd_ulong nn = (cd_ulong)c.nx * (cd_ulong)c.ny,
+             end = (b + 1) * CD_MPM_CN_BLOCK < nn ? (b + 1) * CD_MPM_CN_BLOCK : nn;
+    cd_ulong start = blocks[2 * b], listed = blocks[2 * b + 1];
+    if (b == 0) c.cn_start[0] = 0;
+    for (cd_ulong g = b * CD_MPM_CN_BLOCK; g < end; g++) {
+        cd_ulong count = c.cn_start[g + 1];
+        if (count >= 2) c.cn_list[listed++] = g;
+        start += count;
+        c.cn_start[g + 1] = start;
+    }
+}
+
+CD_INLINE void cd_mpm_item_cn_entries(cd_mpm_cols c, cd_ulong g, CD_GLOBAL const cd_int *row_n,
+                                      CD_GLOBAL const cd_int *rows)
+{
+    cd_int i = (cd_int)(g % (cd_ulong)c.nx), j = (cd_int)(g / (cd_ulong)c.nx);
+    cd_ulong e = c.cn_start[g];
+    for (cd_int m = 0; m < row_n[j]; m++) {
+        cd_long t = cd_mpm_cn_bnode(c, rows[(cd_ulong)j * (cd_ulong)c.n_bodies + m], i, j);
+        if (t >= 0) c.cn_entry[e++] = (cd_ulong)t;
+    }
 }
 
 /* The body pairs in contact at the n_cn listed nodes (bit q of cn_active

@@ -11,9 +11,7 @@
 #include "config/config.h"
 #include "export/export.h"
 #include "analysis/analyze.h"
-#include "mpm/mpm_output.h"
 #include "io/io_h5.h"
-#include "io/io_h5_guard.h"
 #include "io/io_h5_journal.h"
 #include "mpi/mpi_decomp.h"
 #include "capdem_commit.h" /* CAPDEM_COMMIT, generated at build time (src/git_commit.cmake) */
@@ -35,8 +33,9 @@ static void usage(FILE *f)
             "                  microstructure of a packing (docs/analysis.md)\n"
             "  export RUN.h5 [-o OUT.xmf]\n"
             "                  ParaView-ready XDMF description of a run (docs/visualization.md)\n"
-            "  render RUN.h5 [--snapshot N] -o PIC.png [--mode arms|forces] [--color particle|height|shape|speed]\n"
-            "                [--view ELEV,AZIM]   picture of a packing (matplotlib)\n"
+            "  render RUN.h5 [--snapshot N] -o PIC.png [--mode arms|forces] [--view ELEV,AZIM]\n"
+            "                [--color particle|height|shape|speed|plastic]   picture of a packing or of\n"
+            "                material points (matplotlib)\n"
             "  recover RUN.h5  brings a run file left by a killed run to its last commit in place, so that\n"
             "                  programs other than capdem (h5py, h5dump) read it (docs/output.md, \"Crash safety\")\n"
             "  --version       version, build variant and OpenMP devices\n");
@@ -259,19 +258,6 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "shape")) return cmd_shape(argc - 2, argv + 2);
     if (!strcmp(cmd, "recover")) return cmd_recover(argc - 2, argv + 2);
-    if (!strcmp(cmd, "render"))
-        for (int i = 2; i < argc; i++) {
-            if (argv[i][0] == '-') continue;
-            cdh5_guard_begin(cmd, argv[i]);
-            int mpm = cd_mpm_is_run_file(argv[i]);
-            cdh5_guard_end();
-            if (mpm) {
-                fprintf(stderr,
-                        "capdem %s: %s: a run file of solver mpm; `capdem %s` does not read those yet (docs/mpm.md)\n",
-                        cmd, argv[i], cmd);
-                return 2;
-            }
-        }
     if (!strcmp(cmd, "analyze")) return cd_cmd_analyze(argc - 2, argv + 2);
     if (!strcmp(cmd, "export")) return cd_cmd_export(argc - 2, argv + 2);
     if (!strcmp(cmd, "render")) return cd_cmd_render(argc - 2, argv + 2);

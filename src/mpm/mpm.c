@@ -38,6 +38,7 @@ int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, doubl
         return -1;
     }
     for (size_t p = 0; p < n; p++) m->f_xx[p] = m->f_yy[p] = 1;
+    m->observe = 1;
     return 0;
 }
 
@@ -277,10 +278,10 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
     c = cd_mpm_loop_cols(m); /* the body-node columns may have moved */
     CD_STEP_FOR(nb, firstprivate(c))
     for (int k = 0; k < nb; k++) cd_mpm_item_bnode_body(c, k);
-    /* stable counting sort by (body, cell): a point's cell is its stencil's
-     * second node, numbered like the body's nodes */
-    CD_STEP_FOR(1, firstprivate(c, n, nbn))
-    for (int one = 0; one < 1; one++) cd_mpm_item_sort_points(c, n, nbn);
+    /* stable counting sort by (body, cell), body by body: a point's cell is
+     * its stencil's second node, numbered like the body's nodes */
+    CD_STEP_FOR(nb, firstprivate(c))
+    for (int k = 0; k < nb; k++) cd_mpm_item_sort_body(c, k);
     return 0;
 }
 

@@ -81,6 +81,10 @@ typedef struct {
                           * points' kinetic energy the mesh sees (docs/mpm.md "FLIP's noise") */
     double dt, time;     /* [s] */
     long long step;
+    int observe; /* 1 (the default): the next step computes the sums only output reads (the walls' forces,
+                  * the mesh's kinetic energy, the deepest overlap); the OpenCL backend skips them at
+                  * steps with 0, which the run sets where it reads nothing (the omp loops compute them
+                  * at every step) */
 
     /* where the step's loops run (src/mpm/mpm_device.c, docs/mpm.md "Work items") */
     int loop_on;                     /* 1 from the first step on (offload builds: the state is on the device) */
@@ -114,7 +118,8 @@ double cd_mpm_dt_limit(const cd_mpm *m);
 int cd_mpm_bodies(cd_mpm *m, char *err, size_t errlen);
 
 /* One explicit step (MUSL, docs/mpm.md).  0, or -1 with a message when a
- * point leaves the mesh or a value is not finite (the run blew up). */
+ * point leaves the mesh or a value is not finite (the run blew up); on the
+ * OpenCL backend these show at the next cd_mpm_settle. */
 int cd_mpm_step(cd_mpm *m, char *err, size_t errlen);
 
 /* Sums over the points, in index order [J/m]. */
@@ -167,6 +172,7 @@ void cd_mpm_step_done(cd_mpm *m);
 int cd_mpm_cl_open(cd_mpm *m, const char *device, char *err, size_t errlen);
 int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen);
 void cd_mpm_cl_sync(cd_mpm *m);
+int cd_mpm_cl_settle(cd_mpm *m, char *err, size_t errlen);
 void cd_mpm_cl_close(cd_mpm *m);
 /* The device's name, for the run's first line. */
 const char *cd_mpm_cl_device(const cd_mpm *m);
@@ -186,6 +192,14 @@ cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m);
  * body-nodes / contact keys (0, or -1 out of memory). */
 int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen);
 void cd_mpm_device_sync(cd_mpm *m);
+/* Where the run reads the state (a series row, a snapshot, the progress
+ * line): the host columns made current, as cd_mpm_device_sync.  The OpenCL
+ * backend finds out there whether a step since its last look failed: -1
+ * with the message cd_mpm_step would have given (step, time and walls back
+ * at that step's start), or 1 when the body-nodes outgrew their buffers at
+ * an earlier step: the buffers grown, the state back at that step, and the
+ * run steps on from there.  0 otherwise. */
+int cd_mpm_settle(cd_mpm *m, char *err, size_t errlen);
 void cd_mpm_device_stop(cd_mpm *m);
 cd_mpm_cols cd_mpm_loop_cols(const cd_mpm *m);
 int cd_mpm_device_reserve(cd_mpm *m, size_t n);

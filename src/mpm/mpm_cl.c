@@ -6,15 +6,24 @@
  * every .cl file of kernels/cl, this one's kernels included).
  *
  * The state lives in device buffers from the first step on: the columns of
- * kernels/cl/mpm_col_list.h, the body-node ones grown with a margin when a
- * step needs more.  Per step only scalars come back (the walls' forces, the
- * body-node count, the listed common nodes, the mesh's kinetic energy, the
- * deepest overlap, the blow-up flags); cd_mpm_cl_sync brings the columns
- * the host reads back before output.  Blow-up flags are integer atomic
- * maxima (the highest bad index, as the omp loops' max reductions); every
- * floating-point sum is an item's gather or a one-item loop in a fixed
- * order, so the bits are those of the omp backend where the device rounds
- * as the host does. */
+ * kernels/cl/mpm_col_list.h, the body-node ones sized at the first step
+ * with a margin.  A step only enqueues: nothing is read back between steps.
+ * The kernels run over sizes the host knows (points, bodies, the body-node
+ * buffers' rows, a bound on the listed common nodes) and read the counts
+ * the step makes from the device; failures (a point left the mesh, the
+ * body-nodes outgrew their buffers, a crowded common node, a point blew
+ * up) are integer atomics with the step they were seen at, and stop every
+ * later kernel.  The host looks only where the run reads the state (a
+ * series row, a snapshot, the progress line: cd_mpm_cl_settle): it then
+ * reads the checks, the counts and the observed step's sums (walls'
+ * forces, the deepest overlap, the mesh's kinetic energy, computed only at
+ * the steps the run marks in m->observe) and downloads the columns; after
+ * a failure it goes back to the failing step's start (time, step and walls
+ * from a record of the steps since it last looked) and reports it as the
+ * omp loops do; after an overflow it grows the buffers and the run steps
+ * on from there.  Every floating-point sum is an item's gather or a
+ * one-item loop in a fixed order, so the bits are those of the omp backend
+ * where the device rounds as the host does. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,17 +33,22 @@
 #include "backend/opencl/backend_cl.h"
 #include "cl/mpm_col_list.h"
 
-/* Kernels of kernels/cl/mpm.cl; all but K_MAX_OVER take the columns first. */
+/* Kernels of kernels/cl/mpm.cl; every one takes the columns, the mesh and the checks first. */
 enum {
     K_PREPARE,
     K_WALL_FORCE,
     K_WINDOW,
     K_WINDOW_OFFSETS,
     K_BNODE_BODY,
-    K_SORT_POINTS,
+    K_SORT_BODY,
     K_TO_GRID,
     K_NODE_UPDATE,
-    K_CONTACT_NODES,
+    K_CN_ROWS,
+    K_CN_COUNT,
+    K_CN_BLOCK_SUMS,
+    K_CN_BLOCK_SCAN,
+    K_CN_BLOCK_STARTS,
+    K_CN_ENTRIES,
     K_CONTACT_CROWDED,
     K_CONTACT,
     K_MAX_OVER,
@@ -49,12 +63,14 @@ static const struct {
     const char *name;
     int one_item; /* the serial parts: one work-item */
 } kernel_table[K_COUNT] = {
-    {"cd_mpm_cl_prepare", 0},         {"cd_mpm_cl_wall_force", 0},  {"cd_mpm_cl_window", 0},
-    {"cd_mpm_cl_window_offsets", 1},  {"cd_mpm_cl_bnode_body", 0},  {"cd_mpm_cl_sort_points", 1},
-    {"cd_mpm_cl_to_grid", 0},         {"cd_mpm_cl_node_update", 0}, {"cd_mpm_cl_contact_nodes", 1},
-    {"cd_mpm_cl_contact_crowded", 0}, {"cd_mpm_cl_contact", 0},     {"cd_mpm_cl_max_over", 1},
-    {"cd_mpm_cl_point_update", 0},    {"cd_mpm_cl_remap", 0},       {"cd_mpm_cl_mesh_kinetic", 1},
-    {"cd_mpm_cl_stress", 0},          {"cd_mpm_cl_pair_keys", 1},
+    {"cd_mpm_cl_prepare", 0},         {"cd_mpm_cl_wall_force", 0},    {"cd_mpm_cl_window", 0},
+    {"cd_mpm_cl_window_offsets", 1},  {"cd_mpm_cl_bnode_body", 0},    {"cd_mpm_cl_sort_body", 0},
+    {"cd_mpm_cl_to_grid", 0},         {"cd_mpm_cl_node_update", 0},   {"cd_mpm_cl_cn_rows", 0},
+    {"cd_mpm_cl_cn_count", 0},        {"cd_mpm_cl_cn_block_sums", 0}, {"cd_mpm_cl_cn_block_scan", 1},
+    {"cd_mpm_cl_cn_block_starts", 0}, {"cd_mpm_cl_cn_entries", 0},    {"cd_mpm_cl_contact_crowded", 0},
+    {"cd_mpm_cl_contact", 0},         {"cd_mpm_cl_max_over", 1},      {"cd_mpm_cl_point_update", 0},
+    {"cd_mpm_cl_remap", 0},           {"cd_mpm_cl_mesh_kinetic", 1},  {"cd_mpm_cl_stress", 0},
+    {"cd_mpm_cl_pair_keys", 1},
 };
 
 /* Columns, in the kernels' parameter order; and what their rows are. */
@@ -73,25 +89,45 @@ static const struct {
     CD_MPM_CL_COLS(COL_INFO)
 #undef COL_INFO
 };
-/* The first argument after the columns and the mesh (nx, ny, n_bodies, h, ox, oy). */
-#define FIRST_ARG (N_COLS + 6)
+/* The arguments after the columns: the mesh (nx, ny, n_bodies, h, ox, oy),
+ * the checks (flags, counts, j); then each kernel's own. */
+#define ARG_FLAGS (N_COLS + 6)
+#define ARG_J     (N_COLS + 8)
+#define FIRST_ARG (N_COLS + 9)
 
-/* Blow-up flags (cd_int): the highest point that left the mesh, common
- * node too crowded, point that blew up; -1 when none. */
-enum { FLAG_LEFT, FLAG_CROWDED, FLAG_BLEW_UP, N_FLAGS };
-/* Real results: the walls' forces [N/m], the deepest overlap [m], the mesh's kinetic energy [J/m]. */
+/* Failures in the step's order (kernels/cl/mpm.cl): flags[f] the highest
+ * bad index or -1, flags[N_FAILS + f] the step it was first seen at,
+ * counted from the host's last look, or NEVER. */
+enum { FAIL_LEFT, FAIL_OVERFLOW, FAIL_CROWDED, FAIL_BLEW_UP, N_FAILS };
+#define NEVER 0x7fffffff
+/* counts (cd_ulong): body-nodes, listed common nodes, contact keys. */
+enum { COUNT_BNODES, COUNT_LISTED, COUNT_KEYS, N_COUNTS };
+/* Real results of an observed step: the walls' forces [N/m], the deepest overlap [m], the mesh's kinetic energy [J/m]. */
 enum { REAL_WALLS = 0, REAL_PEN = 2 * CD_MPM_MAX_WALLS, REAL_KINETIC, N_REALS };
+
+/* Where a step began (time [s], walls' points [m]): where the host goes
+ * back to when the step failed or must run again. */
+struct step_start {
+    double time;
+    double px[CD_MPM_MAX_WALLS], py[CD_MPM_MAX_WALLS];
+};
 
 struct cd_mpm_cl {
     cd_cl cl;
     cl_kernel k[K_COUNT];
     cl_mem col[N_COLS];
     size_t cap_bnodes;   /* body-node rows of the BNODE columns */
-    cl_mem flags, reals; /* N_FLAGS cd_int, N_REALS cd_real */
-    cl_mem count;        /* cd_ulong: the one-item kernels' counts */
+    cl_mem flags, reals; /* 2 N_FAILS cd_int, N_REALS cd_real */
+    cl_mem count;        /* N_COUNTS cd_ulong */
     cl_mem over;         /* cd_real per common node: the contact's overlaps */
     cl_mem keys;         /* cd_long: the contact pairs' keys */
     size_t cap_keys;
+    cl_mem row_n, rows;       /* the common nodes' lists: bodies per mesh row (cd_int ny, ny x n_bodies) */
+    cl_mem blocks;            /* cd_ulong 2 per CD_MPM_CN_BLOCK common nodes */
+    int sized;                /* the body-node buffers sized from the first step's count */
+    cd_int j;                 /* steps enqueued since the host last looked */
+    struct step_start *since; /* where each of them began */
+    size_t cap_since;
 };
 
 static size_t rows_of(const cd_mpm *m, enum rows_kind r)
@@ -171,7 +207,7 @@ static int bind_col(cd_mpm *m, int f, cl_mem b)
     if (d->col[f]) clReleaseMemObject(d->col[f]);
     d->col[f] = b;
     for (int k = 0; k < K_COUNT && b; k++)
-        if (k != K_MAX_OVER && arg_mem(d, k, (cl_uint)f, b)) return -1;
+        if (arg_mem(d, k, (cl_uint)f, b)) return -1;
     return b ? 0 : -1;
 }
 
@@ -191,8 +227,28 @@ static int reserve_bnodes(cd_mpm *m, size_t nbn)
     return 0;
 }
 
+/* The contact's row lists hold a row per mesh row, each room for every body. */
+static size_t nb_rows(const cd_mpm *m) { return m->n_bodies > 0 ? (size_t)m->n_bodies : 1; }
+/* Blocks of CD_MPM_CN_BLOCK common nodes. */
+static size_t n_blocks(const cd_mpm *m)
+{
+    return ((size_t)m->nx * (size_t)m->ny + CD_MPM_CN_BLOCK - 1) / CD_MPM_CN_BLOCK;
+}
+
+/* The checks as they are before any step: no failure, never seen. */
+static int reset_flags(struct cd_mpm_cl *d)
+{
+    static const cd_int none[2 * N_FAILS] = {-1, -1, -1, -1, NEVER, NEVER, NEVER, NEVER};
+    d->j = 0;
+    return cd_cl_check(&d->cl,
+                       clEnqueueWriteBuffer(d->cl.queue, d->flags, CL_TRUE, 0, sizeof none, none, 0, NULL, NULL),
+                       "resetting the step's checks")
+               ? -1
+               : 0;
+}
+
 /* The first step (or the first after cd_mpm_device_stop): the buffers and
- * the host's columns on the device, the mesh's arguments. */
+ * the host's columns on the device, the mesh's and the checks' arguments. */
 static int start(cd_mpm *m)
 {
     struct cd_mpm_cl *d = m->cl;
@@ -206,16 +262,21 @@ static int start(cd_mpm *m)
                 return -1;
         if (reserve_bnodes(m, 1)) return -1; /* bound before the first step's count sizes them */
         size_t nn = (size_t)m->nx * (size_t)m->ny;
-        d->flags = cd_cl_buffer(cl, N_FLAGS * sizeof(cd_int), "allocating the flags");
+        d->flags = cd_cl_buffer(cl, 2 * N_FAILS * sizeof(cd_int), "allocating the step's checks");
         d->reals = cd_cl_buffer(cl, N_REALS * sizeof(cd_real), "allocating the step's sums");
-        d->count = cd_cl_buffer(cl, sizeof(cd_ulong), "allocating a count");
+        d->count = cd_cl_buffer(cl, N_COUNTS * sizeof(cd_ulong), "allocating the step's counts");
         d->over = cd_cl_buffer(cl, nn * sizeof(cd_real), "allocating the contact's overlaps");
+        d->row_n = cd_cl_buffer(cl, (size_t)m->ny * sizeof(cd_int), "allocating the contact's row lists");
+        d->rows = cd_cl_buffer(cl, (size_t)m->ny * nb_rows(m) * sizeof(cd_int), "allocating the contact's row lists");
+        d->blocks = cd_cl_buffer(cl, 2 * n_blocks(m) * sizeof(cd_ulong), "allocating the contact's block sums");
+        if (!d->flags || !d->reals || !d->count || !d->over || !d->row_n || !d->rows || !d->blocks) return -1;
         cl_int nx = m->nx, ny = m->ny, nb = m->n_bodies;
         double mesh[3] = {m->h, m->ox, m->oy}; /* [m] */
         for (int k = 0; k < K_COUNT; k++)
-            if (k != K_MAX_OVER && (arg(d, k, N_COLS, sizeof nx, &nx) || arg(d, k, N_COLS + 1, sizeof ny, &ny) ||
-                                    arg(d, k, N_COLS + 2, sizeof nb, &nb) || arg_real(d, k, N_COLS + 3, mesh[0]) ||
-                                    arg_real(d, k, N_COLS + 4, mesh[1]) || arg_real(d, k, N_COLS + 5, mesh[2])))
+            if (arg(d, k, N_COLS, sizeof nx, &nx) || arg(d, k, N_COLS + 1, sizeof ny, &ny) ||
+                arg(d, k, N_COLS + 2, sizeof nb, &nb) || arg_real(d, k, N_COLS + 3, mesh[0]) ||
+                arg_real(d, k, N_COLS + 4, mesh[1]) || arg_real(d, k, N_COLS + 5, mesh[2]) ||
+                arg_mem(d, k, ARG_FLAGS, d->flags) || arg_mem(d, k, ARG_FLAGS + 1, d->count))
                 return -1;
     }
     for (int f = 0; f < N_COLS && !cl->status; f++) {
@@ -224,23 +285,38 @@ static int start(cd_mpm *m)
         cd_cl_check(cl, clEnqueueWriteBuffer(cl->queue, d->col[f], CL_TRUE, 0, bytes, host_col(m, f), 0, NULL, NULL),
                     "uploading the material points");
     }
-    if (cl->status) return -1;
+    if (cl->status || reset_flags(d)) return -1;
+    d->sized = 0;
     m->loop_on = 1;
     return 0;
 }
 
-/* The step's failures reported by the device, after the launches that
- * set them: index of the flag, or -1. */
-static int flag(struct cd_mpm_cl *d, int which, cd_int *value)
+/* Where step j (since the host's last look) begins: recorded before it is enqueued. */
+static int record_start(cd_mpm *m)
 {
-    return read_buf(d, d->flags, (size_t)which * sizeof(cd_int), sizeof(cd_int), value, "reading the step's checks");
+    struct cd_mpm_cl *d = m->cl;
+    if ((size_t)d->j >= d->cap_since) {
+        size_t cap = 2 * d->cap_since + 16;
+        struct step_start *q = realloc(d->since, cap * sizeof *q);
+        if (!q) return -1;
+        d->since = q;
+        d->cap_since = cap;
+    }
+    struct step_start *s = &d->since[d->j];
+    s->time = m->time;
+    for (int w = 0; w < m->n_walls; w++) {
+        s->px[w] = m->walls[w].px;
+        s->py[w] = m->walls[w].py;
+    }
+    return 0;
 }
 
-/* Arguments after the columns and the mesh, then the launch. */
+/* Arguments after the columns, the mesh and the checks, then the launch. */
 #define LAUNCH_WITH(k, n, ...)                                                                                         \
     do {                                                                                                               \
         cl_uint a_ = FIRST_ARG;                                                                                        \
         (void)a_;                                                                                                      \
+        arg(d, k, ARG_J, sizeof d->j, &d->j);                                                                          \
         __VA_ARGS__;                                                                                                   \
         launch(d, k, n);                                                                                               \
     } while (0)
@@ -249,70 +325,72 @@ static int flag(struct cd_mpm_cl *d, int which, cd_int *value)
 #define A_REAL(k, v)  arg_real(d, k, a_++, v)
 #define A_ANY(k, v)   arg(d, k, a_++, sizeof(v), &(v))
 
-/* As cd_mpm_step, loop for loop (src/mpm/mpm.c, src/mpm/mpm_contact.c). */
+/* As cd_mpm_step, loop for loop (src/mpm/mpm.c, src/mpm/mpm_contact.c),
+ * enqueued only: the host reads nothing until cd_mpm_cl_settle, except the
+ * body-node count once at the first step (to size their buffers). */
 int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen)
 {
     struct cd_mpm_cl *d = m->cl;
     cd_cl *cl = &d->cl;
     if (!m->loop_on && start(m)) goto failed;
+    if (record_start(m)) {
+        snprintf(err, errlen, "out of memory for the record of %d steps", (int)d->j + 1);
+        return -1;
+    }
     size_t n = m->n, nb = (size_t)m->n_bodies;
     double dt = m->dt; /* [s] */
-    static const cd_int none[N_FLAGS] = {-1, -1, -1};
-    cd_cl_check(cl, clEnqueueWriteBuffer(cl->queue, d->flags, CL_FALSE, 0, sizeof none, none, 0, NULL, NULL),
-                "resetting the step's checks");
     /* stencils, wall forces, windows, the points sorted by (body, cell) */
     cd_mpm_item_walls walls = cd_mpm_walls_items(m);
-    LAUNCH_WITH(K_PREPARE, n, A_ULONG(K_PREPARE, n); A_ANY(K_PREPARE, walls); A_MEM(K_PREPARE, d->flags));
-    LAUNCH_WITH(K_WALL_FORCE, (size_t)m->n_walls, A_ULONG(K_WALL_FORCE, n); A_ANY(K_WALL_FORCE, walls);
-                A_MEM(K_WALL_FORCE, d->reals));
-    cd_int bad;
-    double f[2 * CD_MPM_MAX_WALLS]; /* [N/m] */
-    if (flag(d, FLAG_LEFT, &bad)) goto failed;
-    if (bad >= 0) return cd_mpm_fail_left_mesh(m, (size_t)bad, err, errlen);
-    if (read_buf(d, d->reals, 0, 2 * (size_t)m->n_walls * sizeof(double), f, "reading the wall forces")) goto failed;
-    for (int w = 0; w < m->n_walls; w++) {
-        m->walls[w].fx = f[2 * w];
-        m->walls[w].fy = f[2 * w + 1];
-    }
+    LAUNCH_WITH(K_PREPARE, n, A_ULONG(K_PREPARE, n); A_ANY(K_PREPARE, walls));
+    if (m->observe)
+        LAUNCH_WITH(K_WALL_FORCE, (size_t)m->n_walls, A_ULONG(K_WALL_FORCE, n); A_ANY(K_WALL_FORCE, walls);
+                    A_MEM(K_WALL_FORCE, d->reals));
     LAUNCH_WITH(K_WINDOW, nb, );
-    LAUNCH_WITH(K_WINDOW_OFFSETS, 1, A_MEM(K_WINDOW_OFFSETS, d->count));
-    cl_ulong nbn;
-    if (read_buf(d, d->count, 0, sizeof nbn, &nbn, "reading the body-node count") || reserve_bnodes(m, nbn))
-        goto failed;
-    m->n_bnodes = nbn;
+    /* the first step sizes the body-node buffers from its count; later
+     * steps check it against them on the device (failure OVERFLOW) */
+    LAUNCH_WITH(K_WINDOW_OFFSETS, 1, A_ULONG(K_WINDOW_OFFSETS, d->sized ? d->cap_bnodes : (size_t)-1));
+    if (!d->sized) { /* (unless the step already failed: then it stops here and settle reports it) */
+        cl_ulong nbn;
+        cd_int left;
+        if (read_buf(d, d->count, 0, sizeof nbn, &nbn, "reading the body-node count") ||
+            read_buf(d, d->flags, FAIL_LEFT * sizeof(cd_int), sizeof left, &left, "reading the step's checks") ||
+            (left < 0 && reserve_bnodes(m, nbn)))
+            goto failed;
+        d->sized = 1;
+    }
+    size_t rows = d->cap_bnodes;                                                               /* body-node kernels */
+    size_t nn = (size_t)m->nx * (size_t)m->ny, listed = rows / 2 + 1 < nn ? rows / 2 + 1 : nn; /* >= listed nodes */
     LAUNCH_WITH(K_BNODE_BODY, nb, );
-    LAUNCH_WITH(K_SORT_POINTS, 1, A_ULONG(K_SORT_POINTS, n); A_ULONG(K_SORT_POINTS, nbn));
+    LAUNCH_WITH(K_SORT_BODY, nb, );
     /* to the grid, node update, contact */
     cd_int normals = m->n_bodies > 1;
-    LAUNCH_WITH(K_TO_GRID, nbn, A_ULONG(K_TO_GRID, nbn); A_ANY(K_TO_GRID, normals));
-    LAUNCH_WITH(K_NODE_UPDATE, nbn, A_ULONG(K_NODE_UPDATE, nbn); A_REAL(K_NODE_UPDATE, dt));
+    LAUNCH_WITH(K_TO_GRID, rows, A_ANY(K_TO_GRID, normals));
+    LAUNCH_WITH(K_NODE_UPDATE, rows, A_REAL(K_NODE_UPDATE, dt));
     if (m->n_bodies > 1) {
-        LAUNCH_WITH(K_CONTACT_NODES, 1, A_ULONG(K_CONTACT_NODES, nbn); A_MEM(K_CONTACT_NODES, d->count));
-        cl_ulong n_cn;
-        if (read_buf(d, d->count, 0, sizeof n_cn, &n_cn, "reading the contact nodes' count")) goto failed;
-        m->n_cn = n_cn;
-        LAUNCH_WITH(K_CONTACT_CROWDED, n_cn, A_ULONG(K_CONTACT_CROWDED, n_cn); A_MEM(K_CONTACT_CROWDED, d->flags));
-        if (flag(d, FLAG_CROWDED, &bad)) goto failed;
-        if (bad >= 0) return cd_mpm_fail_crowded(m, (size_t)bad, err, errlen);
-        LAUNCH_WITH(K_CONTACT, n_cn, A_ULONG(K_CONTACT, n_cn); A_REAL(K_CONTACT, m->contact_gap); A_REAL(K_CONTACT, dt);
+        size_t nblk = n_blocks(m);
+        LAUNCH_WITH(K_CN_ROWS, (size_t)m->ny, A_MEM(K_CN_ROWS, d->row_n); A_MEM(K_CN_ROWS, d->rows));
+        LAUNCH_WITH(K_CN_COUNT, nn, A_MEM(K_CN_COUNT, d->row_n); A_MEM(K_CN_COUNT, d->rows));
+        LAUNCH_WITH(K_CN_BLOCK_SUMS, nblk, A_MEM(K_CN_BLOCK_SUMS, d->blocks); A_ULONG(K_CN_BLOCK_SUMS, nblk));
+        LAUNCH_WITH(K_CN_BLOCK_SCAN, 1, A_MEM(K_CN_BLOCK_SCAN, d->blocks); A_ULONG(K_CN_BLOCK_SCAN, nblk));
+        LAUNCH_WITH(K_CN_BLOCK_STARTS, nblk, A_MEM(K_CN_BLOCK_STARTS, d->blocks); A_ULONG(K_CN_BLOCK_STARTS, nblk));
+        LAUNCH_WITH(K_CN_ENTRIES, nn, A_MEM(K_CN_ENTRIES, d->row_n); A_MEM(K_CN_ENTRIES, d->rows));
+        LAUNCH_WITH(K_CONTACT_CROWDED, listed, );
+        LAUNCH_WITH(K_CONTACT, listed, A_REAL(K_CONTACT, m->contact_gap); A_REAL(K_CONTACT, dt);
                     A_MEM(K_CONTACT, d->over));
-        LAUNCH_WITH(K_MAX_OVER, 1, a_ = 0; A_ULONG(K_MAX_OVER, n_cn); A_MEM(K_MAX_OVER, d->over);
-                    A_MEM(K_MAX_OVER, d->reals); A_ULONG(K_MAX_OVER, REAL_PEN));
+        if (m->observe)
+            LAUNCH_WITH(K_MAX_OVER, 1, A_MEM(K_MAX_OVER, d->over); A_MEM(K_MAX_OVER, d->reals);
+                        A_ULONG(K_MAX_OVER, REAL_PEN));
     }
     /* the points' update, MUSL's remap, the stress */
     LAUNCH_WITH(K_POINT_UPDATE, n, A_ULONG(K_POINT_UPDATE, n); A_REAL(K_POINT_UPDATE, dt);
                 A_REAL(K_POINT_UPDATE, m->pic_fraction));
-    LAUNCH_WITH(K_REMAP, nbn, A_ULONG(K_REMAP, nbn));
-    LAUNCH_WITH(K_MESH_KINETIC, 1, A_ULONG(K_MESH_KINETIC, nbn); A_MEM(K_MESH_KINETIC, d->reals);
-                A_ULONG(K_MESH_KINETIC, REAL_KINETIC));
+    LAUNCH_WITH(K_REMAP, rows, );
+    if (m->observe)
+        LAUNCH_WITH(K_MESH_KINETIC, 1, A_MEM(K_MESH_KINETIC, d->reals); A_ULONG(K_MESH_KINETIC, REAL_KINETIC));
     cd_mpm_material mat = m->mat;
-    LAUNCH_WITH(K_STRESS, n, A_ULONG(K_STRESS, n); A_REAL(K_STRESS, dt); A_ANY(K_STRESS, mat);
-                A_MEM(K_STRESS, d->flags));
-    double r[N_REALS];
-    if (read_buf(d, d->reals, 0, sizeof r, r, "reading the step's sums") || flag(d, FLAG_BLEW_UP, &bad)) goto failed;
-    if (m->n_bodies > 1) m->penetration = r[REAL_PEN];
-    m->mesh_kinetic = r[REAL_KINETIC];
-    if (bad >= 0) return cd_mpm_fail_blew_up(m, bad, err, errlen);
+    LAUNCH_WITH(K_STRESS, n, A_ULONG(K_STRESS, n); A_REAL(K_STRESS, dt); A_ANY(K_STRESS, mat));
+    if (cl->status) goto failed;
+    d->j++;
     cd_mpm_step_done(m);
     return 0;
 failed:
@@ -338,14 +416,65 @@ void cd_mpm_cl_sync(cd_mpm *m)
     /* a failure stays recorded: the next step reports it */
 }
 
+int cd_mpm_cl_settle(cd_mpm *m, char *err, size_t errlen)
+{
+    struct cd_mpm_cl *d = m->cl;
+    if (!m->loop_on || d->j == 0) return 0;
+    cd_int flags[2 * N_FAILS];
+    cl_ulong counts[N_COUNTS];
+    double r[N_REALS];
+    if (read_buf(d, d->flags, 0, sizeof flags, flags, "reading the step's checks") ||
+        read_buf(d, d->count, 0, sizeof counts, counts, "reading the step's counts") ||
+        read_buf(d, d->reals, 0, sizeof r, r, "reading the step's sums"))
+        goto failed;
+    int fail = -1; /* the first failure: the earliest step, and in a step the earliest check */
+    cd_int at = NEVER;
+    for (int f = 0; f < N_FAILS; f++)
+        if (flags[N_FAILS + f] < at) at = flags[N_FAILS + f], fail = f;
+    if (fail < 0) {
+        m->n_bnodes = counts[COUNT_BNODES];
+        m->n_cn = m->n_bodies > 1 ? counts[COUNT_LISTED] : 0;
+        if (m->observe) { /* the last step computed them */
+            for (int w = 0; w < m->n_walls; w++) {
+                m->walls[w].fx = r[REAL_WALLS + 2 * w];
+                m->walls[w].fy = r[REAL_WALLS + 2 * w + 1];
+            }
+            if (m->n_bodies > 1) m->penetration = r[REAL_PEN];
+            m->mesh_kinetic = r[REAL_KINETIC];
+        }
+        d->j = 0;
+        cd_mpm_cl_sync(m);
+        if (d->cl.status) goto failed;
+        return 0;
+    }
+    /* back to where the failing step began: as the omp loops stand when they return */
+    const struct step_start *s = &d->since[at];
+    m->step -= d->j - at;
+    m->time = s->time;
+    for (int w = 0; w < m->n_walls; w++) {
+        m->walls[w].px = s->px[w];
+        m->walls[w].py = s->py[w];
+    }
+    if (fail == FAIL_OVERFLOW) { /* room for the count the device found, and the run steps on from there */
+        if (reserve_bnodes(m, counts[COUNT_BNODES]) || reset_flags(d)) goto failed;
+        return 1;
+    }
+    d->j = 0;
+    if (fail == FAIL_LEFT) return cd_mpm_fail_left_mesh(m, (size_t)flags[fail], err, errlen);
+    if (fail == FAIL_CROWDED) return cd_mpm_fail_crowded(m, (size_t)flags[fail], err, errlen);
+    return cd_mpm_fail_blew_up(m, flags[fail], err, errlen);
+failed:
+    cd_cl_report(&d->cl, err, errlen);
+    return -1;
+}
+
 int cd_mpm_cl_pair_keys(cd_mpm *m, size_t *n, char *err, size_t errlen)
 {
     struct cd_mpm_cl *d = m->cl;
-    size_t n_cn = m->n_cn;
     cl_ulong count = 0;
-    LAUNCH_WITH(K_PAIR_KEYS, 1, A_ULONG(K_PAIR_KEYS, n_cn); arg(d, K_PAIR_KEYS, a_++, sizeof(cl_mem), NULL);
-                A_MEM(K_PAIR_KEYS, d->count));
-    if (read_buf(d, d->count, 0, sizeof count, &count, "reading the contact pairs' count")) goto failed;
+    LAUNCH_WITH(K_PAIR_KEYS, 1, arg(d, K_PAIR_KEYS, a_++, sizeof(cl_mem), NULL));
+    if (read_buf(d, d->count, COUNT_KEYS * sizeof(cl_ulong), sizeof count, &count, "reading the contact pairs' count"))
+        goto failed;
     if (cd_mpm_pair_keys_room(m, count, err, errlen)) return -1;
     if (count > d->cap_keys) {
         if (d->keys) clReleaseMemObject(d->keys);
@@ -353,7 +482,7 @@ int cd_mpm_cl_pair_keys(cd_mpm *m, size_t *n, char *err, size_t errlen)
         if (!(d->keys = cd_cl_buffer(&d->cl, d->cap_keys * sizeof(cd_long), "allocating the contact pairs' keys")))
             goto failed;
     }
-    LAUNCH_WITH(K_PAIR_KEYS, 1, A_ULONG(K_PAIR_KEYS, n_cn); A_MEM(K_PAIR_KEYS, d->keys); A_MEM(K_PAIR_KEYS, d->count));
+    LAUNCH_WITH(K_PAIR_KEYS, 1, A_MEM(K_PAIR_KEYS, d->keys));
     if (read_buf(d, d->keys, 0, count * sizeof(cd_long), m->pair_keys, "reading the contact pairs' keys")) goto failed;
     *n = count;
     return 0;
@@ -398,12 +527,13 @@ void cd_mpm_cl_close(cd_mpm *m)
     if (!d) return;
     for (int f = 0; f < N_COLS; f++)
         if (d->col[f]) clReleaseMemObject(d->col[f]);
-    cl_mem scratch[] = {d->flags, d->reals, d->count, d->over, d->keys};
+    cl_mem scratch[] = {d->flags, d->reals, d->count, d->over, d->keys, d->row_n, d->rows, d->blocks};
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++)
         if (scratch[i]) clReleaseMemObject(scratch[i]);
     for (int k = 0; k < K_COUNT; k++)
         if (d->k[k]) clReleaseKernel(d->k[k]);
     cd_cl_close(&d->cl);
+    free(d->since);
     free(d);
     m->cl = NULL;
     m->loop_on = 0;
@@ -427,6 +557,13 @@ int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen)
     return -1;
 }
 void cd_mpm_cl_sync(cd_mpm *m) { (void)m; }
+int cd_mpm_cl_settle(cd_mpm *m, char *err, size_t errlen)
+{
+    (void)m;
+    (void)err;
+    (void)errlen;
+    return 0;
+}
 void cd_mpm_cl_close(cd_mpm *m) { (void)m; }
 const char *cd_mpm_cl_device(const cd_mpm *m)
 {

@@ -184,6 +184,13 @@ void cd_mpm_device_sync(cd_mpm *m)
 #endif
 }
 
+int cd_mpm_settle(cd_mpm *m, char *err, size_t errlen)
+{
+    if (m->cl) return cd_mpm_cl_settle(m, err, errlen);
+    cd_mpm_device_sync(m);
+    return 0;
+}
+
 void cd_mpm_device_stop(cd_mpm *m)
 {
     if (m->cl) { /* the OpenCL buffers stay; the next step uploads the host columns again */

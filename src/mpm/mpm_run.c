@@ -108,18 +108,23 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
     double t0 = now_seconds(), last = t0;
     long long step0 = m.step;
     while (status == 0 && m.step < cfg->steps) {
-        if (cd_mpm_step(&m, err, sizeof err)) {
+        /* what the run reads after this step, decided before it: the OpenCL
+         * backend computes the output-only sums at these steps only */
+        long long next = m.step + 1;
+        int last_step = next == cfg->steps;
+        double t = now_seconds();
+        int show = !opt->quiet && t - last >= (tty ? 0.5 : 10.0);
+        int row = next % cfg->thermo_every == 0 || last_step;
+        int snap = next % cfg->snapshot_every == 0 || last_step;
+        m.observe = row || snap || show;
+        int back = 0; /* the OpenCL backend went back to an earlier step (cd_mpm_settle) */
+        if (cd_mpm_step(&m, err, sizeof err) || (m.observe && (back = cd_mpm_settle(&m, err, sizeof err)) < 0)) {
             fprintf(stderr, "\ncapdem: run stopped: %s\ncapdem: %s keeps the snapshots written before step %lld\n", err,
                     cfg->output, m.step);
             status = 3;
             break;
         }
-        int last_step = m.step == cfg->steps;
-        double t = now_seconds();
-        int show = !opt->quiet && t - last >= (tty ? 0.5 : 10.0);
-        int row = m.step % cfg->thermo_every == 0 || last_step;
-        /* offload builds: the host columns the output and the progress line read, from the device */
-        if (row || m.step % cfg->snapshot_every == 0 || show) cd_mpm_device_sync(&m);
+        if (back) continue;
         /* the contact count Z, read by the series row and the progress line only */
         if ((row || show) && cd_mpm_contact_count(&m, err, sizeof err)) {
             fprintf(stderr, "\ncapdem: %s\n", err);
@@ -129,8 +134,7 @@ int cd_mpm_run(const cd_run_options *opt, cd_config *cfg)
             fprintf(stderr, "\ncapdem: %s\n", err);
             status = 1;
         }
-        if (status == 0 && (m.step % cfg->snapshot_every == 0 || last_step) &&
-            cd_mpm_output_snapshot(out, &m, err, sizeof err)) {
+        if (status == 0 && snap && cd_mpm_output_snapshot(out, &m, err, sizeof err)) {
             fprintf(stderr, "\ncapdem: %s\n", err);
             status = 1;
         }
