@@ -68,11 +68,13 @@ typedef uint64_t cd_ulong;
 #else
 #define CD_ALIGN_VALUE(T)
 #endif
-/* An item that must be inlined on an NVIDIA GPU: Clang 16's inliner left
- * cd_advance_from (two callers) a call, and a call passes its cd_cols by
+/* An item that must be inlined on an NVIDIA GPU: Clang 16's inliner
+ * leaves a large function with two callers in one file a call
+ * (cd_advance_from, cd_nb_collect_rows), and a call passes its cd_cols by
  * value (528 B) and every local whose address it takes through the
  * thread's stack in local memory (docs/performance.md, "The omp offload
- * kernels on sm_90").  Elsewhere (host, OpenCL) a plain inline function. */
+ * kernels on sm_90, read from the compiler").  Elsewhere (host, OpenCL) a
+ * plain inline function. */
 #if defined(__NVPTX__) && !defined(__OPENCL_VERSION__)
 #define CD_INLINE_ALWAYS static inline __attribute__((always_inline))
 #else

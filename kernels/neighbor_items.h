@@ -182,11 +182,11 @@ CD_INLINE void cd_nb_item_cell_fill(cd_particle_id q, const CD_GLOBAL cd_int *pa
  * incomplete and the host runs fill mode).  A row's entries, its order and
  * its count do not depend on which other rows the item makes, nor on the
  * order in which it meets the candidates (their user ids differ). */
-CD_INLINE void cd_nb_collect_rows(cd_cols c, cd_particle_id p, cd_prim_id first, cd_prim_id last,
-                                  const CD_GLOBAL cd_grid *grid, const CD_GLOBAL cd_int *cell_start,
-                                  const CD_GLOBAL cd_int *cell_parts, const CD_GLOBAL cd_real *part_bound, cd_real skin,
-                                  CD_GLOBAL cd_prim_id *out, cd_int slot, const CD_GLOBAL cd_int *offset,
-                                  CD_GLOBAL cd_int *count, cd_order o)
+CD_INLINE_ALWAYS void cd_nb_collect_rows(cd_cols c, cd_particle_id p, cd_prim_id first, cd_prim_id last,
+                                         const CD_GLOBAL cd_grid *grid, const CD_GLOBAL cd_int *cell_start,
+                                         const CD_GLOBAL cd_int *cell_parts, const CD_GLOBAL cd_real *part_bound,
+                                         cd_real skin, CD_GLOBAL cd_prim_id *out, cd_int slot,
+                                         const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count, cd_order o)
 {
     cd_grid g = grid[0];
     cd_int cap = offset ? CD_BP_UNBOUNDED : slot;
