@@ -181,8 +181,13 @@ CD_INLINE void cd_nb_item_cell_fill(cd_particle_id q, const CD_GLOBAL cd_int *pa
  * row's length, which in slot mode may exceed slot (then the row is
  * incomplete and the host runs fill mode).  A row's entries, its order and
  * its count do not depend on which other rows the item makes, nor on the
- * order in which it meets the candidates (their user ids differ). */
-CD_INLINE_ALWAYS void cd_nb_collect_rows(cd_cols c, cd_particle_id p, cd_prim_id first, cd_prim_id last,
+ * order in which it meets the candidates (their user ids differ): host
+ * threads and OpenCL make all of a particle's rows in one item (first =
+ * prim_first[p], last = first + prim_count[p]: one scan of the cells for
+ * the arms of a hexapod), the omp offload build one row per item (first =
+ * i, last = i + 1, p = prim_particle[i]: three times the threads,
+ * src/backend/omp/neighbors.c). */
+CD_INLINE_ALWAYS void cd_nb_item_collect(cd_cols c, cd_particle_id p, cd_prim_id first, cd_prim_id last,
                                          const CD_GLOBAL cd_grid *grid, const CD_GLOBAL cd_int *cell_start,
                                          const CD_GLOBAL cd_int *cell_parts, const CD_GLOBAL cd_real *part_bound,
                                          cd_real skin, CD_GLOBAL cd_prim_id *out, cd_int slot,
@@ -231,31 +236,6 @@ CD_INLINE_ALWAYS void cd_nb_collect_rows(cd_cols c, cd_particle_id p, cd_prim_id
             }
         }
     }
-}
-
-/* Pass 5 per particle p: the rows of all its primitives, one scan of the
- * cells shared by the arms of a hexapod (host threads, OpenCL). */
-CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL cd_grid *grid,
-                                  const CD_GLOBAL cd_int *cell_start, const CD_GLOBAL cd_int *cell_parts,
-                                  const CD_GLOBAL cd_real *part_bound, cd_real skin, CD_GLOBAL cd_prim_id *out,
-                                  cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count, cd_order o)
-{
-    cd_prim_id first = c.prim_first[p];
-    cd_nb_collect_rows(c, p, first, first + c.prim_count[p], grid, cell_start, cell_parts, part_bound, skin, out, slot,
-                       offset, count, o);
-}
-
-/* Pass 5 per primitive i: its row alone (the omp offload build: three
- * times the threads of the per-particle item for hexapods, each with one
- * row's candidates, at the price of scanning the cells once per
- * primitive; the same rows). */
-CD_INLINE void cd_nb_item_collect_prim(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_grid *grid,
-                                       const CD_GLOBAL cd_int *cell_start, const CD_GLOBAL cd_int *cell_parts,
-                                       const CD_GLOBAL cd_real *part_bound, cd_real skin, CD_GLOBAL cd_prim_id *out,
-                                       cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count, cd_order o)
-{
-    cd_nb_collect_rows(c, c.prim_particle[i], i, i + 1, grid, cell_start, cell_parts, part_bound, skin, out, slot,
-                       offset, count, o);
 }
 
 /* Key of pair row k, ascending along the rows: the memory slot of prim_i,

@@ -152,9 +152,10 @@ def count_ops(body):
     return c
 
 
-def ptxas_info(ptxas, s_file, log):
-    """{entry: (regs, stack, spill_st, spill_ld)} from ptxas -v."""
-    r = sh([ptxas, "-arch=sm_90", "-O3", "-v", s_file, "-o", os.devnull])
+def ptxas_info(ptxas, s_file, log, relocatable=False):
+    """{entry: (regs, stack, spill_st, spill_ld)} from ptxas -v (-c: code
+    that calls functions defined elsewhere, e.g. libdevice's sin)."""
+    r = sh([ptxas, "-arch=sm_90", "-O3", "-v"] + (["-c"] if relocatable else []) + [s_file, "-o", os.devnull])
     open(log, "w").write(r.stderr)
     if r.returncode:
         sys.exit(f"read_kernels.py: ptxas failed on {s_file}:\n{r.stderr[-2000:]}")
@@ -215,8 +216,11 @@ def main():
     clang = shutil.which("clang-16") or "clang-16"
     build = os.path.abspath(args.build)
     flags = flags_of(build)
-    out = os.path.abspath(args.out) if args.out else tempfile.mkdtemp(prefix="read_kernels.")
-    os.makedirs(out, exist_ok=True)
+    if args.dry_run:
+        out = os.path.abspath(args.out or "OUT")
+    else:
+        out = os.path.abspath(args.out) if args.out else tempfile.mkdtemp(prefix="read_kernels.")
+        os.makedirs(out, exist_ok=True)
     only = re.compile(args.only) if args.only else None
     rems = Counter()
     print(HEADER)
@@ -254,23 +258,7 @@ def main():
             if r.returncode:
                 sys.exit(f"read_kernels.py: compiling {src} as OpenCL C failed:\n{r.stderr[-3000:]}")
             ptx = open(s_file).read()
-            # libdevice's sin/cos stay external: declare them for ptxas
-            info = ptxas_info(ptxas, s_file, os.path.join(out, base + ".ptxas.log")) if ".extern" not in ptx else {}
-            if not info:
-                r = sh([ptxas, "-arch=sm_90", "-O3", "-v", "-c", s_file, "-o", os.devnull])
-                open(os.path.join(out, base + ".ptxas.log"), "w").write(r.stderr)
-                info, cur = {}, None
-                for line in r.stderr.splitlines():
-                    m = re.search(r"Function properties for ([\w$.]+)", line)
-                    if m:
-                        cur = m.group(1)
-                        info.setdefault(cur, [0, 0, 0, 0])
-                    m = re.search(r"(\d+) bytes stack frame, (\d+) bytes spill stores, (\d+) bytes spill loads", line)
-                    if m and cur:
-                        info[cur][1:4] = [int(x) for x in m.groups()]
-                    m = re.search(r"Used (\d+) registers", line)
-                    if m and cur:
-                        info[cur][0] = int(m.group(1))
+            info = ptxas_info(ptxas, s_file, os.path.join(out, base + ".ptxas.log"), ".extern" in ptx)
             for name, body in entries(ptx).items():
                 if only and not only.search(name):
                     continue
@@ -284,7 +272,7 @@ def main():
             print(f"  {code} ({len(places)}): " + ", ".join(places))
     if args.out:
         print(f"\n(PTX, remarks and ptxas logs in {out})")
-    else:
+    elif not args.dry_run:
         shutil.rmtree(out, ignore_errors=True)
 
 

@@ -235,16 +235,17 @@ static cd_int collect(cd_sim *sim, cd_int slot)
         CD_STEP_FOR(P, CD_BUILD_IN reduction(max : longest) CD_DEV(map(tofrom : longest)))
         for (cd_int i = 0; i < P; i++) {
             /* slot mode: the slots, no offsets; fill mode: the rows in place */
-            cd_nb_item_collect_prim(CD_B.c, i, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound,
-                                    skin, slot > 0 ? CD_B.d.cand : CD_B.c.pair_prim_j, slot,
-                                    slot > 0 ? NULL : CD_B.d.pair_offset, CD_B.d.pair_count, CD_B.order);
+            cd_nb_item_collect(CD_B.c, CD_B.c.prim_particle[i], i, i + 1, CD_B.d.grid, CD_B.d.cell_start,
+                               CD_B.d.cell_parts, CD_B.d.part_bound, skin, slot > 0 ? CD_B.d.cand : CD_B.c.pair_prim_j,
+                               slot, slot > 0 ? NULL : CD_B.d.pair_offset, CD_B.d.pair_count, CD_B.order);
             if (CD_B.d.pair_count[i] > longest) longest = CD_B.d.pair_count[i];
         }
         return longest;
     }
     CD_STEP_FOR(N, CD_BUILD_IN reduction(max : longest) CD_DEV(map(tofrom : longest)))
     for (cd_int p = 0; p < N; p++) {
-        cd_nb_item_collect(CD_B.c, p, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
+        cd_nb_item_collect(CD_B.c, p, CD_B.c.prim_first[p], CD_B.c.prim_first[p] + CD_B.c.prim_count[p], CD_B.d.grid,
+                           CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
                            slot > 0 ? CD_B.d.cand : CD_B.c.pair_prim_j, slot, slot > 0 ? NULL : CD_B.d.pair_offset,
                            CD_B.d.pair_count, CD_B.order);
         for (cd_int i = CD_B.c.prim_first[p]; i < CD_B.c.prim_first[p] + CD_B.c.prim_count[p]; i++)
