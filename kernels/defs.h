@@ -70,7 +70,7 @@ typedef uint64_t cd_ulong;
 #endif
 /* An item that must be inlined on an NVIDIA GPU: Clang 16's inliner
  * leaves a large function with two callers in one file a call
- * (cd_advance_from, cd_nb_collect_rows), and a call passes its cd_cols by
+ * (cd_advance_from, cd_nb_item_collect), and a call passes its cd_cols by
  * value (528 B) and every local whose address it takes through the
  * thread's stack in local memory (docs/performance.md, "The omp offload
  * kernels on sm_90, read from the compiler").  Elsewhere (host, OpenCL) a
