@@ -133,7 +133,9 @@ def side_by_side(runs):
 
 def self_test():
     """A synthetic CSV in ncu's layout: the parser, units and both tables."""
-    head = '"ID","Process ID","Process Name","Host Name","Kernel Name","Context","Stream","Block Size","Grid Size","Device","CC","Section Name","Metric Name","Metric Unit","Metric Value"'
+    head = ('"ID","Process ID","Process Name","Host Name","Kernel Name","Context","Stream","Block Size","Grid Size",'
+            '"Device","CC","Section Name","Metric Name","Metric Unit","Metric Value"')
+
     def row(i, k, metric, unit, v):
         return f'"{i}","1","capdem-bench","h","{k}","1","7","(128, 1, 1)","(782, 1, 1)","0","9.0","Command line profiler metrics","{metric}","{unit}","{v}"'
     omp = [head, "==PROF== Connected to process", row(0, "__omp_offloading_fe00_538372_collect_l222", "gpu__time_duration.sum", "msecond", "1.5"),

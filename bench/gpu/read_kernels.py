@@ -114,7 +114,7 @@ def entries(ptx):
 def count_ops(body):
     c = Counter()
     for m in re.finditer(r"^\s+(?:@%p\d+\s+)?((?:ld|st|call|atom)[\w.]*)\s+(.*)$", body, re.M):
-        op, rest = m.group(1), m.group(2)
+        op = m.group(1)
         parts = op.split(".")
         if parts[0] == "call":
             callee = re.search(r"\b(malloc|__kmpc_alloc_shared|free)\b", body[m.end():m.end() + 200])
