@@ -233,8 +233,8 @@ pack payload-bin.tar.xz bin inputs
 cp -r "$ROOT/configs" "$ROOT/kernels" "$OUT/src/"
 mkdir -p "$OUT/src/host" && cp "$ROOT/host/capdem_h5.py" "$OUT/src/host/"
 mkdir -p "$OUT/src/docs" && cp "$ROOT/docs/output.md" "$OUT/src/docs/" # test_runfile_layout checks its table too
-cp "$ROOT/bench/gpu/run_on_gpu.sh" "$OUT/"
-chmod +x "$OUT/run_on_gpu.sh"
+cp "$ROOT/bench/gpu/run_on_gpu.sh" "$ROOT/bench/gpu/kernel_profile.sh" "$ROOT/bench/gpu/ncu_table.py" "$OUT/"
+chmod +x "$OUT/run_on_gpu.sh" "$OUT/kernel_profile.sh"
 {
     echo "capdem GPU bundle"
     echo "commit: $(git -C "$ROOT" rev-parse HEAD)$(git -C "$ROOT" diff --quiet HEAD -- src kernels host CMakeLists.txt 'bench/*.[ch]' 'tests/*.[ch]' || echo ' (with uncommitted changes to the code)')"

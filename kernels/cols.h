@@ -11,17 +11,28 @@
 #include "geom_types.h"
 #include "field_groups.h"
 
+/* A column of ctype is a cd_col_<ctype>: a pointer known to be aligned as
+ * its element (defs.h, CD_ALIGN_VALUE; the element types of fields.def and
+ * cd_arm). */
+typedef CD_GLOBAL cd_int *cd_col_cd_int CD_ALIGN_VALUE(cd_int);
+typedef CD_GLOBAL cd_real *cd_col_cd_real CD_ALIGN_VALUE(cd_real);
+typedef CD_GLOBAL cd_vec3 *cd_col_cd_vec3 CD_ALIGN_VALUE(cd_vec3);
+typedef CD_GLOBAL cd_quat *cd_col_cd_quat CD_ALIGN_VALUE(cd_quat);
+typedef CD_GLOBAL cd_arm *cd_col_cd_arm CD_ALIGN_VALUE(cd_arm);
+/* the wall candidates' entries, read by the gather (step_items.h) */
+typedef const CD_GLOBAL cd_wall_entry *cd_wall_entries CD_ALIGN_VALUE(cd_wall_entry);
+
 /* The device columns only (field_groups.h), then the primitives' arms
  * (geom_types.h, cd_arm): prim_arm[i] is primitive i's row of arm, or
  * negative for a ball at its particle's centre (a sphere; the value keeps
  * the signs of its zero body ends for the host, src/core/state.c), whose two axis ends are
  * both prim_a[i] (and both prim_a_ref[i] at the last build). */
 typedef struct {
-#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(CD_GLOBAL ctype *name;)
+#define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning) CD_ON_DEVICE_##group(cd_col_##ctype name;)
 #include "fields.def"
 #undef CD_FIELD
-    CD_GLOBAL cd_int *prim_arm;
-    CD_GLOBAL cd_arm *arm;
+    cd_col_cd_int prim_arm;
+    cd_col_cd_arm arm;
 } cd_cols;
 
 CD_DEVICE_BEGIN

@@ -51,6 +51,35 @@ typedef uint64_t cd_ulong;
 #else
 #define CD_NOESCAPE
 #endif
+/* A pointer type declared `typedef T *name CD_ALIGN_VALUE(T)` tells Clang
+ * what C already guarantees, that it points at a T aligned as T.  Without
+ * it a T passed by value from memory reached through a loaded pointer (a
+ * column element: cd_v3_sub(c.position[q], x)) is copied, when the callee
+ * is inlined, by a memcpy of unknown source alignment (LLVM's inliner
+ * writes align 1 for a byval argument and leaves the rest to alignment
+ * inference, which knows nothing of a pointer loaded from memory).  x86-64
+ * loads unaligned words, but NVPTX splits such a copy into byte loads: the
+ * omp offload step's pair kernel read a hexapod's vectors as 1,016 byte
+ * loads (docs/performance.md, "The omp offload kernels on sm_90, read from
+ * the compiler").  Clang only; OpenCL C copies byval arguments from
+ * __global memory with the type's alignment, and GCC has no such attribute. */
+#if defined(__clang__) && !defined(__OPENCL_VERSION__)
+#define CD_ALIGN_VALUE(T) __attribute__((align_value(_Alignof(T))))
+#else
+#define CD_ALIGN_VALUE(T)
+#endif
+/* An item that must be inlined on an NVIDIA GPU: Clang 16's inliner
+ * leaves a large function with two callers in one file a call
+ * (cd_advance_from, cd_nb_item_collect), and a call passes its cd_cols by
+ * value (528 B) and every local whose address it takes through the
+ * thread's stack in local memory (docs/performance.md, "The omp offload
+ * kernels on sm_90, read from the compiler").  Elsewhere (host, OpenCL) a
+ * plain inline function. */
+#if defined(__NVPTX__) && !defined(__OPENCL_VERSION__)
+#define CD_INLINE_ALWAYS static inline __attribute__((always_inline))
+#else
+#define CD_INLINE_ALWAYS static inline
+#endif
 #define CD_R(x) ((cd_real)(x))
 #define CD_PI   CD_R(3.14159265358979323846)
 

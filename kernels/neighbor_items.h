@@ -7,7 +7,8 @@
  *   2. grid      one item: merges the chunks' boxes, makes the grid
  *   3. bin       per particle: its cell, counted (integer atomic)
  *   4. scan      cell counts -> cell_start; cell_parts filled (atomic)
- *   5. collect   per particle: the candidates of its primitives, each row
+ *   5. collect   per particle (host threads, OpenCL) or per primitive (omp
+ *                offload): the candidates of its primitives, each row
  *                sorted by j, into fixed slots (a second pass writes the
  *                rows in place when some primitive overflowed its slot)
  *   6. scan      row counts -> pair offsets; the number of rows goes back
@@ -176,24 +177,31 @@ CD_INLINE void cd_nb_item_cell_fill(cd_particle_id q, const CD_GLOBAL cd_int *pa
     cell_parts[cd_atomic_inc(&cursor[part_cell[q]])] = q;
 }
 
-/* Pass 5: the candidates (i, j) with i a primitive of particle p and j a
- * primitive of a particle q of a higher user id (o.part_uid: the row's
- * orientation, and so the narrow phase's arithmetic, does not depend on
- * the memory order): the particles in the 27 cells around p's
- * centre whose bounding spheres (part_bound [m]) come within the skin [m]
- * of p's, then each pair passing cd_bp_is_candidate.  The scan runs over
- * particles, so the arms of a hexapod share it.  Row i goes to
- * out + i slot (slot mode, offset = 0: at most slot entries written) or to
- * out + offset[i] (fill mode: the row's exact place); either way sorted by
- * the user id of j (insertion), and count[i] = the row's length, which in slot mode may
- * exceed slot (then the row is incomplete and the host runs fill mode). */
-CD_INLINE void cd_nb_item_collect(cd_cols c, cd_particle_id p, const CD_GLOBAL cd_grid *grid,
-                                  const CD_GLOBAL cd_int *cell_start, const CD_GLOBAL cd_int *cell_parts,
-                                  const CD_GLOBAL cd_real *part_bound, cd_real skin, CD_GLOBAL cd_prim_id *out,
-                                  cd_int slot, const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count, cd_order o)
+/* Pass 5: the candidates (i, j) with i one of the primitives first ..
+ * last - 1 of particle p and j a primitive of a particle q of a higher
+ * user id (o.part_uid: the row's orientation, and so the narrow phase's
+ * arithmetic, does not depend on the memory order): the particles in the
+ * 27 cells around p's centre whose bounding spheres (part_bound [m]) come
+ * within the skin [m] of p's, then each pair passing cd_bp_is_candidate.
+ * Row i goes to out + i slot (slot mode, offset = 0: at most slot entries
+ * written) or to out + offset[i] (fill mode: the row's exact place);
+ * either way sorted by the user id of j (insertion), and count[i] = the
+ * row's length, which in slot mode may exceed slot (then the row is
+ * incomplete and the host runs fill mode).  A row's entries, its order and
+ * its count do not depend on which other rows the item makes, nor on the
+ * order in which it meets the candidates (their user ids differ): host
+ * threads and OpenCL make all of a particle's rows in one item (first =
+ * prim_first[p], last = first + prim_count[p]: one scan of the cells for
+ * the arms of a hexapod), the omp offload build one row per item (first =
+ * i, last = i + 1, p = prim_particle[i]: three times the threads,
+ * src/backend/omp/neighbors.c). */
+CD_INLINE_ALWAYS void cd_nb_item_collect(cd_cols c, cd_particle_id p, cd_prim_id first, cd_prim_id last,
+                                         const CD_GLOBAL cd_grid *grid, const CD_GLOBAL cd_int *cell_start,
+                                         const CD_GLOBAL cd_int *cell_parts, const CD_GLOBAL cd_real *part_bound,
+                                         cd_real skin, CD_GLOBAL cd_prim_id *out, cd_int slot,
+                                         const CD_GLOBAL cd_int *offset, CD_GLOBAL cd_int *count, cd_order o)
 {
     cd_grid g = grid[0];
-    cd_int first = c.prim_first[p], last = first + c.prim_count[p];
     cd_int cap = offset ? CD_BP_UNBOUNDED : slot;
     for (cd_int i = first; i < last; i++) count[i] = 0;
     cd_vec3 x = c.position[p];

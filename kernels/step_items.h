@@ -239,8 +239,8 @@ CD_INLINE int cd_pose_moved(cd_cols c, cd_particle_id q, cd_vec3 x, cd_quat o, c
  * once, in locals between, which the compiler cannot do across the
  * columns' stores (any column may alias any other for it).  The kick's own
  * angular velocity is not formed: the drift's replaces it. */
-CD_INLINE int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_vec3 L, cd_vec3 F, cd_vec3 T, cd_real m,
-                              cd_real dt, cd_real limit2, const CD_GLOBAL cd_real *ref_pose)
+CD_INLINE_ALWAYS int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_vec3 L, cd_vec3 F, cd_vec3 T, cd_real m,
+                                     cd_real dt, cd_real limit2, const CD_GLOBAL cd_real *ref_pose)
 {
     cd_vec3 x = c.position[q], w;
     cd_quat o = c.orientation[q];
@@ -515,7 +515,7 @@ CD_INLINE void cd_item_wall_carry(cd_long e, const CD_GLOBAL cd_int *rows, CD_GL
  * row's force and point.  dimension 2 keeps the motion in the x-y plane. */
 CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, const CD_GLOBAL cd_int *gather_start,
                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                             const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension, cd_vec3 *F_out,
+                             cd_wall_entries wall_out, cd_vec3 gravity, cd_int dimension, cd_vec3 *F_out,
                              cd_vec3 *T_out)
 {
     cd_vec3 F = cd_v3_scale(gravity, m);

@@ -16,7 +16,8 @@
 #    libcuda.so.1 (the driver) is the one allowed miss.
 # 3. run_on_gpu.sh PART... with CAPDEM_BUNDLE_HOST=1 (OMP_TARGET_OFFLOAD=
 #    DISABLED: the offload builds run on the host here); default parts:
-#    info tests tests-gcc opencl (PoCL) and a one-entry ladder.  Its status is this
+#    info tests tests-gcc opencl (PoCL), a one-entry ladder and the dry run of
+#    part kernels (bench/gpu/kernel_profile.sh --dry-run).  Its status is this
 #    script's.
 set -euo pipefail
 [ $# -ge 1 ] || { echo "usage: check_bundle.sh BUNDLE [PART...]" >&2; exit 2; }
@@ -88,7 +89,7 @@ for v in $(cd "$BIN" && ls); do
 done
 
 echo "== 3. run_on_gpu.sh on the host (CAPDEM_BUNDLE_HOST=1)"
-[ $# -gt 0 ] || set -- info tests tests-gcc opencl ladder
+[ $# -gt 0 ] || set -- info tests tests-gcc opencl ladder kernels
 OUTDIR=${CHECK_OUT:-$UNPACK/out}
 rc=0
 mapfile -t pass < <(env | grep '^CAPDEM_BUNDLE_' || true) # the caller's settings of run_on_gpu.sh go through

@@ -26,6 +26,10 @@
 #   profile     time per launch kind on 1e6 hexapods: libomptarget's own
 #               profile (LIBOMPTARGET_PROFILE) summarised per kernel line,
 #               then nsys if on PATH, else ncu (kernel time, DRAM bytes)
+#   kernels     bench/gpu/kernel_profile.sh: ncu per kernel on the omp
+#               offload build (pass 5 per primitive and per particle) and
+#               on OpenCL at 1e5 hexapods, side by side (time, registers,
+#               occupancy, local memory), about 110 s; not in `all`
 #   tests-gcc   the tests on the GCC 12 nvptx build
 #   ladder-gcc  the ladder on the GCC build
 # Also: tests-clang, all, quick (info tests-clang ladder).
@@ -416,6 +420,24 @@ EOF
     fi
 }
 
+# Per-kernel registers, occupancy and local memory of the omp offload
+# build against OpenCL's (docs/performance.md, "The omp offload kernels on
+# sm_90, read from the compiler"), into profile.txt; without a GPU
+# (CAPDEM_BUNDLE_HOST=1) its dry run: arguments, tools, the table's parser.
+part_kernels() {
+    has clang || { note "SKIP kernels: no clang build"; return 0; }
+    local hex tile dry=()
+    hex=$(cd "$INPUTS" && ls hexapods_a3_n*.h5 | head -1)
+    case $hex in *_n1000.h5) tile=10,10 ;; *) tile=1,10 ;; esac # 1e5 particles
+    [ "$HOST" = 1 ] && dry=(--dry-run)
+    [ -n "$ICD" ] || note "NOTE kernels: no OpenCL ICD: its opencl run will fail"
+    step kernels "${CAPDEM_BUNDLE_KERNELS_CAP:-125}" env CAPDEM_KERNELS_TILE="${CAPDEM_KERNELS_TILE:-$tile}" \
+        bash "$B/kernel_profile.sh" "${dry[@]}" "$BIN/clang/capdem-bench" "$INPUTS/$hex" "$W/kernels"
+    { echo "== kernels (bench/gpu/kernel_profile.sh, clang build and OpenCL, hexapods tiled ${CAPDEM_KERNELS_TILE:-$tile})"
+        grep -v '^"' "$LOGS/kernels.log" | grep -v '^==PROF==' | head -300; } >>"$PROFILE"
+    mkdir -p "$LOGS/kernels" && cp "$W"/kernels/* "$LOGS/kernels/" 2>/dev/null
+}
+
 # compute-sanitizer's memcheck on a few steps of the Clang build (the first
 # GPU run met an illegal address at 1e6 hexapods, reorder.c, the cell keys):
 # the faulting kernel, source line and address.
@@ -442,8 +464,8 @@ for p in "$@"; do
     quick) PARTS+=(info tests-clang ladder) ;;
     tests) PARTS+=(tests-clang) ;;
     ladder) PARTS+=(ladder-clang) ;;
-    info | tests-clang | tests-gcc | opencl | ladder-clang | ladder-gcc | profile | sanitize) PARTS+=("$p") ;;
-    *) echo "run_on_gpu.sh: unknown part '$p' (info tests tests-gcc opencl ladder ladder-gcc profile sanitize all quick)" >&2; exit 2 ;;
+    info | tests-clang | tests-gcc | opencl | ladder-clang | ladder-gcc | profile | kernels | sanitize) PARTS+=("$p") ;;
+    *) echo "run_on_gpu.sh: unknown part '$p' (info tests tests-gcc opencl ladder ladder-gcc profile kernels sanitize all quick)" >&2; exit 2 ;;
     esac
 done
 note "capdem GPU bundle: parts ${PARTS[*]}; OMP_TARGET_OFFLOAD=$OMP_TARGET_OFFLOAD; budget ${BUDGET}s; $(nvidia-smi -L 2>/dev/null | head -1 || true)"
@@ -456,6 +478,7 @@ for p in "${PARTS[@]}"; do
     ladder-clang) part_ladder clang ;;
     ladder-gcc) part_ladder gcc ;;
     profile) part_profile ;;
+    kernels) part_kernels ;;
     sanitize) part_sanitize ;;
     esac
 done

@@ -86,8 +86,8 @@ __kernel void cd_cl_pair_collect(
 #include "col_bind.h"
     cd_int p = (cd_int)get_global_id(0);
     if (p >= n_particles) return;
-    cd_nb_item_collect(c, p, grid, cell_start, cell_parts, part_bound, skin, cand, slot, (__global const cd_int *)0,
-                       pair_count, cd_order_identity());
+    cd_nb_item_collect(c, p, c.prim_first[p], c.prim_first[p] + c.prim_count[p], grid, cell_start, cell_parts,
+                       part_bound, skin, cand, slot, (__global const cd_int *)0, pair_count, cd_order_identity());
     for (cd_int i = c.prim_first[p]; i < c.prim_first[p] + c.prim_count[p]; i++)
         if (pair_count[i] > slot) flags[2] = 1;
 }
@@ -104,8 +104,8 @@ __kernel void cd_cl_pair_fill(
 #include "col_bind.h"
     cd_int p = (cd_int)get_global_id(0);
     if (p < n_particles)
-        cd_nb_item_collect(c, p, grid, cell_start, cell_parts, part_bound, skin, c.pair_prim_j, 0, pair_offset,
-                           pair_count, cd_order_identity());
+        cd_nb_item_collect(c, p, c.prim_first[p], c.prim_first[p] + c.prim_count[p], grid, cell_start, cell_parts,
+                           part_bound, skin, c.pair_prim_j, 0, pair_offset, pair_count, cd_order_identity());
 }
 
 /* Pass 7: primitive i's rows from its slot (slot 0: from pair_prim_j) and

@@ -4,7 +4,8 @@
 # in for the "clang" offload build), its shared libraries and two tiny
 # settled packings, packed as gpu_bundle.sh packs them (payload-*.tar.xz);
 # then bench/gpu/check_bundle.sh on it: ldd and LD_DEBUG find nothing
-# outside the bundle but glibc, and run_on_gpu.sh (info, tests, ladder;
+# outside the bundle but glibc, and run_on_gpu.sh (info, tests, ladder,
+# the dry run of kernels;
 # CAPDEM_BUNDLE_HOST=1) unpacks the payload, passes, and leaves at most 8
 # files in OUT with valid JSON lines.
 # About 20 s on 2 cores.
@@ -38,16 +39,18 @@ mkdir -p "$B/src/host" && cp "$src/host/capdem_h5.py" "$B/src/host/"
 "$bench" --case spheres --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/spheres_n40.h5" >/dev/null 2>&1
 tar -C "$S" -cf - lib lib.cxx | xz -0 -T2 >"$B/payload-lib.tar.xz"
 tar -C "$S" -cf - bin inputs | xz -0 -T2 >"$B/payload-bin.tar.xz"
-cp "$src/bench/gpu/run_on_gpu.sh" "$B/"
+cp "$src/bench/gpu/run_on_gpu.sh" "$src/bench/gpu/kernel_profile.sh" "$src/bench/gpu/ncu_table.py" "$B/"
 echo "capdem GPU bundle (test fixture: host build as 'clang')" >"$B/MANIFEST.txt"
 
 out=$dir/out
 CHECK_OUT=$out CAPDEM_BUNDLE_LADDER="h1e4 s1e6" CAPDEM_BUNDLE_STEPS=4 CAPDEM_BUNDLE_BUDGET_S=240 \
-    CAPDEM_BUNDLE_TILES="1,1 2,1 2,2" bash "$src/bench/gpu/check_bundle.sh" "$B" info tests ladder
+    CAPDEM_BUNDLE_TILES="1,1 2,1 2,2" bash "$src/bench/gpu/check_bundle.sh" "$B" info tests ladder kernels
 n=$(ls "$out" | wc -l)
 [ "$n" -le 8 ] || { echo "run_on_gpu.sh left $n files in OUT: the device tool returns at most 8"; exit 1; }
 for f in summary.txt info.txt ladder.jsonl logs.tar.gz; do [ -s "$out/$f" ] || { echo "missing $f in OUT"; exit 1; }; done
 grep -q '^PASS tests-clang/test_walls' "$out/summary.txt" || { echo "test_walls did not pass"; cat "$out/summary.txt"; exit 1; }
+# part kernels without a GPU: its dry run (arguments, the ncu table's self-test)
+grep -q '^PASS kernels' "$out/summary.txt" || { echo "part kernels (dry run) did not pass"; cat "$out/summary.txt"; exit 1; }
 grep -q 'libyaml-0.so.2 => /tmp/capdem-bundle-check[^ ]*/u/lib/' "$out/info.txt" || { echo "libyaml was not loaded from the unpacked payload"; exit 1; }
 /usr/bin/python3 - "$out/ladder.jsonl" <<'PY'
 import json, sys

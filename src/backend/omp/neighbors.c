@@ -204,23 +204,49 @@ static void bin_particles(cd_sim *sim)
     for (cd_int q = 0; q < N; q++) cd_nb_item_cell_fill(q, CD_B.d.part_cell, CD_B.d.cell_count, CD_B.d.cell_parts);
 }
 
+/* Pass 5's loop on an offload device: one item per primitive, unless
+ * CAPDEM_COLLECT_PER_PARTICLE=1 asks for the per-particle item of host
+ * threads (both make the same rows; the switch lets a GPU run time the
+ * two shapes against each other: bench/gpu/kernel_profile.sh). */
+static int collect_per_primitive(void)
+{
+    static int per_prim = -1;
+    if (per_prim < 0) {
+        const char *v = getenv("CAPDEM_COLLECT_PER_PARTICLE");
+        per_prim = CD_OFFLOAD && !(v && strcmp(v, "1") == 0);
+    }
+    return per_prim;
+}
+
 /* Pass 5 in slot mode (slot > 0; returns the longest row, which may exceed
  * the slot) or in fill mode (slot = 0: rows written in place into
- * pair_prim_j at pair_offset). */
+ * pair_prim_j at pair_offset).  Host threads: one item per particle (its
+ * arms share one scan of the cells); offload: one item per primitive,
+ * whose row alone the thread makes (docs/performance.md, "The omp offload
+ * kernels on sm_90, read from the compiler"): the same rows. */
 static cd_int collect(cd_sim *sim, cd_int slot)
 {
-    cd_int N = (cd_int)sim->s.n_particles, longest = 0;
+    cd_int N = (cd_int)sim->s.n_particles, P = (cd_int)sim->s.n_prims, longest = 0;
     cd_real skin = sim->nb.skin; /* [m] */
     CD_WIDE_MIN
     CD_BUILD_ARGS(sim)
+    if (collect_per_primitive()) {
+        CD_STEP_FOR(P, CD_BUILD_IN reduction(max : longest) CD_DEV(map(tofrom : longest)))
+        for (cd_int i = 0; i < P; i++) {
+            /* slot mode: the slots, no offsets; fill mode: the rows in place */
+            cd_nb_item_collect(CD_B.c, CD_B.c.prim_particle[i], i, i + 1, CD_B.d.grid, CD_B.d.cell_start,
+                               CD_B.d.cell_parts, CD_B.d.part_bound, skin, slot > 0 ? CD_B.d.cand : CD_B.c.pair_prim_j,
+                               slot, slot > 0 ? NULL : CD_B.d.pair_offset, CD_B.d.pair_count, CD_B.order);
+            if (CD_B.d.pair_count[i] > longest) longest = CD_B.d.pair_count[i];
+        }
+        return longest;
+    }
     CD_STEP_FOR(N, CD_BUILD_IN reduction(max : longest) CD_DEV(map(tofrom : longest)))
     for (cd_int p = 0; p < N; p++) {
-        if (slot > 0)
-            cd_nb_item_collect(CD_B.c, p, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
-                               CD_B.d.cand, slot, 0, CD_B.d.pair_count, CD_B.order);
-        else
-            cd_nb_item_collect(CD_B.c, p, CD_B.d.grid, CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
-                               CD_B.c.pair_prim_j, 0, CD_B.d.pair_offset, CD_B.d.pair_count, CD_B.order);
+        cd_nb_item_collect(CD_B.c, p, CD_B.c.prim_first[p], CD_B.c.prim_first[p] + CD_B.c.prim_count[p], CD_B.d.grid,
+                           CD_B.d.cell_start, CD_B.d.cell_parts, CD_B.d.part_bound, skin,
+                           slot > 0 ? CD_B.d.cand : CD_B.c.pair_prim_j, slot, slot > 0 ? NULL : CD_B.d.pair_offset,
+                           CD_B.d.pair_count, CD_B.order);
         for (cd_int i = CD_B.c.prim_first[p]; i < CD_B.c.prim_first[p] + CD_B.c.prim_count[p]; i++)
             if (CD_B.d.pair_count[i] > longest) longest = CD_B.d.pair_count[i];
     }

@@ -77,7 +77,11 @@ void cd_step_args_fill(cd_sim *sim, cd_step_args *a);
  * reloaded the column addresses (the build took 5 % more instructions,
  * callgrind). */
 #if CD_OFFLOAD
-#define CD_ARGS(sim)       const cd_step_args *a = cd_off_args_or_die(sim);
+/* The block's address, known aligned as the block (kernels/defs.h,
+ * CD_ALIGN_VALUE: a cd_cols copied out of it would otherwise be read a
+ * byte at a time on NVPTX). */
+typedef const cd_step_args *cd_step_args_ptr CD_ALIGN_VALUE(cd_step_args);
+#define CD_ARGS(sim)       cd_step_args_ptr a = cd_off_args_or_die(sim);
 #define CD_ARGS_IN         is_device_ptr(a)
 #define CD_BUILD_ARGS(sim) CD_ARGS(sim)
 #define CD_BUILD_IN        CD_ARGS_IN
