@@ -44,7 +44,7 @@ static void give_back_memory(void)
 #endif
 }
 
-static int world(int *rank)
+int cd_mpi_world(int *rank)
 {
     int on = 0, size = 1;
     *rank = 0;
@@ -77,7 +77,7 @@ int cd_mpi_begin(void)
         if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return -1;
         began_here = 1;
     }
-    if (world(&rank) > 1 && rank > 0) { /* rank 0 speaks for all (mpi_decomp.h) */
+    if (cd_mpi_world(&rank) > 1 && rank > 0) { /* rank 0 speaks for all (mpi_decomp.h) */
         fflush(stderr);
         if (!freopen("/dev/null", "w", stderr)) return -1;
     }
@@ -87,7 +87,7 @@ int cd_mpi_begin(void)
 int cd_mpi_agree(int status)
 {
     int rank, all = status;
-    if (world(&rank) > 1) MPI_Allreduce(&status, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (cd_mpi_world(&rank) > 1) MPI_Allreduce(&status, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     return all;
 }
 
@@ -107,7 +107,7 @@ int cd_mpi_end(int status)
 int cd_mpi_is_writer(void)
 {
     int rank;
-    world(&rank);
+    cd_mpi_world(&rank);
     return rank == 0;
 }
 
@@ -137,7 +137,7 @@ int cd_mpi_opens_output(void) { return parallel_output || cd_mpi_is_writer(); }
 int cd_mpi_decomposed(void)
 {
     int rank;
-    return world(&rank) > 1;
+    return cd_mpi_world(&rank) > 1;
 }
 
 /* The scalars of the local state (step, time, walls, protocol slots) on
@@ -520,7 +520,7 @@ static void devices_taken(cd_mpi_ctx *x)
 
 int cd_mpi_version(void)
 {
-    int rank, size = world(&rank);
+    int rank, size = cd_mpi_world(&rank);
     int on = 0;
     MPI_Initialized(&on);
     if (!on) return 0; /* not under an MPI launcher */

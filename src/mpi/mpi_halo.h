@@ -122,6 +122,9 @@ int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen);
  * counts and scalars kept), so that a rank never holds both.  0, or -1
  * (out of memory). */
 int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, const long long *gid, const long long *gprim, int release);
+/* The rank count of MPI_COMM_WORLD and this process's rank in *rank (1
+ * and 0 when MPI is not started). */
+int cd_mpi_world(int *rank);
 /* The interaction range [m] of particles whose largest bounding radius
  * about the centre is bound_max [m], with the skin [m]: twice the bound
  * plus the skin, widened by roundings (src/mpi/mpi_setup.c). */

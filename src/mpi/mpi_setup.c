@@ -54,19 +54,6 @@ static double largest_bound(const cd_shape *shapes, const int *species, const do
     return bmax;
 }
 
-/* This process's rank and the rank count (1 without MPI). */
-static int world_of(int *rank)
-{
-    int on = 0, size = 1;
-    *rank = 0;
-    MPI_Initialized(&on);
-    if (on) {
-        MPI_Comm_rank(MPI_COMM_WORLD, rank);
-        MPI_Comm_size(MPI_COMM_WORLD, &size);
-    }
-    return size;
-}
-
 /* The centres' decomposition into setup_grid (the ranks' refusals alike)
  * and the particles of this rank (owned, or a ghost here: the test of
  * cd_mpi_distribute), ascending, into a new *held (*n_held).  0, or -1
@@ -74,7 +61,7 @@ static int world_of(int *rank)
 static int decompose(const cd_sim *sim, const double *xyz, size_t n, double range, long long **held, size_t *n_held,
                      char *err, size_t errlen)
 {
-    int rank, size = world_of(&rank), *ranks = malloc((size_t)size * sizeof *ranks);
+    int rank, size = cd_mpi_world(&rank), *ranks = malloc((size_t)size * sizeof *ranks);
     long long *mine = malloc((n + 1) * sizeof *mine);
     if (!ranks || !mine) {
         free(ranks);
@@ -105,7 +92,7 @@ static int decompose(const cd_sim *sim, const double *xyz, size_t n, double rang
 int cd_mpi_setup_keep(const cd_sim *sim, const cd_vec3 *centre, const int *species, const double *scale, size_t n,
                       long long **held, size_t *n_held, char *err, size_t errlen)
 {
-    int rank, size = world_of(&rank);
+    int rank, size = cd_mpi_world(&rank);
     setup_built = -1;
     setup_grid_made = 0;
     const cd_config *c = &sim->cfg;
@@ -140,7 +127,7 @@ int cd_mpi_setup_keep_none(const cd_sim *sim, const cd_vec3 *centre, const int *
     int rank;
     setup_built = -1;
     setup_grid_made = 0;
-    if (world_of(&rank) < 2) return 0;
+    if (cd_mpi_world(&rank) < 2) return 0;
     *n_held = 0;
     *held = malloc(sizeof **held);
     if (*held) return 1;
@@ -152,7 +139,7 @@ int cd_mpi_setup_keep_none(const cd_sim *sim, const cd_vec3 *centre, const int *
  * such rank in err on every rank, and -1.  Collective. */
 static int agreed(int failed, char *err, size_t errlen)
 {
-    int rank, size = world_of(&rank), who = failed ? rank : size, first;
+    int rank, size = cd_mpi_world(&rank), who = failed ? rank : size, first;
     MPI_Allreduce(&who, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     if (first == size) return 0;
     MPI_Bcast(err, (int)errlen, MPI_CHAR, first, MPI_COMM_WORLD);
@@ -188,7 +175,7 @@ static int largest_reach(const char *path, size_t p0, size_t p1, double *reach, 
 int cd_mpi_read_snapshot(cd_sim *sim, const char *path, char *err, size_t errlen)
 {
     if (!sim->part.gid) return 1; /* one rank: the whole snapshot */
-    int rank, size = world_of(&rank);
+    int rank, size = cd_mpi_world(&rank);
     size_t N = sim->part.n_particles, P = sim->part.n_prims, W = sim->s.n_walls;
     /* the centres of all, and the interaction range: the largest reach of
      * the primitives, each rank a block of them (a maximum: any split gives
