@@ -305,7 +305,9 @@ static int run(const cd_run_options *opt)
     }
 
     static cd_sim sim;
-    if (cd_sim_setup(&sim, &cfg, err, sizeof err)) {
+    /* (under MPI a new run's ranks build their own particles only, and a
+     * resume's none: each reads its own, src/mpi/mpi_setup.c) */
+    if (cd_sim_setup_part(&sim, &cfg, opt->resume_path ? cd_mpi_setup_keep_none : cd_mpi_setup_keep, err, sizeof err)) {
         fprintf(stderr, "capdem: %s\n", err);
         cd_config_free(&cfg);
         return 2;
@@ -323,8 +325,17 @@ static int run(const cd_run_options *opt)
     cd_output *out = NULL;
     int status = 0;
     if (opt->resume_path) {
+        /* (several MPI ranks cannot append to a serial writer's file: a
+         * refusal of the input, on every rank before any reads) */
+        if (cd_output_check_appendable(opt->resume_path, err, sizeof err)) {
+            if (err[0]) fprintf(stderr, "capdem: %s\n", err);
+            status = 2;
+            goto done;
+        }
+        int part = 1;
         if (cd_h5_check_tails(opt->resume_path, err, sizeof err) ||
-            cd_h5_read_snapshot(opt->resume_path, -1, &sim.s, err, sizeof err)) {
+            (part = cd_mpi_read_snapshot(&sim, opt->resume_path, err, sizeof err)) < 0 ||
+            (part == 1 && cd_h5_read_snapshot(opt->resume_path, -1, &sim.s, err, sizeof err))) {
             fprintf(stderr, "capdem: --resume %s: %s\n", opt->resume_path, err);
             status = 2;
             goto done;
@@ -367,8 +378,11 @@ static int run(const cd_run_options *opt)
         }
         fprintf(stderr, "capdem: resuming %s at step %lld (t = %.9g s)\n", opt->resume_path, sim.s.step, sim.s.time);
     } else {
-        if (check_wall_placement(&sim, err, sizeof err)) {
-            fprintf(stderr, "capdem: %s\n", err);
+        /* (under MPI every rank checks the particles it set up: with
+         * domain.walls, all of them, src/mpi/mpi_setup.c; all stop together) */
+        int crossing = check_wall_placement(&sim, err, sizeof err) != 0;
+        if (crossing) fprintf(stderr, "capdem: %s\n", err);
+        if (cd_mpi_agree(crossing)) {
             status = 2;
             goto done;
         }

@@ -228,18 +228,51 @@ static size_t random_sites(const cd_config *c, cd_rng *r, double R, cd_vec3 *out
     return count;
 }
 
-/* Do particles i and j overlap at the positions and orientations in s?
+/* Every particle of the run while it is placed: the set-up builds the
+ * rows of the particles it keeps only (cd_sim_setup_part; an MPI rank its
+ * own and its ghosts), but the placement tests each new particle against
+ * every one placed before it.  Species, length scale, centre and, with
+ * init.exclusion = shape, orientation. */
+typedef struct {
+    const cd_shape *shapes;
+    int *species;
+    double *scale;        /* [1] */
+    cd_vec3 *position;    /* [m] */
+    cd_quat *orientation; /* init.exclusion = shape only */
+} placement;
+
+/* Arm a of a particle of shape sh at length scale f [1]: its body ends [m]
+ * and radius [m], as the set-up writes the primitive's rows. */
+static void scaled_arm(const cd_shape *sh, int a, double f, cd_vec3 *end_a, cd_vec3 *end_b, double *radius)
+{
+    *end_a = cd_v3_scale(sh->a[a], f);
+    *end_b = cd_v3_scale(sh->b[a], f);
+    *radius = sh->radius[a] * f;
+}
+
+/* Arm a of particle q of pl in the world: both axis ends [m] and radius [m]. */
+static void world_arm(const placement *pl, size_t q, int a, cd_vec3 *e0, cd_vec3 *e1, double *radius)
+{
+    cd_vec3 ba, bb;
+    scaled_arm(&pl->shapes[pl->species[q]], a, pl->scale[q], &ba, &bb, radius);
+    *e0 = cd_rigid_to_world(pl->position[q], pl->orientation[q], ba);
+    *e1 = cd_rigid_to_world(pl->position[q], pl->orientation[q], bb);
+}
+
+/* Do particles i and j overlap at their places and orientations in pl?
  * Exact for spherocylinder arms: some pair of axes closer than the sum of
  * their radii. */
-static int shapes_overlap(const cd_state *s, size_t i, size_t j)
+static int shapes_overlap(const placement *pl, size_t i, size_t j)
 {
-    for (cd_int u = s->prim_first[i]; u < s->prim_first[i] + s->prim_count[i]; u++) {
-        cd_vec3 p0 = cd_rigid_to_world(s->position[i], s->orientation[i], s->prim_a_body[u]);
-        cd_vec3 p1 = cd_rigid_to_world(s->position[i], s->orientation[i], s->prim_b_body[u]);
-        for (cd_int w = s->prim_first[j]; w < s->prim_first[j] + s->prim_count[j]; w++) {
-            cd_vec3 q0 = cd_rigid_to_world(s->position[j], s->orientation[j], s->prim_a_body[w]);
-            cd_vec3 q1 = cd_rigid_to_world(s->position[j], s->orientation[j], s->prim_b_body[w]);
-            double a, b, reach = s->prim_radius[u] + s->prim_radius[w]; /* [1], [1], [m] */
+    for (int u = 0; u < pl->shapes[pl->species[i]].n_prims; u++) {
+        cd_vec3 p0, p1;
+        double ru; /* [m] */
+        world_arm(pl, i, u, &p0, &p1, &ru);
+        for (int w = 0; w < pl->shapes[pl->species[j]].n_prims; w++) {
+            cd_vec3 q0, q1;
+            double rw; /* [m] */
+            world_arm(pl, j, w, &q0, &q1, &rw);
+            double a, b, reach = ru + rw; /* [1], [1], [m] */
             cd_segseg_closest(p0, p1, q0, q1, &a, &b);
             cd_vec3 d = cd_v3_sub(cd_v3_add(q0, cd_v3_scale(cd_v3_sub(q1, q0), b)),
                                   cd_v3_add(p0, cd_v3_scale(cd_v3_sub(p1, p0), a)));
@@ -251,14 +284,14 @@ static int shapes_overlap(const cd_state *s, size_t i, size_t j)
 
 /* Every arm of particle q inside the domain (both axis ends at least the
  * arm radius from every wall; the domains are convex, so the whole arm is). */
-static int arms_inside_domain(const cd_config *c, const cd_state *s, size_t q)
+static int arms_inside_domain(const cd_config *c, const placement *pl, size_t q)
 {
-    for (cd_int u = s->prim_first[q]; u < s->prim_first[q] + s->prim_count[q]; u++)
-        if (!inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_a_body[u]),
-                           s->prim_radius[u]) ||
-            !inside_domain(c, cd_rigid_to_world(s->position[q], s->orientation[q], s->prim_b_body[u]),
-                           s->prim_radius[u]))
-            return 0;
+    for (int u = 0; u < pl->shapes[pl->species[q]].n_prims; u++) {
+        cd_vec3 e0, e1;
+        double r; /* [m] */
+        world_arm(pl, q, u, &e0, &e1, &r);
+        if (!inside_domain(c, e0, r) || !inside_domain(c, e1, r)) return 0;
+    }
     return 1;
 }
 
@@ -267,22 +300,21 @@ static int arms_inside_domain(const cd_config *c, const cd_state *s, size_t q)
  * arms can start interleaved, much denser than bounding spheres allow.
  * Writes position and orientation of every particle placed; returns the
  * number placed (rejection with a bounded number of tries per particle). */
-static size_t random_shape_placement(const cd_sim *sim, cd_state *s, cd_rng *r, double R, size_t max)
+static size_t random_shape_placement(const cd_config *c, placement *pl, cd_rng *r, double R, size_t max)
 {
-    const cd_config *c = &sim->cfg;
     double lo[3], hi[3];
     sampling_box(c, R, max, lo, hi);
     size_t count = 0;
     for (size_t tries = 0; count < max && tries < 2000 * max; tries++) {
-        s->position[count] = random_point(c, r, lo, hi);
-        s->orientation[count] = random_orientation(r, c->dimension);
-        if (!arms_inside_domain(c, s, count)) continue;
-        double Ri = sim->shapes[s->shape[count]].bounding_radius * s->scale[count]; /* [m] */
+        pl->position[count] = random_point(c, r, lo, hi);
+        pl->orientation[count] = random_orientation(r, c->dimension);
+        if (!arms_inside_domain(c, pl, count)) continue;
+        double Ri = pl->shapes[pl->species[count]].bounding_radius * pl->scale[count]; /* [m] */
         int ok = 1;
         for (size_t k = 0; k < count && ok; k++) {
-            double Rk = sim->shapes[s->shape[k]].bounding_radius * s->scale[k]; /* [m] */
-            if (cd_v3_norm2(cd_v3_sub(s->position[count], s->position[k])) < (Ri + Rk) * (Ri + Rk))
-                ok = !shapes_overlap(s, count, k);
+            double Rk = pl->shapes[pl->species[k]].bounding_radius * pl->scale[k]; /* [m] */
+            if (cd_v3_norm2(cd_v3_sub(pl->position[count], pl->position[k])) < (Ri + Rk) * (Ri + Rk))
+                ok = !shapes_overlap(pl, count, k);
         }
         if (ok) count++;
     }
@@ -341,7 +373,7 @@ static double lattice_spacing(const cd_config *c, double R)
  * lattice of spacing a holds every particle, i.e. rows x a with rows =
  * ceil(N / sites per row).  Rows are centred, so a height of exactly
  * rows x a puts the first row at a/2 >= R above the floor. */
-static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
+static int resolve_lattice_height(cd_sim *sim, size_t N, char *err, size_t errlen)
 {
     cd_config *c = &sim->cfg;
     double *h = c->domain_kind == CD_DOMAIN_BOX        ? &c->box_height
@@ -351,7 +383,7 @@ static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
     double R = largest_bounding_radius(sim), a = lattice_spacing(c, R);               /* [m] */
     double wx = c->domain_kind == CD_DOMAIN_BOX ? c->box_width : c->cyl_diameter;     /* [m] */
     double wz = c->domain_kind == CD_DOMAIN_BOX ? c->box_thickness : c->cyl_diameter; /* [m] */
-    size_t N = sim->s.n_particles, row_max = (size_t)(floor(wx / a) + 1) * (size_t)(floor(wz / a) + 1);
+    size_t row_max = (size_t)(floor(wx / a) + 1) * (size_t)(floor(wz / a) + 1);
     cd_vec3 *sites = malloc(row_max * sizeof(cd_vec3));
     if (!sites) return -1;
     *h = a * (1 + 1e-9); /* one row */
@@ -368,21 +400,22 @@ static int resolve_lattice_height(cd_sim *sim, char *err, size_t errlen)
     return 0;
 }
 
-static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
+/* The places of all N particles (and their orientations with
+ * init.exclusion = shape) into pl. */
+static int place_particles(cd_sim *sim, placement *pl, size_t N, cd_rng *rng, char *err, size_t errlen)
 {
     const cd_config *c = &sim->cfg;
-    cd_state *s = &sim->s;
     double R = largest_bounding_radius(sim); /* [m] */
     double a = lattice_spacing(c, R);        /* [m] */
-    size_t N = s->n_particles, got;
+    size_t got;
     int random = c->random_placement, by_shape = random && c->exclude_by_shape;
     if (by_shape) {
-        got = random_shape_placement(sim, s, rng, R, N);
+        got = random_shape_placement(c, pl, rng, R, N);
     } else {
         cd_vec3 *sites = malloc((N + 1) * sizeof(cd_vec3));
         if (!sites) return -1;
         got = random ? random_sites(c, rng, R, sites, N) : lattice_sites(c, a, R, sites, N);
-        for (size_t q = 0; q < got; q++) s->position[q] = sites[q];
+        for (size_t q = 0; q < got; q++) pl->position[q] = sites[q];
         free(sites);
     }
     if (got < N) {
@@ -397,40 +430,70 @@ static int place_particles(cd_sim *sim, cd_rng *rng, char *err, size_t errlen)
                  c->source_path, N, dom, got, how);
         return -1;
     }
-    for (size_t q = 0; q < N; q++) {
-        if (!by_shape) s->orientation[q] = random_orientation(rng, c->dimension); /* drawn with the place otherwise */
-        double v = c->init_speed;                                                 /* [m/s] */
-        /* z, y, x one by one, as in random_point (argument order is unspecified) */
-        double vz = c->dimension == 2 ? 0 : cd_rng_range(rng, -v, v), vy = cd_rng_range(rng, -v, v);
-        double vx = cd_rng_range(rng, -v, v);
-        s->velocity[q] = cd_v3(vx, vy, vz);
-        s->angmom[q] = cd_v3_zero();
-    }
     return 0;
 }
 
+/* The rows of the particles kept (held: ascending global ids; NULL: every
+ * particle) into sim->s, in that order: shape, mass, inertia, primitives,
+ * place, and the orientation (unless placed with it) and velocity drawn
+ * for every particle of the run in turn, kept or not, so that each draws
+ * the numbers it draws in the whole run.  gprim (or NULL): the global id
+ * of each primitive written. */
+static void build_rows(cd_sim *sim, const placement *pl, size_t N, cd_rng *rng, const long long *held, long long *gprim)
+{
+    const cd_config *c = &sim->cfg;
+    cd_state *s = &sim->s;
+    int by_shape = c->random_placement && c->exclude_by_shape;
+    size_t l = 0, prim = 0;
+    long long global_prim = 0;
+    for (size_t q = 0; q < N; q++) {
+        const cd_shape *sh = &sim->shapes[pl->species[q]];
+        cd_quat o = by_shape ? pl->orientation[q] : random_orientation(rng, c->dimension); /* drawn with the place */
+        double v = c->init_speed;                                                          /* [m/s] */
+        /* z, y, x one by one, as in random_point (argument order is unspecified) */
+        double vz = c->dimension == 2 ? 0 : cd_rng_range(rng, -v, v), vy = cd_rng_range(rng, -v, v);
+        double vx = cd_rng_range(rng, -v, v);
+        long long g0 = global_prim;
+        global_prim += sh->n_prims;
+        if (held && (l >= s->n_particles || held[l] != (long long)q)) continue;
+        double f = pl->scale[q]; /* length scale [1] */
+        s->shape[l] = pl->species[q];
+        s->scale[l] = f;
+        s->mass[l] = sh->mass * f * f * f;
+        s->inertia[l] = cd_v3(sh->principal[0] * pow(f, 5), sh->principal[1] * pow(f, 5), sh->principal[2] * pow(f, 5));
+        s->prim_first[l] = (cd_int)prim;
+        s->prim_count[l] = sh->n_prims;
+        for (int a = 0; a < sh->n_prims; a++, prim++) {
+            s->prim_particle[prim] = (cd_int)l;
+            scaled_arm(sh, a, f, &s->prim_a_body[prim], &s->prim_b_body[prim], &s->prim_radius[prim]);
+            if (gprim) gprim[prim] = g0 + a;
+        }
+        s->position[l] = pl->position[q];
+        s->orientation[l] = o;
+        s->velocity[l] = cd_v3(vx, vy, vz);
+        s->angmom[l] = cd_v3_zero();
+        l++;
+    }
+}
+
+/* The lightest and second lightest particle [kg] and the largest arm
+ * radius [m], of the whole run. */
+typedef struct {
+    double m1, m2, r_max;
+} lightest;
+
 /* The collision time of the lightest pair [s]; run.steps_per_collision
  * sets dt from it, otherwise dt is checked against it. */
-static int check_time_step(cd_sim *sim, char *err, size_t errlen)
+static int check_time_step(cd_sim *sim, size_t N, const lightest *lt, char *err, size_t errlen)
 {
     cd_config *c = &sim->cfg;
-    const cd_state *s = &sim->s;
     /* The two lightest particles give the shortest collision. */
-    double m1 = INFINITY, m2 = INFINITY;
-    for (size_t q = 0; q < s->n_particles; q++) {
-        if (s->mass[q] < m1) {
-            m2 = m1;
-            m1 = s->mass[q];
-        } else if (s->mass[q] < m2) m2 = s->mass[q];
-    }
-    double m_eff = s->n_particles > 1 ? cd_law_effective_mass(m1, m2) : m1;
+    double m_eff = N > 1 ? cd_law_effective_mass(lt->m1, lt->m2) : lt->m1;
     if (c->law == CD_LAW_HERTZ_MINDLIN) {
         /* The Hertz time falls with the impact speed (as v^(-1/5)) and with
          * R_eff: the lightest pair with the largest arm radius, undamped,
          * at material.impact_speed (damping only lengthens it). */
-        double r_max = 0; /* [m] */
-        for (size_t i = 0; i < s->n_prims; i++) r_max = fmax(r_max, s->prim_radius[i]);
-        double r_eff = s->n_particles > 1 ? cd_law_pair_radius(r_max, r_max) : r_max;
+        double r_eff = N > 1 ? cd_law_pair_radius(lt->r_max, lt->r_max) : lt->r_max;
         double e_eff = cd_law_contact_modulus(c->young_modulus, c->poisson_ratio);
         sim->collision_time = cd_law_hertz_collision_time(e_eff, r_eff, m_eff, c->impact_speed);
     } else {
@@ -452,7 +515,80 @@ static int check_time_step(cd_sim *sim, char *err, size_t errlen)
     return 0;
 }
 
+/* The length scales of every particle (drawn in turn: the first numbers
+ * of the stream) and the whole run's sums and extremes from them. */
+static void scale_particles(cd_sim *sim, placement *pl, cd_rng *rng, lightest *lt, double *dmin)
+{
+    const cd_config *c = &sim->cfg;
+    size_t q = 0;
+    *lt = (lightest){INFINITY, INFINITY, 0};
+    *dmin = INFINITY;
+    for (int k = 0; k < c->n_species; k++) {
+        const cd_shape *sh = &sim->shapes[k];
+        double p = c->species[k].polydispersity;
+        for (long n = 0; n < c->species[k].count; n++, q++) {
+            double f = p > 0 ? cd_rng_range(rng, 1 - p, 1 + p) : 1.0; /* length scale [1] */
+            pl->species[q] = k;
+            pl->scale[q] = f;
+            double m = sh->mass * f * f * f; /* [kg] */
+            sim->total_mass += m;
+            sim->solid_volume += sh->volume * f * f * f;
+            if (m < lt->m1) {
+                lt->m2 = lt->m1;
+                lt->m1 = m;
+            } else if (m < lt->m2) lt->m2 = m;
+            for (int a = 0; a < sh->n_prims; a++) {
+                double r = sh->radius[a] * f; /* [m] */
+                if (2 * r < *dmin) *dmin = 2 * r;
+                lt->r_max = fmax(lt->r_max, r);
+            }
+        }
+    }
+}
+
+static void placement_free(placement *pl)
+{
+    free(pl->species);
+    free(pl->scale);
+    free(pl->position);
+    free(pl->orientation);
+}
+
+/* The run's particles placed (pl), the particles kept counted and their
+ * columns allocated: every column of sim->s for the particles held (NULL:
+ * all N) with P primitives in all. */
+static int alloc_rows(cd_sim *sim, const placement *pl, size_t N, size_t P, const long long *held, size_t n_held)
+{
+    size_t n = held ? n_held : N, prims = held ? 0 : P;
+    for (size_t l = 0; held && l < n_held; l++) prims += (size_t)pl->shapes[pl->species[held[l]]].n_prims;
+    cd_state *s = &sim->s;
+    size_t n_walls = s->n_walls;
+    cd_wall walls[CD_MAX_WALLS];
+    memcpy(walls, s->walls, sizeof walls);
+    if (cd_state_alloc(s, n, prims, 0, 2 * prims + 64)) return -1;
+    s->n_walls = n_walls;
+    memcpy(s->walls, walls, sizeof walls);
+    /* wall-contact columns depend on the wall count */
+    for (size_t f = 0; f < cd_n_fields; f++) {
+        if (cd_fields[f].group != CD_GROUP_WALLC) continue;
+        void **slot = cd_field_ptr(s, &cd_fields[f]);
+        free(*slot);
+        *slot = calloc(prims * (n_walls ? n_walls : 1) + 1, cd_fields[f].elem_size);
+        if (!*slot) return -1;
+    }
+    if (held) {
+        sim->part.gprim = malloc((prims + 1) * sizeof *sim->part.gprim);
+        if (!sim->part.gprim) return -1;
+    }
+    return 0;
+}
+
 int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
+{
+    return cd_sim_setup_part(sim, cfg, NULL, err, errlen);
+}
+
+int cd_sim_setup_part(cd_sim *sim, const cd_config *cfg, cd_setup_keep_fn keep, char *err, size_t errlen)
 {
     memset(sim, 0, sizeof(*sim));
     sim->cfg = *cfg;
@@ -472,52 +608,45 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
         N += (size_t)c->species[k].count;
         P += (size_t)c->species[k].count * (size_t)sim->shapes[k].n_prims;
     }
-    if (cd_state_alloc(&sim->s, N, P, 0, 2 * P + 64)) {
+    int by_shape = c->random_placement && c->exclude_by_shape;
+    placement pl = {sim->shapes, malloc((N + 1) * sizeof(int)), malloc((N + 1) * sizeof(double)),
+                    malloc((N + 1) * sizeof(cd_vec3)), by_shape ? malloc((N + 1) * sizeof(cd_quat)) : NULL};
+    if (!pl.species || !pl.scale || !pl.position || (by_shape && !pl.orientation)) {
+        placement_free(&pl);
         snprintf(err, errlen, "out of memory for %zu particles", N);
         return -1;
     }
-    if (cd_protocol_check(c, err, errlen)) return -1;
-    if (resolve_lattice_height(sim, err, errlen)) return -1;
-    if (make_walls(sim, err, errlen)) return -1;
-    /* wall-contact columns depend on the wall count: allocate them now */
-    cd_state *s = &sim->s;
-    for (size_t f = 0; f < cd_n_fields; f++) {
-        if (cd_fields[f].group != CD_GROUP_WALLC) continue;
-        void **slot = cd_field_ptr(s, &cd_fields[f]);
-        free(*slot);
-        *slot = calloc(P * (s->n_walls ? s->n_walls : 1), cd_fields[f].elem_size);
-        if (!*slot) return -1;
-    }
-
+    long long *held = NULL;
+    size_t n_held = 0;
+    int rc =
+        cd_protocol_check(c, err, errlen) || resolve_lattice_height(sim, N, err, errlen) || make_walls(sim, err, errlen)
+            ? -1
+            : 0;
     cd_rng rng;
     cd_rng_seed(&rng, c->seed);
-    size_t q = 0, prim = 0;
-    double dmin = INFINITY;
-    for (int k = 0; k < c->n_species; k++) {
-        const cd_shape *sh = &sim->shapes[k];
-        double p = c->species[k].polydispersity;
-        for (long n = 0; n < c->species[k].count; n++, q++) {
-            double f = p > 0 ? cd_rng_range(&rng, 1 - p, 1 + p) : 1.0; /* length scale [1] */
-            s->shape[q] = k;
-            s->scale[q] = f;
-            s->mass[q] = sh->mass * f * f * f;
-            sim->total_mass += s->mass[q];
-            sim->solid_volume += sh->volume * f * f * f;
-            s->inertia[q] =
-                cd_v3(sh->principal[0] * pow(f, 5), sh->principal[1] * pow(f, 5), sh->principal[2] * pow(f, 5));
-            s->prim_first[q] = (cd_int)prim;
-            s->prim_count[q] = sh->n_prims;
-            for (int a = 0; a < sh->n_prims; a++, prim++) {
-                s->prim_particle[prim] = (cd_int)q;
-                s->prim_a_body[prim] = cd_v3_scale(sh->a[a], f);
-                s->prim_b_body[prim] = cd_v3_scale(sh->b[a], f);
-                s->prim_radius[prim] = sh->radius[a] * f;
-                if (2 * s->prim_radius[prim] < dmin) dmin = 2 * s->prim_radius[prim];
-            }
-        }
+    lightest lt = {0, 0, 0};
+    double dmin = 0; /* [m] the thinnest arm's diameter */
+    if (!rc) {
+        scale_particles(sim, &pl, &rng, &lt, &dmin);
+        cd_neighbors_init(&sim->nb, c->skin > 0 ? c->skin : 0.1 * dmin, c->reorder == CD_REORDER_CELLS);
+        rc = place_particles(sim, &pl, N, &rng, err, errlen);
     }
-    if (place_particles(sim, &rng, err, errlen)) return -1;
-    if (check_time_step(sim, err, errlen)) return -1;
+    if (!rc) rc = check_time_step(sim, N, &lt, err, errlen);
+    int kept = rc || !keep ? 0 : keep(sim, pl.position, pl.species, pl.scale, N, &held, &n_held, err, errlen);
+    if (kept < 0) rc = -1;
+    if (!rc && kept == 1) {
+        sim->part.gid = held;
+        sim->part.n_particles = N;
+        sim->part.n_prims = P;
+    } else free(held);
+    if (!rc && alloc_rows(sim, &pl, N, P, sim->part.gid, n_held)) {
+        snprintf(err, errlen, "out of memory for %zu particles", N);
+        rc = -1;
+    }
+    if (!rc) build_rows(sim, &pl, N, &rng, sim->part.gid, sim->part.gprim);
+    placement_free(&pl);
+    if (rc) return -1;
+    cd_state *s = &sim->s;
     /* the arms the step reads (kernels/cols.h); a start derives them anew */
     if (cd_state_arms_derive(s)) {
         snprintf(err, errlen, "out of memory while setting up the primitives' arms");
@@ -545,7 +674,6 @@ int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen)
     }
     sp->wall_law = sp->law;
     sp->wall_law.mu = c->wall_friction;
-    cd_neighbors_init(&sim->nb, c->skin > 0 ? c->skin : 0.1 * dmin, c->reorder == CD_REORDER_CELLS);
     sim->threads = 1;
 #ifdef _OPENMP
     sim->threads = omp_get_max_threads();
@@ -558,6 +686,9 @@ void cd_sim_free(cd_sim *sim)
     if (sim->backend) sim->backend->stop(sim);
     cd_state_free(&sim->s);
     cd_state_free(&sim->probe_base);
+    free(sim->part.gid);
+    free(sim->part.gprim);
+    sim->part.gid = sim->part.gprim = NULL;
     cd_neighbors_free(&sim->nb);
     cd_sim_observe_free(sim);
 }

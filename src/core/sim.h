@@ -136,6 +136,15 @@ typedef struct cd_sim {
      * message in err: the run stops. */
     int (*rebuild_hook)(struct cd_sim *sim, int rebuild, char *err, size_t errlen);
     void *rebuild_hook_data;
+    /* A set-up of part of the run (cd_sim_setup_part; src/mpi, docs/mpi.md
+     * "Set-up"): s holds the particles of the global ids gid only
+     * (ascending), gprim the global id of each of its primitives, and
+     * n_particles, n_prims are the whole run's counts; gid NULL: s is the
+     * whole run. */
+    struct {
+        long long *gid, *gprim;
+        size_t n_particles, n_prims;
+    } part;
 } cd_sim;
 
 /* Builds a simulation from a validated config: shapes, particles placed as
@@ -143,6 +152,18 @@ typedef struct cd_sim {
  * against the collision time.  Returns 0, or -1 with a message that names
  * the file and key in err (exit status 2 for the caller). */
 int cd_sim_setup(cd_sim *sim, const cd_config *cfg, char *err, size_t errlen);
+/* Which particles a set-up builds (an MPI rank: its own and its ghosts),
+ * asked once every particle is placed: n centres [m], each particle's
+ * species and length scale [1] (sim's shapes, config and skin are set).
+ * Returns 0: every particle; 1: the ascending global ids in *held (a new
+ * array, *n_held of them); -1: refused (err names the key, exit 2). */
+typedef int (*cd_setup_keep_fn)(const struct cd_sim *sim, const cd_vec3 *centre, const int *species,
+                                const double *scale, size_t n, long long **held, size_t *n_held, char *err,
+                                size_t errlen);
+/* cd_sim_setup building the particles keep chooses only (sim->part; keep
+ * NULL: every particle, cd_sim_setup).  Every random number is drawn as
+ * the whole run draws it, so the rows built have the whole run's bits. */
+int cd_sim_setup_part(cd_sim *sim, const cd_config *cfg, cd_setup_keep_fn keep, char *err, size_t errlen);
 void cd_sim_free(cd_sim *sim);
 
 /* Chooses the backend (before cd_sim_start).  device: cpu | gpu | auto,

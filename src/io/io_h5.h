@@ -120,6 +120,12 @@ int cd_output_snapshot_part(cd_output *o, const cd_output_part *part);
 /* Under cd_output_use_mpi: the bytes of data this rank has written into
  * run files (its rows, and on rank 0 the rest), for the closing report. */
 unsigned long long cd_output_bytes_written(void);
+/* Under cd_output_use_mpi, before a resume: can the ranks append to the
+ * run file at path?  A file of the serial writer cannot be (docs/mpi.md,
+ * "Resume"): -1 on every rank, the reason in err on rank 0 (empty on the
+ * others), a refusal of the input (exit 2).  Collective; 0 without
+ * cd_output_use_mpi. */
+int cd_output_check_appendable(const char *path, char *err, size_t errlen);
 
 /* Number of snapshots in a run file, or -1 (message in err). */
 int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
@@ -130,6 +136,24 @@ int cd_h5_snapshot_count(const char *path, char *err, size_t errlen);
  * the active contacts with their history, the wall contacts, walls, time and
  * step. */
 int cd_h5_read_snapshot(const char *path, int k, cd_state *s, char *err, size_t errlen);
+/* Some of a snapshot's particles (an MPI rank's own and its ghosts,
+ * docs/mpi.md "Resume"): n of the file's n_all particles, their global
+ * ids ascending, and their primitives' (n_prims of n_all_prims). */
+typedef struct {
+    size_t n, n_prims, n_all, n_all_prims;
+    const long long *gid, *gprim;
+} cd_h5_part;
+/* cd_h5_read_snapshot for the particles of part only (NULL: all): s holds
+ * part->n particles, part->n_prims primitives and the run's walls; it gets
+ * their rows, their wall contacts and the active contacts between two of
+ * them, numbered in s (ascending global ids), read by hyperslabs of those
+ * rows alone. */
+int cd_h5_read_snapshot_part(const char *path, int k, const cd_h5_part *part, cd_state *s, char *err, size_t errlen);
+/* Rows row0 .. row0 + n - 1 of the particle or primitive column `name`
+ * (fields.def) of snapshot k (k < 0: the last) into buf (doubles or
+ * int32, as the state holds them).  0, or -1 with a message. */
+int cd_h5_read_column_rows(const char *path, int k, const char *name, long long row0, long long n, void *buf, char *err,
+                           size_t errlen);
 
 /* Reads the last row of every chunked dataset of the run file at path, so
  * that HDF5 verifies the Fletcher-32 checksums of the chunks a resume

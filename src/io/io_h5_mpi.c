@@ -60,6 +60,13 @@ int cdh5_par_appendable(const char *path, char *err, size_t errlen)
     return found ? -1 : 0;
 }
 
+int cd_output_check_appendable(const char *path, char *err, size_t errlen)
+{
+    if (errlen) err[0] = 0;
+    if (!cdh5_par_on()) return 0;
+    return cdh5_par_max(cdh5_par_root() && cdh5_par_appendable(path, err, errlen) < 0) ? -1 : 0;
+}
+
 #if defined(CAPDEM_MPI) && CAPDEM_MPI && defined(H5_HAVE_PARALLEL)
 
 static struct {

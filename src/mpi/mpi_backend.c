@@ -44,7 +44,7 @@ static void give_back_memory(void)
 #endif
 }
 
-static int world(int *rank)
+int cd_mpi_world(int *rank)
 {
     int on = 0, size = 1;
     *rank = 0;
@@ -77,7 +77,7 @@ int cd_mpi_begin(void)
         if (MPI_Init(NULL, NULL) != MPI_SUCCESS) return -1;
         began_here = 1;
     }
-    if (world(&rank) > 1 && rank > 0) { /* rank 0 speaks for all (mpi_decomp.h) */
+    if (cd_mpi_world(&rank) > 1 && rank > 0) { /* rank 0 speaks for all (mpi_decomp.h) */
         fflush(stderr);
         if (!freopen("/dev/null", "w", stderr)) return -1;
     }
@@ -87,7 +87,7 @@ int cd_mpi_begin(void)
 int cd_mpi_agree(int status)
 {
     int rank, all = status;
-    if (world(&rank) > 1) MPI_Allreduce(&status, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (cd_mpi_world(&rank) > 1) MPI_Allreduce(&status, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     return all;
 }
 
@@ -107,7 +107,7 @@ int cd_mpi_end(int status)
 int cd_mpi_is_writer(void)
 {
     int rank;
-    world(&rank);
+    cd_mpi_world(&rank);
     return rank == 0;
 }
 
@@ -137,7 +137,7 @@ int cd_mpi_opens_output(void) { return parallel_output || cd_mpi_is_writer(); }
 int cd_mpi_decomposed(void)
 {
     int rank;
-    return world(&rank) > 1;
+    return cd_mpi_world(&rank) > 1;
 }
 
 /* The scalars of the local state (step, time, walls, protocol slots) on
@@ -217,7 +217,7 @@ static double interaction_range(const cd_sim *sim)
                                         s->prim_count[q], cd_v3_zero());
         if (b > bmax) bmax = b;
     }
-    return (2 * bmax + sim->nb.skin) * (1 + 1e-6);
+    return cd_mpi_range(bmax, sim->nb.skin);
 }
 
 /* Rank 0's summary of the decomposition: migrations, and the owned
@@ -243,6 +243,9 @@ static void report(const cd_mpi_ctx *x)
     double red = x->reduces > 0 ? (double)x->reduce_bytes / (double)x->reduces : 0, rsum, rmax;
     MPI_Reduce(&red, &rsum, 1, MPI_DOUBLE, MPI_SUM, 0, x->comm);
     MPI_Reduce(&red, &rmax, 1, MPI_DOUBLE, MPI_MAX, 0, x->comm);
+    long built = cd_mpi_setup_built(), bmin, bmax; /* particles each rank's set-up built (-1: all) */
+    MPI_Reduce(&built, &bmin, 1, MPI_LONG, MPI_MIN, 0, x->comm);
+    MPI_Reduce(&built, &bmax, 1, MPI_LONG, MPI_MAX, 0, x->comm);
     double wrote = (double)cd_output_bytes_written(), wmin, wmax; /* [bytes] into the run file */
     MPI_Reduce(&wrote, &wmin, 1, MPI_DOUBLE, MPI_MIN, 0, x->comm);
     MPI_Reduce(&wrote, &wmax, 1, MPI_DOUBLE, MPI_MAX, 0, x->comm);
@@ -263,6 +266,16 @@ static void report(const cd_mpi_ctx *x)
             "migration %.4g, %.4g messages and %.6g, %.6g bytes, %.4g, %.4g particle records\n",
             csum[0] / x->size, cmax[0], csum[1] / x->size, cmax[1], csum[2] / x->size, cmax[2], csum[3] / x->size,
             cmax[3], csum[4] / x->size, cmax[4]);
+        if (bmin >= 0)
+            fprintf(stderr,
+                    "capdem: MPI set-up: each rank built or read the rows of %ld..%ld of the %ld particles (its own "
+                    "and its ghosts)\n",
+                    bmin, bmax, sum[2]);
+        else
+            fprintf(stderr,
+                    "capdem: MPI set-up: every rank built all %ld particles (domain.walls, or a protocol whose start "
+                    "reads every particle)\n",
+                    sum[2]);
         if (parallel_output)
             fprintf(stderr,
                     "capdem: MPI output: each rank wrote its rows from its local state; the whole state gathered %lld "
@@ -322,7 +335,7 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     /* The sub-domains are cut at the first start and kept for a restart
      * (the bulk probe's, from a compacted packing that it might not split
      * as well): the bits do not depend on them. */
-    if (!x->ran) {
+    if (!x->ran && !cd_mpi_setup_grid(&x->grid)) {                    /* (a set-up of this rank's part made it) */
         double *xyz = malloc((3 * s->n_particles + 1) * sizeof *xyz); /* [m] the centres */
         if (!xyz) {
             snprintf(err, errlen, "out of memory while cutting the domain for %d MPI ranks", x->size);
@@ -362,7 +375,18 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     x->recv_count = calloc(R, sizeof(int));
     x->recv_displ = calloc(R, sizeof(int));
     int rc = x->send_count && x->send_displ && x->recv_count && x->recv_displ ? 0 : -1;
-    if (!rc) rc = cd_mpi_distribute(x, &sim->s, parallel_output);
+    /* (a set-up of this rank's part: its rows always go, the counts become
+     * the whole run's; a gather allocates the whole run's columns anew) */
+    int part = sim->part.gid != NULL;
+    if (!rc) rc = cd_mpi_distribute(x, &sim->s, sim->part.gid, sim->part.gprim, parallel_output || part);
+    if (!rc && part) {
+        sim->s.n_particles = sim->part.n_particles;
+        sim->s.n_prims = sim->part.n_prims;
+        sim->s.n_pairs = 0;
+        free(sim->part.gid);
+        free(sim->part.gprim);
+        memset(&sim->part, 0, sizeof sim->part);
+    }
     if (rc) snprintf(err, errlen, "out of memory while distributing the particles over %d MPI ranks", x->size);
     /* (a rank without particles has no list to build and no forces) */
     if (!rc) rc = x->inner->start(loc, compute && loc->s.n_particles > 0, err, errlen);
@@ -496,7 +520,7 @@ static void devices_taken(cd_mpi_ctx *x)
 
 int cd_mpi_version(void)
 {
-    int rank, size = world(&rank);
+    int rank, size = cd_mpi_world(&rank);
     int on = 0;
     MPI_Initialized(&on);
     if (!on) return 0; /* not under an MPI launcher */

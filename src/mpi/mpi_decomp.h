@@ -17,6 +17,7 @@
 #define CD_MPI_DECOMP_H
 #include <stddef.h>
 #include "config/config.h"
+#include "geom_types.h"
 
 struct cd_sim;
 struct cd_output;
@@ -59,6 +60,26 @@ int cd_mpi_write_snapshot(struct cd_output *out, struct cd_sim *sim);
  * (solver, protocol, backend) and puts cd_backend_mpi in front of the
  * chosen backend.  0, or -1 with a message naming the key (exit 2). */
 int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err, size_t errlen);
+/* The particles this rank sets up (core/sim.h cd_setup_keep_fn; src/mpi/mpi_setup.c):
+ * with more than one rank, the decomposition made from every particle's
+ * centre (the start takes it), and the rank's own particles and ghosts;
+ * every particle (0) with one rank, or where the run needs the whole
+ * state at its start (a protocol whose begin reads every particle,
+ * domain.walls, whose check reads every particle's arms).  Refusals of
+ * the decomposition (-1): exit 2, every rank alike. */
+int cd_mpi_setup_keep(const struct cd_sim *sim, const cd_vec3 *centre, const int *species, const double *scale,
+                      size_t n, long long **held, size_t *n_held, char *err, size_t errlen);
+/* The same for a resume: with more than one rank, no particle (each rank
+ * reads its own from the file, cd_mpi_read_snapshot). */
+int cd_mpi_setup_keep_none(const struct cd_sim *sim, const cd_vec3 *centre, const int *species, const double *scale,
+                           size_t n, long long **held, size_t *n_held, char *err, size_t errlen);
+/* --resume with more than one rank: the decomposition made from the
+ * file's centres (the start takes it), and the rows of this rank's
+ * particles and ghosts read from the last snapshot of path by hyperslabs
+ * (io_h5.h cd_h5_read_snapshot_part) into sim's part (core/sim.h).
+ * Collective; 0, -1 (err: the lowest failing rank's message, on every
+ * rank), or 1: one rank (the caller reads the whole snapshot). */
+int cd_mpi_read_snapshot(struct cd_sim *sim, const char *path, char *err, size_t errlen);
 #else
 static inline int cd_mpi_begin(void) { return 0; }
 static inline int cd_mpi_end(int status) { return status; }
@@ -84,6 +105,30 @@ static inline int cd_mpi_wrap(struct cd_sim *sim, const char *backend, char *err
 {
     (void)sim;
     (void)backend;
+    (void)err;
+    (void)errlen;
+    return 0;
+}
+static inline int cd_mpi_read_snapshot(struct cd_sim *sim, const char *path, char *err, size_t errlen)
+{
+    (void)sim;
+    (void)path;
+    (void)err;
+    (void)errlen;
+    return 1;
+}
+#define cd_mpi_setup_keep_none cd_mpi_setup_keep
+static inline int cd_mpi_setup_keep(const struct cd_sim *sim, const cd_vec3 *centre, const int *species,
+                                    const double *scale, size_t n, long long **held, size_t *n_held, char *err,
+                                    size_t errlen)
+{
+    (void)sim;
+    (void)centre;
+    (void)species;
+    (void)scale;
+    (void)n;
+    (void)held;
+    (void)n_held;
     (void)err;
     (void)errlen;
     return 0;

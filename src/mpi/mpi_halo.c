@@ -404,7 +404,7 @@ static int find_neighbors(cd_mpi_ctx *x)
     return x->requests ? 0 : -1;
 }
 
-int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, int release)
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, const long long *gid, const long long *gprim, int release)
 {
     size_t cb = 0, N = global->n_particles;
     int *ranks = malloc((size_t)x->size * sizeof *ranks);
@@ -426,10 +426,12 @@ int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, int release)
     }
     for (size_t k = 0; !rc && k < global->n_pairs; k++)
         if (global->pair_active[k])
-            at = cd_mpi_pack_pair(global, k, global->pair_prim_i[k], global->pair_prim_j[k], 0, at);
-    /* the particles' rows straight from the global columns (global ids:
-     * their rows), which go as they are copied when release is set */
-    if (!rc) rc = cd_mpi_assemble(x, global, NULL, NULL, here, release, NULL, 0, cbuf, (size_t)(at - cbuf), global);
+            at = cd_mpi_pack_pair(global, k, gprim ? gprim[global->pair_prim_i[k]] : global->pair_prim_i[k],
+                                  gprim ? gprim[global->pair_prim_j[k]] : global->pair_prim_j[k], 0, at);
+    /* the particles' rows straight from the global columns (of a whole
+     * run, its rows are the global ids), which go as they are copied when
+     * release is set */
+    if (!rc) rc = cd_mpi_assemble(x, global, gid, gprim, here, release, NULL, 0, cbuf, (size_t)(at - cbuf), global);
     free(ranks);
     free(here);
     free(cbuf);

@@ -113,12 +113,28 @@ int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen);
 int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen);
 
 /* The local state of this rank cut from a global state (every rank holds
- * the same one at start): owned particles, ghosts, the active pair rows
- * among them; the neighbours and the ghost refresh planned.  release: the
- * global state's columns freed as soon as this rank's records are packed,
- * before the local state is assembled (its counts and scalars kept), so
- * that a rank never holds both.  0, or -1 (out of memory). */
-int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, int release);
+ * the same one at start), or from this rank's part of it (gid, gprim: the
+ * global ids of its particles and primitives, ascending, as a set-up of
+ * part of the run builds it, core/sim.h; NULL: global is the whole run):
+ * owned particles, ghosts, the active pair rows among them; the
+ * neighbours and the ghost refresh planned.  release: the global state's
+ * columns let go column by column as the local state is assembled (its
+ * counts and scalars kept), so that a rank never holds both.  0, or -1
+ * (out of memory). */
+int cd_mpi_distribute(cd_mpi_ctx *x, cd_state *global, const long long *gid, const long long *gprim, int release);
+/* The rank count of MPI_COMM_WORLD and this process's rank in *rank (1
+ * and 0 when MPI is not started). */
+int cd_mpi_world(int *rank);
+/* The interaction range [m] of particles whose largest bounding radius
+ * about the centre is bound_max [m], with the skin [m]: twice the bound
+ * plus the skin, widened by roundings (src/mpi/mpi_setup.c). */
+double cd_mpi_range(double bound_max, double skin);
+/* The decomposition made by the set-up of this rank's part of the run
+ * (cd_mpi_setup_keep) into g, once: 1, or 0 when none was made. */
+int cd_mpi_setup_grid(cd_decomp_grid *g);
+/* Particles the set-up of this rank built (its own and its ghosts), or -1
+ * when it built every particle. */
+long cd_mpi_setup_built(void);
 /* Every particle to the ranks that hold it by its centre now (its owner,
  * and as a ghost the ranks within the interaction range): a rank keeps
  * the copies it has and gets, from the particle's owner, only the ones

@@ -24,9 +24,12 @@
 /* n items of `size` bytes to the ranks dest[k] (MPI_Alltoallv over all
  * ranks, after an MPI_Alltoall of the byte counts); what came into a new
  * *recv of *rlen bytes.  Counted in x->reduce_msgs, x->reduce_bytes.
- * 0, or -1 (out of memory). */
-static int route(cd_mpi_ctx *x, const char *items, const int *dest, size_t n, size_t size, char **recv, size_t *rlen)
+ * items and dest (malloc'd by the caller) are let go once packed in rank
+ * order, before the receive buffer is allocated: a rank holds two copies
+ * of its rows at a time, not three.  0, or -1 (out of memory). */
+static int route(cd_mpi_ctx *x, void *items_in, int *dest, size_t n, size_t size, char **recv, size_t *rlen)
 {
+    const char *items = items_in;
     int R = x->size, *cnt = calloc(4 * (size_t)R + 1, sizeof(int));
     char *send = malloc(n * size + 1);
     size_t *fill = calloc((size_t)R + 1, sizeof *fill);
@@ -45,6 +48,10 @@ static int route(cd_mpi_ctx *x, const char *items, const int *dest, size_t n, si
             memcpy(send + fill[dest[k]], items + k * size, size);
             fill[dest[k]] += size;
         }
+        free(items_in);
+        free(dest);
+        items_in = NULL;
+        dest = NULL;
         MPI_Alltoall(sc, 1, MPI_INT, rcn, 1, MPI_INT, x->comm);
         size_t nr = 0;
         for (int r = 0; r < R; r++) {
@@ -63,6 +70,8 @@ static int route(cd_mpi_ctx *x, const char *items, const int *dest, size_t n, si
     free(cnt);
     free(send);
     free(fill);
+    free(items_in);
+    free(dest);
     return rc;
 }
 
@@ -146,7 +155,8 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn)
             }
     char *got = NULL;
     size_t len = 0;
-    if (route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len)) MPI_Abort(x->comm, 1);
+    if (route(x, mine, dest, n, sizeof *mine, &got, &len)) MPI_Abort(x->comm, 1);
+    /* (route let mine and dest go) */
     /* this rank's chunks: each summed in primitive order */
     size_t m = len / sizeof(prim_load), nc = 0;
     prim_load *e = (prim_load *)got;
@@ -163,8 +173,6 @@ double cd_mpi_wall_load(cd_mpi_ctx *x, int w, const double *fn)
     if (gather_partials(x, (const char *)sums, (int)(nc * sizeof *sums), sizeof *sums, &load, 1, merge_chunks))
         MPI_Abort(x->comm, 1);
     x->reduces++;
-    free(mine);
-    free(dest);
     free(got);
     free(sums);
     return load;
@@ -315,7 +323,8 @@ static int particle_leaves(cd_mpi_ctx *x, const cd_sim *g, const cd_int *touch_l
         }
     char *got = NULL;
     size_t len = 0;
-    int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
+    int rc = route(x, mine, dest, n, sizeof *mine, &got, &len);
+    /* (route let mine and dest go) */
     size_t m = len / sizeof(obs_particle);
     obs_particle *e = (obs_particle *)got;
     if (!rc) qsort(e, m, sizeof *e, by_key); /* each leaf's rows together, ascending */
@@ -352,8 +361,6 @@ static int particle_leaves(cd_mpi_ctx *x, const cd_sim *g, const cd_int *touch_l
         if (!acc) rc = -1;
         else cd_obs_block_particles(c, 0, rows, g->p.gravity, touch, acc, cd_order_identity());
     }
-    free(mine);
-    free(dest);
     free(got);
     return rc;
 }
@@ -396,7 +403,8 @@ static int wall_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
             }
     char *got = NULL;
     size_t len = 0;
-    int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
+    int rc = route(x, mine, dest, n, sizeof *mine, &got, &len);
+    /* (route let mine and dest go) */
     size_t m = len / sizeof(obs_wall);
     obs_wall *e = (obs_wall *)got;
     if (!rc) qsort(e, m, sizeof *e, by_key); /* rows ascending: each leaf's together */
@@ -432,8 +440,6 @@ static int wall_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
             cd_obs_block_walls(c, bf, (cd_long)(rows - shift), (cd_int)W, g->p.wall_law, acc, cd_order_identity(),
                                start, wrows, outs);
     }
-    free(mine);
-    free(dest);
     free(got);
     return rc;
 }
@@ -465,7 +471,8 @@ static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
     }
     char *got = NULL;
     size_t len = 0;
-    int rc = route(x, (const char *)mine, dest, n, sizeof *mine, &got, &len);
+    int rc = route(x, mine, dest, n, sizeof *mine, &got, &len);
+    /* (route let mine and dest go) */
     size_t m = len / sizeof(obs_pair);
     obs_pair *e = (obs_pair *)got;
     cd_int *active = malloc((m + 1) * sizeof *active), *pi = malloc((m + 1) * sizeof *pi),
@@ -499,8 +506,6 @@ static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
         if (!acc) rc = -1;
         else cd_obs_block_pairs(c, 0, nb, g->p.law, acc, cd_order_identity());
     }
-    free(mine);
-    free(dest);
     free(got);
     free(active);
     free(pi);

@@ -48,6 +48,12 @@ void cd_protocol_begin(cd_sim *sim)
     else cd_proto_enter(sim, CD_PHASE_FREE, NULL);
 }
 
+int cd_protocol_begin_reads_particles(const cd_config *c)
+{
+    if (CD_PROTOCOL_IN_BALL(c->protocol_kind)) return 1; /* cd_proto_ball_begin: the net motion */
+    return c->protocol_kind == CD_PROTOCOL_DEPOSIT && cd_proto_deposit_removes_rotation(c);
+}
+
 long long cd_protocol_steps_until_control(const cd_sim *sim)
 {
     int phase = cd_proto_phase(sim);

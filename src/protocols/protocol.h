@@ -25,6 +25,10 @@ int cd_protocol_check(const cd_config *c, char *err, size_t errlen);
 
 /* Prepares a new run (phase, driven wall). */
 void cd_protocol_begin(cd_sim *sim);
+/* Whether cd_protocol_begin reads every particle (sums over them that set
+ * the initial velocities: the net motion in a ball, the rotation in a
+ * frictionless cylinder), so that it needs the whole run's state. */
+int cd_protocol_begin_reads_particles(const cd_config *c);
 
 /* After a resume from path: a bulk probe in progress reads back its base
  * state (the snapshot of control slot CTL_BASE_STEP).  Returns 0, or -1

@@ -44,12 +44,17 @@ static void remove_axial_rotation(cd_sim *sim)
     }
 }
 
+int cd_proto_deposit_removes_rotation(const cd_config *c)
+{
+    return c->domain_kind == CD_DOMAIN_CYLINDER && c->wall_friction == 0;
+}
+
 static void begin(cd_sim *sim)
 {
     /* the piston is the last wall: the box's top wall, or the one added
      * over the cylinder */
     sim->s.control[CTL_WALL] = sim->cfg.domain_kind == CD_DOMAIN_BOX ? 1 : (double)(sim->s.n_walls - 1);
-    if (sim->cfg.domain_kind == CD_DOMAIN_CYLINDER && sim->cfg.wall_friction == 0) remove_axial_rotation(sim);
+    if (cd_proto_deposit_removes_rotation(&sim->cfg)) remove_axial_rotation(sim);
     cd_proto_enter(sim, CD_PHASE_SETTLE, NULL);
 }
 

@@ -56,6 +56,9 @@ extern const cd_protocol_ops cd_protocol_deposit, cd_protocol_radial, cd_protoco
  * (protocol_ball.c). */
 int cd_proto_ball_check(const cd_config *c, char *err, size_t errlen);
 void cd_proto_ball_begin(cd_sim *sim);
+/* The deposit's begin removes the rotation about the cylinder axis (a
+ * frictionless cylinder): it reads every particle. */
+int cd_proto_deposit_removes_rotation(const cd_config *c);
 int cd_proto_compact(cd_sim *sim, double load, char *err, size_t errlen, int *done);
 
 #endif

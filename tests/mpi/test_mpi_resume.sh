@@ -26,17 +26,25 @@ for np in 2 1; do
   if [ "$np" -eq 1 ]; then "$capdem" run "$cfg" --resume "from3to$np.h5" --quiet 2> err
   else mpi "$np" run "$cfg" --resume "from3to$np.h5" --quiet 2> err; fi
   if [ $? -ne 0 ]; then bad "resume of a 3-rank file with $np: failed"; continue; fi
+  # each rank read its own particles and ghosts (docs/mpi.md, "Resume")
+  if [ "$np" -gt 1 ]; then
+    if grep -q 'capdem: MPI set-up: each rank built or read the rows of [0-9]*\.\.[0-9]* of the 40 particles' err; then ok
+    else bad "resume with $np ranks: expected each rank to read its own rows: $(grep 'MPI set-up' err)"; fi
+  fi
   if same serial.h5 "from3to$np.h5"; then ok; else bad "3 ranks, then $np: differs from the serial resume"; head diff.txt; fi
   if same whole.h5 "from3to$np.h5" "${whole_only[@]}"; then ok; else bad "3 ranks, then $np: differs from the whole run"; fi
 done
 # A file of the serial writer (one process here) gets its chunks as it is
 # written, which HDF5 1.10 cannot append to from several ranks (docs/mpi.md,
-# "Resume"; it hung before the check): refused on 2 ranks, once, the file
-# as it was; with mpi.output: rank0 (the serial writer on rank 0) it
-# resumes and equals the whole run but for the reference ends.
+# "Resume"; it hung before the check): refused on 2 ranks as bad input
+# (exit 2), once, the file as it was; with mpi.output: rank0 (the serial
+# writer on rank 0) it resumes and equals the whole run but for the
+# reference ends.
 "$capdem" run "$cfg" --output one.h5 --steps 2000 --quiet 2> err || bad "the serial run to step 2000 failed"
 cp one.h5 one_kept.h5
-if mpi 2 run "$cfg" --resume one.h5 --quiet 2> err; then bad "a serially written file resumed on 2 ranks: expected a refusal"
+mpi 2 run "$cfg" --resume one.h5 --quiet 2> err
+rc=$?
+if [ $rc -ne 2 ]; then bad "a serially written file resumed on 2 ranks: exit status $rc, expected 2 (refused)"; cat err
 elif [ "$(grep -c 'was written by one process' err)" -eq 1 ] && cmp -s one.h5 one_kept.h5; then ok
 else bad "a serially written file on 2 ranks: expected one message and the file unchanged"; cat err; fi
 { printf 'mpi:\n  output: rank0\n'; cat "$cfg"; } > rank0.yaml

@@ -416,6 +416,79 @@ static void test_io_h5_replace_keeps_old_file_until_first_snapshot(void **state)
 }
 
 /* Every function closes what it opened. */
+/* Index of v among ids[0..n), or -1. */
+static long long index_of(const long long *ids, size_t n, long long v)
+{
+    for (size_t i = 0; i < n; i++)
+        if (ids[i] == v) return (long long)i;
+    return -1;
+}
+
+/* A part of a snapshot (an MPI rank's particles, docs/mpi.md "Resume"):
+ * the rows of particles 1, 3, 4 of the whole read's, their primitives',
+ * their wall contacts' and the active contacts between two of their
+ * primitives, in that order, with the row numbers in the part's
+ * numbering; and cd_h5_read_column_rows gives rows of the whole read. */
+static void test_io_h5_part_read_equals_whole_rows(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    test_path(path, sizeof path, "part");
+    cd_state s[3], whole, part;
+    for (int j = 0; j < 3; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
+    write_run(path, 3, s);
+    alloc_garbage(&whole);
+    assert_int_equal(cd_h5_read_snapshot(path, 0, &whole, err, sizeof err), 0);
+    const long long gid[3] = {1, 3, 4}, gprim[6] = {2, 3, 6, 7, 8, 9};
+    cd_h5_part sel = {3, 6, NP, NPRIM, gid, gprim};
+    alloc_state(&part, 3, 6, NW, 1);
+    int rc = cd_h5_read_snapshot_part(path, 0, &sel, &part, err, sizeof err);
+    if (rc) print_error("%s\n", err);
+    assert_int_equal(rc, 0);
+    size_t m = 0;
+    for (size_t k = 0; k < cd_n_fields; k++) {
+        const cd_field_info *f = &cd_fields[k];
+        const char *a = *cd_field_ptr(&whole, f), *b = *cd_field_ptr(&part, f);
+        size_t e = f->elem_size;
+        if (f->group == CD_GROUP_PARTICLE && f->offset == offsetof(cd_state, prim_first)) {
+            for (size_t q = 0; q < 3; q++)
+                assert_int_equal(part.prim_first[q], (cd_int)index_of(gprim, 6, whole.prim_first[gid[q]]));
+        } else if (f->group == CD_GROUP_PARTICLE) {
+            for (size_t q = 0; q < 3; q++) assert_memory_equal(a + (size_t)gid[q] * e, b + q * e, e);
+        } else if (f->group == CD_GROUP_PRIM && f->offset == offsetof(cd_state, prim_particle)) {
+            for (size_t i = 0; i < 6; i++)
+                assert_int_equal(part.prim_particle[i], (cd_int)index_of(gid, 3, whole.prim_particle[gprim[i]]));
+        } else if (f->group == CD_GROUP_PRIM) {
+            for (size_t i = 0; i < 6; i++) assert_memory_equal(a + (size_t)gprim[i] * e, b + i * e, e);
+        } else if (f->group == CD_GROUP_WALLC) {
+            for (size_t i = 0; i < 6; i++) assert_memory_equal(a + ((size_t)gprim[i] * NW) * e, b + i * NW * e, NW * e);
+        } else {
+            m = 0; /* the whole read's rows between two of the part's primitives, in order */
+            for (size_t r = 0; r < whole.n_pairs; r++) {
+                long long i = index_of(gprim, 6, whole.pair_prim_i[r]), j = index_of(gprim, 6, whole.pair_prim_j[r]);
+                if (i < 0 || j < 0) continue;
+                if (f->offset == offsetof(cd_state, pair_prim_i)) assert_int_equal(part.pair_prim_i[m], i);
+                else if (f->offset == offsetof(cd_state, pair_prim_j)) assert_int_equal(part.pair_prim_j[m], j);
+                else assert_memory_equal(a + r * e, b + m * e, e);
+                m++;
+            }
+        }
+    }
+    assert_true(m > 0); /* (contacts among the part: the test would prove little without) */
+    assert_int_equal(part.n_pairs, m);
+    assert_memory_equal(whole.walls, part.walls, NW * sizeof(cd_wall));
+    assert_memory_equal(&whole.time, &part.time, sizeof whole.time);
+    assert_int_equal(whole.step, part.step);
+    double pos[3][3];
+    assert_int_equal(cd_h5_read_column_rows(path, 0, "position", 2, 3, pos, err, sizeof err), 0);
+    assert_memory_equal(pos, &whole.position[2], sizeof pos);
+    assert_int_equal(cd_h5_read_column_rows(path, 0, "position", 3, 3, pos, err, sizeof err), -1);
+    cd_state_free(&whole);
+    cd_state_free(&part);
+    for (int j = 0; j < 3; j++) cd_state_free(&s[j]);
+    remove_run(path);
+}
+
 static void test_io_h5_leaves_no_hdf5_object_open(void **state)
 {
     (void)state;
@@ -433,6 +506,7 @@ int main(void)
         cmocka_unit_test(test_io_h5_missing_file_is_named),
         cmocka_unit_test(test_io_h5_bad_observables_are_refused),
         cmocka_unit_test(test_io_h5_replace_keeps_old_file_until_first_snapshot),
+        cmocka_unit_test(test_io_h5_part_read_equals_whole_rows),
         cmocka_unit_test(test_io_h5_leaves_no_hdf5_object_open),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
