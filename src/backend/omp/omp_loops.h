@@ -51,6 +51,20 @@ static inline size_t cd_wide_min(void)
 #define CD_STEP_FOR(rows, ...)                                                                                         \
     CD_PRAGMA(omp target teams distribute parallel for if (parallel : (size_t)(rows) >= wide_min_) __VA_ARGS__)
 #endif
+/* A small step's loops in one launch (src/backend/omp/step_omp.c,
+ * forces_and_advance): `CD_ONE_TEAM(rows, clauses)` opens a region of
+ * one team whose threads share the loops marked `CD_TEAM_FOR(clauses)`,
+ * with a barrier after each unless `nowait`.  On a GPU that is one launch
+ * where separate loops were one each (about 8 us apiece, synchronous:
+ * small systems are bound by it); on host devices the region is one
+ * thread running the loops in turn, as its one-team loops did. */
+#if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
+#define CD_ONE_TEAM(rows, ...) CD_PRAGMA(omp target __VA_ARGS__)
+#define CD_TEAM_FOR(...)
+#else
+#define CD_ONE_TEAM(rows, ...) CD_PRAGMA(omp target parallel if (parallel : (size_t)(rows) >= wide_min_) __VA_ARGS__)
+#define CD_TEAM_FOR(...)       CD_PRAGMA(omp for schedule(static) __VA_ARGS__)
+#endif
 /* Clauses only the offload variant needs. */
 #define CD_DEV(...) __VA_ARGS__
 
