@@ -50,8 +50,10 @@
 #                              device tool's limit is 600 per command)
 #   CAPDEM_BUNDLE_HOST=1       a check without a GPU (bench/gpu/check_bundle.sh):
 #                              OMP_TARGET_OFFLOAD=DISABLED, any OpenCL ICD
-#   CAPDEM_BUNDLE_JOBS         tests run at once (default: the cores, at most 16;
-#                              4 with CAPDEM_BUNDLE_HOST)
+#   CAPDEM_BUNDLE_JOBS         tests run at once without a GPU (CAPDEM_BUNDLE_HOST:
+#                              default 4)
+#   CAPDEM_BUNDLE_GPU_JOBS     tests run at once on a GPU (default @GPUJOBS@: they
+#                              share the device; see run_tests)
 #   CAPDEM_BUNDLE_TESTS_CAP    seconds for one test part (default 240)
 #   CAPDEM_BUNDLE_ONLY         regular expression: only the test programs it matches
 #   CAPDEM_BUNDLE_MPM_STEPS    steps of the full-size MPM throughput run (default 200)
@@ -300,8 +302,15 @@ run_tests() { # variant backend label tests...
     [ "$cap" -gt "${CAPDEM_BUNDLE_TESTS_CAP:-240}" ] && cap=${CAPDEM_BUNDLE_TESTS_CAP:-240}
     if [ "$cap" -lt 30 ]; then note "SKIP(no time) $label"; return 0; fi
     mkdir -p "$d"
+    # On a GPU the tests share one device, and CUDA contexts of separate
+    # processes take turns on it: the H100 runs with 4 and 16 tests at a
+    # time left tests unfinished in 300 s that need 3-50 s alone by their
+    # launches and copies (docs/gpu_bundle.md, "The test part on a GPU"), so
+    # there they run CAPDEM_BUNDLE_GPU_JOBS at a time, shortest first.
+    local jobs=$JOBS
+    [ "$HOST" = 1 ] || jobs=${CAPDEM_BUNDLE_GPU_JOBS:-@GPUJOBS@}
     printf '%s\n' "$@" | CAPDEM_BUNDLE_TEST_TIMEOUT=$((cap < 300 ? cap : 300)) \
-        timeout -k 5 "$cap" xargs -P "$JOBS" -I{} bash "$B/run_on_gpu.sh" _test "$BIN/$v" {} "$d/{}" "$be"
+        timeout -k 5 "$cap" xargs -P "$jobs" -I{} bash "$B/run_on_gpu.sh" _test "$BIN/$v" {} "$d/{}" "$be"
     for t in "$@"; do
         if [ -e "$d/$t/status" ]; then s=$(cat "$d/$t/status"); else s="TIMEOUT $t (not finished)"; fi
         note "${s%% *} $label/${s#* }"

@@ -279,12 +279,19 @@ static int differing_span(const void *x, const void *y, size_t n, size_t *first,
  * block a process; a new start finds it as the last launch left it). */
 static int args_sent = 0;
 
-/* Sends bytes [lo, hi) of the host's cd_step_block to the device's. */
-static void args_put(size_t lo, size_t hi)
+/* Copies bytes at host address p to the device: a span of a mapped
+ * column or of the mapped global cd_step_block (the runtime finds either
+ * in its table). */
+static void off_to(void *p, size_t bytes)
 {
-    char *p = (char *)&cd_step_block;
-#pragma omp target update to(p [lo:hi - lo])
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target update to(c [0:bytes])
+    }
 }
+
+/* Sends bytes [lo, hi) of the host's cd_step_block to the device's. */
+static void args_put(size_t lo, size_t hi) { off_to((char *)&cd_step_block + lo, hi - lo); }
 
 /* The step's argument block on the device, brought up to date before a
  * launch: what differs from the last block sent goes out (all of it the
