@@ -39,7 +39,8 @@ static inline size_t cd_wide_min(void)
     return devices > 0 ? 0 : (size_t)cd_parallel_min_rows;
 #endif
 }
-#define CD_WIDE_MIN const size_t wide_min_ = cd_wide_min();
+/* (unused where a loop needs no test: CD_ONE_TEAM on host devices) */
+#define CD_WIDE_MIN const size_t wide_min_ __attribute__((unused)) = cd_wide_min();
 #if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
 /* Host devices: teams of one thread each (host threads), one team for a
  * small loop.  No inner parallel: a serialized one (if (parallel : 0))

@@ -208,6 +208,22 @@ static size_t one_team_rows(void)
     return (size_t)rows;
 }
 
+CD_DEVICE_BEGIN
+/* Particle q's gather, second kick and, with next, the next step's
+ * advance, from the device's argument block; the skin flag set when q's
+ * ends moved beyond half the skin and the flag is there (flagged). */
+CD_INLINE_ALWAYS void gather_kick_advance_item(size_t q, int next, int flagged)
+{
+    if (cd_item_gather_kick_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows,
+                                    CD_A.d.wall_start, CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt,
+                                    CD_A.limit2, CD_A.d.ref_pose, next) &&
+        flagged) {
+#pragma omp atomic write
+        CD_A.d.skin_flag[0] = 1;
+    }
+}
+CD_DEVICE_END
+
 /* The offload step of a small system: pair rows, wall candidates, then
  * (a barrier) the gather with the kick and the next advance, the items of
  * the three launches in one; each row is computed by the same item as
@@ -219,7 +235,7 @@ static void forces_and_advance_one_team(cd_sim *sim, int next, int flagged)
     size_t most = n_pairs > n ? n_pairs : n;
     most = n_walls > most ? n_walls : most;
     cd_int outputs = !next;
-    CD_WIDE_MIN(void) wide_min_; /* (host devices: the region is one thread whatever the rows) */
+    CD_WIDE_MIN
     CD_ARGS(sim)
     CD_ONE_TEAM(most, CD_ARGS_IN)
     {
@@ -231,14 +247,7 @@ static void forces_and_advance_one_team(cd_sim *sim, int next, int flagged)
             cd_item_wall_row(CD_A.c, CD_A.d.wall_rows[e], CD_A.d.wall_out + e, CD_A.walls, CD_A.n_walls, CD_A.wall_law,
                              CD_A.dt, CD_A.sin_parallel, CD_A.blend);
         CD_TEAM_FOR(nowait)
-        for (size_t q = 0; q < n; q++)
-            if (cd_item_gather_kick_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows,
-                                            CD_A.d.wall_start, CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt,
-                                            CD_A.limit2, CD_A.d.ref_pose, next) &&
-                flagged) {
-#pragma omp atomic write
-                CD_A.d.skin_flag[0] = 1;
-            }
+        for (size_t q = 0; q < n; q++) gather_kick_advance_item(q, next, flagged);
     }
     sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
 }
@@ -273,14 +282,7 @@ static int forces_and_advance(cd_sim *sim, int next)
         CD_WIDE_MIN
         CD_ARGS(sim)
         CD_STEP_FOR(n, CD_ARGS_IN)
-        for (size_t q = 0; q < n; q++)
-            if (cd_item_gather_kick_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows,
-                                            CD_A.d.wall_start, CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt,
-                                            CD_A.limit2, CD_A.d.ref_pose, next) &&
-                flagged) {
-#pragma omp atomic write
-                CD_A.d.skin_flag[0] = 1;
-            }
+        for (size_t q = 0; q < n; q++) gather_kick_advance_item(q, next, flagged);
     }
     if (!next) return 0;
     return flagged ? skin_flag_read(sim) : 1; /* without the flag: a rebuild, still correct */
