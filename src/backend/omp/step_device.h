@@ -51,17 +51,17 @@ void cd_off_release(cd_sim *sim);
 /* Copies bytes at host address p back from the device. */
 void cd_off_from(void *p, size_t bytes);
 /* Brings the device's argument block (cd_step_block) up to date for this
- * state; stops the run when the device cannot take it. */
+ * state (`target update`: a copy the device refuses stops the run in the
+ * OpenMP runtime, which has no error return for it). */
 void cd_off_args_or_die(cd_sim *sim);
 
 /* The loops' argument block: one global of the host program and of the
  * device image (declare target), sent by cd_off_args_or_die, read by the
  * loops by name.  Clang puts it in the GPU's constant memory
  * (omp_const_mem_alloc, src/backend/omp/step_device.c): loaded with
- * ld.const, which the compiler knows no store of the kernel can change, so
- * a column address is read where it is used, as an OpenCL kernel reads its
- * arguments, instead of being held in registers from the kernel's start
- * (docs/performance.md, "Session 16").  One block per process: a launch
+ * ld.const, which no store of the kernel can change, so that ptxas need
+ * not hold the column addresses in registers for the whole kernel (pair
+ * forces 197 -> 160 registers; docs/performance.md, "Session 16").  One block per process: a launch
  * fills it for the state it steps. */
 #pragma omp declare target
 extern cd_step_args cd_step_block;
