@@ -86,7 +86,7 @@ fi
 # with its resume cases, the omp/OpenCL parity test) and the cheap unit and
 # config tests; analysis is host-only code.
 TESTS=()
-for d in physics regression protocols unit config; do
+for d in physics regression protocols unit config mpm; do
     for f in "$ROOT"/tests/$d/test_*.c; do TESTS+=("$(basename "$f" .c)"); done
 done
 TESTS+=(test_parity test_drift_bound)
@@ -139,6 +139,16 @@ for c in hexapods_a3 spheres; do
         mv "$f.tmp" "$f"
     fi
 done
+# The full-size MPM compaction's packing (run_on_gpu.sh part mpm): the
+# 300 disks of configs/mpm/deposit_disks.yaml deposited by the DEM solver
+# (250,000 steps, a few CPU-minutes here, once).
+if [ $RESETTLE = 1 ] || [ ! -s "$SETTLED/deposit_disks.h5" ]; then
+    say "depositing the 300 disks of the full-size MPM packing (once; niced; minutes)"
+    (cd "$SETTLED" && rm -f deposit_disks.h5 &&
+        env LD_LIBRARY_PATH="$LLVM" OMP_TARGET_OFFLOAD=DISABLED OMP_WAIT_POLICY=PASSIVE \
+            nice "$WORK/${VARIANTS[-1]}/capdem" run "$ROOT/configs/mpm/deposit_disks.yaml" --quiet >deposit_disks.log 2>&1) ||
+        { tail "$SETTLED/deposit_disks.log" >&2; die "the MPM deposit failed"; }
+fi
 
 # ------------------------------------------------------------- assemble
 say "assembling $OUT"
@@ -149,12 +159,15 @@ case $OUT/ in "$ROOT"/*) git -C "$ROOT" check-ignore -q "$OUT" || die "$OUT is i
 # build, which share most of their code, pack 25 to 1.
 STAGE=$WORK/stage
 rm -rf "$OUT" "$STAGE"
-mkdir -p "$OUT/src" "$STAGE"/{bin,lib,lib.cxx,inputs}
+mkdir -p "$OUT/src" "$STAGE"/{bin,lib,lib.cxx,inputs,tools}
 for v in "${VARIANTS[@]}"; do
     mkdir -p "$STAGE/bin/$v"
     cp "$WORK/$v/capdem" "$WORK/$v/capdem-bench" "$STAGE/bin/$v/"
     for t in "${TESTS[@]}"; do cp "$WORK/$v/tests/$t" "$STAGE/bin/$v/"; done
 done
+# HDF5's command-line tools, which the MPM shell tests read run files with
+# (their libraries are collected below with the programs').
+cp -L "$(command -v h5dump)" "$(command -v h5diff)" "$STAGE/tools/" || die "h5dump/h5diff missing (hdf5-tools)"
 # What the runtimes open with dlopen, not as DT_NEEDED: the CUDA offload
 # plugins (and, through them, libLLVM-16) and the OpenCL ICD loader (the
 # NVIDIA ICD itself comes from the driver).  libomptarget's host-device
@@ -193,7 +206,7 @@ collect() { # binary-or-library
         SEEN[$name]=$path
     done < <(LD_LIBRARY_PATH="$LLVM${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" ldd "$1")
 }
-for f in "$STAGE"/bin/*/* "${DLOPENED[@]}"; do collect "$f"; done
+for f in "$STAGE"/bin/*/* "$STAGE"/tools/* "${DLOPENED[@]}"; do collect "$f"; done
 SEEN[libOpenCL.so.1]=${SEEN[libOpenCL.so.1]:-/usr/lib/x86_64-linux-gnu/libOpenCL.so.1}
 for name in "${!SEEN[@]}"; do
     case $name in
@@ -204,7 +217,7 @@ for name in "${!SEEN[@]}"; do
     *) [ -e "$STAGE/lib/$name" ] || cp -L "${SEEN[$name]}" "$STAGE/lib/$name" ;;
     esac
 done
-cp "$SETTLED"/*_n"$SETTLED_N".h5 "$STAGE/inputs/"
+cp "$SETTLED"/*_n"$SETTLED_N".h5 "$SETTLED/deposit_disks.h5" "$STAGE/inputs/"
 # Two archives: the libraries (220 MiB raw, several minutes of xz -9
 # here) are packed again only when one of them changed; the programs and
 # inputs (they change with every commit: capdem --version names it) pack in
@@ -224,7 +237,7 @@ pack() { # archive folders...
     cp "$WORK/$a" "$OUT/$a"
 }
 pack payload-lib.tar.xz lib lib.cxx
-pack payload-bin.tar.xz bin inputs
+pack payload-bin.tar.xz bin inputs tools
 
 # The part of the source tree the tests read through CAPDEM_SOURCE_DIR
 # (presets, example configs, kernels, and host/capdem_h5.py and
@@ -233,6 +246,9 @@ pack payload-bin.tar.xz bin inputs
 cp -r "$ROOT/configs" "$ROOT/kernels" "$OUT/src/"
 mkdir -p "$OUT/src/host" && cp "$ROOT/host/capdem_h5.py" "$OUT/src/host/"
 mkdir -p "$OUT/src/docs" && cp "$ROOT/docs/output.md" "$OUT/src/docs/" # test_runfile_layout checks its table too
+# the MPM shell tests and what they source or call (part mpm)
+mkdir -p "$OUT/src/tests/mpm" "$OUT/src/tests/cli" && cp "$ROOT"/tests/mpm/*.sh "$ROOT"/tests/mpm/*.py "$OUT/src/tests/mpm/" &&
+    cp "$ROOT/tests/cli/common.sh" "$OUT/src/tests/cli/"
 cp "$ROOT/bench/gpu/run_on_gpu.sh" "$ROOT/bench/gpu/kernel_profile.sh" "$ROOT/bench/gpu/ncu_table.py" "$OUT/"
 chmod +x "$OUT/run_on_gpu.sh" "$OUT/kernel_profile.sh"
 {

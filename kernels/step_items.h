@@ -303,8 +303,8 @@ CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force
  * docs/performance.md, "Argument blocks on the device").  The normal, F_t
  * and the torques are derived on the host for output only (fields.def,
  * PAIR_OUT). */
-CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
-                                  cd_int parallel_blend, cd_int outputs)
+CD_INLINE_ALWAYS void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
+                                         cd_int parallel_blend, cd_int outputs)
 {
     cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
     cd_particle_id pi = c.prim_particle[i], pj = c.prim_particle[j];
@@ -391,9 +391,9 @@ CD_INLINE cd_long cd_wall_out_place(cd_cols c, cd_long row, cd_int n_walls, cons
  * particle-wall law (its mu is replaced by the wall's friction).  *out:
  * the candidate's entry (cd_wall_entry): its history read and written,
  * its outputs written while in contact. */
-CD_INLINE void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_entry *out, const CD_GLOBAL cd_wall *walls,
-                                cd_int n_walls, cd_law_params wall_law, cd_real dt, cd_real sin_parallel,
-                                cd_int parallel_blend)
+CD_INLINE_ALWAYS void cd_item_wall_row(cd_cols c, cd_long row, CD_GLOBAL cd_wall_entry *out,
+                                       const CD_GLOBAL cd_wall *walls, cd_int n_walls, cd_law_params wall_law,
+                                       cd_real dt, cd_real sin_parallel, cd_int parallel_blend)
 {
     cd_prim_id i = (cd_prim_id)(row / n_walls);
     cd_particle_id pi = c.prim_particle[i];
@@ -576,10 +576,12 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
  * with next = 1, the next step's cd_item_advance (returns its skin test),
  * all on particle q's state read once (cd_advance_from): the same
  * arithmetic in the same order as the three items one after the other. */
-CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
-                                          const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                                          const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
-                                          cd_real dt, cd_real limit2, const CD_GLOBAL cd_real *ref_pose, int next)
+CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
+                                                 const CD_GLOBAL cd_pair_id *gather_rows,
+                                                 const CD_GLOBAL cd_int *wall_start,
+                                                 const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity,
+                                                 cd_int dimension, cd_real dt, cd_real limit2,
+                                                 const CD_GLOBAL cd_real *ref_pose, int next)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];

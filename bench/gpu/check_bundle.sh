@@ -16,9 +16,9 @@
 #    libcuda.so.1 (the driver) is the one allowed miss.
 # 3. run_on_gpu.sh PART... with CAPDEM_BUNDLE_HOST=1 (OMP_TARGET_OFFLOAD=
 #    DISABLED: the offload builds run on the host here); default parts:
-#    info tests tests-gcc opencl (PoCL), a one-entry ladder and the dry run of
-#    part kernels (bench/gpu/kernel_profile.sh --dry-run).  Its status is this
-#    script's.
+#    info tests tests-gcc opencl (PoCL), a one-entry ladder, the dry run of
+#    part kernels (bench/gpu/kernel_profile.sh --dry-run) and part mpm (its
+#    throughput runs shortened to 5 steps).  Its status is this script's.
 set -euo pipefail
 [ $# -ge 1 ] || { echo "usage: check_bundle.sh BUNDLE [PART...]" >&2; exit 2; }
 B=$(cd "$1" && pwd)
@@ -52,7 +52,7 @@ allowed() { # path of a loaded library -> 0 if inside the bundle or glibc's
 
 echo "== 1. ldd, env -i, LD_LIBRARY_PATH=$LP"
 n=0
-for f in "$BIN"/*/* "$R"/lib/*.so*; do
+for f in "$BIN"/*/* "$R"/tools/* "$R"/lib/*.so*; do
     [ -L "$f" ] && continue
     out=$(env -i PATH=/usr/bin:/bin LD_LIBRARY_PATH="$LP" ldd "$f" 2>&1) || { echo "ldd $f failed: $out"; fail=1; continue; }
     case $f in */bin/*/capdem) echo "  ${f#"$R"/}: $(grep -c '=>' <<<"$out") libraries; resolved outside the bundle (must be glibc's): $(grep '=>' <<<"$out" | grep -v -e "$R" | awk '{print $1}' | tr '\n' ' ')" ;; esac
@@ -89,11 +89,11 @@ for v in $(cd "$BIN" && ls); do
 done
 
 echo "== 3. run_on_gpu.sh on the host (CAPDEM_BUNDLE_HOST=1)"
-[ $# -gt 0 ] || set -- info tests tests-gcc opencl ladder kernels
+[ $# -gt 0 ] || set -- info tests tests-gcc opencl ladder kernels mpm
 OUTDIR=${CHECK_OUT:-$UNPACK/out}
 rc=0
 mapfile -t pass < <(env | grep '^CAPDEM_BUNDLE_' || true) # the caller's settings of run_on_gpu.sh go through
-env -i PATH=/usr/bin:/bin HOME="$UNPACK" CAPDEM_BUNDLE_JOBS=2 CAPDEM_BUNDLE_LADDER=h1e4 CAPDEM_BUNDLE_STEPS=20 \
+env -i PATH=/usr/bin:/bin HOME="$UNPACK" CAPDEM_BUNDLE_JOBS=2 CAPDEM_BUNDLE_LADDER=h1e4 CAPDEM_BUNDLE_STEPS=20 CAPDEM_BUNDLE_MPM_STEPS=5 \
     CAPDEM_BUNDLE_BUDGET_S=1500 CAPDEM_BUNDLE_TESTS_CAP=600 "${pass[@]}" CAPDEM_BUNDLE_HOST=1 CAPDEM_BUNDLE_UNPACK="$U" OUT="$OUTDIR" \
     POCL_CACHE_DIR="$UNPACK/pocl" nice bash "$B/run_on_gpu.sh" "$@" || rc=$?
 echo "run_on_gpu.sh exit status $rc; files back: $(ls "$OUTDIR" | tr '\n' ' ')"

@@ -30,6 +30,16 @@
 #               offload build (pass 5 per primitive and per particle) and
 #               on OpenCL at 1e5 hexapods, side by side (time, registers,
 #               occupancy, local memory), about 110 s; not in `all`
+#   mpm         the material point method (docs/mpm.md) on the Clang build:
+#               its test programs and shell tests (label mpm, but the two
+#               that draw with matplotlib) with OMP_TARGET_OFFLOAD=MANDATORY,
+#               mpm_opencl_same_bits (omp on the host against OpenCL on the
+#               GPU, bit for bit) when an ICD is there, and the throughput
+#               of the full-size compaction (300 disks, about 121,000
+#               points, configs/mpm/packing_elastic.yaml) shortened to
+#               CAPDEM_BUNDLE_MPM_STEPS steps on omp and OpenCL: JSON lines
+#               in ladder.jsonl; at most about 5 minutes by its caps; not
+#               in `all`
 #   tests-gcc   the tests on the GCC 12 nvptx build
 #   ladder-gcc  the ladder on the GCC build
 # Also: tests-clang, all, quick (info tests-clang ladder).
@@ -40,10 +50,17 @@
 #                              device tool's limit is 600 per command)
 #   CAPDEM_BUNDLE_HOST=1       a check without a GPU (bench/gpu/check_bundle.sh):
 #                              OMP_TARGET_OFFLOAD=DISABLED, any OpenCL ICD
-#   CAPDEM_BUNDLE_JOBS         tests run at once (default: the cores, at most 16;
-#                              4 with CAPDEM_BUNDLE_HOST)
+#   CAPDEM_BUNDLE_JOBS         tests run at once without a GPU (CAPDEM_BUNDLE_HOST:
+#                              default 4)
+#   CAPDEM_BUNDLE_GPU_JOBS     tests run at once on a GPU (default 1: they
+#                              share the device; see run_tests)
 #   CAPDEM_BUNDLE_TESTS_CAP    seconds for one test part (default 240)
 #   CAPDEM_BUNDLE_ONLY         regular expression: only the test programs it matches
+#   CAPDEM_BUNDLE_MPM_STEPS    steps of the full-size MPM throughput run (default 200)
+#   CAPDEM_BUNDLE_MPM_CAP      seconds for the mpm tests (default 150); the
+#                              OpenCL comparison gets 90, each throughput run 60
+#                              (CAPDEM_BUNDLE_MPM_RATE_CAP)
+#   CAPDEM_BUNDLE_MPM_BACKENDS the throughput runs' backends (default "omp opencl")
 #   CAPDEM_BUNDLE_LADDER       ladder entries (default "h1e4 h1e5 h1e6 s1e6")
 #   CAPDEM_BUNDLE_STEPS        timed steps per repeat (default 200; 100 at 1e6)
 #   CAPDEM_BUNDLE_TILES        "KX,KZ KX,KZ KX,KZ": the copies of the settled
@@ -63,9 +80,7 @@ BUDGET=${CAPDEM_BUNDLE_BUDGET_S:-560}
 OUT=${OUT:-$PWD/bundle-out}
 mkdir -p "$OUT"
 HOST=${CAPDEM_BUNDLE_HOST:-0}
-# On a GPU the tests are bound by launch latency, not by the host: the
-# first H100 run, 4 at a time, left 8 of 22 programs unstarted after 300 s
-# behind three that each needed more; the GPU machine has 16 cores.
+# Host work at once (the GPU's tests: CAPDEM_BUNDLE_GPU_JOBS, run_tests).
 NCPU=$(nproc 2>/dev/null || echo 4)
 [ "$NCPU" -gt 16 ] && NCPU=16
 [ "$HOST" = 1 ] && NCPU=4 # the shared development machine
@@ -78,7 +93,11 @@ if [ "${1:-}" = _test ]; then
     bindir=$2 t=$3 d=$4 be=$5
     mkdir -p "$d" && cd "$d" || exit 1
     s=$SECONDS
-    CAPDEM_TEST_BACKEND=$be timeout -k 5 "${CAPDEM_BUNDLE_TEST_TIMEOUT:-300}" "$bindir/$t" >log 2>&1
+    # a test program of the build, or a shell test of tests/mpm (they take
+    # capdem and the source folder, as their CTest entries do)
+    cmd=("$bindir/$t")
+    [ -x "$bindir/$t" ] || cmd=(bash "$CAPDEM_SOURCE_DIR/tests/mpm/$t.sh" "$bindir/capdem" "$CAPDEM_SOURCE_DIR")
+    CAPDEM_TEST_BACKEND=$be timeout -k 5 "${CAPDEM_BUNDLE_TEST_TIMEOUT:-300}" "${cmd[@]}" >log 2>&1
     rc=$?
     w=$((SECONDS - s))
     if [ $rc = 0 ]; then st=PASS; elif [ $rc = 124 ] || [ $rc = 137 ]; then st=TIMEOUT; else st="FAIL(rc=$rc)"; fi
@@ -161,6 +180,9 @@ fi
 # find libcuda.so.1 through it (/usr/local/nvidia/lib64), not ldconfig.
 export LD_LIBRARY_PATH=$LIBPATH${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export CAPDEM_SOURCE_DIR=$B/src
+# HDF5's h5dump and h5diff travel in tools/ (the MPM shell tests read run
+# files with them); the GPU machine has none.
+[ -d "$R/tools" ] && export PATH=$R/tools:$PATH
 # no clang on GPU machines: test_geometry_opencl_c leaves its OpenCL C check to the
 # device compiler (part opencl) instead of failing for want of clang
 command -v clang-14 >/dev/null || command -v clang >/dev/null || export CAPDEM_TEST_NO_CLANG=1
@@ -278,8 +300,15 @@ run_tests() { # variant backend label tests...
     [ "$cap" -gt "${CAPDEM_BUNDLE_TESTS_CAP:-240}" ] && cap=${CAPDEM_BUNDLE_TESTS_CAP:-240}
     if [ "$cap" -lt 30 ]; then note "SKIP(no time) $label"; return 0; fi
     mkdir -p "$d"
+    # On a GPU the tests share one device, and CUDA contexts of separate
+    # processes take turns on it: the H100 runs with 4 and 16 tests at a
+    # time left tests unfinished in 300 s that need 3-50 s alone by their
+    # launches and copies (docs/gpu_bundle.md, "The test part on a GPU"), so
+    # there they run CAPDEM_BUNDLE_GPU_JOBS at a time, shortest first.
+    local jobs=$JOBS
+    [ "$HOST" = 1 ] || jobs=${CAPDEM_BUNDLE_GPU_JOBS:-1}
     printf '%s\n' "$@" | CAPDEM_BUNDLE_TEST_TIMEOUT=$((cap < 300 ? cap : 300)) \
-        timeout -k 5 "$cap" xargs -P "$JOBS" -I{} bash "$B/run_on_gpu.sh" _test "$BIN/$v" {} "$d/{}" "$be"
+        timeout -k 5 "$cap" xargs -P "$jobs" -I{} bash "$B/run_on_gpu.sh" _test "$BIN/$v" {} "$d/{}" "$be"
     for t in "$@"; do
         if [ -e "$d/$t/status" ]; then s=$(cat "$d/$t/status"); else s="TIMEOUT $t (not finished)"; fi
         note "${s%% *} $label/${s#* }"
@@ -288,10 +317,74 @@ run_tests() { # variant backend label tests...
     done
     note "-- $label took $((SECONDS - t0))s"
 }
-ALL_TESTS=$(cd "$BIN/$(echo "$VARIANTS" | head -1)" && ls test_* | grep -vE '^test_(parity|drift_bound)$' | grep -E "${CAPDEM_BUNDLE_ONLY:-.}")
+# Estimated seconds of each test program on a GPU alone, bound by launch
+# and copy latency (bench/gpu/test_launches.sh on the clang-14 host-offload
+# build: launches x 8 us + copies x 10 us; docs/gpu_bundle.md, "The test
+# part on a GPU"); programs not listed step little.  The test part starts
+# them shortest first, so that a capped call reports as many as it can.
+GPU_ESTIMATE_S="test_pair_output:1 test_wall_out:3 test_coulomb_sliding:3 test_hertz_mindlin:4 test_reorder:6 test_determinism:7 test_rest:8 test_conservation:10 test_rotation_order:48 test_protocols:83"
+by_estimate() { # test programs -> the same, shortest estimate first (unlisted first, in name order)
+    local t e
+    for t in "$@"; do
+        e=$(printf '%s\n' $GPU_ESTIMATE_S | sed -n "s/^$t:\([0-9]*\)$/\1/p")
+        echo "${e:-0} $t"
+    done | sort -s -n -k1,1 | cut -d' ' -f2
+}
+# shellcheck disable=SC2046
+ALL_TESTS=$(by_estimate $(cd "$BIN/$(echo "$VARIANTS" | head -1)" && ls test_* | grep -vE '^test_(parity|drift_bound|mpm_.*)$' | grep -E "${CAPDEM_BUNDLE_ONLY:-.}"))
 part_tests() { # variant
     # shellcheck disable=SC2086
     run_tests "$1" omp "tests-$1" $ALL_TESTS
+}
+
+# The material point method: tests, OpenCL against the host, throughput.
+# The mpm test programs of the build and the shell tests of tests/mpm
+# (label mpm) but test_mpm_plots and test_mpm_render (matplotlib, which
+# the GPU machines lack).
+MPM_TESTS=$( (cd "$BIN/$(echo "$VARIANTS" | head -1)" && ls test_mpm_* 2>/dev/null)
+    for f in "$B"/src/tests/mpm/test_mpm_*.sh; do [ -e "$f" ] && basename "$f" .sh; done | grep -vE '^test_mpm_(plots|render)$')
+# One throughput run of the full-size compaction: mpm_rate VARIANT BACKEND
+# (the settled deposit of configs/mpm/deposit_disks.yaml travels as
+# inputs/deposit_disks.h5; the progress line's rate is over the run's
+# steps, snapshots included, and is what the JSON line reports).
+mpm_rate() {
+    local v=$1 be=$2 d=$W/mpm-rate-$2 n rate gpu dev=()
+    [ "$be" = opencl ] && dev=(--device gpu)
+    [ "$HOST" = 1 ] && dev=()
+    mkdir -p "$d" && ln -sf "$INPUTS/deposit_disks.h5" "$d/deposit_disks.h5"
+    step "mpm_rate_$be" "${CAPDEM_BUNDLE_MPM_RATE_CAP:-60}" bash -c "cd '$d' && '$BIN/$v/capdem' run '$B/src/configs/mpm/packing_elastic.yaml' \
+        --steps '${CAPDEM_BUNDLE_MPM_STEPS:-200}' --backend $be ${dev[*]} --output rate.h5 --overwrite; rc=\$?; rm -f rate.h5; exit \$rc"
+    n=$(sed -n 's/^capdem: mpm: \([0-9]*\) material points.*/\1/p' "$LOGS/mpm_rate_$be.log" | head -1)
+    rate=$(grep -o '[0-9.e+-]* point-steps/s' "$LOGS/mpm_rate_$be.log" | tail -1 | cut -d' ' -f1)
+    gpu=$(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | head -1)
+    [ -n "$n" ] && [ -n "$rate" ] || return 0
+    printf '{"build": "%s", "gpu": "%s", "entry": "mpm_packing_elastic", "backend": "%s", "N": %s, "steps": %s, "point_steps_per_s": %s, "particle_steps_per_s": %s, "device": "%s"}\n' \
+        "$v" "${gpu:-none}" "$be" "$n" "${CAPDEM_BUNDLE_MPM_STEPS:-200}" "$rate" "$rate" \
+        "$(sed -n 's/.*backend [a-z]* on \(.*\), output .*/\1/p' "$LOGS/mpm_rate_$be.log" | head -1 | tr -d '"')" >>"$W/ladder.jsonl"
+}
+part_mpm() {
+    local v=clang
+    has "$v" || v=$(echo "$VARIANTS" | head -1)
+    # shellcheck disable=SC2086
+    CAPDEM_BUNDLE_TESTS_CAP=${CAPDEM_BUNDLE_MPM_CAP:-150} run_tests "$v" omp "mpm-$v" $MPM_TESTS
+    if [ -n "$ICD" ] && [ -e "$B/src/tests/mpm/opencl_same_bits.sh" ]; then
+        # omp on the host (one thread: LLVM 16's host fallback, see
+        # CAPDEM_BUNDLE_HOST) against OpenCL on the GPU: the MPM step is
+        # sqrt, +, -, *, / only, rounded alike everywhere, so the same bits
+        step mpm_opencl_same_bits 90 env OMP_TARGET_OFFLOAD=DISABLED OMP_NUM_THREADS=1 bash -c "mkdir -p '$W/mpm-cl' && cd '$W/mpm-cl' && bash '$B/src/tests/mpm/opencl_same_bits.sh' '$BIN/$v/capdem' '$B/src'"
+    else
+        note "SKIP mpm_opencl_same_bits: no OpenCL ICD, or no tests/mpm in the bundle"
+    fi
+    if [ -e "$INPUTS/deposit_disks.h5" ]; then
+        local be
+        for be in ${CAPDEM_BUNDLE_MPM_BACKENDS:-omp opencl}; do
+            [ "$be" = opencl ] && [ -z "$ICD" ] && { note "SKIP mpm_rate_opencl: no OpenCL ICD"; continue; }
+            mpm_rate "$v" "$be"
+        done
+    else
+        note "SKIP mpm_rate: no inputs/deposit_disks.h5 in the bundle"
+    fi
+    return 0
 }
 
 part_opencl() {
@@ -464,8 +557,8 @@ for p in "$@"; do
     quick) PARTS+=(info tests-clang ladder) ;;
     tests) PARTS+=(tests-clang) ;;
     ladder) PARTS+=(ladder-clang) ;;
-    info | tests-clang | tests-gcc | opencl | ladder-clang | ladder-gcc | profile | kernels | sanitize) PARTS+=("$p") ;;
-    *) echo "run_on_gpu.sh: unknown part '$p' (info tests tests-gcc opencl ladder ladder-gcc profile kernels sanitize all quick)" >&2; exit 2 ;;
+    info | tests-clang | tests-gcc | opencl | ladder-clang | ladder-gcc | profile | kernels | sanitize | mpm) PARTS+=("$p") ;;
+    *) echo "run_on_gpu.sh: unknown part '$p' (info tests tests-gcc opencl ladder ladder-gcc profile kernels sanitize mpm all quick)" >&2; exit 2 ;;
     esac
 done
 note "capdem GPU bundle: parts ${PARTS[*]}; OMP_TARGET_OFFLOAD=$OMP_TARGET_OFFLOAD; budget ${BUDGET}s; $(nvidia-smi -L 2>/dev/null | head -1 || true)"
@@ -480,6 +573,7 @@ for p in "${PARTS[@]}"; do
     profile) part_profile ;;
     kernels) part_kernels ;;
     sanitize) part_sanitize ;;
+    mpm) part_mpm ;;
     esac
 done
 
@@ -492,8 +586,9 @@ if [ -s "$W/ladder.jsonl" ]; then
 import json, sys
 for line in open(sys.argv[1]):
     r = json.loads(line)
-    print("ladder %s %-8s %-6s N=%8d %.3g particle-steps/s (%s)" % (r["build"], r["entry"], r["backend"], r["N"],
-          r["particle_steps_per_s"], r.get("device", "")))
+    unit = "point-steps/s" if "point_steps_per_s" in r else "particle-steps/s"
+    print("ladder %s %-8s %-6s N=%8d %.3g %s (%s)" % (r["build"], r["entry"], r["backend"], r["N"],
+          r["particle_steps_per_s"], unit, r.get("device", "")))
 EOF
 fi
 # At most 6 files come back (the device tool returns 8).

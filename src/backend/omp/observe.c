@@ -186,19 +186,19 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
     CD_STEP_FOR(N, is_device_ptr(touch))
     for (cd_long q = 0; q < N; q++) touch[q] = 0;
     CD_STEP_FOR(K, CD_ARGS_IN is_device_ptr(touch))
-    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(a->c, k, touch);
+    for (cd_long k = 0; k < K; k++) cd_obs_item_touch_pair(CD_A.c, k, touch);
     CD_STEP_FOR(n_cand, CD_ARGS_IN is_device_ptr(touch))
-    for (cd_long e = 0; e < n_cand; e++) cd_obs_item_touch_wall(a->c, e, W, a->d.wall_rows, a->d.wall_out, touch);
+    for (cd_long e = 0; e < n_cand; e++) cd_obs_item_touch_wall(CD_A.c, e, W, CD_A.d.wall_rows, CD_A.d.wall_out, touch);
     CD_STEP_FOR(N, CD_ARGS_IN is_device_ptr(touch, part))
     for (cd_long b = 0; b < nb.particles; b++)
-        cd_obs_block_particles(a->c, b, N, a->gravity, touch, part + b * CD_OBS_SLOTS, a->order);
+        cd_obs_block_particles(CD_A.c, b, N, CD_A.gravity, touch, part + b * CD_OBS_SLOTS, CD_A.order);
     CD_STEP_FOR(P, CD_ARGS_IN is_device_ptr(part))
     for (cd_long b = 0; b < nb.pairs; b++)
-        cd_obs_block_pairs(a->c, b, K, a->law, part + pk + b * CD_OBS_SLOTS, a->order);
+        cd_obs_block_pairs(CD_A.c, b, K, CD_A.law, part + pk + b * CD_OBS_SLOTS, CD_A.order);
     CD_STEP_FOR(R, CD_ARGS_IN is_device_ptr(part))
     for (cd_long b = 0; b < nb.walls; b++)
-        cd_obs_block_walls(a->c, b, R, W, a->wall_law, part + pw + b * CD_OBS_SLOTS, a->order, a->d.wall_start,
-                           a->d.wall_rows, a->d.wall_out);
+        cd_obs_block_walls(CD_A.c, b, R, W, CD_A.wall_law, part + pw + b * CD_OBS_SLOTS, CD_A.order, CD_A.d.wall_start,
+                           CD_A.d.wall_rows, CD_A.d.wall_out);
     merge_tree(part, leaves(nb), total, 1);
     return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;
 }

@@ -39,7 +39,8 @@ static inline size_t cd_wide_min(void)
     return devices > 0 ? 0 : (size_t)cd_parallel_min_rows;
 #endif
 }
-#define CD_WIDE_MIN const size_t wide_min_ = cd_wide_min();
+/* (unused where a loop needs no test: CD_ONE_TEAM on host devices) */
+#define CD_WIDE_MIN const size_t wide_min_ __attribute__((unused)) = cd_wide_min();
 #if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
 /* Host devices: teams of one thread each (host threads), one team for a
  * small loop.  No inner parallel: a serialized one (if (parallel : 0))
@@ -50,6 +51,20 @@ static inline size_t cd_wide_min(void)
 #else
 #define CD_STEP_FOR(rows, ...)                                                                                         \
     CD_PRAGMA(omp target teams distribute parallel for if (parallel : (size_t)(rows) >= wide_min_) __VA_ARGS__)
+#endif
+/* A small step's loops in one launch (src/backend/omp/step_omp.c,
+ * forces_and_advance): `CD_ONE_TEAM(rows, clauses)` opens a region of
+ * one team whose threads share the loops marked `CD_TEAM_FOR(clauses)`,
+ * with a barrier after each unless `nowait`.  On a GPU that is one launch
+ * where separate loops were one each (about 8 us apiece, synchronous:
+ * small systems are bound by it); on host devices the region is one
+ * thread running the loops in turn, as its one-team loops did. */
+#if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
+#define CD_ONE_TEAM(rows, ...) CD_PRAGMA(omp target __VA_ARGS__)
+#define CD_TEAM_FOR(...)
+#else
+#define CD_ONE_TEAM(rows, ...) CD_PRAGMA(omp target parallel if (parallel : (size_t)(rows) >= wide_min_) __VA_ARGS__)
+#define CD_TEAM_FOR(...)       CD_PRAGMA(omp for schedule(static) __VA_ARGS__)
 #endif
 /* Clauses only the offload variant needs. */
 #define CD_DEV(...) __VA_ARGS__

@@ -10,6 +10,18 @@
 #include "step_items.h"
 #include "broadphase.h"
 
+#if CD_OFFLOAD
+/* The loops' argument block (step_device.h).  On an NVIDIA GPU Clang
+ * places it in constant memory (64 kB a device; the block is 1.6 kB),
+ * which the host writes between launches as CUDA's cudaMemcpyToSymbol
+ * does, and which a kernel reads through the constant cache; GCC 12 has
+ * no such allocator (`#pragma omp allocate` of a global is not
+ * implemented there) and keeps it in global memory, as do LLVM's host
+ * offload devices. */
+#pragma omp declare target
+cd_step_args cd_step_block;
+#pragma omp end declare target
+#endif
 
 /* The state's device columns for the per-item functions of
  * kernels/step_items.h. */
@@ -95,7 +107,6 @@ void cd_off_release(cd_sim *sim)
     for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
     for (int k = 0; k < 2; k++) off_unmap(o->arm_host[k], o->arm_bytes[k]);
     off_unmap(o->part, o->part_n * sizeof(double));
-    cd_dev_free(o->args_dev);
     free(o->part);
     free(o->host);
     free(o->bytes);
@@ -264,43 +275,49 @@ static int differing_span(const void *x, const void *y, size_t n, size_t *first,
     return 1;
 }
 
+/* What the device's block holds: 0 until the first block went out (one
+ * block a process; a new start finds it as the last launch left it). */
+static int args_sent = 0;
+
+/* Copies bytes at host address p to the device: a span of a mapped
+ * column or of the mapped global cd_step_block (the runtime finds either
+ * in its table). */
+static void off_to(void *p, size_t bytes)
+{
+    char *c = p;
+    if (c && bytes) {
+#pragma omp target update to(c [0:bytes])
+    }
+}
+
+/* Sends bytes [lo, hi) of the host's cd_step_block to the device's. */
+static void args_put(size_t lo, size_t hi) { off_to((char *)&cd_step_block + lo, hi - lo); }
+
 /* The step's argument block on the device, brought up to date before a
- * launch: what differs from the last block sent goes out (all of it after
- * a start; otherwise the span of the head from its first to its last
+ * launch: what differs from the last block sent goes out (all of it the
+ * first time; otherwise the span of the head from its first to its last
  * changed word: the addresses a build or re-map moved, the two swapped
- * wall-candidate lists of every build, a change of the laws; the walls in
- * use after they moved), nothing otherwise.  NULL when the device block
- * could not be had. */
-static const cd_step_args *cd_off_args(cd_sim *sim)
+ * wall-candidate lists of every build, a change of the laws, another
+ * state's block; the walls in use after they moved), nothing otherwise.
+ * The host's cd_step_block is the copy of what the device holds. */
+void cd_off_args_or_die(cd_sim *sim)
 {
     cd_off *o = sim->backend_data;
     cd_step_args a;
     cd_step_args_fill(sim, &a);
     size_t head = offsetof(cd_step_args, walls), walls = sim->s.n_walls * sizeof(cd_wall), lo = 0, hi = head;
-    if (!o->args_dev && !(o->args_dev = cd_dev_alloc(sizeof(cd_step_args)))) return NULL;
-    if (!o->args_sent || differing_span(&a, &o->args_host, head, &lo, &hi)) {
-        if (cd_dev_put((char *)o->args_dev + lo, (const char *)&a + lo, hi - lo)) return NULL;
+    if (!args_sent || differing_span(&a, &cd_step_block, head, &lo, &hi)) {
+        memcpy((char *)&cd_step_block + lo, (const char *)&a + lo, hi - lo);
+        args_put(lo, hi);
         o->args_copies[0]++;
         o->args_bytes[0] += (long long)(hi - lo);
     }
-    if (walls && (!o->args_sent || memcmp(a.walls, o->args_host.walls, walls))) {
-        if (cd_dev_put(o->args_dev->walls, a.walls, walls)) return NULL;
+    if (walls && (!args_sent || memcmp(a.walls, cd_step_block.walls, walls))) {
+        memcpy(cd_step_block.walls, a.walls, walls);
+        args_put(head, head + walls);
         o->args_copies[1]++;
         o->args_bytes[1] += (long long)walls;
     }
-    o->args_host = a;
-    o->args_sent = 1;
-    return o->args_dev;
-}
-/* The loops have no error path: a device that cannot take 1.5 kB is
- * gone, and the run stops here rather than compute with stale arguments. */
-const cd_step_args *cd_off_args_or_die(cd_sim *sim)
-{
-    const cd_step_args *a = cd_off_args(sim);
-    if (!a) {
-        fprintf(stderr, "capdem: the offload device refused the step's argument block (1.5 kB): stopping\n");
-        abort();
-    }
-    return a;
+    args_sent = 1;
 }
 #endif

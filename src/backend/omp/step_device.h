@@ -10,12 +10,13 @@
 
 /* What every loop of a step takes besides its row count: the columns, the
  * lists, the laws and the walls, as one block.  In the offload variant the
- * block lives on the device (cd_off_args_or_die): the loops take its device address
- * (is_device_ptr), so a launch copies and allocates nothing; a
- * firstprivate struct was one packed host-to-device copy per launch
- * (280-624 B; docs/offload.md, "Per-step copies").  The walls come last:
- * they change every step while a protocol moves one, the rest only when a
- * build or a re-map moves the buffers. */
+ * block is one global of the device image (cd_step_block, below): the
+ * loops read it by name, so a launch copies and allocates nothing and, on
+ * an NVIDIA GPU, the block sits in constant memory; a firstprivate struct
+ * was one packed host-to-device copy per launch (280-624 B;
+ * docs/offload.md, "Per-step copies").  The walls come last: they change
+ * every step while a protocol moves one, the rest only when a build or a
+ * re-map moves the buffers. */
 typedef struct {
     cd_cols c;
     cd_nb_lists d;
@@ -38,9 +39,6 @@ typedef struct {
     double *part;        /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;              /* device addresses of the columns */
-    cd_step_args *args_dev;   /* the loops' argument block on the device (cd_off_args_or_die) */
-    cd_step_args args_host;   /* what it holds */
-    int args_sent;            /* 0 until the first block went out */
     long long args_copies[2]; /* copies of the block's head and of its walls since start */
     long long args_bytes[2];  /* their bytes */
 } cd_off;
@@ -52,46 +50,61 @@ int cd_off_acquire(cd_sim *sim, char *err, size_t errlen);
 void cd_off_release(cd_sim *sim);
 /* Copies bytes at host address p back from the device. */
 void cd_off_from(void *p, size_t bytes);
-/* The step's argument block on the device, up to date; stops the run
- * when the device cannot hold it. */
-const cd_step_args *cd_off_args_or_die(cd_sim *sim);
+/* Brings the device's argument block (cd_step_block) up to date for this
+ * state (`target update`: a copy the device refuses stops the run in the
+ * OpenMP runtime, which has no error return for it). */
+void cd_off_args_or_die(cd_sim *sim);
+
+/* The loops' argument block: one global of the host program and of the
+ * device image (declare target), sent by cd_off_args_or_die, read by the
+ * loops by name.  Clang puts it in the GPU's constant memory
+ * (omp_const_mem_alloc, src/backend/omp/step_device.c): loaded with
+ * ld.const, which no store of the kernel can change, so that ptxas need
+ * not hold the column addresses in registers for the whole kernel (pair
+ * forces 197 -> 160 registers; docs/performance.md, "Session 16").  One block per process: a launch
+ * fills it for the state it steps. */
+#pragma omp declare target
+extern cd_step_args cd_step_block;
+#if defined(__clang__) && __clang_major__ >= 16
+/* (every file that reads it must know where it lives) */
+#pragma omp allocate(cd_step_block) allocator(omp_const_mem_alloc)
+#endif
+#pragma omp end declare target
 #endif
 
 /* The block for the state as it is now, padding zeroed (blocks are
  * compared byte by byte). */
 void cd_step_args_fill(cd_sim *sim, cd_step_args *a);
 
-/* A loop's arguments: `CD_ARGS(sim)` declares `a`, the block for the state
- * as it is now, and `CD_ARGS_IN` hands it to a CD_STEP_FOR loop.  Offload:
- * the device block, brought up to date (a launch copies nothing unless the
- * block changed); host threads: a block on the stack, shared by the
- * threads.
+/* A loop's arguments: `CD_ARGS(sim)` makes the block for the state as it
+ * is now, `CD_ARGS_IN` hands it to a CD_STEP_FOR loop and `CD_A` is its
+ * address there (`CD_A->c`, `CD_A->dt`).  Offload: the device's global
+ * block, brought up to date (a launch copies nothing unless the block
+ * changed); host threads: a block on the stack, shared by the threads.
  *
  * The passes of the neighbour-list build and the reorder read only the
  * columns, lists, order and walls: `CD_BUILD_ARGS(sim)` and `CD_BUILD_IN`,
  * and the loops name them `CD_B.c`, `CD_B.d`, `CD_B.order`, `CD_B.walls`.
- * Offload: the device block (`CD_B` is `*a`); host threads: a private copy
- * of those alone per thread (cd_build_view, firstprivate, as the structs
- * of these loops were), which the compiler knows no store of the loop
- * can change: read through a shared pointer, every store to a list
- * reloaded the column addresses (the build took 5 % more instructions,
- * callgrind). */
+ * Offload: the device's block (`CD_B` is cd_step_block); host threads: a
+ * private copy of those alone per thread (cd_build_view, firstprivate, as
+ * the structs of these loops were), which the compiler knows no store of
+ * the loop can change: read through a shared pointer, every store to a
+ * list reloaded the column addresses (the build took 5 % more
+ * instructions, callgrind). */
 #if CD_OFFLOAD
-/* The block's address, known aligned as the block (kernels/defs.h,
- * CD_ALIGN_VALUE: a cd_cols copied out of it would otherwise be read a
- * byte at a time on NVPTX). */
-typedef const cd_step_args *cd_step_args_ptr CD_ALIGN_VALUE(cd_step_args);
-#define CD_ARGS(sim)       cd_step_args_ptr a = cd_off_args_or_die(sim);
-#define CD_ARGS_IN         is_device_ptr(a)
+#define CD_ARGS(sim) cd_off_args_or_die(sim);
+#define CD_ARGS_IN
+#define CD_A               cd_step_block
 #define CD_BUILD_ARGS(sim) CD_ARGS(sim)
-#define CD_BUILD_IN        CD_ARGS_IN
-#define CD_B               (*a)
+#define CD_BUILD_IN
+#define CD_B cd_step_block
 #else
 #define CD_ARGS(sim)                                                                                                   \
     cd_step_args a_;                                                                                                   \
     cd_step_args_fill(sim, &a_);                                                                                       \
     const cd_step_args *a = &a_;
 #define CD_ARGS_IN         firstprivate(a)
+#define CD_A               (*a)
 typedef struct {
     cd_cols c;
     cd_nb_lists d;

@@ -77,15 +77,16 @@ static int advance_particles(cd_sim *sim)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
-        if (cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2, a->d.ref_pose)) {
+        if (cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose)) {
 #pragma omp atomic write
-            a->d.skin_flag[0] = 1;
+            CD_A.d.skin_flag[0] = 1;
         }
     moved = skin_flag_read(sim);
 #else
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN reduction(| : moved))
-    for (size_t q = 0; q < n; q++) moved |= cd_item_advance(a->c, (cd_particle_id)q, a->dt, a->limit2, a->d.ref_pose);
+    for (size_t q = 0; q < n; q++)
+        moved |= cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
 #endif
     return moved;
 }
@@ -113,7 +114,7 @@ static void pair_forces(cd_sim *sim, cd_int outputs)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t k = 0; k < n; k++)
-        cd_item_pair_force(a->c, (cd_pair_id)k, a->law, a->dt, a->sin_parallel, a->blend, outputs);
+        cd_item_pair_force(CD_A.c, (cd_pair_id)k, CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
 }
 
 /* One work item per wall candidate of the last build (cd_item_wall_row).
@@ -126,8 +127,8 @@ static void wall_forces(cd_sim *sim)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t e = 0; e < n; e++)
-        cd_item_wall_row(a->c, a->d.wall_rows[e], a->d.wall_out + e, a->walls, a->n_walls, a->wall_law, a->dt,
-                         a->sin_parallel, a->blend);
+        cd_item_wall_row(CD_A.c, CD_A.d.wall_rows[e], CD_A.d.wall_out + e, CD_A.walls, CD_A.n_walls, CD_A.wall_law,
+                         CD_A.dt, CD_A.sin_parallel, CD_A.blend);
     sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
 }
 
@@ -140,8 +141,8 @@ static void gather(cd_sim *sim)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
-        cd_item_gather(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start, a->d.wall_out,
-                       a->gravity, a->dimension);
+        cd_item_gather(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                       CD_A.d.wall_out, CD_A.gravity, CD_A.dimension);
 }
 
 /* Forces for the current positions (neighbour list up to date), without
@@ -187,6 +188,71 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
 }
 #endif
 
+#if CD_OFFLOAD
+/* Rows (the most of pair rows, wall candidates and particles) up to which
+ * a step's three loops run as one launch of one team (CD_ONE_TEAM): the
+ * launches of a small system cost more than its work (on an H100 about
+ * 8 us each, synchronous; the GPU test runs of 2026-11-26/27 left small
+ * cases unfinished in 300 s).  256: about two rows a thread of a team of
+ * LLVM 16's default 128 threads (its register budget, 65,536 / 128, holds
+ * the step's 196-212 registers a thread); CAPDEM_ONE_TEAM_ROWS=N sets it
+ * (0: never), so that a GPU run can compare. */
+static size_t one_team_rows(void)
+{
+    static long rows = -1;
+    if (rows < 0) {
+        const char *v = getenv("CAPDEM_ONE_TEAM_ROWS");
+        rows = v && *v ? atol(v) : 256;
+        if (rows < 0) rows = 0;
+    }
+    return (size_t)rows;
+}
+
+CD_DEVICE_BEGIN
+/* Particle q's gather, second kick and, with next, the next step's
+ * advance, from the device's argument block; the skin flag set when q's
+ * ends moved beyond half the skin and the flag is there (flagged). */
+CD_INLINE_ALWAYS void gather_kick_advance_item(size_t q, int next, int flagged)
+{
+    if (cd_item_gather_kick_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows,
+                                    CD_A.d.wall_start, CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt,
+                                    CD_A.limit2, CD_A.d.ref_pose, next) &&
+        flagged) {
+#pragma omp atomic write
+        CD_A.d.skin_flag[0] = 1;
+    }
+}
+CD_DEVICE_END
+
+/* The offload step of a small system: pair rows, wall candidates, then
+ * (a barrier) the gather with the kick and the next advance, the items of
+ * the three launches in one; each row is computed by the same item as
+ * there, so the same bits; the skin flag is written on the device when
+ * flagged, as there. */
+static void forces_and_advance_one_team(cd_sim *sim, int next, int flagged)
+{
+    size_t n_pairs = sim->s.n_pairs, n_walls = sim->s.n_walls ? sim->nb.n_wall_rows : 0, n = sim->s.n_particles;
+    size_t most = n_pairs > n ? n_pairs : n;
+    most = n_walls > most ? n_walls : most;
+    cd_int outputs = !next;
+    CD_WIDE_MIN
+    CD_ARGS(sim)
+    CD_ONE_TEAM(most, CD_ARGS_IN)
+    {
+        CD_TEAM_FOR(nowait) /* the wall rows write other rows and read only the particles */
+        for (size_t k = 0; k < n_pairs; k++)
+            cd_item_pair_force(CD_A.c, (cd_pair_id)k, CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
+        CD_TEAM_FOR()
+        for (size_t e = 0; e < n_walls; e++)
+            cd_item_wall_row(CD_A.c, CD_A.d.wall_rows[e], CD_A.d.wall_out + e, CD_A.walls, CD_A.n_walls, CD_A.wall_law,
+                             CD_A.dt, CD_A.sin_parallel, CD_A.blend);
+        CD_TEAM_FOR(nowait)
+        for (size_t q = 0; q < n; q++) gather_kick_advance_item(q, next, flagged);
+    }
+    sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
+}
+#endif
+
 /* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
  * the next step (its advance; returns its skin test); next = 0 (the call's
  * last step): the pair rows' overlap and F_n are written too.
@@ -200,25 +266,24 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
  * its own loop, in the same order: the same bits.  An offload device runs
  * three launches: pair rows, wall candidates, and the gather with the
  * kick and the next advance (the same item as on host threads; the skin
- * flag stays on the device, one int back). */
+ * flag stays on the device, one int back); a small system (up to
+ * one_team_rows() rows) the same loops in one launch of one team. */
 static int forces_and_advance(cd_sim *sim, int next)
 {
 #if CD_OFFLOAD
-    pair_forces(sim, !next);
-    wall_forces(sim);
-    size_t n = sim->s.n_particles;
+    size_t n = sim->s.n_particles, most = sim->s.n_pairs > n ? sim->s.n_pairs : n;
+    if (sim->s.n_walls && sim->nb.n_wall_rows > most) most = sim->nb.n_wall_rows;
     int flagged = next && skin_flag(sim);
-    CD_WIDE_MIN
-    CD_ARGS(sim)
-    CD_STEP_FOR(n, CD_ARGS_IN)
-    for (size_t q = 0; q < n; q++)
-        if (cd_item_gather_kick_advance(a->c, (cd_particle_id)q, a->d.gather_start, a->d.gather_rows, a->d.wall_start,
-                                        a->d.wall_out, a->gravity, a->dimension, a->dt, a->limit2, a->d.ref_pose,
-                                        next) &&
-            flagged) {
-#pragma omp atomic write
-            a->d.skin_flag[0] = 1;
-        }
+    if (most <= one_team_rows()) {
+        forces_and_advance_one_team(sim, next, flagged);
+    } else {
+        pair_forces(sim, !next);
+        wall_forces(sim);
+        CD_WIDE_MIN
+        CD_ARGS(sim)
+        CD_STEP_FOR(n, CD_ARGS_IN)
+        for (size_t q = 0; q < n; q++) gather_kick_advance_item(q, next, flagged);
+    }
     if (!next) return 0;
     return flagged ? skin_flag_read(sim) : 1; /* without the flag: a rebuild, still correct */
 #else
@@ -292,7 +357,7 @@ static int check_step_state(cd_sim *sim, char *err, size_t errlen)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN reduction(max : bad) map(tofrom : bad))
     for (size_t q = 0; q < n; q++)
-        if (cd_item_not_finite(a->c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
+        if (cd_item_not_finite(CD_A.c, (cd_particle_id)q)) bad = (long)q > bad ? (long)q : bad;
     cd_int uid = (cd_int)bad;
     if (bad >= 0 && sim->nb.ordered) cd_dev_get(&uid, sim->nb.d.part_uid + bad, sizeof uid);
     return report_bad(&sim->s, uid, err, errlen);
@@ -313,7 +378,7 @@ static void store_ends(cd_sim *sim)
     CD_WIDE_MIN
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
-    for (size_t q = 0; q < n; q++) cd_item_particle_ends(a->c, (cd_particle_id)q);
+    for (size_t q = 0; q < n; q++) cd_item_particle_ends(CD_A.c, (cd_particle_id)q);
 #else
     (void)sim;
 #endif
@@ -551,8 +616,8 @@ static int omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     CD_ARGS(sim)
     CD_STEP_FOR(nch, CD_ARGS_IN is_device_ptr(prim_at))
     for (size_t ch = 0; ch < nch; ch++)
-        part[ch] = cd_item_wall_load_chunk(a->c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at, a->d.wall_start,
-                                           a->d.wall_rows, a->d.wall_out);
+        part[ch] = cd_item_wall_load_chunk(CD_A.c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at, CD_A.d.wall_start,
+                                           CD_A.d.wall_rows, CD_A.d.wall_out);
         /* the chunks in order into the slot after them, which alone comes
      * back: no mapping made per call, one double copied */
 #pragma omp target
