@@ -67,10 +67,10 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * history (24) and its particles' x, v, omega, m (80 per particle,
      * counted for every particle; with CD_ENDS_FROM_POSE the orientation
      * too); writes flag, history, point, force (76; the flag only when it
-     * changes with CD_ENDS_FROM_POSE: 72), and the overlap and F_n (16) at
-     * the last step of a call only. */
+     * changes with CD_ENDS_FROM_POSE: 72), and F_n (8) at the last step of
+     * a call only (the overlap is derived where it is read). */
     out[0] = (cd_traffic){"pair_forces", R * 12 + P * 12 + ends + A * 24 + N * (80 + pose),
-                          A * (CD_ENDS_FROM_POSE ? 72 : 76) + A * 16 / steps_per_call};
+                          A * (CD_ENDS_FROM_POSE ? 72 : 76) + A * 8 / steps_per_call};
     /* cd_item_wall_row over the wall candidates: per candidate its row,
      * its entry's flag and its primitive (particle, radius, end a, arm
      * index: 4 + 4 + 40; an arm's b: 24; an upper bound when a primitive
