@@ -92,15 +92,18 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * (cd_item_gather_kick_advance; omp on host threads and offload, and
      * OpenCL's cd_cl_gather_kick in mode 2) reading the particle once: m,
      * x, the two CSR starts (40), v, L, q, I (104), its primitive range
-     * (8), its primitives' as the advance (advance_prims); writes F, T, v,
-     * L, x, omega (144), q (32) and the primitives' world ends
-     * (advance_writes).  The advance of its own runs once per call of the
-     * step. */
-    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + advance_prims + gather_rows, N * 176 + advance_writes};
+     * (8), its primitives' as the advance (advance_prims); writes v, L, x,
+     * omega (96), q (32) and the primitives' world ends (advance_writes),
+     * and F, T (48) at the last step of a call only.  The advance of its
+     * own runs once per call of the step. */
+    double force_writes = N * 48 / steps_per_call;
+    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + advance_prims + gather_rows,
+                          N * 128 + force_writes + advance_writes};
     /* with CD_ENDS_FROM_POSE: the pose at the build (64) instead of the
      * primitive range and the primitives' ends (8 + advance_prims), no ends
      * written */
-    if (CD_ENDS_FROM_POSE) out[2] = (cd_traffic){"gather_kick_advance", N * (144 + 64) + gather_rows, N * 176};
+    if (CD_ENDS_FROM_POSE)
+        out[2] = (cd_traffic){"gather_kick_advance", N * (144 + 64) + gather_rows, N * 128 + force_writes};
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};

@@ -309,21 +309,31 @@ CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force
 CD_INLINE int cd_pair_narrow(cd_cols c, cd_prim_id i, cd_prim_id j, cd_real ri, cd_real rj, cd_real sin_parallel,
                              cd_int parallel_blend, cd_contact_geom *g)
 {
-    if (c.prim_arm && c.prim_arm[i] < 0 && c.prim_arm[j] < 0)
-        return cd_segseg_point_contact(cd_ball_world_point(c, i), ri, cd_ball_world_point(c, j), rj, g);
-    cd_vec3 ai, bi, aj, bj;
-    cd_prim_world_ends(c, i, &ai, &bi);
-    cd_prim_world_ends(c, j, &aj, &bj);
-    int point_i = cd_segseg_is_point(ai, bi), point_j = cd_segseg_is_point(aj, bj);
-    /* two points (balls with an arm of zero length): the same geometry
-     * without the segment machinery */
-    if (point_i && point_j) return cd_segseg_point_contact(ai, ri, aj, rj, g);
-    /* a sphere and an arm: the same, without the parallel rule */
-    if (point_i || point_j) return cd_segseg_point_segment_contact(ai, bi, ri, aj, bj, rj, g);
-    cd_real s, t;
-    cd_segseg_closest(ai, bi, aj, bj, &s, &t);
-    int apart = cd_segseg_clearly_apart(ai, bi, ri, aj, bj, rj, s, t);
-    if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, g);
+    /* (one return at the end: the shape of the pair item before this was
+     * a function, whose object code returning from each branch took 1 %
+     * more instructions in the pair pass, callgrind) */
+    int apart;
+    if (c.prim_arm && c.prim_arm[i] < 0 && c.prim_arm[j] < 0) {
+        apart = cd_segseg_point_contact(cd_ball_world_point(c, i), ri, cd_ball_world_point(c, j), rj, g);
+    } else {
+        cd_vec3 ai, bi, aj, bj;
+        cd_prim_world_ends(c, i, &ai, &bi);
+        cd_prim_world_ends(c, j, &aj, &bj);
+        int point_i = cd_segseg_is_point(ai, bi), point_j = cd_segseg_is_point(aj, bj);
+        if (point_i && point_j) {
+            /* two points (balls with an arm of zero length): the same
+             * geometry without the segment machinery */
+            apart = cd_segseg_point_contact(ai, ri, aj, rj, g);
+        } else if (point_i || point_j) {
+            /* a sphere and an arm: the same, without the parallel rule */
+            apart = cd_segseg_point_segment_contact(ai, bi, ri, aj, bj, rj, g);
+        } else {
+            cd_real s, t;
+            cd_segseg_closest(ai, bi, aj, bj, &s, &t);
+            apart = cd_segseg_clearly_apart(ai, bi, ri, aj, bj, rj, s, t);
+            if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, g);
+        }
+    }
     return apart;
 }
 
@@ -577,7 +587,13 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
 /* cd_item_gather, then the second half kick over dt/2 (cd_item_kick) and,
  * with next = 1, the next step's cd_item_advance (returns its skin test),
  * all on particle q's state read once (cd_advance_from): the same
- * arithmetic in the same order as the three items one after the other. */
+ * arithmetic in the same order as the three items one after the other.
+ * The force and torque go into their columns at the call's last step only
+ * (next = 0): within a call only this item's advance reads them, from its
+ * locals; the next call's first advance (cd_item_advance), output, the
+ * observables and the protocols read the columns after a call (48 B
+ * written a particle-step less; docs/performance.md, "Session 16, issue
+ * 21"). */
 CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                                           const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
                                           const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
@@ -586,10 +602,10 @@ CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
     cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F, &T);
-    c.force[q] = F;
-    c.torque[q] = T;
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
     if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2, ref_pose);
+    c.force[q] = F;
+    c.torque[q] = T;
     c.velocity[q] = v;
     c.angmom[q] = L;
     c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, c.inertia[q]);
