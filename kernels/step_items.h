@@ -602,10 +602,12 @@ CD_INLINE int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
     cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F, &T);
+    if (!next) {
+        c.force[q] = F;
+        c.torque[q] = T;
+    }
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
     if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2, ref_pose);
-    c.force[q] = F;
-    c.torque[q] = T;
     c.velocity[q] = v;
     c.angmom[q] = L;
     c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, c.inertia[q]);
