@@ -347,7 +347,7 @@ CD_INLINE int cd_pair_narrow(cd_cols c, cd_prim_id i, cd_prim_id j, cd_real ri, 
  * device").  The overlap, the normal, F_t and the torques are derived
  * where they are read: the overlap by the observables from the same
  * narrow phase (cd_pair_narrow), all four on the host for output
- * (fields.def, PAIR_OUT; docs/performance.md, "Session 16"). */
+ * (fields.def, PAIR_OUT; docs/performance.md, "Session 16, issue 21"). */
 CD_INLINE void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
                                   cd_int parallel_blend, cd_int outputs)
 {
@@ -532,6 +532,9 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
 {
     cd_vec3 F = cd_v3_scale(gravity, m);
     cd_vec3 T = cd_v3_zero();
+    /* the factor of a side, read from a table: one load where the integer
+     * 2 side - 1 took three instructions and a conversion (the same +-1) */
+    const cd_real side_sign[2] = {CD_R(-1), CD_R(1)};
     for (cd_int r = wall_start[q]; r < wall_start[q + 1]; r++) {
         if (!wall_out[r].active) continue;
         F = cd_v3_add(F, wall_out[r].force);
@@ -558,7 +561,7 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
          * F + (-f) is F - f).  Branches on the row's activity and side
          * follow no pattern: they were mispredicted about three times per
          * particle-step (callgrind --branch-sim, 10,000 spheres). */
-        cd_vec3 f = cd_v3_scale(c.pair_force[k], (cd_real)(2 * (e & 1) - 1));
+        cd_vec3 f = cd_v3_scale(c.pair_force[k], side_sign[e & 1]);
         F = cd_v3_add(F, f);
         T = cd_v3_add(T, cd_contact_torque(c.pair_point[k], x, f));
     }
