@@ -309,9 +309,6 @@ CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force
 CD_INLINE int cd_pair_narrow(cd_cols c, cd_prim_id i, cd_prim_id j, cd_real ri, cd_real rj, cd_real sin_parallel,
                              cd_int parallel_blend, cd_contact_geom *g)
 {
-    /* (one return at the end: the shape of the pair item before this was
-     * a function, whose object code returning from each branch took 1 %
-     * more instructions in the pair pass, callgrind) */
     int apart;
     if (c.prim_arm && c.prim_arm[i] < 0 && c.prim_arm[j] < 0) {
         apart = cd_segseg_point_contact(cd_ball_world_point(c, i), ri, cd_ball_world_point(c, j), rj, g);
