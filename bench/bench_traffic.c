@@ -67,10 +67,10 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * history (24) and its particles' x, v, omega, m (80 per particle,
      * counted for every particle; with CD_ENDS_FROM_POSE the orientation
      * too); writes flag, history, point, force (76; the flag only when it
-     * changes with CD_ENDS_FROM_POSE: 72), and the overlap and F_n (16) at
-     * the last step of a call only. */
+     * changes with CD_ENDS_FROM_POSE: 72), and F_n (8) at the last step of
+     * a call only (the overlap is derived where it is read). */
     out[0] = (cd_traffic){"pair_forces", R * 12 + P * 12 + ends + A * 24 + N * (80 + pose),
-                          A * (CD_ENDS_FROM_POSE ? 72 : 76) + A * 16 / steps_per_call};
+                          A * (CD_ENDS_FROM_POSE ? 72 : 76) + A * 8 / steps_per_call};
     /* cd_item_wall_row over the wall candidates: per candidate its row,
      * its entry's flag and its primitive (particle, radius, end a, arm
      * index: 4 + 4 + 40; an arm's b: 24; an upper bound when a primitive
@@ -92,15 +92,18 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * (cd_item_gather_kick_advance; omp on host threads and offload, and
      * OpenCL's cd_cl_gather_kick in mode 2) reading the particle once: m,
      * x, the two CSR starts (40), v, L, q, I (104), its primitive range
-     * (8), its primitives' as the advance (advance_prims); writes F, T, v,
-     * L, x, omega (144), q (32) and the primitives' world ends
-     * (advance_writes).  The advance of its own runs once per call of the
-     * step. */
-    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + advance_prims + gather_rows, N * 176 + advance_writes};
+     * (8), its primitives' as the advance (advance_prims); writes v, L, x,
+     * omega (96), q (32) and the primitives' world ends (advance_writes),
+     * and F, T (48) at the last step of a call only.  The advance of its
+     * own runs once per call of the step. */
+    double force_writes = N * 48 / steps_per_call;
+    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + advance_prims + gather_rows,
+                          N * 128 + force_writes + advance_writes};
     /* with CD_ENDS_FROM_POSE: the pose at the build (64) instead of the
      * primitive range and the primitives' ends (8 + advance_prims), no ends
      * written */
-    if (CD_ENDS_FROM_POSE) out[2] = (cd_traffic){"gather_kick_advance", N * (144 + 64) + gather_rows, N * 176};
+    if (CD_ENDS_FROM_POSE)
+        out[2] = (cd_traffic){"gather_kick_advance", N * (144 + 64) + gather_rows, N * 128 + force_writes};
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};

@@ -86,7 +86,6 @@ COLUMN = {
     "pair_shear": ("/contacts/pair_shear", "rows", "pair", 3, "m"),
     "pair_point": ("/contacts/pair_point", "rows", "pair", 3, "m"),
     "pair_force": ("/contacts/pair_force", "rows", "pair", 3, "N"),
-    "pair_overlap": ("/contacts/pair_overlap", "rows", "pair", 1, "m"),
     "pair_fn": ("/contacts/pair_fn", "rows", "pair", 1, "N"),
     "prim_a_body": ("/particles/prims/prim_a_body", "fixed", "prim", 3, "m"),
     "prim_b_body": ("/particles/prims/prim_b_body", "fixed", "prim", 3, "m"),
@@ -102,6 +101,7 @@ COLUMN = {
     "pair_ft": ("/contacts/pair_ft", "rows", "pair_out", 3, "N"),
     "pair_torque_i": ("/contacts/pair_torque_i", "rows", "pair_out", 3, "N m"),
     "pair_torque_j": ("/contacts/pair_torque_j", "rows", "pair_out", 3, "N m"),
+    "pair_overlap": ("/contacts/pair_overlap", "rows", "pair_out", 1, "m"),
 }
 # members of the compound /walls/value: (name, type, components, unit)
 WALL_MEMBERS = (

@@ -155,12 +155,28 @@ CD_INLINE cd_long cd_obs_pair_first(cd_cols c, cd_long n, cd_long p, cd_order o)
     return lo;
 }
 
+/* Overlap [m] of active pair row k: overlap[k] where the rows come with
+ * it (the MPI leaves' gathered rows, src/mpi/mpi_reduce.c), else from the
+ * narrow phase of the step on the columns' ends (cd_pair_narrow: the value
+ * the pair pass computed from the same ends; no row keeps it, fields.def). */
+CD_INLINE cd_real cd_obs_pair_overlap(cd_cols c, cd_long k, const CD_GLOBAL cd_real *overlap, cd_real sin_parallel,
+                                      cd_int parallel_blend)
+{
+    if (overlap) return overlap[k];
+    cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
+    cd_contact_geom g;
+    return cd_pair_narrow(c, i, j, c.prim_radius[i], c.prim_radius[j], sin_parallel, parallel_blend, &g) ? CD_R(0)
+                                                                                                         : g.overlap;
+}
+
 /* Block b of the pair rows (n of them), the rows of primitives i = b
  * CD_OBS_BLOCK .. (b + 1) CD_OBS_BLOCK - 1 (user ids): elastic energy,
  * contacts, largest overlap.  Inactive rows add nothing, so the sums do not
- * depend on how many a list holds. */
+ * depend on how many a list holds.  overlap, sin_parallel [1],
+ * parallel_blend: cd_obs_pair_overlap. */
 CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params law, CD_GLOBAL cd_real *acc,
-                                  cd_order o)
+                                  cd_order o, const CD_GLOBAL cd_real *overlap, cd_real sin_parallel,
+                                  cd_int parallel_blend)
 {
     cd_real el = 0, contacts = 0, most = 0; /* [J], count, overlap / diameter */
     cd_long end = cd_obs_pair_first(c, n, (b + 1) * CD_OBS_BLOCK, o);
@@ -168,9 +184,10 @@ CD_INLINE void cd_obs_block_pairs(cd_cols c, cd_long b, cd_long n, cd_law_params
         cd_long k = cd_map(o.pair_at, u);
         if (!c.pair_active[k]) continue;
         cd_real ri = c.prim_radius[c.pair_prim_i[k]], rj = c.prim_radius[c.pair_prim_j[k]];
-        el += cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), c.pair_overlap[k], c.pair_shear[k]);
+        cd_real delta = cd_obs_pair_overlap(c, k, overlap, sin_parallel, parallel_blend); /* [m] */
+        el += cd_contact_elastic_energy(law, cd_law_pair_radius(ri, rj), delta, c.pair_shear[k]);
         contacts += 1;
-        cd_real ratio = c.pair_overlap[k] / (2 * (ri < rj ? ri : rj));
+        cd_real ratio = delta / (2 * (ri < rj ? ri : rj));
         if (ratio > most) most = ratio;
     }
     cd_obs_clear(acc);

@@ -50,7 +50,8 @@ CD_INLINE cd_quat cd_q_renormalize(cd_quat q)
 CD_INLINE void cd_sincos(cd_real x, cd_real *sin_x, cd_real *cos_x)
 {
     cd_real k = CD_R(0), r = x;
-    if (!(x >= CD_R(-0.78539816339744828) && x <= CD_R(0.78539816339744828))) {
+    int reduced = !(x >= CD_R(-0.78539816339744828) && x <= CD_R(0.78539816339744828));
+    if (reduced) {
         k = floor(x * CD_R(0.63661977236758138) + CD_R(0.5));
         r = ((x - k * CD_R(1.57079632673412561417e+00)) - k * CD_R(6.07710050630396597660e-11)) -
             k * CD_R(2.02226624871116645580e-21);
@@ -66,6 +67,11 @@ CD_INLINE void cd_sincos(cd_real x, cd_real *sin_x, cd_real *cos_x)
          z * (CD_R(2.4801587301587302e-05) +
               z * (CD_R(-2.755731922398589e-07) + z * (CD_R(2.08767569878681e-09) + z * pc)));
     cd_real cr = CD_R(1) + z * (CD_R(-0.5) + z * (CD_R(4.1666666666666664e-02) + z * pc));
+    if (!reduced) { /* k = 0, quadrant 0 (the usual case: a step's angle) */
+        *sin_x = sr;
+        *cos_x = cr;
+        return;
+    }
     /* quadrant: k mod 4 (exact for |k| < 2^53; a non-finite x gives NaN) */
     cd_real m = k - CD_R(4) * floor(CD_R(0.25) * k);
     if (m == CD_R(0)) {

@@ -293,34 +293,25 @@ CD_INLINE cd_vec3 cd_contact_torque(cd_vec3 point, cd_vec3 centre, cd_vec3 force
     return cd_v3_cross(cd_v3_sub(point, centre), force);
 }
 
-/* Pair row k of the Verlet list: narrow phase and contact law with history
- * (docs/references.md, Contacts, Contact law).  law: particle-particle law, dt [s], sin_parallel [1],
- * parallel_blend 0/1 (material.parallel_blend).  An active row keeps what
- * the next step and the gather need: history, point, force on j; with
- * outputs = 1 also F_n and the overlap, which only the observables (the
- * elastic energy) and output read, between calls of the step: the step
- * writes them at the last step of a call only (16 B per contact-step less;
- * docs/performance.md, "Argument blocks on the device").  The normal, F_t
- * and the torques are derived on the host for output only (fields.def,
- * PAIR_OUT). */
-CD_INLINE_ALWAYS void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
-                                         cd_int parallel_blend, cd_int outputs)
+/* Narrow phase of primitives i and j (radii ri, rj [m]) on the step's
+ * columns: fills g and returns 1 when they are clearly apart (g then
+ * unset); a contact is a row not apart with g.overlap > 0.  The pair pass
+ * and the observables (kernels/observe_items.h: the overlap, which no row
+ * keeps) take it, so both get the same bits from the same ends.  The
+ * path is chosen per row: two balls without an arm (spheres:
+ * cd_prim_arm_of < 0; where every primitive has an arm, prim_arm is null
+ * and one test decides for every row) by their centres' distance only (no
+ * end b read, no point test of the ends: 0.86x the instructions of a
+ * sphere row; rows of one kind take one path, docs/performance.md, "Fewer
+ * bytes per sphere"), the same call on the same values as the point test
+ * below makes for them (a ball's two ends are its centre), so the same
+ * bits. */
+CD_INLINE_ALWAYS int cd_pair_narrow(cd_cols c, cd_prim_id i, cd_prim_id j, cd_real ri, cd_real rj, cd_real sin_parallel,
+                                    cd_int parallel_blend, cd_contact_geom *g)
 {
-    cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
-    cd_particle_id pi = c.prim_particle[i], pj = c.prim_particle[j];
-    cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
-    cd_contact_geom g;
     int apart;
     if (c.prim_arm && c.prim_arm[i] < 0 && c.prim_arm[j] < 0) {
-        /* Two balls without an arm (spheres: cd_prim_arm_of < 0; where
-         * every primitive has an arm, prim_arm is null and one test decides
-         * for every row): their centres' distance only, chosen by the arm
-         * indices (no end b read, no point test of the ends: 0.86x the
-         * instructions of a sphere row; rows of one kind take one path,
-         * docs/performance.md, "Fewer bytes per sphere").  The same call on
-         * the same values as the point test below makes for them (a ball's
-         * two ends are its centre), so the same bits. */
-        apart = cd_segseg_point_contact(cd_ball_world_point(c, i), ri, cd_ball_world_point(c, j), rj, &g);
+        apart = cd_segseg_point_contact(cd_ball_world_point(c, i), ri, cd_ball_world_point(c, j), rj, g);
     } else {
         cd_vec3 ai, bi, aj, bj;
         cd_prim_world_ends(c, i, &ai, &bi);
@@ -329,17 +320,39 @@ CD_INLINE_ALWAYS void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params 
         if (point_i && point_j) {
             /* two points (balls with an arm of zero length): the same
              * geometry without the segment machinery */
-            apart = cd_segseg_point_contact(ai, ri, aj, rj, &g);
+            apart = cd_segseg_point_contact(ai, ri, aj, rj, g);
         } else if (point_i || point_j) {
             /* a sphere and an arm: the same, without the parallel rule */
-            apart = cd_segseg_point_segment_contact(ai, bi, ri, aj, bj, rj, &g);
+            apart = cd_segseg_point_segment_contact(ai, bi, ri, aj, bj, rj, g);
         } else {
             cd_real s, t;
             cd_segseg_closest(ai, bi, aj, bj, &s, &t);
             apart = cd_segseg_clearly_apart(ai, bi, ri, aj, bj, rj, s, t);
-            if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, &g);
+            if (!apart) cd_segseg_contact_at(ai, bi, ri, aj, bj, rj, s, t, sin_parallel, parallel_blend, g);
         }
     }
+    return apart;
+}
+
+/* Pair row k of the Verlet list: narrow phase and contact law with history
+ * (docs/references.md, Contacts, Contact law).  law: particle-particle law, dt [s], sin_parallel [1],
+ * parallel_blend 0/1 (material.parallel_blend).  An active row keeps what
+ * the next step and the gather need: history, point, force on j; with
+ * outputs = 1 also F_n, which only output reads, between calls of the
+ * step: the step writes it at the last step of a call only (8 B per
+ * contact-step less; docs/performance.md, "Argument blocks on the
+ * device").  The overlap, the normal, F_t and the torques are derived
+ * where they are read: the overlap by the observables from the same
+ * narrow phase (cd_pair_narrow), all four on the host for output
+ * (fields.def, PAIR_OUT; docs/performance.md, "Session 16, issue 21"). */
+CD_INLINE_ALWAYS void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params law, cd_real dt, cd_real sin_parallel,
+                                         cd_int parallel_blend, cd_int outputs)
+{
+    cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
+    cd_particle_id pi = c.prim_particle[i], pj = c.prim_particle[j];
+    cd_real ri = c.prim_radius[i], rj = c.prim_radius[j];
+    cd_contact_geom g;
+    int apart = cd_pair_narrow(c, i, j, ri, rj, sin_parallel, parallel_blend, &g);
     if (apart || !(g.overlap > 0)) {
         /* Separated: the contact and its history end.  An inactive row
          * holds a zero force (the gather adds it) and a finite point, and
@@ -351,7 +364,6 @@ CD_INLINE_ALWAYS void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params 
             c.pair_shear[k] = cd_v3_zero();
             c.pair_force[k] = cd_v3_zero();
             c.pair_fn[k] = 0;
-            c.pair_overlap[k] = 0;
         }
         return;
     }
@@ -367,10 +379,7 @@ CD_INLINE_ALWAYS void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params 
     c.pair_shear[k] = shear;
     c.pair_point[k] = g.point;
     c.pair_force[k] = f.force_j;
-    if (outputs) {
-        c.pair_overlap[k] = g.overlap;
-        c.pair_fn[k] = f.fn;
-    }
+    if (outputs) c.pair_fn[k] = f.fn;
 }
 
 /* The place e of wall-contact row `row` (primitive i = row / n_walls)
@@ -520,6 +529,9 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
 {
     cd_vec3 F = cd_v3_scale(gravity, m);
     cd_vec3 T = cd_v3_zero();
+    /* the factor of a side, read from a table: one load where the integer
+     * 2 side - 1 took three instructions and a conversion (the same +-1) */
+    const cd_real side_sign[2] = {CD_R(-1), CD_R(1)};
     for (cd_int r = wall_start[q]; r < wall_start[q + 1]; r++) {
         if (!wall_out[r].active) continue;
         F = cd_v3_add(F, wall_out[r].force);
@@ -546,7 +558,7 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
          * F + (-f) is F - f).  Branches on the row's activity and side
          * follow no pattern: they were mispredicted about three times per
          * particle-step (callgrind --branch-sim, 10,000 spheres). */
-        cd_vec3 f = cd_v3_scale(c.pair_force[k], (cd_real)(2 * (e & 1) - 1));
+        cd_vec3 f = cd_v3_scale(c.pair_force[k], side_sign[e & 1]);
         F = cd_v3_add(F, f);
         T = cd_v3_add(T, cd_contact_torque(c.pair_point[k], x, f));
     }
@@ -575,7 +587,13 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
 /* cd_item_gather, then the second half kick over dt/2 (cd_item_kick) and,
  * with next = 1, the next step's cd_item_advance (returns its skin test),
  * all on particle q's state read once (cd_advance_from): the same
- * arithmetic in the same order as the three items one after the other. */
+ * arithmetic in the same order as the three items one after the other.
+ * The force and torque go into their columns at the call's last step only
+ * (next = 0): within a call only this item's advance reads them, from its
+ * locals; the next call's first advance (cd_item_advance), output, the
+ * observables and the protocols read the columns after a call (48 B
+ * written a particle-step less; docs/performance.md, "Session 16, issue
+ * 21"). */
 CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                                                  const CD_GLOBAL cd_pair_id *gather_rows,
                                                  const CD_GLOBAL cd_int *wall_start,
@@ -586,8 +604,10 @@ CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, co
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
     cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F, &T);
-    c.force[q] = F;
-    c.torque[q] = T;
+    if (!next) {
+        c.force[q] = F;
+        c.torque[q] = T;
+    }
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
     if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2, ref_pose);
     c.velocity[q] = v;

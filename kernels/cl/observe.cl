@@ -36,15 +36,19 @@ __kernel void cd_cl_obs_particles(
         cd_obs_block_particles(c, b, n, gravity, touch, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
 }
 
-/* n pair rows, their leaves by blocks of n_prims primitives. */
+/* n pair rows, their leaves by blocks of n_prims primitives; the
+ * overlaps from the narrow phase (sin_parallel, parallel_blend: the pair
+ * pass's). */
 __kernel void cd_cl_obs_pairs(
 #include "col_params.h"
-    cd_long n, cd_law_params law, __global cd_real *part, cd_long first, cd_long n_prims)
+    cd_long n, cd_law_params law, __global cd_real *part, cd_long first, cd_long n_prims, cd_real sin_parallel,
+    cd_int parallel_blend)
 {
 #include "col_bind.h"
     cd_long b = (cd_long)get_global_id(0);
     if (b < cd_obs_pair_blocks(n_prims))
-        cd_obs_block_pairs(c, b, n, law, part + (first + b) * CD_OBS_SLOTS, cd_order_identity());
+        cd_obs_block_pairs(c, b, n, law, part + (first + b) * CD_OBS_SLOTS, cd_order_identity(), 0, sin_parallel,
+                           parallel_blend);
 }
 
 __kernel void cd_cl_obs_walls(

@@ -21,7 +21,7 @@ __kernel void cd_cl_advance(
 }
 
 /* Step 5: narrow phase and contact law of pair row k (outputs: 1 at the
- * last step of a call, when the rows' overlap and F_n are written too). */
+ * last step of a call, when the rows' F_n is written too). */
 __kernel void cd_cl_pair_forces(
 #include "col_params.h"
     cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend, cd_int outputs)

@@ -629,6 +629,9 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
     if (cdh5_read_rows(r->time, (hsize_t)k, 1, H5T_NATIVE_DOUBLE, &s->time) < 0)
         return rfail(r, "cannot read row %lld of %s", k, CDH5_SNAP_TIME);
     s->step = step;
+    /* arms derived before (a set-up's) follow the ends read: the host's
+     * observables derive the overlaps from them (kernels/observe_items.h) */
+    if (s->prim_arm && cd_state_arms_derive(s)) return rfail(r, "out of memory for the arms of snapshot %lld", k);
     return 0;
 }
 

@@ -129,10 +129,12 @@ int cd_mpi_dev_observe_cols(cd_mpi_ctx *x)
     cd_state *s = &loc->s;
     /* (the local state is never reordered: reorder is off under MPI) */
     if (!on_device(x) || cd_step_memory_is_host() || loc->nb.reorder) return 1;
-    const size_t read[] = {
-        offsetof(cd_state, position),    offsetof(cd_state, velocity),     offsetof(cd_state, angmom),
-        offsetof(cd_state, orientation), offsetof(cd_state, pair_prim_i),  offsetof(cd_state, pair_prim_j),
-        offsetof(cd_state, pair_active), offsetof(cd_state, pair_overlap), offsetof(cd_state, pair_shear)};
+    /* (the pair rows' overlaps are derived from the pose: CD_ENDS_FROM_POSE,
+     * kernels/observe_items.h) */
+    const size_t read[] = {offsetof(cd_state, position),    offsetof(cd_state, velocity),
+                           offsetof(cd_state, angmom),      offsetof(cd_state, orientation),
+                           offsetof(cd_state, pair_prim_i), offsetof(cd_state, pair_prim_j),
+                           offsetof(cd_state, pair_active), offsetof(cd_state, pair_shear)};
     for (size_t f = 0; f < cd_n_fields; f++)
         for (size_t k = 0; k < sizeof read / sizeof read[0]; k++) {
             const void *dev = cd_sim_step_field(loc, f);

@@ -460,13 +460,23 @@ static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
     obs_pair *mine = malloc((s->n_pairs + 1) * sizeof *mine);
     int *dest = malloc((s->n_pairs + 1) * sizeof *dest);
     if (!mine || !dest) return -1;
+    /* each row's overlap from the local step's ends, as the serial leaf
+     * derives it (kernels/observe_items.h, cd_obs_pair_overlap); from the
+     * host's columns where the arms were never derived (as at sync) */
+    cd_cols lc = cd_sim_host_cols(s);
+    const double *host_overlap = NULL;
+    if (!s->prim_arm) {
+        cd_sim_derive_pair_output(&x->loc);
+        host_overlap = s->pair_overlap;
+    }
     for (size_t k = 0; k < s->n_pairs; k++) {
         cd_int i = s->pair_prim_i[k], j = s->pair_prim_j[k];
         if (!s->pair_active[k] || !x->owned[s->prim_particle[i]]) continue;
         long long gi = x->gprim[i], gj = x->gprim[j];
-        mine[n] = (obs_pair){
-            gi * P + gj,      gi, gj, s->pair_shear[k], s->pair_overlap[k], s->prim_radius[i], s->prim_radius[j],
-            s->pair_active[k]};
+        double overlap =
+            cd_obs_pair_overlap(lc, (cd_long)k, host_overlap, x->loc.p.sin_parallel, x->loc.p.parallel_blend);
+        mine[n] = (obs_pair){gi * P + gj,      gi, gj, s->pair_shear[k], overlap, s->prim_radius[i], s->prim_radius[j],
+                             s->pair_active[k]};
         dest[n++] = leaf_rank(x, &lp, lp.pairs + gi / CD_OBS_BLOCK);
     }
     char *got = NULL;
@@ -486,7 +496,6 @@ static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
     c.pair_active = active;
     c.pair_prim_i = pi;
     c.pair_prim_j = pj;
-    c.pair_overlap = overlap;
     c.pair_shear = shear;
     c.prim_radius = radius;
     size_t k = 0;
@@ -504,7 +513,7 @@ static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
         }
         double *acc = push(out, lp.pairs + b);
         if (!acc) rc = -1;
-        else cd_obs_block_pairs(c, 0, nb, g->p.law, acc, cd_order_identity());
+        else cd_obs_block_pairs(c, 0, nb, g->p.law, acc, cd_order_identity(), overlap, 0, 0);
     }
     free(got);
     free(active);

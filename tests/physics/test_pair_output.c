@@ -4,6 +4,9 @@
  * of hexapods in a cylinder (many contacts, friction, walls):
  *  - the normal is a unit vector and F_t lies in the tangent plane;
  *  - F_n n + F_t gives back the force the step stored for j;
+ *  - the overlap of a contact, which no row keeps (derived at sync from the
+ *    host's ends, and by the observables from the step's), is positive, and
+ *    the largest overlap the observables find is the largest of these;
  *  - for every particle, gravity, its wall contacts and its pair rows' forces
  *    and derived torques add up to the force and torque the step's gather
  *    gave it. */
@@ -44,6 +47,36 @@ static void test_derived_contact_columns_match_the_applied_forces(void **state)
     }
     print_message("%zu active contacts among %zu pair rows\n", active, s->n_pairs);
     assert_true(active > 60); /* a pile, not a gas */
+
+    /* The overlaps: derived at sync on the host (src/io/pair_output.c) and
+     * by the observables on the step's columns (kernels/observe_items.h),
+     * each by the narrow phase the step ran on the same ends: the largest
+     * ratio overlap / diameter is the same number both ways (a maximum
+     * does not depend on the order). */
+    double most = 0, elastic = 0; /* [1], [J] */
+    for (size_t k = 0; k < s->n_pairs; k++) {
+        if (!s->pair_active[k]) continue;
+        double ri = s->prim_radius[s->pair_prim_i[k]], rj = s->prim_radius[s->pair_prim_j[k]];
+        assert_true(s->pair_overlap[k] > 0);
+        double ratio = s->pair_overlap[k] / (2 * (ri < rj ? ri : rj));
+        if (ratio > most) most = ratio;
+        elastic +=
+            cd_contact_elastic_energy(sim.p.law, cd_law_pair_radius(ri, rj), s->pair_overlap[k], s->pair_shear[k]);
+    }
+    for (size_t r = 0; r < s->n_prims * s->n_walls; r++) {
+        if (!s->wallc_active[r]) continue;
+        double ri = s->prim_radius[r / s->n_walls];
+        double ratio = s->wallc_overlap[r] / (2 * ri);
+        if (ratio > most) most = ratio;
+        elastic += cd_contact_elastic_energy(sim.p.wall_law, ri, s->wallc_overlap[r], s->wallc_shear[r]);
+    }
+    cd_observables o;
+    cd_sim_observe(&sim, &o);
+    print_message("largest overlap / diameter %.6g, observables %.6g; elastic energy %.9g J, observables %.9g J\n",
+                  most, o.max_overlap_ratio, elastic, o.elastic);
+    assert_true(most > 0 && o.max_overlap_ratio == most);
+    /* the same terms summed in another order (the observables' tree) */
+    assert_true(elastic > 0 && fabs(o.elastic - elastic) <= 1e-12 * elastic);
 
     /* Per particle: the step's gather against the sum of the output columns
      * (the same terms; on the host backend in the same order, elsewhere the

@@ -51,7 +51,6 @@ static cd_cols cols_of(pair_rows *r, double *radius)
     c.pair_active = r->active;
     c.pair_prim_i = r->pi;
     c.pair_prim_j = r->pj;
-    c.pair_overlap = r->overlap;
     c.pair_shear = r->shear;
     c.prim_radius = radius;
     return c;
@@ -79,8 +78,8 @@ static void test_pair_leaves_ignore_inactive_rows(void **state)
     double total = 0;
     for (long leaf = 0; leaf < leaves; leaf++) {
         double sa[CD_OBS_SLOTS], sb[CD_OBS_SLOTS];
-        cd_obs_block_pairs(a, leaf, few.n, law, sa, cd_order_identity());
-        cd_obs_block_pairs(b, leaf, many.n, law, sb, cd_order_identity());
+        cd_obs_block_pairs(a, leaf, few.n, law, sa, cd_order_identity(), few.overlap, 0, 0);
+        cd_obs_block_pairs(b, leaf, many.n, law, sb, cd_order_identity(), many.overlap, 0, 0);
         assert_memory_equal(sa, sb, sizeof sa);
         long contacts = 0;
         for (long k = 0; k < few.n; k++) contacts += few.active[k] && few.pi[k] / CD_OBS_BLOCK == leaf;
@@ -94,7 +93,7 @@ static void test_pair_leaves_ignore_inactive_rows(void **state)
     assert_true(total == (double)all);
     /* an empty list sums to nothing */
     double s[CD_OBS_SLOTS];
-    cd_obs_block_pairs(a, 0, 0, law, s, cd_order_identity());
+    cd_obs_block_pairs(a, 0, 0, law, s, cd_order_identity(), few.overlap, 0, 0);
     assert_true(s[CD_OBS_NC] == 0 && s[CD_OBS_EL] == 0);
 }
 

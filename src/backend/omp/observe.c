@@ -125,8 +125,19 @@ void cd_observables_slots(const cd_sim *sim, double *total)
     double *pp = part, *pk = part + nb.particles * CD_OBS_SLOTS, *pw = pk + nb.pairs * CD_OBS_SLOTS;
     CD_HOST_FOR(N, firstprivate(c, o))
     for (cd_long b = 0; b < nb.particles; b++) cd_obs_block_particles(c, b, N, g, touch, pp + b * CD_OBS_SLOTS, o);
-    CD_HOST_FOR(P, firstprivate(c, o))
-    for (cd_long b = 0; b < nb.pairs; b++) cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS, o);
+    /* The overlaps from the step's columns (the arms: cd_state_arms_derive);
+     * a state whose arms were never derived (set up by hand) from the host's
+     * columns, as at sync (src/io/pair_output.c): the same bits. */
+    const double *overlap = NULL;
+    if (!s->prim_arm) {
+        cd_sim_derive_pair_output((cd_sim *)sim);
+        overlap = s->pair_overlap;
+    }
+    cd_real sin_parallel = sim->p.sin_parallel;
+    cd_int blend = sim->p.parallel_blend;
+    CD_HOST_FOR(P, firstprivate(c, o, overlap, sin_parallel, blend))
+    for (cd_long b = 0; b < nb.pairs; b++)
+        cd_obs_block_pairs(c, b, K, law, pk + b * CD_OBS_SLOTS, o, overlap, sin_parallel, blend);
     CD_HOST_FOR(R, firstprivate(c, o))
     for (cd_long b = 0; b < nb.walls; b++)
         cd_obs_block_walls(c, b, R, W, wall_law, pw + b * CD_OBS_SLOTS, o, wall_start, wall_rows, out);
@@ -194,7 +205,8 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
         cd_obs_block_particles(CD_A.c, b, N, CD_A.gravity, touch, part + b * CD_OBS_SLOTS, CD_A.order);
     CD_STEP_FOR(P, CD_ARGS_IN is_device_ptr(part))
     for (cd_long b = 0; b < nb.pairs; b++)
-        cd_obs_block_pairs(CD_A.c, b, K, CD_A.law, part + pk + b * CD_OBS_SLOTS, CD_A.order);
+        cd_obs_block_pairs(CD_A.c, b, K, CD_A.law, part + pk + b * CD_OBS_SLOTS, CD_A.order, NULL, CD_A.sin_parallel,
+                           CD_A.blend);
     CD_STEP_FOR(R, CD_ARGS_IN is_device_ptr(part))
     for (cd_long b = 0; b < nb.walls; b++)
         cd_obs_block_walls(CD_A.c, b, R, W, CD_A.wall_law, part + pw + b * CD_OBS_SLOTS, CD_A.order, CD_A.d.wall_start,

@@ -255,7 +255,7 @@ static void forces_and_advance_one_team(cd_sim *sim, int next, int flagged)
 
 /* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
  * the next step (its advance; returns its skin test); next = 0 (the call's
- * last step): the pair rows' overlap and F_n are written too.
+ * last step): the pair rows' F_n is written too.
  * Host threads: one parallel region, where four loops used to fork and
  * join their threads each (docs/performance.md, "One parallel region per
  * step"): the pair loop without a barrier before the wall loop (they

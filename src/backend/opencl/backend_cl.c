@@ -70,7 +70,7 @@ static void set_list_args(cd_cl *cl)
 /* Rebuild of the list, then steps 5-8 (forces, gather, second kick) and
  * the next step's 1-4, by mode (cd_cl_gather_kick): 0 the forces of a
  * start, 1 the last step of a call, 2 a step with the next one's advance.
- * The pair rows' overlap and F_n are written where a call ends (modes 0
+ * The pair rows' F_n is written where a call ends (modes 0
  * and 1). */
 static int forces(cd_cl *cl, cd_sim *sim, int rebuild, cd_int mode)
 {
@@ -297,6 +297,8 @@ static int cl_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 2, sizeof cl->obs_part, &cl->obs_part);
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 3, sizeof first, &first);
     cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 4, sizeof P, &P);
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 5, sizeof sim->p.sin_parallel, &sim->p.sin_parallel);
+    cd_cl_arg(cl, CD_CLK_OBS_PAIRS, F + 6, sizeof sim->p.parallel_blend, &sim->p.parallel_blend);
     cd_cl_run(cl, CD_CLK_OBS_PAIRS, (size_t)bk);
     first = bp + bk;
     cd_cl_arg(cl, CD_CLK_OBS_WALLS, F, sizeof R, &R);
