@@ -76,6 +76,17 @@ CD_INLINE void cd_mpm_fail(CD_GLOBAL cd_int *flags, cd_int f, cd_int i, cd_int j
     cd_mpm_atomic_min(&flags[CD_MPM_N_FAILS + f], j);
 }
 
+/* One item: the checks as before any step: no failure, never seen, nothing counted or summed. */
+CD_INLINE void cd_mpm_checks_clear(CD_GLOBAL cd_int *flags, CD_GLOBAL cd_ulong *counts, CD_GLOBAL cd_real *reals)
+{
+    for (cd_int f = 0; f < CD_MPM_N_FAILS; f++) {
+        flags[f] = -1;
+        flags[CD_MPM_N_FAILS + f] = CD_MPM_NEVER;
+    }
+    for (cd_int i = 0; i < CD_MPM_N_COUNTS; i++) counts[i] = 0;
+    for (cd_int i = 0; i < CD_MPM_N_REALS; i++) reals[i] = 0;
+}
+
 /* ---- the items of the step with their checks (stage, failure) */
 
 /* Stage 0: point p's stencil and wall forces; LEFT. */

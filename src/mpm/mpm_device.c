@@ -120,26 +120,26 @@ static int scratch_alloc(cd_mpm *m)
     return 0;
 }
 
-/* The checks as before any step: no failure, never seen, nothing counted. */
-static int checks_clear(cd_mpm *m)
+/* The checks as before any step, where the loops run (a one-item loop: no copy). */
+static void checks_clear(cd_mpm *m)
 {
-    cd_mpm_checks none;
-    memset(&none, 0, sizeof none);
-    for (int f = 0; f < CD_MPM_N_FAILS; f++) {
-        none.flags[f] = -1;
-        none.flags[CD_MPM_N_FAILS + f] = CD_MPM_NEVER;
-    }
+    cd_int *flags = m->loop_flags;
+    cd_ulong *counts = m->loop_counts;
+    double *reals = m->loop_reals;
+    CD_WIDE_MIN
+    CD_STEP_FOR(1, CD_DEV(is_device_ptr(flags, counts, reals)))
+    for (int one = 0; one < 1; one++) cd_mpm_checks_clear(flags, counts, reals);
     m->pending = 0;
-    return cd_dev_put(m->loop_checks, &none, sizeof none);
 }
 
 int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen)
 {
     if (m->loop_on) return 0;
-    if (scratch_alloc(m) || checks_clear(m)) {
+    if (scratch_alloc(m)) {
         snprintf(err, errlen, "out of device memory for the step's scratch");
         return -1;
     }
+    checks_clear(m);
     m->sized = 0;
 #if CD_OFFLOAD
     map_all(m, MAP_ENTER);
@@ -241,7 +241,10 @@ int cd_mpm_settle(cd_mpm *m, char *err, size_t errlen)
     }
     int rc = cd_mpm_checks_apply(m, k.flags, k.counts, k.reals, err, errlen);
     if (rc == 0) cd_mpm_device_sync(m);
-    if (rc == 1 && (cd_mpm_bnodes_room(m, k.counts[CD_MPM_COUNT_BNODES], err, errlen) || checks_clear(m))) return -1;
+    if (rc == 1) {
+        if (cd_mpm_bnodes_room(m, k.counts[CD_MPM_COUNT_BNODES], err, errlen)) return -1;
+        checks_clear(m);
+    }
     return rc;
 }
 
