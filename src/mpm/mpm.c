@@ -246,6 +246,7 @@ int cd_mpm_bnodes_room(cd_mpm *m, size_t n, char *err, size_t errlen)
         snprintf(err, errlen, "out of device memory for %zu body-nodes", n);
         return -1;
     }
+    cd_mpm_loop_args_refresh(m); /* the body-node columns may have moved */
     return 0;
 }
 
@@ -274,35 +275,34 @@ static int prepare(cd_mpm *m, char *err, size_t errlen)
     cd_ulong *counts = m->loop_counts;
     double *reals = m->loop_reals;
     cd_mpm_item_walls walls = cd_mpm_walls_items(m);
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
     CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, walls, j) CD_DEV(is_device_ptr(flags)))
-    for (size_t p = 0; p < n; p++) cd_mpm_checked_prepare(c, p, walls, flags, j);
+    CD_STEP_FOR(n, firstprivate(walls, j) CD_DEV(is_device_ptr(args, flags)))
+    for (size_t p = 0; p < n; p++) cd_mpm_checked_prepare(*args, p, walls, flags, j);
     /* the walls' forces: the reaction of the points' penalty forces, summed in point order */
     int nw = m->n_walls;
     if (m->observe && nw > 0) {
-        CD_STEP_FOR(nw, firstprivate(c, walls, n, j) CD_DEV(is_device_ptr(flags, reals)))
+        CD_STEP_FOR(nw, firstprivate(walls, n, j) CD_DEV(is_device_ptr(args, flags, reals)))
         for (int w = 0; w < nw; w++)
-            if (!cd_mpm_stopped(flags, j, 1)) cd_mpm_item_wall_force(c, n, walls, w, reals + CD_MPM_REAL_WALLS);
+            if (!cd_mpm_stopped(flags, j, 1)) cd_mpm_item_wall_force(*args, n, walls, w, reals + CD_MPM_REAL_WALLS);
     }
     /* each body's window: the nodes its points' stencils reach, and where its nodes start */
     int nb = m->n_bodies;
-    CD_STEP_FOR(nb, firstprivate(c, j) CD_DEV(is_device_ptr(flags)))
+    CD_STEP_FOR(nb, firstprivate(j) CD_DEV(is_device_ptr(args, flags)))
     for (int k = 0; k < nb; k++)
-        if (!cd_mpm_stopped(flags, j, 1)) cd_mpm_item_window(c, k);
+        if (!cd_mpm_stopped(flags, j, 1)) cd_mpm_item_window(*args, k);
     cd_ulong cap = m->sized ? cd_mpm_loop_rows(m) : (cd_ulong)-1;
-    CD_STEP_FOR(1, firstprivate(c, cap, j) CD_DEV(is_device_ptr(flags, counts)))
-    for (int one = 0; one < 1; one++) cd_mpm_checked_window_offsets(c, counts, cap, flags, j);
+    CD_STEP_FOR(1, firstprivate(cap, j) CD_DEV(is_device_ptr(args, flags, counts)))
+    for (int one = 0; one < 1; one++) cd_mpm_checked_window_offsets(*args, counts, cap, flags, j);
     if (!m->sized && size_bnodes(m, err, errlen)) return -1;
-    c = cd_mpm_loop_cols(m); /* the body-node columns may have moved */
-    CD_STEP_FOR(nb, firstprivate(c, j) CD_DEV(is_device_ptr(flags)))
+    CD_STEP_FOR(nb, firstprivate(j) CD_DEV(is_device_ptr(args, flags)))
     for (int k = 0; k < nb; k++)
-        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_bnode_body(c, k);
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_bnode_body(*args, k);
     /* stable counting sort by (body, cell), body by body: a point's cell is
      * its stencil's second node, numbered like the body's nodes */
-    CD_STEP_FOR(nb, firstprivate(c, j) CD_DEV(is_device_ptr(flags)))
+    CD_STEP_FOR(nb, firstprivate(j) CD_DEV(is_device_ptr(args, flags)))
     for (int k = 0; k < nb; k++)
-        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_sort_body(c, k);
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_sort_body(*args, k);
     return 0;
 }
 
@@ -315,42 +315,42 @@ int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
     if (m->cl) return cd_mpm_cl_step(m, err, errlen); /* the OpenCL backend (src/mpm/mpm_cl.c) */
     if (cd_mpm_device_start(m, err, errlen) || cd_mpm_record_start(m, err, errlen) || prepare(m, err, errlen))
         return -1;
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
     size_t n = m->n, rows = cd_mpm_loop_rows(m);
     cd_int j = m->pending, *flags = m->loop_flags, normals = m->n_bodies > 1;
     cd_ulong *counts = m->loop_counts;
     CD_WIDE_MIN
-    CD_STEP_FOR(rows, firstprivate(c, normals, j) CD_DEV(is_device_ptr(flags, counts)))
+    CD_STEP_FOR(rows, firstprivate(normals, j) CD_DEV(is_device_ptr(args, flags, counts)))
     for (size_t t = 0; t < rows; t++)
-        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_to_grid(c, t, normals);
-    CD_STEP_FOR(rows, firstprivate(c, dt, j) CD_DEV(is_device_ptr(flags, counts)))
+        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_to_grid(*args, t, normals);
+    CD_STEP_FOR(rows, firstprivate(dt, j) CD_DEV(is_device_ptr(args, flags, counts)))
     for (size_t t = 0; t < rows; t++)
-        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_node_update(c, t, dt);
+        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_node_update(*args, t, dt);
     if (m->n_bodies > 1) {
         cd_mpm_contact_nodes(m);
         cd_mpm_contact_correct(m);
     }
     double pic = m->pic_fraction; /* [1] */
-    CD_STEP_FOR(n, firstprivate(c, dt, pic, j) CD_DEV(is_device_ptr(flags)))
+    CD_STEP_FOR(n, firstprivate(dt, pic, j) CD_DEV(is_device_ptr(args, flags)))
     for (size_t p = 0; p < n; p++)
-        if (!cd_mpm_stopped(flags, j, 3)) cd_mpm_item_point_update(c, p, dt, pic);
-    CD_STEP_FOR(rows, firstprivate(c, j) CD_DEV(is_device_ptr(flags, counts)))
+        if (!cd_mpm_stopped(flags, j, 3)) cd_mpm_item_point_update(*args, p, dt, pic);
+    CD_STEP_FOR(rows, firstprivate(j) CD_DEV(is_device_ptr(args, flags, counts)))
     for (size_t t = 0; t < rows; t++)
-        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 3)) cd_mpm_item_remap(c, t);
+        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 3)) cd_mpm_item_remap(*args, t);
     /* observed steps: [J/m], summed in body-node order: the same bits for any thread count */
     double *reals = m->loop_reals;
     if (m->observe) {
-        CD_STEP_FOR(1, firstprivate(c, j) CD_DEV(is_device_ptr(flags, counts, reals)))
+        CD_STEP_FOR(1, firstprivate(j) CD_DEV(is_device_ptr(args, flags, counts, reals)))
         for (int one = 0; one < 1; one++)
             if (!cd_mpm_stopped(flags, j, 3))
-                cd_mpm_item_mesh_kinetic(c, counts[CD_MPM_COUNT_BNODES], reals + CD_MPM_REAL_KINETIC);
+                cd_mpm_item_mesh_kinetic(*args, counts[CD_MPM_COUNT_BNODES], reals + CD_MPM_REAL_KINETIC);
     }
     /* no second contact correction of the remapped velocities: the strain follows each body's own
      * remapped field, the motion its points made; re-imposing the contact there, on the contact's
      * widened nodes, made strain the points' motion did not have and fed energy (docs/mpm.md) */
     cd_mpm_material mat = m->mat;
-    CD_STEP_FOR(n, firstprivate(c, dt, mat, j) CD_DEV(is_device_ptr(flags)))
-    for (size_t p = 0; p < n; p++) cd_mpm_checked_stress(c, p, dt, mat, flags, j);
+    CD_STEP_FOR(n, firstprivate(dt, mat, j) CD_DEV(is_device_ptr(args, flags)))
+    for (size_t p = 0; p < n; p++) cd_mpm_checked_stress(*args, p, dt, mat, flags, j);
     m->pending++;
     cd_mpm_step_done(m);
     return 0;

@@ -111,6 +111,8 @@ typedef struct {
     cd_ulong *loop_blocks;          /* 2 per CD_MPM_CN_BLOCK common nodes */
     double *loop_over;              /* per listed common node: the contact's overlap [m] */
     cd_long *loop_keys;             /* the contact pairs' keys */
+    cd_mpm_cols *loop_args;         /* the loops' argument: cd_mpm_loop_cols, copied there when it changes
+                                     * (cd_mpm_loop_args_refresh), not at every launch */
     struct cd_mpm_cl *cl;           /* the OpenCL backend's state (src/mpm/mpm_cl.c); NULL: the omp loops */
 } cd_mpm;
 
@@ -239,6 +241,8 @@ void cd_mpm_device_stop(cd_mpm *m);
 cd_mpm_cols cd_mpm_loop_cols(const cd_mpm *m);
 /* The body-node rows the loops' columns hold. */
 size_t cd_mpm_loop_rows(const cd_mpm *m);
+/* m->loop_args made cd_mpm_loop_cols(m) (after the columns moved). */
+void cd_mpm_loop_args_refresh(cd_mpm *m);
 int cd_mpm_device_reserve(cd_mpm *m, size_t n);
 int cd_mpm_device_keys(cd_mpm *m, size_t n);
 /* The common-mesh coordinates (i, j) of body-node t. */

@@ -29,29 +29,29 @@
 /* The steps of kernels/mpm_step_items.h's cd_mpm_item_cn_* (stage 2). */
 void cd_mpm_contact_nodes(cd_mpm *m)
 {
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
     cd_int j = m->pending, *flags = m->loop_flags, *row_n = m->loop_row_n, *rows = m->loop_rows, ny = m->ny;
     cd_ulong *counts = m->loop_counts, *blocks = m->loop_blocks, nn = (cd_ulong)m->nx * (cd_ulong)m->ny,
              nblk = (nn + CD_MPM_CN_BLOCK - 1) / CD_MPM_CN_BLOCK;
     CD_WIDE_MIN
-    CD_STEP_FOR(ny, firstprivate(c, j) CD_DEV(is_device_ptr(flags, row_n, rows)))
+    CD_STEP_FOR(ny, firstprivate(j) CD_DEV(is_device_ptr(args, flags, row_n, rows)))
     for (cd_int row = 0; row < ny; row++)
-        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_rows(c, row, row_n, rows);
-    CD_STEP_FOR(nn, firstprivate(c, j) CD_DEV(is_device_ptr(flags, row_n, rows)))
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_rows(*args, row, row_n, rows);
+    CD_STEP_FOR(nn, firstprivate(j) CD_DEV(is_device_ptr(args, flags, row_n, rows)))
     for (cd_ulong g = 0; g < nn; g++)
-        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_count(c, g, row_n, rows);
-    CD_STEP_FOR(nblk, firstprivate(c, j) CD_DEV(is_device_ptr(flags, blocks)))
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_count(*args, g, row_n, rows);
+    CD_STEP_FOR(nblk, firstprivate(j) CD_DEV(is_device_ptr(args, flags, blocks)))
     for (cd_ulong b = 0; b < nblk; b++)
-        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_sums(c, b, blocks);
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_sums(*args, b, blocks);
     CD_STEP_FOR(1, firstprivate(nblk, j) CD_DEV(is_device_ptr(flags, blocks, counts)))
     for (int one = 0; one < 1; one++)
         if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_scan(nblk, blocks, counts + CD_MPM_COUNT_LISTED);
-    CD_STEP_FOR(nblk, firstprivate(c, j) CD_DEV(is_device_ptr(flags, blocks)))
+    CD_STEP_FOR(nblk, firstprivate(j) CD_DEV(is_device_ptr(args, flags, blocks)))
     for (cd_ulong b = 0; b < nblk; b++)
-        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_starts(c, b, blocks);
-    CD_STEP_FOR(nn, firstprivate(c, j) CD_DEV(is_device_ptr(flags, row_n, rows)))
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_starts(*args, b, blocks);
+    CD_STEP_FOR(nn, firstprivate(j) CD_DEV(is_device_ptr(args, flags, row_n, rows)))
     for (cd_ulong g = 0; g < nn; g++)
-        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_entries(c, g, row_n, rows);
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_entries(*args, g, row_n, rows);
 }
 
 static int cmp_key(const void *a, const void *b)
@@ -77,12 +77,12 @@ int cd_mpm_pair_keys_room(cd_mpm *m, size_t n, char *err, size_t errlen)
  * number into *w, where the omp loops run. */
 static int loop_pair_keys(cd_mpm *m, size_t *w, char *err, size_t errlen)
 {
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
     cd_ulong *count = m->loop_counts + CD_MPM_COUNT_KEYS, n_cn = m->n_cn, n;
     cd_long *none = NULL;
     CD_WIDE_MIN
-    CD_STEP_FOR(1, firstprivate(c, n_cn, none) CD_DEV(is_device_ptr(count)))
-    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, none, count);
+    CD_STEP_FOR(1, firstprivate(n_cn, none) CD_DEV(is_device_ptr(args, count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(*args, n_cn, none, count);
     cd_dev_get(&n, count, sizeof n);
     if (cd_mpm_pair_keys_room(m, n, err, errlen)) return -1;
     if (cd_mpm_device_keys(m, n)) {
@@ -90,8 +90,8 @@ static int loop_pair_keys(cd_mpm *m, size_t *w, char *err, size_t errlen)
         return -1;
     }
     cd_long *keys = m->loop_keys;
-    CD_STEP_FOR(1, firstprivate(c, n_cn) CD_DEV(is_device_ptr(keys, count)))
-    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, keys, count);
+    CD_STEP_FOR(1, firstprivate(n_cn) CD_DEV(is_device_ptr(args, keys, count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(*args, n_cn, keys, count);
     cd_dev_get(m->pair_keys, keys, n * sizeof(cd_long));
     *w = (size_t)n;
     return 0;
@@ -124,7 +124,7 @@ int cd_mpm_fail_crowded(cd_mpm *m, size_t g, char *err, size_t errlen)
 
 void cd_mpm_contact_correct(cd_mpm *m)
 {
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
     size_t rows = cd_mpm_loop_rows(m), nn = (size_t)m->nx * (size_t)m->ny;
     cd_ulong listed = rows / 2 + 1 < nn ? rows / 2 + 1 : nn; /* >= the listed nodes: each holds 2 body-nodes */
     cd_int j = m->pending, *flags = m->loop_flags;
@@ -132,10 +132,10 @@ void cd_mpm_contact_correct(cd_mpm *m)
     double gap_max = m->contact_gap, dt = m->dt, *over = m->loop_over, *reals = m->loop_reals; /* [m], [s] */
     CD_WIDE_MIN
     /* (the check apart from the contact: it stops the contact of a step that has a crowded node) */
-    CD_STEP_FOR(listed, firstprivate(c, j) CD_DEV(is_device_ptr(flags, counts)))
-    for (cd_ulong ci = 0; ci < listed; ci++) cd_mpm_checked_crowded(c, ci, counts, flags, j);
-    CD_STEP_FOR(listed, firstprivate(c, gap_max, dt, j) CD_DEV(is_device_ptr(flags, counts, over)))
-    for (cd_ulong ci = 0; ci < listed; ci++) cd_mpm_checked_contact(c, ci, gap_max, dt, over, counts, flags, j);
+    CD_STEP_FOR(listed, firstprivate(j) CD_DEV(is_device_ptr(args, flags, counts)))
+    for (cd_ulong ci = 0; ci < listed; ci++) cd_mpm_checked_crowded(*args, ci, counts, flags, j);
+    CD_STEP_FOR(listed, firstprivate(gap_max, dt, j) CD_DEV(is_device_ptr(args, flags, counts, over)))
+    for (cd_ulong ci = 0; ci < listed; ci++) cd_mpm_checked_contact(*args, ci, gap_max, dt, over, counts, flags, j);
     if (m->observe) {
         CD_STEP_FOR(1, firstprivate(j) CD_DEV(is_device_ptr(flags, counts, over, reals)))
         for (int one = 0; one < 1; one++) cd_mpm_checked_max_over(over, counts, reals, flags, j);

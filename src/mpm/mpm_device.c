@@ -111,13 +111,23 @@ static int scratch_alloc(cd_mpm *m)
     m->loop_rows = cd_dev_alloc(ny * nb * sizeof(cd_int));
     m->loop_blocks = cd_dev_alloc(2 * ((nn + CD_MPM_CN_BLOCK - 1) / CD_MPM_CN_BLOCK) * sizeof(cd_ulong));
     m->loop_over = cd_dev_alloc(nn * sizeof(double));
-    if (!m->loop_checks || !m->loop_row_n || !m->loop_rows || !m->loop_blocks || !m->loop_over) return -1;
+    m->loop_args = cd_dev_alloc(sizeof(cd_mpm_cols));
+    if (!m->loop_checks || !m->loop_row_n || !m->loop_rows || !m->loop_blocks || !m->loop_over || !m->loop_args)
+        return -1;
     /* (device addresses: offsets into the block, not dereferenced here) */
     char *b = m->loop_checks;
     m->loop_flags = (cd_int *)(void *)(b + offsetof(cd_mpm_checks, flags));
     m->loop_counts = (cd_ulong *)(void *)(b + offsetof(cd_mpm_checks, counts));
     m->loop_reals = (double *)(void *)(b + offsetof(cd_mpm_checks, reals));
     return 0;
+}
+
+void cd_mpm_loop_args_refresh(cd_mpm *m)
+{
+    cd_mpm_cols c = cd_mpm_loop_cols(m), *args = m->loop_args;
+    CD_WIDE_MIN
+    CD_STEP_FOR(1, firstprivate(c) CD_DEV(is_device_ptr(args)))
+    for (int one = 0; one < 1; one++) *args = c;
 }
 
 /* The checks as before any step, where the loops run (a one-item loop: no copy). */
@@ -157,6 +167,7 @@ int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen)
     m->loop_cap = 0;
 #endif
     m->loop_on = 1;
+    cd_mpm_loop_args_refresh(m);
     return 0;
 }
 
@@ -317,7 +328,8 @@ void cd_mpm_device_stop(cd_mpm *m)
         free_bnodes(m);
     }
 #endif
-    void *scratch[] = {m->loop_checks, m->loop_row_n, m->loop_rows, m->loop_blocks, m->loop_over, m->loop_keys};
+    void *scratch[] = {m->loop_checks, m->loop_row_n, m->loop_rows, m->loop_blocks,
+                       m->loop_over,   m->loop_keys,  m->loop_args};
     for (size_t i = 0; i < sizeof scratch / sizeof scratch[0]; i++) cd_dev_free(scratch[i]);
     m->loop_checks = NULL;
     m->loop_flags = NULL;
@@ -327,6 +339,7 @@ void cd_mpm_device_stop(cd_mpm *m)
     m->loop_blocks = NULL;
     m->loop_over = NULL;
     m->loop_keys = NULL;
+    m->loop_args = NULL;
     m->loop_cap_keys = 0;
     m->loop_on = 0;
 }
