@@ -334,39 +334,10 @@ CD_INLINE void cd_mpm_item_mesh_kinetic(cd_mpm_cols c, cd_ulong nbn, CD_GLOBAL c
     *e = sum;
 }
 
-/* The common node of body-node t. */
-CD_INLINE cd_ulong cd_mpm_common_node(cd_mpm_cols c, cd_ulong t)
-{
-    cd_int k = c.bnode_body[t];
-    cd_ulong loc = t - c.win_off[k];
-    cd_int i = c.win_i0[k] + (cd_int)(loc % (cd_ulong)c.win_nx[k]);
-    cd_int j = c.win_j0[k] + (cd_int)(loc / (cd_ulong)c.win_nx[k]);
-    return (cd_ulong)j * (cd_ulong)c.nx + (cd_ulong)i;
-}
-
-/* The common nodes' body-nodes with mass, sorted by common node (a stable
- * counting sort: bodies ascending), into cn_start / cn_entry; the common
- * nodes holding two or more into cn_list, their count into *listed. */
-CD_INLINE void cd_mpm_item_contact_nodes(cd_mpm_cols c, cd_ulong nbn, CD_GLOBAL cd_ulong *listed)
-{
-    cd_ulong nn = (cd_ulong)c.nx * (cd_ulong)c.ny;
-    CD_GLOBAL cd_ulong *cs = c.cn_start;
-    for (cd_ulong g = 0; g <= nn; g++) cs[g] = 0;
-    for (cd_ulong t = 0; t < nbn; t++)
-        if (c.gm[t] > 0) cs[cd_mpm_common_node(c, t) + 1]++;
-    for (cd_ulong g = 0; g < nn; g++) cs[g + 1] += cs[g];
-    for (cd_ulong t = 0; t < nbn; t++)
-        if (c.gm[t] > 0) c.cn_entry[cs[cd_mpm_common_node(c, t)]++] = t;
-    for (cd_ulong g = nn; g > 0; g--) cs[g] = cs[g - 1];
-    cs[0] = 0;
-    cd_ulong n_cn = 0;
-    for (cd_ulong g = 0; g < nn; g++)
-        if (cs[g + 1] - cs[g] >= 2) c.cn_list[n_cn++] = g;
-    *listed = n_cn;
-}
-
-/* The same lists in parallel (the OpenCL backend; every count an integer,
- * so the lists are those of cd_mpm_item_contact_nodes bit for bit):
+/* The common nodes' body-nodes with mass, sorted by common node, bodies
+ * ascending, into cn_start / cn_entry, and the common nodes holding two or
+ * more into cn_list (the lists of a stable counting sort by common node;
+ * every count an integer, so the same lists whatever runs the steps):
  *   1. per mesh row j, the bodies whose window holds it, ascending, into
  *      rows[j * n_bodies ...], their number into row_n[j];
  *   2. per common node g, its body-nodes with mass into cn_start[g + 1];

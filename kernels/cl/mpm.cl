@@ -1,30 +1,21 @@
 /* The material point method's step as OpenCL kernels (docs/mpm.md, "The
  * OpenCL backend"): one work-item per point, body, body-node or listed
  * common node, each a thin wrapper around the items of
- * kernels/mpm_step_items.h and kernels/mpm_contact.h that the omp loops of
- * src/mpm/mpm.c run too.  What the omp loops do in one item is parallel
- * here where the result is a count (the points' sort, one item per body;
- * the common nodes' lists, in six kernels); the sums in a fixed order (the
- * walls' forces, the mesh's kinetic energy) and the deepest overlap stay
- * one item (per wall) and run only at the steps the host reads them.  src/mpm/mpm_cl.c launches them without reading anything back
- * between steps.
+ * kernels/mpm_step_items.h, kernels/mpm_contact.h and kernels/mpm_checks.h
+ * that the omp loops of src/mpm/mpm.c run too, loop for loop (the points'
+ * sort one item per body, the common nodes' lists in six kernels; the sums
+ * in a fixed order, the walls' forces and the mesh's kinetic energy, and
+ * the deepest overlap one item (per wall), only at the steps the host
+ * reads them).  src/mpm/mpm_cl.c launches them without reading anything
+ * back between steps.
  *
  * Every kernel takes the columns of kernels/cl/mpm_col_list.h first, then
- * the mesh, then the step's checks: flags (cd_int[8]: the failures LEFT,
- * OVERFLOW, CROWDED, BLEW_UP in the step's order, each the highest bad
- * index or -1, then the step each was first seen at, counted from the last
- * time the host looked, or CD_MPM_CL_NEVER), counts (cd_ulong[3]: body-nodes,
- * listed common nodes, contact keys) and j, this step's number counted
- * likewise.  A kernel at stage s of the step does nothing once a failure
- * was seen at an earlier step, or at this step by a kernel before it
- * (cd_mpm_cl_stopped): the state stays as the failing step left it, as
- * the omp loops leave it when they return, and the host finds out at its
- * next look (cd_mpm_cl_settle). */
-#include "../mpm_step_items.h"
-#include "../mpm_contact.h"
+ * the mesh, then the step's checks (kernels/mpm_checks.h): flags, counts
+ * and j, this step's number counted from the host's last look; a kernel
+ * does nothing once an earlier stage failed (cd_mpm_stopped), and the host
+ * finds out at its next look (cd_mpm_settle). */
+#include "../mpm_checks.h"
 #include "mpm_col_list.h"
-
-#define CD_MPM_CL_NEVER 0x7fffffff
 
 #define CD_MPM_CL_PARAM(type, name, host, rows) __global type *name,
 #define CD_MPM_CL_PARAMS                                                                                               \
@@ -43,33 +34,13 @@
     c.ox = ox;                                                                                                         \
     c.oy = oy
 
-/* 1 when a failure was seen at an earlier step, or at step j by one of the
- * stage checks before this kernel's (flag f < stage). */
-CD_INLINE cd_int cd_mpm_cl_stopped(__global const cd_int *flags, cd_int j, cd_int stage)
-{
-    for (cd_int f = 0; f < 4; f++) {
-        cd_int at = flags[4 + f];
-        if (at < j || (f < stage && at == j)) return 1;
-    }
-    return 0;
-}
-
-/* Failure f at index i, seen at step j: the highest index and the first
- * step (integer atomics: the same answer in any order). */
-CD_INLINE void cd_mpm_cl_fail(__global cd_int *flags, cd_int f, cd_int i, cd_int j)
-{
-    atomic_max(&flags[f], i);
-    atomic_min(&flags[4 + f], j);
-}
-
-/* Stage 0.  Point p's stencil and wall forces; failure 0 (LEFT): the
+/* Point p's stencil and wall forces; LEFT: the
  * highest point whose stencil left the mesh. */
 __kernel void cd_mpm_cl_prepare(CD_MPM_CL_PARAMS, cd_ulong n, cd_mpm_item_walls walls)
 {
     CD_MPM_CL_BIND;
     cd_ulong p = (cd_ulong)get_global_id(0);
-    if (p >= n || cd_mpm_cl_stopped(flags, j, 0)) return;
-    if (cd_mpm_item_prepare(c, p, walls)) cd_mpm_cl_fail(flags, 0, (cd_int)p, j);
+    if (p < n) cd_mpm_checked_prepare(c, p, walls, flags, j);
 }
 
 /* Stage 1, observed steps only: wall w's force [N/m], summed in point
@@ -78,32 +49,29 @@ __kernel void cd_mpm_cl_wall_force(CD_MPM_CL_PARAMS, cd_ulong n, cd_mpm_item_wal
 {
     CD_MPM_CL_BIND;
     cd_int w = (cd_int)get_global_id(0);
-    if (w < walls.n && !cd_mpm_cl_stopped(flags, j, 1)) cd_mpm_item_wall_force(c, n, walls, w, f);
+    if (w < walls.n && !cd_mpm_stopped(flags, j, 1)) cd_mpm_item_wall_force(c, n, walls, w, f);
 }
 
 __kernel void cd_mpm_cl_window(CD_MPM_CL_PARAMS)
 {
     CD_MPM_CL_BIND;
     cd_int k = (cd_int)get_global_id(0);
-    if (k < n_bodies && !cd_mpm_cl_stopped(flags, j, 1)) cd_mpm_item_window(c, k);
+    if (k < n_bodies && !cd_mpm_stopped(flags, j, 1)) cd_mpm_item_window(c, k);
 }
 
-/* Stage 1, one item: the windows' offsets (300 integer additions at full
- * size), the body-node count into counts[0]; failure 1 (OVERFLOW) when
- * they need more than the cap rows the body-node buffers hold. */
+/* One item: the windows' offsets (300 integer additions at full size);
+ * OVERFLOW when they need more than the cap rows the body-node buffers hold. */
 __kernel void cd_mpm_cl_window_offsets(CD_MPM_CL_PARAMS, cd_ulong cap)
 {
     CD_MPM_CL_BIND;
-    if (get_global_id(0) != 0 || cd_mpm_cl_stopped(flags, j, 1)) return;
-    cd_mpm_item_window_offsets(c, counts);
-    if (counts[0] > cap) cd_mpm_cl_fail(flags, 1, 0, j);
+    if (get_global_id(0) == 0) cd_mpm_checked_window_offsets(c, counts, cap, flags, j);
 }
 
 __kernel void cd_mpm_cl_bnode_body(CD_MPM_CL_PARAMS)
 {
     CD_MPM_CL_BIND;
     cd_int k = (cd_int)get_global_id(0);
-    if (k < n_bodies && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_bnode_body(c, k);
+    if (k < n_bodies && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_bnode_body(c, k);
 }
 
 /* Body k's points sorted by cell (stable counting sort, one item per body). */
@@ -111,115 +79,100 @@ __kernel void cd_mpm_cl_sort_body(CD_MPM_CL_PARAMS)
 {
     CD_MPM_CL_BIND;
     cd_int k = (cd_int)get_global_id(0);
-    if (k < n_bodies && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_sort_body(c, k);
+    if (k < n_bodies && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_sort_body(c, k);
 }
 
-/* The body-node kernels run over the buffers' rows; those past counts[0] do nothing. */
+/* The body-node kernels run over the buffers' rows; those past counts[CD_MPM_COUNT_BNODES] do nothing. */
 __kernel void cd_mpm_cl_to_grid(CD_MPM_CL_PARAMS, cd_int normals)
 {
     CD_MPM_CL_BIND;
     cd_ulong t = (cd_ulong)get_global_id(0);
-    if (t < counts[0] && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_to_grid(c, t, normals);
+    if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_to_grid(c, t, normals);
 }
 
 __kernel void cd_mpm_cl_node_update(CD_MPM_CL_PARAMS, cd_real dt)
 {
     CD_MPM_CL_BIND;
     cd_ulong t = (cd_ulong)get_global_id(0);
-    if (t < counts[0] && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_node_update(c, t, dt);
+    if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_node_update(c, t, dt);
 }
 
 /* The common nodes' body lists in six steps (kernels/mpm_step_items.h,
  * cd_mpm_item_cn_*: the lists of the omp loops' one-item sort, bit for
- * bit); the listed nodes' count into counts[1]. */
+ * bit); the listed nodes' count into counts[CD_MPM_COUNT_LISTED]. */
 __kernel void cd_mpm_cl_cn_rows(CD_MPM_CL_PARAMS, __global cd_int *row_n, __global cd_int *rows)
 {
     CD_MPM_CL_BIND;
     cd_int row = (cd_int)get_global_id(0);
-    if (row < ny && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_rows(c, row, row_n, rows);
+    if (row < ny && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_rows(c, row, row_n, rows);
 }
 
 __kernel void cd_mpm_cl_cn_count(CD_MPM_CL_PARAMS, __global const cd_int *row_n, __global const cd_int *rows)
 {
     CD_MPM_CL_BIND;
     cd_ulong g = (cd_ulong)get_global_id(0);
-    if (g < (cd_ulong)nx * (cd_ulong)ny && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_count(c, g, row_n, rows);
+    if (g < (cd_ulong)nx * (cd_ulong)ny && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_count(c, g, row_n, rows);
 }
 
 __kernel void cd_mpm_cl_cn_block_sums(CD_MPM_CL_PARAMS, __global cd_ulong *blocks, cd_ulong n_blocks)
 {
     CD_MPM_CL_BIND;
     cd_ulong b = (cd_ulong)get_global_id(0);
-    if (b < n_blocks && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_block_sums(c, b, blocks);
+    if (b < n_blocks && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_sums(c, b, blocks);
 }
 
 /* One item over the nn / CD_MPM_CN_BLOCK blocks' sums. */
 __kernel void cd_mpm_cl_cn_block_scan(CD_MPM_CL_PARAMS, __global cd_ulong *blocks, cd_ulong n_blocks)
 {
-    if (get_global_id(0) == 0 && !cd_mpm_cl_stopped(flags, j, 2))
-        cd_mpm_item_cn_block_scan(n_blocks, blocks, counts + 1);
+    if (get_global_id(0) == 0 && !cd_mpm_stopped(flags, j, 2))
+        cd_mpm_item_cn_block_scan(n_blocks, blocks, counts + CD_MPM_COUNT_LISTED);
 }
 
 __kernel void cd_mpm_cl_cn_block_starts(CD_MPM_CL_PARAMS, __global const cd_ulong *blocks, cd_ulong n_blocks)
 {
     CD_MPM_CL_BIND;
     cd_ulong b = (cd_ulong)get_global_id(0);
-    if (b < n_blocks && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_block_starts(c, b, blocks);
+    if (b < n_blocks && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_starts(c, b, blocks);
 }
 
 __kernel void cd_mpm_cl_cn_entries(CD_MPM_CL_PARAMS, __global const cd_int *row_n, __global const cd_int *rows)
 {
     CD_MPM_CL_BIND;
     cd_ulong g = (cd_ulong)get_global_id(0);
-    if (g < (cd_ulong)nx * (cd_ulong)ny && !cd_mpm_cl_stopped(flags, j, 2)) cd_mpm_item_cn_entries(c, g, row_n, rows);
+    if (g < (cd_ulong)nx * (cd_ulong)ny && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_entries(c, g, row_n, rows);
 }
 
-/* Stage 2 (the listed-node kernels run over a bound; those past counts[1]
- * do nothing).  Failure 2 (CROWDED): the highest common node where too
- * many bodies meet. */
+/* The listed-node kernels run over a bound; those past the count do nothing. */
 __kernel void cd_mpm_cl_contact_crowded(CD_MPM_CL_PARAMS)
 {
     CD_MPM_CL_BIND;
-    cd_ulong ci = (cd_ulong)get_global_id(0);
-    if (ci >= counts[1] || cd_mpm_cl_stopped(flags, j, 2)) return;
-    if (cd_mpm_item_contact_crowded(c, ci)) cd_mpm_cl_fail(flags, 2, (cd_int)c.cn_list[ci], j);
+    cd_mpm_checked_crowded(c, (cd_ulong)get_global_id(0), counts, flags, j);
 }
 
-/* Stage 3.  Listed common node ci's contacts; its deepest overlap (0 if
- * none) [m] into over[ci], for cd_mpm_cl_max_over. */
 __kernel void cd_mpm_cl_contact(CD_MPM_CL_PARAMS, cd_real gap_max, cd_real dt, __global cd_real *over)
 {
     CD_MPM_CL_BIND;
-    cd_ulong ci = (cd_ulong)get_global_id(0);
-    if (ci >= counts[1] || cd_mpm_cl_stopped(flags, j, 3)) return;
-    cd_real o = 0;
-    cd_mpm_item_contact(c, ci, gap_max, dt, &o);
-    over[ci] = o;
+    cd_mpm_checked_contact(c, (cd_ulong)get_global_id(0), gap_max, dt, over, counts, flags, j);
 }
 
-/* Observed steps only, one item: the largest of the overlaps and 0 [m]
- * into out[at] (a maximum: the same bits in any order). */
-__kernel void cd_mpm_cl_max_over(CD_MPM_CL_PARAMS, __global const cd_real *over, __global cd_real *out, cd_ulong at)
+/* Observed steps only, one item. */
+__kernel void cd_mpm_cl_max_over(CD_MPM_CL_PARAMS, __global const cd_real *over, __global cd_real *reals)
 {
-    if (get_global_id(0) != 0 || cd_mpm_cl_stopped(flags, j, 3)) return;
-    cd_real m = 0;
-    for (cd_ulong ci = 0; ci < counts[1]; ci++)
-        if (over[ci] > m) m = over[ci];
-    out[at] = m;
+    if (get_global_id(0) == 0) cd_mpm_checked_max_over(over, counts, reals, flags, j);
 }
 
 __kernel void cd_mpm_cl_point_update(CD_MPM_CL_PARAMS, cd_ulong n, cd_real dt, cd_real pic)
 {
     CD_MPM_CL_BIND;
     cd_ulong p = (cd_ulong)get_global_id(0);
-    if (p < n && !cd_mpm_cl_stopped(flags, j, 3)) cd_mpm_item_point_update(c, p, dt, pic);
+    if (p < n && !cd_mpm_stopped(flags, j, 3)) cd_mpm_item_point_update(c, p, dt, pic);
 }
 
 __kernel void cd_mpm_cl_remap(CD_MPM_CL_PARAMS)
 {
     CD_MPM_CL_BIND;
     cd_ulong t = (cd_ulong)get_global_id(0);
-    if (t < counts[0] && !cd_mpm_cl_stopped(flags, j, 3)) cd_mpm_item_remap(c, t);
+    if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 3)) cd_mpm_item_remap(c, t);
 }
 
 /* Observed steps only, one item: the mesh's kinetic energy [J/m], summed in
@@ -227,17 +180,15 @@ __kernel void cd_mpm_cl_remap(CD_MPM_CL_PARAMS)
 __kernel void cd_mpm_cl_mesh_kinetic(CD_MPM_CL_PARAMS, __global cd_real *out, cd_ulong at)
 {
     CD_MPM_CL_BIND;
-    if (get_global_id(0) == 0 && !cd_mpm_cl_stopped(flags, j, 3)) cd_mpm_item_mesh_kinetic(c, counts[0], out + at);
+    if (get_global_id(0) == 0 && !cd_mpm_stopped(flags, j, 3))
+        cd_mpm_item_mesh_kinetic(c, counts[CD_MPM_COUNT_BNODES], out + at);
 }
 
-/* Point p's stress, deformation gradient and volume; failure 3 (BLEW_UP):
- * the highest point that is not finite or lost its volume. */
 __kernel void cd_mpm_cl_stress(CD_MPM_CL_PARAMS, cd_ulong n, cd_real dt, cd_mpm_material mat)
 {
     CD_MPM_CL_BIND;
     cd_ulong p = (cd_ulong)get_global_id(0);
-    if (p >= n || cd_mpm_cl_stopped(flags, j, 3)) return;
-    if (cd_mpm_item_stress(c, p, dt, mat)) cd_mpm_cl_fail(flags, 3, (cd_int)p, j);
+    if (p < n) cd_mpm_checked_stress(c, p, dt, mat, flags, j);
 }
 
 /* Where the host looks (no failure seen), one item: the keys of the body
@@ -246,7 +197,7 @@ __kernel void cd_mpm_cl_stress(CD_MPM_CL_PARAMS, cd_ulong n, cd_real dt, cd_mpm_
 __kernel void cd_mpm_cl_pair_keys(CD_MPM_CL_PARAMS, __global cd_long *keys)
 {
     CD_MPM_CL_BIND;
-    if (get_global_id(0) == 0) cd_mpm_item_pair_keys(c, counts[1], keys, counts + 2);
+    if (get_global_id(0) == 0) cd_mpm_item_pair_keys(c, counts[CD_MPM_COUNT_LISTED], keys, counts + CD_MPM_COUNT_KEYS);
 }
 
 #undef CD_MPM_CL_PARAM

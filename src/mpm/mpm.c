@@ -10,6 +10,7 @@
 #include "mpm/mpm.h"
 #include "backend/omp/omp_loops.h" /* CD_STEP_FOR: the loops of the step, on the host or the offload device */
 #include "mpm_step_items.h"
+#include "mpm_checks.h"
 
 int cd_mpm_alloc(cd_mpm *m, size_t n, int nx, int ny, double h, double ox, double oy, char *err, size_t errlen)
 {
@@ -46,13 +47,13 @@ void cd_mpm_free(cd_mpm *m)
 {
     cd_mpm_cl_close(m);
     cd_mpm_device_stop(m);
-    void *cols[] = {m->x,          m->y,        m->vx,       m->vy,       m->mass,      m->vol,      m->half,
-                    m->sxx,        m->syy,      m->sxy,      m->szz,      m->eps_p,     m->f_xx,     m->f_xy,
-                    m->f_yx,       m->f_yy,     m->ex,       m->ey,       m->wx,        m->wy,       m->dwx,
-                    m->dwy,        m->gm,       m->gpx,      m->gpy,      m->gfx,       m->gfy,      m->gvx,
-                    m->gvy,        m->gnx,      m->gny,      m->particle, m->bx,        m->by,       m->order,
-                    m->cell_start, m->pfirst,   m->win_i0,   m->win_j0,   m->win_nx,    m->win_ny,   m->win_off,
-                    m->bnode_body, m->cn_start, m->cn_entry, m->cn_list,  m->cn_active, m->pair_keys};
+    void *cols[] = {m->x,          m->y,        m->vx,       m->vy,       m->mass,      m->vol,       m->half,
+                    m->sxx,        m->syy,      m->sxy,      m->szz,      m->eps_p,     m->f_xx,      m->f_xy,
+                    m->f_yx,       m->f_yy,     m->ex,       m->ey,       m->wx,        m->wy,        m->dwx,
+                    m->dwy,        m->gm,       m->gpx,      m->gpy,      m->gfx,       m->gfy,       m->gvx,
+                    m->gvy,        m->gnx,      m->gny,      m->particle, m->bx,        m->by,        m->order,
+                    m->cell_start, m->pfirst,   m->win_i0,   m->win_j0,   m->win_nx,    m->win_ny,    m->win_off,
+                    m->bnode_body, m->cn_start, m->cn_entry, m->cn_list,  m->cn_active, m->pair_keys, m->since};
     for (size_t i = 0; i < sizeof cols / sizeof cols[0]; i++) free(cols[i]);
     memset(m, 0, sizeof *m);
 }
@@ -238,87 +239,119 @@ void cd_mpm_step_done(cd_mpm *m)
     m->step++;
 }
 
-/* Stencil of every point, the wall forces on it, each body's window of
- * nodes, and the points sorted by body and cell.  -1 when a point's stencil leaves the mesh. */
-static int prepare(cd_mpm *m, char *err, size_t errlen)
+int cd_mpm_bnodes_room(cd_mpm *m, size_t n, char *err, size_t errlen)
 {
-    size_t n = m->n;
-    long long bad = -1;
-    cd_mpm_item_walls walls = cd_mpm_walls_items(m);
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
-    CD_WIDE_MIN
-    CD_STEP_FOR(n, firstprivate(c, walls) reduction(max : bad) CD_DEV(map(tofrom : bad)))
-    for (size_t p = 0; p < n; p++)
-        if (cd_mpm_item_prepare(c, p, walls)) bad = (long long)p > bad ? (long long)p : bad;
-    if (bad >= 0) return cd_mpm_fail_left_mesh(m, (size_t)bad, err, errlen);
-    /* wall forces: the reaction of the points' penalty forces, summed in point order */
-    double *wf = m->loop_wall_f, f[2 * CD_MPM_MAX_WALLS]; /* [N/m] */
-    int nw = m->n_walls;
-    CD_STEP_FOR(nw, firstprivate(c, walls, n) CD_DEV(is_device_ptr(wf)))
-    for (int w = 0; w < nw; w++) cd_mpm_item_wall_force(c, n, walls, w, wf);
-    cd_dev_get(f, wf, 2 * (size_t)nw * sizeof(double));
-    for (int w = 0; w < nw; w++) {
-        m->walls[w].fx = f[2 * w];
-        m->walls[w].fy = f[2 * w + 1];
-    }
-    /* each body's window: the nodes its points' stencils reach, and where its nodes start */
-    int nb = m->n_bodies;
-    CD_STEP_FOR(nb, firstprivate(c))
-    for (int k = 0; k < nb; k++) cd_mpm_item_window(c, k);
-    cd_ulong *count = m->loop_count, nbn;
-    CD_STEP_FOR(1, firstprivate(c) CD_DEV(is_device_ptr(count)))
-    for (int one = 0; one < 1; one++) cd_mpm_item_window_offsets(c, count);
-    cd_dev_get(&nbn, count, sizeof nbn);
-    if (reserve_bnodes(m, nbn, err, errlen)) return -1;
-    if (cd_mpm_device_reserve(m, nbn)) {
-        snprintf(err, errlen, "out of device memory for %zu body-nodes", (size_t)nbn);
+    if (reserve_bnodes(m, n, err, errlen)) return -1;
+    if (cd_mpm_device_reserve(m, n)) {
+        snprintf(err, errlen, "out of device memory for %zu body-nodes", n);
         return -1;
     }
-    m->n_bnodes = nbn;
-    c = cd_mpm_loop_cols(m); /* the body-node columns may have moved */
-    CD_STEP_FOR(nb, firstprivate(c))
-    for (int k = 0; k < nb; k++) cd_mpm_item_bnode_body(c, k);
-    /* stable counting sort by (body, cell), body by body: a point's cell is
-     * its stencil's second node, numbered like the body's nodes */
-    CD_STEP_FOR(nb, firstprivate(c))
-    for (int k = 0; k < nb; k++) cd_mpm_item_sort_body(c, k);
+    cd_mpm_loop_args_refresh(m); /* the body-node columns may have moved */
     return 0;
 }
 
+/* The first step (since the loops started) sizes the body-node columns
+ * from its count, the one read between steps (unless the step already
+ * failed: then it stops before it needs them, and cd_mpm_settle reports
+ * it). */
+static int size_bnodes(cd_mpm *m, char *err, size_t errlen)
+{
+    cd_ulong nbn;
+    cd_int left;
+    cd_dev_get(&nbn, m->loop_counts + CD_MPM_COUNT_BNODES, sizeof nbn);
+    cd_dev_get(&left, m->loop_flags + CD_MPM_FAIL_LEFT, sizeof left);
+    if (left < 0 && cd_mpm_bnodes_room(m, nbn, err, errlen)) return -1;
+    m->sized = 1;
+    return 0;
+}
+
+/* Stencil of every point, the wall forces on it (observed steps: the
+ * walls' forces), each body's window of nodes, and the points sorted by
+ * body and cell: stages 0 and 1 of the checks (kernels/mpm_checks.h). */
+static int prepare(cd_mpm *m, char *err, size_t errlen)
+{
+    size_t n = m->n;
+    cd_int j = m->pending, *flags = m->loop_flags;
+    cd_ulong *counts = m->loop_counts;
+    double *reals = m->loop_reals;
+    cd_mpm_item_walls walls = cd_mpm_walls_items(m);
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
+    CD_WIDE_MIN
+    CD_STEP_FOR(n, firstprivate(walls, j) CD_DEV(is_device_ptr(args, flags)))
+    for (size_t p = 0; p < n; p++) cd_mpm_checked_prepare(*args, p, walls, flags, j);
+    /* the walls' forces: the reaction of the points' penalty forces, summed in point order */
+    int nw = m->n_walls;
+    if (m->observe && nw > 0) {
+        CD_STEP_FOR(nw, firstprivate(walls, n, j) CD_DEV(is_device_ptr(args, flags, reals)))
+        for (int w = 0; w < nw; w++)
+            if (!cd_mpm_stopped(flags, j, 1)) cd_mpm_item_wall_force(*args, n, walls, w, reals + CD_MPM_REAL_WALLS);
+    }
+    /* each body's window: the nodes its points' stencils reach, and where its nodes start */
+    int nb = m->n_bodies;
+    CD_STEP_FOR(nb, firstprivate(j) CD_DEV(is_device_ptr(args, flags)))
+    for (int k = 0; k < nb; k++)
+        if (!cd_mpm_stopped(flags, j, 1)) cd_mpm_item_window(*args, k);
+    cd_ulong cap = m->sized ? cd_mpm_loop_rows(m) : (cd_ulong)-1;
+    CD_STEP_FOR(1, firstprivate(cap, j) CD_DEV(is_device_ptr(args, flags, counts)))
+    for (int one = 0; one < 1; one++) cd_mpm_checked_window_offsets(*args, counts, cap, flags, j);
+    if (!m->sized && size_bnodes(m, err, errlen)) return -1;
+    CD_STEP_FOR(nb, firstprivate(j) CD_DEV(is_device_ptr(args, flags)))
+    for (int k = 0; k < nb; k++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_bnode_body(*args, k);
+    /* stable counting sort by (body, cell), body by body: a point's cell is
+     * its stencil's second node, numbered like the body's nodes */
+    CD_STEP_FOR(nb, firstprivate(j) CD_DEV(is_device_ptr(args, flags)))
+    for (int k = 0; k < nb; k++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_sort_body(*args, k);
+    return 0;
+}
+
+/* The loops over body-nodes run over the rows their columns hold; those
+ * past the step's count (counts[CD_MPM_COUNT_BNODES]) do nothing. */
 int cd_mpm_step(cd_mpm *m, char *err, size_t errlen)
 {
     double dt = m->dt;
     if (m->n_bodies == 0 && cd_mpm_bodies(m, err, errlen)) return -1;
     if (m->cl) return cd_mpm_cl_step(m, err, errlen); /* the OpenCL backend (src/mpm/mpm_cl.c) */
-    if (cd_mpm_device_start(m, err, errlen) || prepare(m, err, errlen)) return -1;
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
-    size_t n = m->n, nbn = m->n_bnodes;
-    int normals = m->n_bodies > 1;
+    if (cd_mpm_device_start(m, err, errlen) || cd_mpm_record_start(m, err, errlen) || prepare(m, err, errlen))
+        return -1;
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
+    size_t n = m->n, rows = cd_mpm_loop_rows(m);
+    cd_int j = m->pending, *flags = m->loop_flags, normals = m->n_bodies > 1;
+    cd_ulong *counts = m->loop_counts;
     CD_WIDE_MIN
-    CD_STEP_FOR(nbn, firstprivate(c, normals))
-    for (size_t t = 0; t < nbn; t++) cd_mpm_item_to_grid(c, t, normals);
-    CD_STEP_FOR(nbn, firstprivate(c, dt))
-    for (size_t t = 0; t < nbn; t++) cd_mpm_item_node_update(c, t, dt);
-    if (m->n_bodies > 1 && (cd_mpm_contact_nodes(m), cd_mpm_contact_correct(m, err, errlen))) return -1;
+    CD_STEP_FOR(rows, firstprivate(normals, j) CD_DEV(is_device_ptr(args, flags, counts)))
+    for (size_t t = 0; t < rows; t++)
+        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_to_grid(*args, t, normals);
+    CD_STEP_FOR(rows, firstprivate(dt, j) CD_DEV(is_device_ptr(args, flags, counts)))
+    for (size_t t = 0; t < rows; t++)
+        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 2)) cd_mpm_item_node_update(*args, t, dt);
+    if (m->n_bodies > 1) {
+        cd_mpm_contact_nodes(m);
+        cd_mpm_contact_correct(m);
+    }
     double pic = m->pic_fraction; /* [1] */
-    CD_STEP_FOR(n, firstprivate(c, dt, pic))
-    for (size_t p = 0; p < n; p++) cd_mpm_item_point_update(c, p, dt, pic);
-    CD_STEP_FOR(nbn, firstprivate(c))
-    for (size_t t = 0; t < nbn; t++) cd_mpm_item_remap(c, t);
-    /* [J/m], summed in body-node order: the same bits for any thread count */
-    double *e = m->loop_real;
-    CD_STEP_FOR(1, firstprivate(c, nbn) CD_DEV(is_device_ptr(e)))
-    for (int one = 0; one < 1; one++) cd_mpm_item_mesh_kinetic(c, nbn, e);
-    cd_dev_get(&m->mesh_kinetic, e, sizeof(double));
+    CD_STEP_FOR(n, firstprivate(dt, pic, j) CD_DEV(is_device_ptr(args, flags)))
+    for (size_t p = 0; p < n; p++)
+        if (!cd_mpm_stopped(flags, j, 3)) cd_mpm_item_point_update(*args, p, dt, pic);
+    CD_STEP_FOR(rows, firstprivate(j) CD_DEV(is_device_ptr(args, flags, counts)))
+    for (size_t t = 0; t < rows; t++)
+        if (t < counts[CD_MPM_COUNT_BNODES] && !cd_mpm_stopped(flags, j, 3)) cd_mpm_item_remap(*args, t);
+    /* observed steps: [J/m], summed in body-node order: the same bits for any thread count */
+    double *reals = m->loop_reals;
+    if (m->observe) {
+        CD_STEP_FOR(1, firstprivate(j) CD_DEV(is_device_ptr(args, flags, counts, reals)))
+        for (int one = 0; one < 1; one++)
+            if (!cd_mpm_stopped(flags, j, 3))
+                cd_mpm_item_mesh_kinetic(*args, counts[CD_MPM_COUNT_BNODES], reals + CD_MPM_REAL_KINETIC);
+    }
     /* no second contact correction of the remapped velocities: the strain follows each body's own
      * remapped field, the motion its points made; re-imposing the contact there, on the contact's
      * widened nodes, made strain the points' motion did not have and fed energy (docs/mpm.md) */
-    long long bad = -1;
     cd_mpm_material mat = m->mat;
-    CD_STEP_FOR(n, firstprivate(c, dt, mat) reduction(max : bad) CD_DEV(map(tofrom : bad)))
-    for (size_t p = 0; p < n; p++)
-        if (cd_mpm_item_stress(c, p, dt, mat)) bad = (long long)p > bad ? (long long)p : bad;
-    if (bad >= 0) return cd_mpm_fail_blew_up(m, bad, err, errlen);
+    CD_STEP_FOR(n, firstprivate(dt, mat, j) CD_DEV(is_device_ptr(args, flags)))
+    for (size_t p = 0; p < n; p++) cd_mpm_checked_stress(*args, p, dt, mat, flags, j);
+    m->pending++;
     cd_mpm_step_done(m);
     return 0;
 }

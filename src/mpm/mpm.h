@@ -19,6 +19,13 @@ typedef struct {
     double fx, fy; /* force of the material on the wall in the last step [N/m] */
 } cd_mpm_wall;
 
+/* Where a step began (time [s], walls' points [m]): where the run goes
+ * back to when the checks show that the step failed or must run again. */
+typedef struct {
+    double time;
+    double px[CD_MPM_MAX_WALLS], py[CD_MPM_MAX_WALLS];
+} cd_mpm_step_start;
+
 typedef struct {
     /* material points (n of them) */
     size_t n;
@@ -82,18 +89,31 @@ typedef struct {
     double dt, time;     /* [s] */
     long long step;
     int observe; /* 1 (the default): the next step computes the sums only output reads (the walls' forces,
-                  * the mesh's kinetic energy, the deepest overlap); the OpenCL backend skips them at
-                  * steps with 0, which the run sets where it reads nothing (the omp loops compute them
-                  * at every step) */
+                  * the mesh's kinetic energy, the deepest overlap); steps with 0, which the run sets
+                  * where it reads nothing, skip them */
+    /* the checks where the loops run (kernels/mpm_checks.h): what the host has not looked at yet */
+    int pending;              /* steps run since the host last looked (cd_mpm_settle) */
+    cd_mpm_step_start *since; /* where each of them began */
+    size_t cap_since;
+    int sized; /* the body-node columns sized from the first step's count (since the loops started) */
 
     /* where the step's loops run (src/mpm/mpm_device.c, docs/mpm.md "Work items") */
-    int loop_on;                     /* 1 from the first step on (offload builds: the state is on the device) */
-    cd_mpm_cols loop_cols;           /* offload builds: the device addresses of the columns */
-    size_t loop_cap, loop_cap_keys;  /* offload builds: body-nodes allocated there; pair keys allocated */
-    double *loop_wall_f, *loop_real; /* where the loops run: wall forces [N/m], the mesh's kinetic energy */
-    cd_ulong *loop_count;            /* where the loops run: counts the serial parts return */
-    cd_long *loop_keys;              /* where the loops run: the contact pairs' keys */
-    struct cd_mpm_cl *cl;            /* the OpenCL backend's state (src/mpm/mpm_cl.c); NULL: the omp loops */
+    int loop_on;                    /* 1 from the first step on (offload builds: the state is on the device) */
+    cd_mpm_cols loop_cols;          /* offload builds: the device addresses of the columns */
+    size_t loop_cap, loop_cap_keys; /* offload builds: body-nodes allocated there; pair keys allocated */
+    /* where the loops run (host memory or the offload device): the checks, as one block
+     * (cd_mpm_checks: the host reads it in one copy), and the contact's scratch */
+    void *loop_checks;
+    cd_int *loop_flags;
+    cd_ulong *loop_counts;
+    double *loop_reals;
+    cd_int *loop_row_n, *loop_rows; /* the common nodes' lists: bodies per mesh row (ny, ny x n_bodies) */
+    cd_ulong *loop_blocks;          /* 2 per CD_MPM_CN_BLOCK common nodes */
+    double *loop_over;              /* per listed common node: the contact's overlap [m] */
+    cd_long *loop_keys;             /* the contact pairs' keys */
+    cd_mpm_cols *loop_args;         /* the loops' argument: cd_mpm_loop_cols, copied there when it changes
+                                     * (cd_mpm_loop_args_refresh), not at every launch */
+    struct cd_mpm_cl *cl;           /* the OpenCL backend's state (src/mpm/mpm_cl.c); NULL: the omp loops */
 } cd_mpm;
 
 /* Allocates n points and an nx x ny node mesh of cell size h [m] whose
@@ -117,9 +137,11 @@ double cd_mpm_dt_limit(const cd_mpm *m);
  * calls it at the first step. */
 int cd_mpm_bodies(cd_mpm *m, char *err, size_t errlen);
 
-/* One explicit step (MUSL, docs/mpm.md).  0, or -1 with a message when a
- * point leaves the mesh or a value is not finite (the run blew up); on the
- * OpenCL backend these show at the next cd_mpm_settle. */
+/* One explicit step (MUSL, docs/mpm.md), only launched: a point leaving
+ * the mesh, a value not finite (the run blew up), a crowded common node
+ * show at the next cd_mpm_settle, which also makes the columns, counts and
+ * observed sums current on the host.  0, or -1 with a message (out of
+ * memory, the OpenCL runtime). */
 int cd_mpm_step(cd_mpm *m, char *err, size_t errlen);
 
 /* Sums over the points, in index order [J/m]. */
@@ -135,13 +157,13 @@ double cd_mpm_strain_energy(const cd_mpm *m);
  * coordination number 2 N_c / N of the body pairs in contact [1]. */
 void cd_mpm_packing_measures(const cd_mpm *m, double *phi, double *sigma, double *strain, double *z);
 
-/* Contact (src/mpm/mpm_contact.c, docs/mpm.md "Contact"): lists the common
- * nodes two or more bodies share; after the forces, detects the contacts
- * there, corrects the bodies' node velocities and sets the accelerations to
- * match.  -1 with a message when more bodies than CD_MPM_NODE_BODIES
- * (kernels/mpm_contact.h) meet at a node. */
+/* Contact (src/mpm/mpm_contact.c, docs/mpm.md "Contact"), steps of
+ * cd_mpm_step: lists the common nodes two or more bodies share; after the
+ * forces, detects the contacts there, corrects the bodies' node velocities
+ * and sets the accelerations to match (CROWDED when more bodies than
+ * CD_MPM_NODE_BODIES, kernels/mpm_contact.h, meet at a node). */
 void cd_mpm_contact_nodes(cd_mpm *m);
-int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen);
+void cd_mpm_contact_correct(cd_mpm *m);
 /* n_contacts from the last step's contact bits: called where the count is
  * read (a series row, the progress line), not every step (on an offload
  * device it copies the pair keys to the host and sorts them).  Before the
@@ -161,6 +183,20 @@ int cd_mpm_fail_left_mesh(cd_mpm *m, size_t p, char *err, size_t errlen);
 int cd_mpm_fail_blew_up(cd_mpm *m, long long p, char *err, size_t errlen);
 int cd_mpm_fail_crowded(cd_mpm *m, size_t g, char *err, size_t errlen);
 void cd_mpm_step_done(cd_mpm *m);
+/* Where step m->pending begins, recorded before it runs (0, or -1 out of memory). */
+int cd_mpm_record_start(cd_mpm *m, char *err, size_t errlen);
+/* The checks as read back from where the loops ran (kernels/mpm_checks.h):
+ * 0 when no step since the last look failed (the counts and, at an
+ * observed step, its sums made m's; the caller brings the columns back);
+ * 1 when the body-nodes outgrew their columns (m back at that step: the
+ * caller grows them to counts[CD_MPM_COUNT_BNODES] and clears the checks);
+ * -1 with the message cd_mpm_step gave before it read nothing (m back at
+ * the failing step).  m->pending is 0 after it. */
+int cd_mpm_checks_apply(cd_mpm *m, const cd_int *flags, const cd_ulong *counts, const double *reals, char *err,
+                        size_t errlen);
+/* Room for n body-nodes in the columns the loops work on (host and, in
+ * offload builds, device); 0, or -1 with a message. */
+int cd_mpm_bnodes_room(cd_mpm *m, size_t n, char *err, size_t errlen);
 
 /* The OpenCL backend (src/mpm/mpm_cl.c, docs/mpm.md "The OpenCL backend"):
  * cd_mpm_cl_open opens the device (request cpu | gpu | auto, NULL: auto)
@@ -193,15 +229,20 @@ cd_mpm_cols cd_mpm_step_cols(const cd_mpm *m);
 int cd_mpm_device_start(cd_mpm *m, char *err, size_t errlen);
 void cd_mpm_device_sync(cd_mpm *m);
 /* Where the run reads the state (a series row, a snapshot, the progress
- * line): the host columns made current, as cd_mpm_device_sync.  The OpenCL
- * backend finds out there whether a step since its last look failed: -1
- * with the message cd_mpm_step would have given (step, time and walls back
- * at that step's start), or 1 when the body-nodes outgrew their buffers at
- * an earlier step: the buffers grown, the state back at that step, and the
- * run steps on from there.  0 otherwise. */
+ * line): the host reads the checks (one copy) and finds out whether a step
+ * since its last look failed: -1 with the message the step itself used to
+ * give (step, time and walls back at that step's start), or 1 when the
+ * body-nodes outgrew their columns at an earlier step: the columns grown,
+ * the state back at that step, and the run steps on from there.  0
+ * otherwise: the counts, the observed step's sums and the host columns
+ * current (cd_mpm_device_sync). */
 int cd_mpm_settle(cd_mpm *m, char *err, size_t errlen);
 void cd_mpm_device_stop(cd_mpm *m);
 cd_mpm_cols cd_mpm_loop_cols(const cd_mpm *m);
+/* The body-node rows the loops' columns hold. */
+size_t cd_mpm_loop_rows(const cd_mpm *m);
+/* m->loop_args made cd_mpm_loop_cols(m) (after the columns moved). */
+void cd_mpm_loop_args_refresh(cd_mpm *m);
 int cd_mpm_device_reserve(cd_mpm *m, size_t n);
 int cd_mpm_device_keys(cd_mpm *m, size_t n);
 /* The common-mesh coordinates (i, j) of body-node t. */

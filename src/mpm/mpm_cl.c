@@ -32,6 +32,7 @@
 #ifdef CAPDEM_HAVE_OPENCL
 #include "backend/opencl/backend_cl.h"
 #include "cl/mpm_col_list.h"
+#include "mpm_checks.h"
 
 /* Kernels of kernels/cl/mpm.cl; every one takes the columns, the mesh and the checks first. */
 enum {
@@ -95,39 +96,21 @@ static const struct {
 #define ARG_J     (N_COLS + 8)
 #define FIRST_ARG (N_COLS + 9)
 
-/* Failures in the step's order (kernels/cl/mpm.cl): flags[f] the highest
- * bad index or -1, flags[N_FAILS + f] the step it was first seen at,
- * counted from the host's last look, or NEVER. */
-enum { FAIL_LEFT, FAIL_OVERFLOW, FAIL_CROWDED, FAIL_BLEW_UP, N_FAILS };
-#define NEVER 0x7fffffff
-/* counts (cd_ulong): body-nodes, listed common nodes, contact keys. */
-enum { COUNT_BNODES, COUNT_LISTED, COUNT_KEYS, N_COUNTS };
-/* Real results of an observed step: the walls' forces [N/m], the deepest overlap [m], the mesh's kinetic energy [J/m]. */
-enum { REAL_WALLS = 0, REAL_PEN = 2 * CD_MPM_MAX_WALLS, REAL_KINETIC, N_REALS };
-
-/* Where a step began (time [s], walls' points [m]): where the host goes
- * back to when the step failed or must run again. */
-struct step_start {
-    double time;
-    double px[CD_MPM_MAX_WALLS], py[CD_MPM_MAX_WALLS];
-};
+/* The checks (kernels/mpm_checks.h): flags, counts, an observed step's sums. */
+#define N_FLAGS (2 * CD_MPM_N_FAILS)
 
 struct cd_mpm_cl {
     cd_cl cl;
     cl_kernel k[K_COUNT];
     cl_mem col[N_COLS];
     size_t cap_bnodes;   /* body-node rows of the BNODE columns */
-    cl_mem flags, reals; /* 2 N_FAILS cd_int, N_REALS cd_real */
-    cl_mem count;        /* N_COUNTS cd_ulong */
+    cl_mem flags, reals; /* N_FLAGS cd_int, CD_MPM_N_REALS cd_real */
+    cl_mem count;        /* CD_MPM_N_COUNTS cd_ulong */
     cl_mem over;         /* cd_real per common node: the contact's overlaps */
     cl_mem keys;         /* cd_long: the contact pairs' keys */
     size_t cap_keys;
-    cl_mem row_n, rows;       /* the common nodes' lists: bodies per mesh row (cd_int ny, ny x n_bodies) */
-    cl_mem blocks;            /* cd_ulong 2 per CD_MPM_CN_BLOCK common nodes */
-    int sized;                /* the body-node buffers sized from the first step's count */
-    cd_int j;                 /* steps enqueued since the host last looked */
-    struct step_start *since; /* where each of them began */
-    size_t cap_since;
+    cl_mem row_n, rows; /* the common nodes' lists: bodies per mesh row (cd_int ny, ny x n_bodies) */
+    cl_mem blocks;      /* cd_ulong 2 per CD_MPM_CN_BLOCK common nodes */
 };
 
 static size_t rows_of(const cd_mpm *m, enum rows_kind r)
@@ -236,10 +219,11 @@ static size_t n_blocks(const cd_mpm *m)
 }
 
 /* The checks as they are before any step: no failure, never seen. */
-static int reset_flags(struct cd_mpm_cl *d)
+static int reset_flags(cd_mpm *m)
 {
-    static const cd_int none[2 * N_FAILS] = {-1, -1, -1, -1, NEVER, NEVER, NEVER, NEVER};
-    d->j = 0;
+    struct cd_mpm_cl *d = m->cl;
+    static const cd_int none[N_FLAGS] = {-1, -1, -1, -1, CD_MPM_NEVER, CD_MPM_NEVER, CD_MPM_NEVER, CD_MPM_NEVER};
+    m->pending = 0;
     return cd_cl_check(&d->cl,
                        clEnqueueWriteBuffer(d->cl.queue, d->flags, CL_TRUE, 0, sizeof none, none, 0, NULL, NULL),
                        "resetting the step's checks")
@@ -262,9 +246,9 @@ static int start(cd_mpm *m)
                 return -1;
         if (reserve_bnodes(m, 1)) return -1; /* bound before the first step's count sizes them */
         size_t nn = (size_t)m->nx * (size_t)m->ny;
-        d->flags = cd_cl_buffer(cl, 2 * N_FAILS * sizeof(cd_int), "allocating the step's checks");
-        d->reals = cd_cl_buffer(cl, N_REALS * sizeof(cd_real), "allocating the step's sums");
-        d->count = cd_cl_buffer(cl, N_COUNTS * sizeof(cd_ulong), "allocating the step's counts");
+        d->flags = cd_cl_buffer(cl, N_FLAGS * sizeof(cd_int), "allocating the step's checks");
+        d->reals = cd_cl_buffer(cl, CD_MPM_N_REALS * sizeof(cd_real), "allocating the step's sums");
+        d->count = cd_cl_buffer(cl, CD_MPM_N_COUNTS * sizeof(cd_ulong), "allocating the step's counts");
         d->over = cd_cl_buffer(cl, nn * sizeof(cd_real), "allocating the contact's overlaps");
         d->row_n = cd_cl_buffer(cl, (size_t)m->ny * sizeof(cd_int), "allocating the contact's row lists");
         d->rows = cd_cl_buffer(cl, (size_t)m->ny * nb_rows(m) * sizeof(cd_int), "allocating the contact's row lists");
@@ -285,29 +269,9 @@ static int start(cd_mpm *m)
         cd_cl_check(cl, clEnqueueWriteBuffer(cl->queue, d->col[f], CL_TRUE, 0, bytes, host_col(m, f), 0, NULL, NULL),
                     "uploading the material points");
     }
-    if (cl->status || reset_flags(d)) return -1;
-    d->sized = 0;
+    if (cl->status || reset_flags(m)) return -1;
+    m->sized = 0;
     m->loop_on = 1;
-    return 0;
-}
-
-/* Where step j (since the host's last look) begins: recorded before it is enqueued. */
-static int record_start(cd_mpm *m)
-{
-    struct cd_mpm_cl *d = m->cl;
-    if ((size_t)d->j >= d->cap_since) {
-        size_t cap = 2 * d->cap_since + 16;
-        struct step_start *q = realloc(d->since, cap * sizeof *q);
-        if (!q) return -1;
-        d->since = q;
-        d->cap_since = cap;
-    }
-    struct step_start *s = &d->since[d->j];
-    s->time = m->time;
-    for (int w = 0; w < m->n_walls; w++) {
-        s->px[w] = m->walls[w].px;
-        s->py[w] = m->walls[w].py;
-    }
     return 0;
 }
 
@@ -316,7 +280,7 @@ static int record_start(cd_mpm *m)
     do {                                                                                                               \
         cl_uint a_ = FIRST_ARG;                                                                                        \
         (void)a_;                                                                                                      \
-        arg(d, k, ARG_J, sizeof d->j, &d->j);                                                                          \
+        arg(d, k, ARG_J, sizeof m->pending, &m->pending);                                                              \
         __VA_ARGS__;                                                                                                   \
         launch(d, k, n);                                                                                               \
     } while (0)
@@ -333,10 +297,7 @@ int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen)
     struct cd_mpm_cl *d = m->cl;
     cd_cl *cl = &d->cl;
     if (!m->loop_on && start(m)) goto failed;
-    if (record_start(m)) {
-        snprintf(err, errlen, "out of memory for the record of %d steps", (int)d->j + 1);
-        return -1;
-    }
+    if (cd_mpm_record_start(m, err, errlen)) return -1;
     size_t n = m->n, nb = (size_t)m->n_bodies;
     double dt = m->dt; /* [s] */
     /* stencils, wall forces, windows, the points sorted by (body, cell) */
@@ -344,19 +305,19 @@ int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen)
     LAUNCH_WITH(K_PREPARE, n, A_ULONG(K_PREPARE, n); A_ANY(K_PREPARE, walls));
     if (m->observe)
         LAUNCH_WITH(K_WALL_FORCE, (size_t)m->n_walls, A_ULONG(K_WALL_FORCE, n); A_ANY(K_WALL_FORCE, walls);
-                    A_MEM(K_WALL_FORCE, d->reals));
+                    A_MEM(K_WALL_FORCE, d->reals)); /* at CD_MPM_REAL_WALLS = 0 */
     LAUNCH_WITH(K_WINDOW, nb, );
     /* the first step sizes the body-node buffers from its count; later
      * steps check it against them on the device (failure OVERFLOW) */
-    LAUNCH_WITH(K_WINDOW_OFFSETS, 1, A_ULONG(K_WINDOW_OFFSETS, d->sized ? d->cap_bnodes : (size_t)-1));
-    if (!d->sized) { /* (unless the step already failed: then it stops here and settle reports it) */
+    LAUNCH_WITH(K_WINDOW_OFFSETS, 1, A_ULONG(K_WINDOW_OFFSETS, m->sized ? d->cap_bnodes : (size_t)-1));
+    if (!m->sized) { /* (unless the step already failed: then it stops here and settle reports it) */
         cl_ulong nbn;
         cd_int left;
         if (read_buf(d, d->count, 0, sizeof nbn, &nbn, "reading the body-node count") ||
-            read_buf(d, d->flags, FAIL_LEFT * sizeof(cd_int), sizeof left, &left, "reading the step's checks") ||
+            read_buf(d, d->flags, CD_MPM_FAIL_LEFT * sizeof(cd_int), sizeof left, &left, "reading the step's checks") ||
             (left < 0 && reserve_bnodes(m, nbn)))
             goto failed;
-        d->sized = 1;
+        m->sized = 1;
     }
     size_t rows = d->cap_bnodes;                                                               /* body-node kernels */
     size_t nn = (size_t)m->nx * (size_t)m->ny, listed = rows / 2 + 1 < nn ? rows / 2 + 1 : nn; /* >= listed nodes */
@@ -377,20 +338,18 @@ int cd_mpm_cl_step(cd_mpm *m, char *err, size_t errlen)
         LAUNCH_WITH(K_CONTACT_CROWDED, listed, );
         LAUNCH_WITH(K_CONTACT, listed, A_REAL(K_CONTACT, m->contact_gap); A_REAL(K_CONTACT, dt);
                     A_MEM(K_CONTACT, d->over));
-        if (m->observe)
-            LAUNCH_WITH(K_MAX_OVER, 1, A_MEM(K_MAX_OVER, d->over); A_MEM(K_MAX_OVER, d->reals);
-                        A_ULONG(K_MAX_OVER, REAL_PEN));
+        if (m->observe) LAUNCH_WITH(K_MAX_OVER, 1, A_MEM(K_MAX_OVER, d->over); A_MEM(K_MAX_OVER, d->reals));
     }
     /* the points' update, MUSL's remap, the stress */
     LAUNCH_WITH(K_POINT_UPDATE, n, A_ULONG(K_POINT_UPDATE, n); A_REAL(K_POINT_UPDATE, dt);
                 A_REAL(K_POINT_UPDATE, m->pic_fraction));
     LAUNCH_WITH(K_REMAP, rows, );
     if (m->observe)
-        LAUNCH_WITH(K_MESH_KINETIC, 1, A_MEM(K_MESH_KINETIC, d->reals); A_ULONG(K_MESH_KINETIC, REAL_KINETIC));
+        LAUNCH_WITH(K_MESH_KINETIC, 1, A_MEM(K_MESH_KINETIC, d->reals); A_ULONG(K_MESH_KINETIC, CD_MPM_REAL_KINETIC));
     cd_mpm_material mat = m->mat;
     LAUNCH_WITH(K_STRESS, n, A_ULONG(K_STRESS, n); A_REAL(K_STRESS, dt); A_ANY(K_STRESS, mat));
     if (cl->status) goto failed;
-    d->j++;
+    m->pending++;
     cd_mpm_step_done(m);
     return 0;
 failed:
@@ -419,50 +378,21 @@ void cd_mpm_cl_sync(cd_mpm *m)
 int cd_mpm_cl_settle(cd_mpm *m, char *err, size_t errlen)
 {
     struct cd_mpm_cl *d = m->cl;
-    if (!m->loop_on || d->j == 0) return 0;
-    cd_int flags[2 * N_FAILS];
-    cl_ulong counts[N_COUNTS];
-    double r[N_REALS];
+    if (!m->loop_on || m->pending == 0) return 0;
+    cd_int flags[N_FLAGS];
+    cl_ulong counts[CD_MPM_N_COUNTS];
+    double r[CD_MPM_N_REALS];
     if (read_buf(d, d->flags, 0, sizeof flags, flags, "reading the step's checks") ||
         read_buf(d, d->count, 0, sizeof counts, counts, "reading the step's counts") ||
         read_buf(d, d->reals, 0, sizeof r, r, "reading the step's sums"))
         goto failed;
-    int fail = -1; /* the first failure: the earliest step, and in a step the earliest check */
-    cd_int at = NEVER;
-    for (int f = 0; f < N_FAILS; f++)
-        if (flags[N_FAILS + f] < at) at = flags[N_FAILS + f], fail = f;
-    if (fail < 0) {
-        m->n_bnodes = counts[COUNT_BNODES];
-        m->n_cn = m->n_bodies > 1 ? counts[COUNT_LISTED] : 0;
-        if (m->observe) { /* the last step computed them */
-            for (int w = 0; w < m->n_walls; w++) {
-                m->walls[w].fx = r[REAL_WALLS + 2 * w];
-                m->walls[w].fy = r[REAL_WALLS + 2 * w + 1];
-            }
-            if (m->n_bodies > 1) m->penetration = r[REAL_PEN];
-            m->mesh_kinetic = r[REAL_KINETIC];
-        }
-        d->j = 0;
-        cd_mpm_cl_sync(m);
-        if (d->cl.status) goto failed;
-        return 0;
-    }
-    /* back to where the failing step began: as the omp loops stand when they return */
-    const struct step_start *s = &d->since[at];
-    m->step -= d->j - at;
-    m->time = s->time;
-    for (int w = 0; w < m->n_walls; w++) {
-        m->walls[w].px = s->px[w];
-        m->walls[w].py = s->py[w];
-    }
-    if (fail == FAIL_OVERFLOW) { /* room for the count the device found, and the run steps on from there */
-        if (reserve_bnodes(m, counts[COUNT_BNODES]) || reset_flags(d)) goto failed;
-        return 1;
-    }
-    d->j = 0;
-    if (fail == FAIL_LEFT) return cd_mpm_fail_left_mesh(m, (size_t)flags[fail], err, errlen);
-    if (fail == FAIL_CROWDED) return cd_mpm_fail_crowded(m, (size_t)flags[fail], err, errlen);
-    return cd_mpm_fail_blew_up(m, flags[fail], err, errlen);
+    cd_ulong c[CD_MPM_N_COUNTS];
+    for (int i = 0; i < CD_MPM_N_COUNTS; i++) c[i] = counts[i];
+    int rc = cd_mpm_checks_apply(m, flags, c, r, err, errlen);
+    if (rc == 0) cd_mpm_cl_sync(m);
+    if (rc == 1 && (reserve_bnodes(m, counts[CD_MPM_COUNT_BNODES]) || reset_flags(m))) goto failed;
+    if (d->cl.status) goto failed;
+    return rc;
 failed:
     cd_cl_report(&d->cl, err, errlen);
     return -1;
@@ -473,7 +403,8 @@ int cd_mpm_cl_pair_keys(cd_mpm *m, size_t *n, char *err, size_t errlen)
     struct cd_mpm_cl *d = m->cl;
     cl_ulong count = 0;
     LAUNCH_WITH(K_PAIR_KEYS, 1, arg(d, K_PAIR_KEYS, a_++, sizeof(cl_mem), NULL));
-    if (read_buf(d, d->count, COUNT_KEYS * sizeof(cl_ulong), sizeof count, &count, "reading the contact pairs' count"))
+    if (read_buf(d, d->count, CD_MPM_COUNT_KEYS * sizeof(cl_ulong), sizeof count, &count,
+                 "reading the contact pairs' count"))
         goto failed;
     if (cd_mpm_pair_keys_room(m, count, err, errlen)) return -1;
     if (count > d->cap_keys) {
@@ -533,7 +464,6 @@ void cd_mpm_cl_close(cd_mpm *m)
     for (int k = 0; k < K_COUNT; k++)
         if (d->k[k]) clReleaseKernel(d->k[k]);
     cd_cl_close(&d->cl);
-    free(d->since);
     free(d);
     m->cl = NULL;
     m->loop_on = 0;

@@ -10,28 +10,48 @@
  * along the contact normal: momentum is conserved pair by pair, so exactly
  * for any number of bodies.
  *
- * Deterministic: the common nodes' body lists come from a stable counting
- * sort, each listed node is handled by one thread and writes only its own
+ * Deterministic: the common nodes' body lists come from counts in a fixed
+ * order (six parallel loops, the same lists as a stable counting sort),
+ * each listed node is handled by one thread and writes only its own
  * body-nodes, and the pairs are counted after a sort (cd_mpm_contact_count,
- * only where a reader needs the count: not every step). */
+ * only where a reader needs the count: not every step).  Nothing is read
+ * back: the loops over listed nodes run over a bound and skip those past
+ * the count, which stays where the loops run (kernels/mpm_checks.h). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "mpm/mpm.h"
 #include "backend/omp/omp_loops.h" /* CD_STEP_FOR */
-#include "mpm_contact.h"
+#include "mpm_checks.h"
 
 
+/* The steps of kernels/mpm_step_items.h's cd_mpm_item_cn_* (stage 2). */
 void cd_mpm_contact_nodes(cd_mpm *m)
 {
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
-    cd_ulong *listed = m->loop_count, nbn = m->n_bnodes, n_cn;
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
+    cd_int j = m->pending, *flags = m->loop_flags, *row_n = m->loop_row_n, *rows = m->loop_rows, ny = m->ny;
+    cd_ulong *counts = m->loop_counts, *blocks = m->loop_blocks, nn = (cd_ulong)m->nx * (cd_ulong)m->ny,
+             nblk = (nn + CD_MPM_CN_BLOCK - 1) / CD_MPM_CN_BLOCK;
     CD_WIDE_MIN
-    CD_STEP_FOR(1, firstprivate(c, nbn) CD_DEV(is_device_ptr(listed)))
-    for (int one = 0; one < 1; one++) cd_mpm_item_contact_nodes(c, nbn, listed);
-    cd_dev_get(&n_cn, listed, sizeof n_cn);
-    m->n_cn = n_cn;
+    CD_STEP_FOR(ny, firstprivate(j) CD_DEV(is_device_ptr(args, flags, row_n, rows)))
+    for (cd_int row = 0; row < ny; row++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_rows(*args, row, row_n, rows);
+    CD_STEP_FOR(nn, firstprivate(j) CD_DEV(is_device_ptr(args, flags, row_n, rows)))
+    for (cd_ulong g = 0; g < nn; g++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_count(*args, g, row_n, rows);
+    CD_STEP_FOR(nblk, firstprivate(j) CD_DEV(is_device_ptr(args, flags, blocks)))
+    for (cd_ulong b = 0; b < nblk; b++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_sums(*args, b, blocks);
+    CD_STEP_FOR(1, firstprivate(nblk, j) CD_DEV(is_device_ptr(flags, blocks, counts)))
+    for (int one = 0; one < 1; one++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_scan(nblk, blocks, counts + CD_MPM_COUNT_LISTED);
+    CD_STEP_FOR(nblk, firstprivate(j) CD_DEV(is_device_ptr(args, flags, blocks)))
+    for (cd_ulong b = 0; b < nblk; b++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_block_starts(*args, b, blocks);
+    CD_STEP_FOR(nn, firstprivate(j) CD_DEV(is_device_ptr(args, flags, row_n, rows)))
+    for (cd_ulong g = 0; g < nn; g++)
+        if (!cd_mpm_stopped(flags, j, 2)) cd_mpm_item_cn_entries(*args, g, row_n, rows);
 }
 
 static int cmp_key(const void *a, const void *b)
@@ -57,12 +77,12 @@ int cd_mpm_pair_keys_room(cd_mpm *m, size_t n, char *err, size_t errlen)
  * number into *w, where the omp loops run. */
 static int loop_pair_keys(cd_mpm *m, size_t *w, char *err, size_t errlen)
 {
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
-    cd_ulong *count = m->loop_count, n_cn = m->n_cn, n;
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
+    cd_ulong *count = m->loop_counts + CD_MPM_COUNT_KEYS, n_cn = m->n_cn, n;
     cd_long *none = NULL;
     CD_WIDE_MIN
-    CD_STEP_FOR(1, firstprivate(c, n_cn, none) CD_DEV(is_device_ptr(count)))
-    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, none, count);
+    CD_STEP_FOR(1, firstprivate(n_cn, none) CD_DEV(is_device_ptr(args, count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(*args, n_cn, none, count);
     cd_dev_get(&n, count, sizeof n);
     if (cd_mpm_pair_keys_room(m, n, err, errlen)) return -1;
     if (cd_mpm_device_keys(m, n)) {
@@ -70,8 +90,8 @@ static int loop_pair_keys(cd_mpm *m, size_t *w, char *err, size_t errlen)
         return -1;
     }
     cd_long *keys = m->loop_keys;
-    CD_STEP_FOR(1, firstprivate(c, n_cn) CD_DEV(is_device_ptr(keys, count)))
-    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(c, n_cn, keys, count);
+    CD_STEP_FOR(1, firstprivate(n_cn) CD_DEV(is_device_ptr(args, keys, count)))
+    for (int one = 0; one < 1; one++) cd_mpm_item_pair_keys(*args, n_cn, keys, count);
     cd_dev_get(m->pair_keys, keys, n * sizeof(cd_long));
     *w = (size_t)n;
     return 0;
@@ -102,29 +122,22 @@ int cd_mpm_fail_crowded(cd_mpm *m, size_t g, char *err, size_t errlen)
     return -1;
 }
 
-int cd_mpm_contact_correct(cd_mpm *m, char *err, size_t errlen)
+void cd_mpm_contact_correct(cd_mpm *m)
 {
-    long long bad = -1;
-    double pen = 0, dt = m->dt;
-    long ncn = (long)m->n_cn;
-    double gap_max = m->contact_gap; /* [m] */
-    cd_mpm_cols c = cd_mpm_loop_cols(m);
+    const cd_mpm_cols *args = m->loop_args; /* the columns, where the loops run */
+    size_t rows = cd_mpm_loop_rows(m), nn = (size_t)m->nx * (size_t)m->ny;
+    cd_ulong listed = rows / 2 + 1 < nn ? rows / 2 + 1 : nn; /* >= the listed nodes: each holds 2 body-nodes */
+    cd_int j = m->pending, *flags = m->loop_flags;
+    cd_ulong *counts = m->loop_counts;
+    double gap_max = m->contact_gap, dt = m->dt, *over = m->loop_over, *reals = m->loop_reals; /* [m], [s] */
     CD_WIDE_MIN
-    /* (the check apart from the contact: GCC's nvptx offload has no 16-byte atomic for a reduction
-     * of two 8-byte variables) */
-    CD_STEP_FOR(ncn, firstprivate(c) reduction(max : bad) CD_DEV(map(tofrom : bad)))
-    for (long ci = 0; ci < ncn; ci++)
-        if (cd_mpm_item_contact_crowded(c, (size_t)ci)) {
-            long long g = (long long)c.cn_list[ci];
-            bad = g > bad ? g : bad;
-        }
-    if (bad >= 0) return cd_mpm_fail_crowded(m, (size_t)bad, err, errlen);
-    CD_STEP_FOR(ncn, firstprivate(c, gap_max, dt) reduction(max : pen) CD_DEV(map(tofrom : pen)))
-    for (long ci = 0; ci < ncn; ci++) {
-        double over = pen;
-        cd_mpm_item_contact(c, (size_t)ci, gap_max, dt, &over);
-        pen = over;
+    /* (the check apart from the contact: it stops the contact of a step that has a crowded node) */
+    CD_STEP_FOR(listed, firstprivate(j) CD_DEV(is_device_ptr(args, flags, counts)))
+    for (cd_ulong ci = 0; ci < listed; ci++) cd_mpm_checked_crowded(*args, ci, counts, flags, j);
+    CD_STEP_FOR(listed, firstprivate(gap_max, dt, j) CD_DEV(is_device_ptr(args, flags, counts, over)))
+    for (cd_ulong ci = 0; ci < listed; ci++) cd_mpm_checked_contact(*args, ci, gap_max, dt, over, counts, flags, j);
+    if (m->observe) {
+        CD_STEP_FOR(1, firstprivate(j) CD_DEV(is_device_ptr(flags, counts, over, reals)))
+        for (int one = 0; one < 1; one++) cd_mpm_checked_max_over(over, counts, reals, flags, j);
     }
-    m->penetration = pen;
-    return 0;
 }

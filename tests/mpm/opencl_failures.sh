@@ -1,30 +1,41 @@
 #!/usr/bin/env bash
-# The OpenCL backend's failures, seen late (docs/mpm.md, "The OpenCL
-# backend"): its step reads nothing back, so a step that fails is found at
-# the run's next look (a series row, 20 steps on here) and the host goes
-# back to that step's start.  Each case below must end as on the omp
-# backend of the same binary, which stops at the failing step itself: exit
-# status 3, the same "run stopped" message (point, position, step, time,
-# the same digits) and run files equal bit for bit (h5diff /mpm).  The
-# cases are planted into the last snapshot (step 100) of a CI elastic
-# packing, then resumed to step 200:
+# Failures seen late (docs/mpm.md, "Reading nothing between steps"): the
+# step reads nothing back, so a step that fails is found at the run's next
+# look (a series row, 20 steps on here) and the host goes back to that
+# step's start.  Each case below must end on the OpenCL backend as on the
+# omp loops of the same binary (which look late as well, on their own
+# code): exit status 3, the same "run stopped" message (point, position,
+# step, time, the same digits) and run files equal bit for bit (h5diff
+# /mpm).  The cases are planted into the last snapshot (step 100) of a CI
+# elastic packing, then resumed to step 200:
 #   blew_up   a point's velocity NaN: not finite at step 101;
 #   left      a point moved 1 m away: its stencil leaves the mesh at step 101;
 #   crowded   one point of each of 9 bodies moved onto one spot: 9 bodies at
 #             a common node, more than the contact's 8, at step 101;
 #   overflow  every body shrunk to 0.3 of its size about its centre and sent
 #             outwards at 10^5 /s times its former extent: at the resume's
-#             first step the OpenCL backend gives the body-node buffers room
+#             first step the body-node columns get room
 #             for 1.25 times its body-nodes + 64; the bodies grow back in
-#             about 14 steps, past that room, so the backend goes back to the
+#             about 14 steps, past that room, so the run goes back to the
 #             step that overflowed and runs on from there; exit status,
-#             message and run files must still equal omp's (checked: the
+#             message and run files must still be equal (checked: the
 #             bodies' windows outgrew the room, from the points' extents in
 #             the snapshots written every 20 steps).
-# Registered in OpenCL builds, labels backend and mpm.
-# usage: opencl_failures.sh CAPDEM SOURCE_DIR
+# Registered in OpenCL builds, labels backend and mpm.  With a third
+# argument, the host-offload build's capdem (mpm_offload_failures, label
+# mpm), whose omp loops read nothing back between steps either, stands
+# where the OpenCL backend does: its runs are checked against CAPDEM's omp
+# (the default build's) in the same way.
+# usage: opencl_failures.sh CAPDEM SOURCE_DIR [OFFLOAD_CAPDEM]
 set -u
-capdem=$1 src=$2
+capdem=$1 src=$2 late=opencl
+run_late() { "$capdem" "$@" --backend opencl; }
+if [ $# -gt 2 ]; then
+  late=offload
+  offload=$3
+  export OMP_TARGET_OFFLOAD=MANDATORY
+  run_late() { "$offload" "$@" --backend omp; }
+fi
 export OMP_WAIT_POLICY=PASSIVE
 . "$src/tests/cli/common.sh"
 
@@ -55,22 +66,42 @@ for b in np.unique(body):
     x[body == b] = c + 0.3 * d; v[body == b] = 1e5 * d"
 
 for case in blew_up left crowded overflow; do
-  for b in omp opencl; do
+  for b in omp $late; do
     cp "$case.h5" "${case}_$b.h5"
     cfg=pack.yaml
     [ $case = overflow ] && cfg="soft.yaml --allow-change mpm.material.young_modulus"
-    "$capdem" run $cfg --steps 200 --resume "${case}_$b.h5" --backend $b > "${case}_$b.log" 2>&1
+    if [ $b = omp ]; then
+      "$capdem" run $cfg --steps 200 --resume "${case}_$b.h5" --backend omp > "${case}_$b.log" 2>&1
+    else
+      run_late run $cfg --steps 200 --resume "${case}_$b.h5" > "${case}_$b.log" 2>&1
+    fi
     echo $? > "${case}_$b.rc"
     grep -v "^capdem: mpm:\|^step " "${case}_$b.log" | sed "s/${case}_$b\.h5/RUN.h5/g" > "${case}_$b.msg"
   done
   want=3
   [ $case = overflow ] && want=$(cat overflow_omp.rc)
-  [ "$(cat ${case}_omp.rc)" = $want ] && [ "$(cat ${case}_opencl.rc)" = $want ] && ok \
-    || bad "$case: exit status omp $(cat ${case}_omp.rc), opencl $(cat ${case}_opencl.rc), expected $want"
-  cmp -s "${case}_omp.msg" "${case}_opencl.msg" && ok \
-    || { bad "$case: the messages differ"; diff "${case}_omp.msg" "${case}_opencl.msg" | head -6; }
-  h5diff "${case}_omp.h5" "${case}_opencl.h5" /mpm > diff 2>&1 && ok \
+  [ "$(cat ${case}_omp.rc)" = $want ] && [ "$(cat ${case}_$late.rc)" = $want ] && ok \
+    || bad "$case: exit status omp $(cat ${case}_omp.rc), $late $(cat ${case}_$late.rc), expected $want"
+  cmp -s "${case}_omp.msg" "${case}_$late.msg" && ok \
+    || { bad "$case: the messages differ"; diff "${case}_omp.msg" "${case}_$late.msg" | head -6; }
+  h5diff "${case}_omp.h5" "${case}_$late.h5" /mpm > diff 2>&1 && ok \
     || { bad "$case: the run files differ"; head -5 diff; }
+done
+# the way back to a failing step, checked apart from the comparison (both sides take it): the
+# walls' positions and the time of every series row as stepping gives them, x_0 + v t and t = step dt
+for f in *_omp.h5 *_$late.h5; do
+  /usr/bin/python3 -c "
+import h5py, numpy as np
+f = h5py.File('$f', 'r')
+S = '/mpm/series/'
+x, t, step = f[S + 'wall_position'][()], f[S + 'time'][()], f[S + 'step'][()]
+v = f['/mpm/walls/velocity'][()]
+dt = t[1] / step[1]
+walls = np.abs(x - x[0] - v[None] * t[:, None, None]).max()
+clock = np.abs(t - step * dt).max() / t[-1]
+print('$f: walls off x_0 + v t by %.2g m at most, time off step dt by %.2g' % (walls, clock))
+raise SystemExit(0 if walls < 1e-12 and clock < 1e-12 else 1)
+" && ok || bad "$f: a series row's walls or time are not those of its step"
 done
 grep -q "run stopped: material point [0-9]* is not finite .* at step 101 " blew_up_omp.msg && ok \
   || bad "blew_up: not the message expected: $(cat blew_up_omp.msg)"
@@ -78,8 +109,8 @@ grep -q "run stopped: material point 7 at .* step 100) left the background mesh"
   || bad "left: not the message expected: $(cat left_omp.msg)"
 grep -q "run stopped: common node .* at step 101: 9 bodies meet there" crowded_omp.msg && ok \
   || bad "crowded: not the message expected: $(cat crowded_omp.msg)"
-grep -q "keeps the snapshots written before step 100" crowded_opencl.msg && ok \
-  || bad "crowded on OpenCL: not back at step 100: $(cat crowded_opencl.msg)"
+grep -q "keeps the snapshots written before step 100" crowded_$late.msg && ok \
+  || bad "crowded on OpenCL: not back at step 100: $(cat crowded_$late.msg)"
 # the overflow case: the bodies' windows (their points' extent in cells + 3 for the stencil) at the
 # resumed step and at the largest snapshot after it, against the room the first step gave them
 h=$(sed -n 's/.*(h = \([0-9.e+-]*\) m).*/\1/p' overflow_omp.log)
