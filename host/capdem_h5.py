@@ -175,7 +175,7 @@ def dataset(f, key):
 
 def snapshot_count(f):
     """Snapshots completely on disk, as the C readers count them
-    (src/io/io_h5_read.c, cdh5_committed): the commit record n_snapshots,
+    (src/io/io_h5_layout.c, cdh5_committed): the commit record n_snapshots,
     bounded by the rows of the snapshot clock and offsets; 0 before the
     first snapshot."""
     if PATH["snap_step"] not in f:

@@ -2,7 +2,7 @@
  * primitives that every C reader of run files shares: the resume
  * (io_h5_read.c), `capdem analyze` (host/analysis/analyze_read.c) and `capdem
  * export` (host/export/export_read.c).  The writer (io_h5*.c) uses the same names
- * through io_h5_internal.h.  Implemented in io_h5_read.c; the layout is
+ * through io_h5_internal.h.  Implemented in io_h5_layout.c; the layout is
  * documented in docs/output.md. */
 #ifndef CD_IO_H5_LAYOUT_H
 #define CD_IO_H5_LAYOUT_H
