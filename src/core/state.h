@@ -100,4 +100,18 @@ cd_wall_entry cd_state_wall_entry(const cd_state *s, size_t r);
  * returns how many. */
 size_t cd_state_wall_entries(const cd_state *s, cd_int *rows, cd_wall_entry *ent);
 
+/* Index of global id g among the ascending ids[0..n) (a rank's global
+ * particle or primitive ids: its part of the run, in global order), or
+ * -1 when it is not there.  Binary search. */
+static inline long long cd_sorted_index(const long long *ids, size_t n, long long g)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (ids[mid] < g) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < n && ids[lo] == g ? (long long)lo : -1;
+}
+
 #endif

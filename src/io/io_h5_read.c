@@ -36,18 +36,6 @@ typedef struct {
 
 enum { RUN_PARTICLES, RUN_PRIMS, RUN_WALLS, RUN_PAIRS };
 
-/* Index of global id g among the ascending ids[0..n), or -1. */
-static long long find_id(const long long *ids, size_t n, long long g)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (ids[mid] < g) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo < n && ids[lo] == g ? (long long)lo : -1;
-}
-
 /* Row `row` of the file appended to the runs of kind w (rows ascending). */
 static int add_run(reader *r, int w, hsize_t row)
 {
@@ -136,7 +124,7 @@ static int select_part(reader *r, const cd_state *s, long long wm, long long m)
     r->wall_at = malloc(((size_t)wm + 1) * sizeof *r->wall_at);
     if (rc || !r->wall_at) return rfail(r, "out of memory");
     for (long long j = 0; W && j < wm; j++) {
-        long long lp = find_id(p->gprim, p->n_prims, r->windex[j] / (long long)W);
+        long long lp = cd_sorted_index(p->gprim, p->n_prims, r->windex[j] / (long long)W);
         if (lp < 0) continue;
         r->wall_at[r->n_sel[RUN_WALLS]] = (size_t)lp * W + (size_t)(r->windex[j] % (long long)W);
         if (add_run(r, RUN_WALLS, (hsize_t)(r->w0 + j))) return rfail(r, "out of memory");
@@ -155,7 +143,8 @@ static int select_part(reader *r, const cd_state *s, long long wm, long long m)
         return rfail(r, "cannot read the contacts' primitives of snapshot rows %lld..%lld", r->c0, r->c1);
     }
     for (long long j = 0; !rc && j < m; j++) {
-        long long li = find_id(p->gprim, p->n_prims, ij[j]), lj = find_id(p->gprim, p->n_prims, ij[m + j]);
+        long long li = cd_sorted_index(p->gprim, p->n_prims, ij[j]),
+                  lj = cd_sorted_index(p->gprim, p->n_prims, ij[m + j]);
         if (li < 0 || lj < 0) continue;
         r->pair_ij[2 * r->n_sel[RUN_PAIRS]] = (cd_int)li;
         r->pair_ij[2 * r->n_sel[RUN_PAIRS] + 1] = (cd_int)lj;
@@ -171,8 +160,9 @@ static void part_numbering(reader *r, cd_state *s)
 {
     const cd_h5_part *p = r->part;
     for (size_t q = 0; q < s->n_particles; q++)
-        s->prim_first[q] = (cd_int)find_id(p->gprim, p->n_prims, s->prim_first[q]);
-    for (size_t i = 0; i < s->n_prims; i++) s->prim_particle[i] = (cd_int)find_id(p->gid, p->n, s->prim_particle[i]);
+        s->prim_first[q] = (cd_int)cd_sorted_index(p->gprim, p->n_prims, s->prim_first[q]);
+    for (size_t i = 0; i < s->n_prims; i++)
+        s->prim_particle[i] = (cd_int)cd_sorted_index(p->gid, p->n, s->prim_particle[i]);
     for (size_t k = 0; k < s->n_pairs; k++) {
         s->pair_prim_i[k] = r->pair_ij[2 * k];
         s->pair_prim_j[k] = r->pair_ij[2 * k + 1];

@@ -130,18 +130,6 @@ static rec_ref *parse(const char *buf, size_t n, int pairs, size_t n_walls, size
     return r;
 }
 
-/* Index of global primitive g among the ascending gprim[0..n), or -1. */
-static long long local_prim(const long long *gprim, size_t n, long long g)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (gprim[mid] < g) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo < n && gprim[lo] == g ? (long long)lo : -1;
-}
-
 /* The pair records (sorted by key, a key given twice taken once) whose two
  * primitives the local state s holds (gprim: their global ids) into its
  * pair rows, in key order: the order the serial build keeps them in, which
@@ -152,7 +140,7 @@ static int place_pairs(cd_state *s, const rec_ref *r, size_t n, const long long 
     size_t m = 0;
     for (size_t k = 0; k < n; k++) {
         if (k > 0 && r[k].a == r[k - 1].a && r[k].b == r[k - 1].b) continue;
-        long long i = local_prim(gprim, s->n_prims, r[k].a), j = local_prim(gprim, s->n_prims, r[k].b);
+        long long i = cd_sorted_index(gprim, s->n_prims, r[k].a), j = cd_sorted_index(gprim, s->n_prims, r[k].b);
         if (i < 0 || j < 0) continue;
         rows_io(s, CD_GROUP_PAIR, m, 1, (char *)r[k].at + sizeof(pair_head), 0);
         s->pair_prim_i[m] = (cd_int)i;

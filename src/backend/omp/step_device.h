@@ -77,8 +77,8 @@ extern cd_step_args cd_step_block;
 void cd_step_args_fill(cd_sim *sim, cd_step_args *a);
 
 /* A loop's arguments: `CD_ARGS(sim)` makes the block for the state as it
- * is now, `CD_ARGS_IN` hands it to a CD_STEP_FOR loop and `CD_A` is its
- * address there (`CD_A->c`, `CD_A->dt`).  Offload: the device's global
+ * is now, `CD_ARGS_IN` hands it to a CD_STEP_FOR loop and `CD_A` names
+ * it there (`CD_A.c`, `CD_A.dt`).  Offload: the device's global
  * block, brought up to date (a launch copies nothing unless the block
  * changed); host threads: a block on the stack, shared by the threads.
  *
