@@ -110,33 +110,38 @@ static int inside_domain(const cd_config *c, cd_vec3 p, double R)
     return 1;
 }
 
-/* Lattice sites (square in 2D, simple cubic in 3D) with spacing a inside
- * the domain, lowest layers first.  Returns the number of sites written
- * (at most max). */
-static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out, size_t max)
+/* The box that holds the domain [m] (the box itself; the cylinder's and
+ * the ball's bounding boxes) in lo, hi; 0 without a domain (free space). */
+static int domain_bounds(const cd_config *c, double lo[3], double hi[3])
 {
-    double lo[3], hi[3];
     if (c->domain_kind == CD_DOMAIN_BOX) {
-        lo[0] = 0;
+        lo[0] = lo[1] = lo[2] = 0;
         hi[0] = c->box_width;
-        lo[1] = 0;
         hi[1] = c->box_height;
-        lo[2] = 0;
         hi[2] = c->box_thickness;
     } else if (c->domain_kind == CD_DOMAIN_CYLINDER) {
-        double rc = 0.5 * c->cyl_diameter;
-        lo[0] = -rc;
-        hi[0] = rc;
+        lo[0] = lo[2] = -0.5 * c->cyl_diameter;
+        hi[0] = hi[2] = 0.5 * c->cyl_diameter;
         lo[1] = 0;
         hi[1] = c->cyl_height;
-        lo[2] = -rc;
-        hi[2] = rc;
     } else if (c->domain_kind == CD_DOMAIN_BALL) {
         for (int k = 0; k < 3; k++) {
             lo[k] = -c->ball_radius;
             hi[k] = c->ball_radius;
         }
     } else {
+        return 0;
+    }
+    return 1;
+}
+
+/* Lattice sites (square in 2D, simple cubic in 3D) with spacing a inside
+ * the domain, lowest layers first.  Returns the number of sites written
+ * (at most max). */
+static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out, size_t max)
+{
+    double lo[3], hi[3];
+    if (!domain_bounds(c, lo, hi)) {
         /* Free space: a cube of sites about the origin. */
         double side = a * ceil(cbrt((double)max) + 1);
         if (c->dimension == 2) side = a * ceil(sqrt((double)max) + 1);
@@ -174,24 +179,7 @@ static size_t lattice_sites(const cd_config *c, double a, double R, cd_vec3 *out
  * quarter of their own volume each. */
 static void sampling_box(const cd_config *c, double R, size_t max, double lo[3], double hi[3])
 {
-    if (c->domain_kind == CD_DOMAIN_BOX) {
-        lo[0] = 0;
-        hi[0] = c->box_width;
-        lo[1] = 0;
-        hi[1] = c->box_height;
-        lo[2] = 0;
-        hi[2] = c->box_thickness;
-    } else if (c->domain_kind == CD_DOMAIN_CYLINDER) {
-        lo[0] = lo[2] = -0.5 * c->cyl_diameter;
-        hi[0] = hi[2] = 0.5 * c->cyl_diameter;
-        lo[1] = 0;
-        hi[1] = c->cyl_height;
-    } else if (c->domain_kind == CD_DOMAIN_BALL) {
-        for (int k = 0; k < 3; k++) {
-            lo[k] = -c->ball_radius;
-            hi[k] = c->ball_radius;
-        }
-    } else {
+    if (!domain_bounds(c, lo, hi)) {
         double side = 2 * R * cbrt(4.0 * (double)max) + 2 * R;
         for (int k = 0; k < 3; k++) {
             lo[k] = -0.5 * side;

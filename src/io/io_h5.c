@@ -266,6 +266,39 @@ static int claim_target(cd_output *o, const char *path, enum cd_output_mode how)
     return 0;
 }
 
+/* The start of cd_output_create_mode and cd_output_reopen: HDF5's own
+ * messages silenced (q) and a new output for path; NULL (q ended, the
+ * message printed and in err) when there is no memory. */
+static cd_output *open_begin(const char *path, cdh5_quiet *q, char *err, size_t errlen)
+{
+    cdh5_quiet_begin(q);
+    cd_output *o = output_new(path, err, errlen);
+    if (!o) {
+        fprintf(stderr, "capdem: %s\n", err);
+        cdh5_quiet_end(q);
+    }
+    return o;
+}
+
+/* Their end: the observables' series set up and the first commit made
+ * unless rc already failed; on failure the output is let go (the file
+ * keeps its last commit; a resumed one stays as it was before) and NULL
+ * returned with the reason in err.  Ends q. */
+static cd_output *open_end(cd_output *o, int rc, const cd_observable_info *obs, int n_obs, cdh5_quiet *q, char *err,
+                           size_t errlen)
+{
+    if (!rc) rc = obs_setup(o, obs, n_obs);
+    if (!rc) rc = cdh5_commit_output(o);
+    if (rc) {
+        o->io_failed = 1;
+        snprintf(err, errlen, "%s", o->err);
+        output_free(o);
+        o = NULL;
+    }
+    cdh5_quiet_end(q);
+    return o;
+}
+
 cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_shape *shapes, int n_shapes,
                             const cd_observable_info *obs, int n_obs, char *err, size_t errlen)
 {
@@ -277,26 +310,12 @@ cd_output *cd_output_create_mode(const char *path, enum cd_output_mode how, cons
                                  char *err, size_t errlen)
 {
     cdh5_quiet q;
-    cdh5_quiet_begin(&q);
-    cd_output *o = output_new(path, err, errlen);
-    if (!o) {
-        fprintf(stderr, "capdem: %s\n", err);
-        cdh5_quiet_end(&q);
-        return NULL;
-    }
+    cd_output *o = open_begin(path, &q, err, errlen);
+    if (!o) return NULL;
     int rc = create_file(o, path, how);
     if (!rc) rc = obs_check(o, obs, n_obs);
     if (!rc) rc = cdh5_write_header(o, cfg, shapes, n_shapes);
-    if (!rc) rc = obs_setup(o, obs, n_obs);
-    if (!rc) rc = cdh5_commit_output(o);
-    if (rc) {
-        o->io_failed = 1; /* the file keeps its last commit (a resumed one: as it was before) */
-        snprintf(err, errlen, "%s", o->err);
-        output_free(o);
-        o = NULL;
-    }
-    cdh5_quiet_end(&q);
-    return o;
+    return open_end(o, rc, obs, n_obs, &q, err, errlen);
 }
 
 int cd_output_close(cd_output *o)
@@ -407,13 +426,8 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
                             char *err, size_t errlen)
 {
     cdh5_quiet q;
-    cdh5_quiet_begin(&q);
-    cd_output *o = output_new(path, err, errlen);
-    if (!o) {
-        fprintf(stderr, "capdem: %s\n", err);
-        cdh5_quiet_end(&q);
-        return NULL;
-    }
+    cd_output *o = open_begin(path, &q, err, errlen);
+    if (!o) return NULL;
     int rc = 0;
     /* parallel output: a journal a killed writer left (io_h5_journal.h) is
      * replayed in place by rank 0 before the ranks open the file through
@@ -439,14 +453,5 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
     if (!rc && cdh5_exists(o->file, CDH5_SNAP_STEP))
         rc = (cdh5_layout_open(o) || truncate_snapshots(o, resume_step)) ? -1 : 0;
     if (!rc) rc = truncate_observables(o, resume_step);
-    if (!rc) rc = obs_setup(o, obs, n_obs);
-    if (!rc) rc = cdh5_commit_output(o);
-    if (rc) {
-        o->io_failed = 1; /* the file keeps its last commit (a resumed one: as it was before) */
-        snprintf(err, errlen, "%s", o->err);
-        output_free(o);
-        o = NULL;
-    }
-    cdh5_quiet_end(&q);
-    return o;
+    return open_end(o, rc, obs, n_obs, &q, err, errlen);
 }
