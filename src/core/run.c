@@ -386,8 +386,7 @@ static int run(const cd_run_options *opt)
             status = 2;
             goto done;
         }
-        cd_protocol_begin(&sim);
-        if (cd_sim_start(&sim, 1, err, sizeof err)) {
+        if (cd_protocol_begin(&sim, err, sizeof err) || cd_sim_start(&sim, 1, err, sizeof err)) {
             fprintf(stderr, "capdem: %s\n", err);
             status = 2;
             goto done;

@@ -273,8 +273,8 @@ static void report(const cd_mpi_ctx *x)
                     bmin, bmax, sum[2]);
         else
             fprintf(stderr,
-                    "capdem: MPI set-up: every rank built all %ld particles (domain.walls, or a protocol whose start "
-                    "reads every particle)\n",
+                    "capdem: MPI set-up: every rank built all %ld particles (domain.walls: the start checks every "
+                    "particle's arms)\n",
                     sum[2]);
         if (parallel_output)
             fprintf(stderr,

@@ -80,6 +80,21 @@ int cd_mpi_setup_keep_none(const struct cd_sim *sim, const cd_vec3 *centre, cons
  * Collective; 0, -1 (err: the lowest failing rank's message, on every
  * rank), or 1: one rank (the caller reads the whole snapshot). */
 int cd_mpi_read_snapshot(struct cd_sim *sim, const char *path, char *err, size_t errlen);
+/* Rows of every particle of the run in global id order, for a sum that
+ * must keep the serial program's order (a protocol's begin, src/protocols):
+ * pack(sim, row, out) writes `width` doubles of local row `row`.  Under a
+ * set-up of part of the run (sim->part.gid: each rank built its own
+ * particles and ghosts, src/mpi/mpi_setup.c), each rank sends the rows it
+ * owns to rank 0, which gets them in global order in a new *rows (the
+ * caller frees it; NULL on the other ranks), *n the run's particle count:
+ * 0.  1: no such set-up (one process, or every rank holds the whole
+ * state): the caller reads its own state.  -1: out of memory on some rank
+ * (every rank alike).  Collective. */
+int cd_mpi_rows_in_order(const struct cd_sim *sim, int width, void (*pack)(const struct cd_sim *, size_t, double *),
+                         double **rows, size_t *n);
+/* v[0 .. n) of rank 0 on every rank (what rank 0 computed from the rows
+ * of cd_mpi_rows_in_order); collective.  No-op in one process. */
+void cd_mpi_share(double *v, int n);
 #else
 static inline int cd_mpi_begin(void) { return 0; }
 static inline int cd_mpi_end(int status) { return status; }
@@ -116,6 +131,21 @@ static inline int cd_mpi_read_snapshot(struct cd_sim *sim, const char *path, cha
     (void)err;
     (void)errlen;
     return 1;
+}
+static inline int cd_mpi_rows_in_order(const struct cd_sim *sim, int width,
+                                       void (*pack)(const struct cd_sim *, size_t, double *), double **rows, size_t *n)
+{
+    (void)sim;
+    (void)width;
+    (void)pack;
+    (void)rows;
+    (void)n;
+    return 1;
+}
+static inline void cd_mpi_share(double *v, int n)
+{
+    (void)v;
+    (void)n;
 }
 #define cd_mpi_setup_keep_none cd_mpi_setup_keep
 static inline int cd_mpi_setup_keep(const struct cd_sim *sim, const cd_vec3 *centre, const int *species,

@@ -13,11 +13,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mpi/mpi_halo.h"
-#include "protocols/protocol.h"
 
 static cd_decomp_grid setup_grid; /* made at the set-up, taken by the first start */
 static int setup_grid_made;
 static long setup_built = -1; /* particles this rank's set-up built (-1: every particle) */
+/* which of them this rank owns (1) rather than holds as a ghost (0), in
+ * the set-up's row order (ascending global id): the rows it sends to
+ * cd_mpi_rows_in_order */
+static unsigned char *setup_owns;
 
 double cd_mpi_range(double bound_max, double skin) { return (2 * bound_max + skin) * (1 + 1e-6); }
 
@@ -69,16 +72,20 @@ static int decompose(const cd_sim *sim, const double *xyz, size_t n, double rang
         snprintf(err, errlen, "out of memory while cutting the domain for %d MPI ranks", size);
         return -1;
     }
-    int rc = cd_decomp_make(&setup_grid, &sim->cfg, size, xyz, n, range, 0, err, errlen);
+    free(setup_owns);
+    setup_owns = malloc(n + 1);
+    int rc = setup_owns ? cd_decomp_make(&setup_grid, &sim->cfg, size, xyz, n, range, 0, err, errlen) : -1;
+    if (!setup_owns) snprintf(err, errlen, "out of memory while cutting the domain for %d MPI ranks", size);
     size_t m = 0;
     for (size_t q = 0; !rc && q < n; q++) {
         int o = cd_decomp_owner(&setup_grid, xyz + 3 * q), here = o == rank;
         int k = cd_decomp_ghost_ranks(&setup_grid, xyz + 3 * q, o, ranks);
         for (int j = 0; j < k && !here; j++) here = ranks[j] == rank;
+        if (here) setup_owns[m] = o == rank;
         if (here) mine[m++] = (long long)q;
     }
     free(ranks);
-    if (rc) { /* every rank: the same data, the same refusal */
+    if (rc) { /* every rank: the same data, the same refusal (out of memory: agreed by the caller) */
         free(mine);
         return -1;
     }
@@ -97,9 +104,9 @@ int cd_mpi_setup_keep(const cd_sim *sim, const cd_vec3 *centre, const int *speci
     setup_grid_made = 0;
     const cd_config *c = &sim->cfg;
     /* the run's start reads the whole state: check_wall_placement
-     * (src/core/run.c) every arm against domain.walls, a protocol's begin
-     * every particle's motion */
-    if (size < 2 || c->n_extra_walls > 0 || cd_protocol_begin_reads_particles(c)) return 0;
+     * (src/core/run.c) every arm against domain.walls (a protocol's begin
+     * sums every particle's motion from the rows of cd_mpi_rows_in_order) */
+    if (size < 2 || c->n_extra_walls > 0) return 0;
     double *xyz = malloc((3 * n + 1) * sizeof *xyz); /* [m] */
     if (!xyz) {
         snprintf(err, errlen, "out of memory while cutting the domain for %d MPI ranks", size);
@@ -133,6 +140,64 @@ int cd_mpi_setup_keep_none(const cd_sim *sim, const cd_vec3 *centre, const int *
     if (*held) return 1;
     snprintf(err, errlen, "out of memory");
     return -1;
+}
+
+int cd_mpi_rows_in_order(const cd_sim *sim, int width, void (*pack)(const cd_sim *, size_t, double *), double **rows,
+                         size_t *n)
+{
+    int rank, size = cd_mpi_world(&rank);
+    const size_t local = sim->s.n_particles, N = sim->part.n_particles, w = (size_t)width;
+    *rows = NULL;
+    *n = N;
+    if (size < 2 || !sim->part.gid || !setup_owns || setup_built != (long)local) return 1;
+    /* this rank's owned rows, each its global id and its values */
+    size_t own = 0;
+    for (size_t l = 0; l < local; l++) own += setup_owns[l];
+    double *send = malloc((own * (w + 1) + 1) * sizeof *send);
+    int *counts = rank == 0 ? malloc((size_t)size * 2 * sizeof *counts) : NULL;
+    int failed = !send || (rank == 0 && !counts) || own * (w + 1) > (size_t)2147483647;
+    for (size_t l = 0, k = 0; !failed && l < local; l++)
+        if (setup_owns[l]) {
+            send[k * (w + 1)] = (double)sim->part.gid[l]; /* exact: ids below 2^53 */
+            pack(sim, l, send + k * (w + 1) + 1);
+            k++;
+        }
+    int mine = (int)(own * (w + 1));
+    double *recv = NULL;
+    if (!cd_mpi_agree(failed)) {
+        MPI_Gather(&mine, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        size_t total = 0;
+        for (int r = 0; rank == 0 && r < size; r++) {
+            counts[size + r] = (int)total;
+            total += (size_t)counts[r];
+        }
+        if (rank == 0) {
+            recv = malloc((total + 1) * sizeof *recv);
+            *rows = malloc((N * w + 1) * sizeof **rows);
+            failed = !recv || !*rows || total != N * (w + 1) || total > (size_t)2147483647;
+        }
+        if (!cd_mpi_agree(failed)) {
+            MPI_Gatherv(send, mine, MPI_DOUBLE, recv, counts, counts + size, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+            /* every particle is owned by exactly one rank: place each row at its id */
+            for (size_t k = 0; rank == 0 && k < N; k++)
+                memcpy(*rows + (size_t)recv[k * (w + 1)] * w, recv + k * (w + 1) + 1, w * sizeof **rows);
+        } else failed = 1;
+    } else failed = 1;
+    free(send);
+    free(counts);
+    free(recv);
+    if (failed) {
+        free(*rows);
+        *rows = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+void cd_mpi_share(double *v, int n)
+{
+    int rank;
+    if (cd_mpi_world(&rank) > 1) MPI_Bcast(v, n, MPI_DOUBLE, 0, MPI_COMM_WORLD);
 }
 
 /* Whether some rank failed (failed != 0): then the message of the lowest

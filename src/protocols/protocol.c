@@ -3,6 +3,7 @@
  * checks, the protocol observables -- and the table of their operations
  * (protocol_internal.h), selected by protocol.type. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "protocols/protocol_internal.h"
 #include "core/observables.h"
@@ -40,18 +41,42 @@ void cd_proto_enter(cd_sim *sim, int phase, FILE *log)
                 sim->s.step, sim->s.time);
 }
 
-void cd_protocol_begin(cd_sim *sim)
+int cd_protocol_begin(cd_sim *sim, char *err, size_t errlen)
 {
     memset(sim->s.control, 0, sizeof sim->s.control);
     const cd_protocol_ops *ops = ops_of(&sim->cfg);
-    if (ops) ops->begin(sim);
-    else cd_proto_enter(sim, CD_PHASE_FREE, NULL);
+    if (ops) return ops->begin(sim, err, errlen);
+    cd_proto_enter(sim, CD_PHASE_FREE, NULL);
+    return 0;
 }
 
-int cd_protocol_begin_reads_particles(const cd_config *c)
+/* One particle's row of cd_proto_motion_rows (local row q). */
+static void pack_motion(const cd_sim *sim, size_t q, double *out)
 {
-    if (CD_PROTOCOL_IN_BALL(c->protocol_kind)) return 1; /* cd_proto_ball_begin: the net motion */
-    return c->protocol_kind == CD_PROTOCOL_DEPOSIT && cd_proto_deposit_removes_rotation(c);
+    const cd_state *s = &sim->s;
+    const cd_vec3 v[3] = {s->position[q], s->velocity[q], s->angmom[q]};
+    out[CD_MOTION_MASS] = s->mass[q];
+    for (int k = 0; k < 3; k++) {
+        out[CD_MOTION_POSITION + 3 * k] = v[k].x;
+        out[CD_MOTION_POSITION + 3 * k + 1] = v[k].y;
+        out[CD_MOTION_POSITION + 3 * k + 2] = v[k].z;
+    }
+}
+
+int cd_proto_motion_rows(const cd_sim *sim, double **rows, size_t *n, char *err, size_t errlen)
+{
+    int rc = cd_mpi_rows_in_order(sim, CD_MOTION_WIDTH, pack_motion, rows, n);
+    if (rc < 0) snprintf(err, errlen, "out of memory for the particles' motion at the protocol's start");
+    if (rc <= 0) return rc;
+    /* the whole run is here: its rows, in order */
+    *n = sim->s.n_particles;
+    *rows = malloc((*n * CD_MOTION_WIDTH + 1) * sizeof **rows);
+    if (!*rows) {
+        snprintf(err, errlen, "out of memory for the motion of %zu particles at the protocol's start", *n);
+        return -1;
+    }
+    for (size_t q = 0; q < *n; q++) pack_motion(sim, q, *rows + q * CD_MOTION_WIDTH);
+    return 0;
 }
 
 long long cd_protocol_steps_until_control(const cd_sim *sim)

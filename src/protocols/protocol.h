@@ -23,12 +23,12 @@ enum {
 /* Checks that the protocol fits the domain (message names the keys). */
 int cd_protocol_check(const cd_config *c, char *err, size_t errlen);
 
-/* Prepares a new run (phase, driven wall). */
-void cd_protocol_begin(cd_sim *sim);
-/* Whether cd_protocol_begin reads every particle (sums over them that set
- * the initial velocities: the net motion in a ball, the rotation in a
- * frictionless cylinder), so that it needs the whole run's state. */
-int cd_protocol_begin_reads_particles(const cd_config *c);
+/* Prepares a new run (phase, driven wall, initial velocities: the net
+ * motion in a ball and the rotation in a frictionless cylinder removed,
+ * sums over every particle of the run in the serial order, also when
+ * each MPI rank set up its own particles only).  0, or -1 (err: out of
+ * memory, every rank alike). */
+int cd_protocol_begin(cd_sim *sim, char *err, size_t errlen);
 
 /* After a resume from path: a bulk probe in progress reads back its base
  * state (the snapshot of control slot CTL_BASE_STEP).  Returns 0, or -1

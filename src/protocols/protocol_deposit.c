@@ -3,6 +3,7 @@
  * protocol.piston_speed until it carries protocol.piston_force, then holds
  * that load (or its position) until the packing has relaxed. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "protocols/protocol_internal.h"
 
@@ -27,35 +28,46 @@ static int check(const cd_config *c, char *err, size_t errlen)
  * gravity: the angular momentum about it is conserved, so a packing that
  * starts with some (random velocities of a finite sample do) turns for
  * ever, its kinetic energy never falls below the relaxation criterion. */
-static void remove_axial_rotation(cd_sim *sim)
+static int remove_axial_rotation(cd_sim *sim, char *err, size_t errlen)
 {
+    double *rows, w[2] = {0, 0}; /* the rotation [1/s], and 1 where it is defined */
+    size_t n;
+    if (cd_proto_motion_rows(sim, &rows, &n, err, errlen)) return -1;
+    if (rows) { /* the sums in particle order: the serial bits at any MPI rank count */
+        double L = 0, I = 0; /* [kg m^2/s], [kg m^2] */
+        for (size_t q = 0; q < n; q++) {
+            const double *row = rows + q * CD_MOTION_WIDTH, m = row[CD_MOTION_MASS];
+            const double *r = row + CD_MOTION_POSITION, *v = row + CD_MOTION_VELOCITY;
+            L += m * (r[2] * v[0] - r[0] * v[2]) + row[CD_MOTION_ANGMOM + 1];
+            I += m * (r[0] * r[0] + r[2] * r[2]);
+        }
+        if (I > 0) w[0] = L / I, w[1] = 1;
+    }
+    free(rows);
+    cd_mpi_share(w, 2);
     cd_state *s = &sim->s;
-    double L = 0, I = 0; /* [kg m^2/s], [kg m^2] */
-    for (size_t q = 0; q < s->n_particles; q++) {
-        cd_vec3 r = s->position[q], v = s->velocity[q];
-        L += s->mass[q] * (r.z * v.x - r.x * v.z) + s->angmom[q].y;
-        I += s->mass[q] * (r.x * r.x + r.z * r.z);
+    for (size_t q = 0; w[1] && q < s->n_particles; q++) {
+        s->velocity[q].x -= w[0] * s->position[q].z;
+        s->velocity[q].z += w[0] * s->position[q].x;
     }
-    if (!(I > 0)) return;
-    double w = L / I; /* [1/s] */
-    for (size_t q = 0; q < s->n_particles; q++) {
-        s->velocity[q].x -= w * s->position[q].z;
-        s->velocity[q].z += w * s->position[q].x;
-    }
+    return 0;
 }
 
-int cd_proto_deposit_removes_rotation(const cd_config *c)
+/* Whether the begin removes the rotation about the cylinder axis (a
+ * frictionless cylinder). */
+static int removes_rotation(const cd_config *c)
 {
     return c->domain_kind == CD_DOMAIN_CYLINDER && c->wall_friction == 0;
 }
 
-static void begin(cd_sim *sim)
+static int begin(cd_sim *sim, char *err, size_t errlen)
 {
     /* the piston is the last wall: the box's top wall, or the one added
      * over the cylinder */
     sim->s.control[CTL_WALL] = sim->cfg.domain_kind == CD_DOMAIN_BOX ? 1 : (double)(sim->s.n_walls - 1);
-    if (cd_proto_deposit_removes_rotation(&sim->cfg)) remove_axial_rotation(sim);
+    if (removes_rotation(&sim->cfg) && remove_axial_rotation(sim, err, errlen)) return -1;
     cd_proto_enter(sim, CD_PHASE_SETTLE, NULL);
+    return 0;
 }
 
 static double settle_time(const cd_sim *sim)

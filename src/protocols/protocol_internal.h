@@ -6,6 +6,7 @@
 #define CD_PROTOCOL_INTERNAL_H
 #include <stdio.h>
 #include "protocols/protocol.h"
+#include "mpi/mpi_decomp.h"
 
 /* Slots of sim->s.control. */
 enum {
@@ -39,8 +40,9 @@ int cd_proto_relaxed(cd_sim *sim, char *err, size_t errlen, int *done);
 typedef struct {
     /* config checks that need more than one key (the schema did the rest) */
     int (*check)(const cd_config *c, char *err, size_t errlen);
-    /* control slots, driven wall and initial velocities of a new run */
-    void (*begin)(cd_sim *sim);
+    /* control slots, driven wall and initial velocities of a new run; 0,
+     * or -1 (err: out of memory, every MPI rank alike) */
+    int (*begin)(cd_sim *sim, char *err, size_t errlen);
     /* steps until control must run again in this phase */
     long long (*steps_until_control)(const cd_sim *sim, int phase);
     /* one control call in this phase, load [N] the driven wall's normal
@@ -55,10 +57,18 @@ extern const cd_protocol_ops cd_protocol_deposit, cd_protocol_radial, cd_protoco
 /* The ball's compaction, which the bulk probe starts with
  * (protocol_ball.c). */
 int cd_proto_ball_check(const cd_config *c, char *err, size_t errlen);
-void cd_proto_ball_begin(cd_sim *sim);
-/* The deposit's begin removes the rotation about the cylinder axis (a
- * frictionless cylinder): it reads every particle. */
-int cd_proto_deposit_removes_rotation(const cd_config *c);
+int cd_proto_ball_begin(cd_sim *sim, char *err, size_t errlen);
+
+/* The motion of every particle of the run, for the sums of a begin that
+ * must not depend on how the particles are spread over MPI ranks: each
+ * particle's CD_MOTION_WIDTH values (mass [kg], position [m], velocity
+ * [m/s], angular momentum [kg m^2/s]) in global id order into a new *rows
+ * (the caller frees it), *n particles, where the sums are made: the one
+ * process, or rank 0 when each rank set up its own particles (the other
+ * ranks: *rows NULL, they take the result from cd_mpi_share).  0, or -1
+ * (err: out of memory, every rank alike). */
+enum { CD_MOTION_MASS, CD_MOTION_POSITION, CD_MOTION_VELOCITY = 4, CD_MOTION_ANGMOM = 7, CD_MOTION_WIDTH = 10 };
+int cd_proto_motion_rows(const cd_sim *sim, double **rows, size_t *n, char *err, size_t errlen);
 int cd_proto_compact(cd_sim *sim, double load, char *err, size_t errlen, int *done);
 
 #endif

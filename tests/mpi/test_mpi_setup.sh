@@ -5,7 +5,9 @@
 # crosses placed before it, one random stream) and with bounding spheres
 # apart (bounding_sphere), on 2 and 3 ranks, against the serial run; the
 # lattice pile of test_mpi_bitwise on 3.  The closing line must show that
-# no rank built every particle.  A run whose start reads every particle
+# no rank built every particle; so must the radial compaction of spheres
+# on 2 ranks and the deposit in a frictionless cylinder on 3, whose begin
+# sums every particle's motion.  A run whose start reads every particle
 # (domain.walls: the sheared crosses) still builds them all, and says so.
 # usage: test_mpi_setup.sh CAPDEM SOURCE_DIR
 set -u
@@ -41,6 +43,20 @@ pile="$src/tests/mpi/hexapod_pile.yaml"
 if mpi 3 run "$pile" --output pile.3.h5 --steps 600 --quiet 2> err && same pile.serial.h5 pile.3.h5; then ok
 else bad "pile: 3 ranks: failed or differs from the serial run"; head -20 diff.txt; fi
 built_part 40
+
+# Protocols whose begin sums every particle's motion (the ball's net
+# motion and rotation, radial compaction and bulk probe; the rotation about
+# a frictionless cylinder's axis): rank 0 sums the rows it gathers in
+# particle order, each rank changes its own particles and ghosts, and no
+# rank builds every particle.  The velocities set there reach the files.
+for twin in radial_spheres:2:150 deposit_cylinder_D6L:3:60; do
+  IFS=: read -r name np n <<< "$twin"
+  cfg="$src/configs/protocols/ci/$name.yaml"
+  "$capdem" run "$cfg" --output "$name.serial.h5" --steps 300 --quiet 2> err || bad "$name: the serial run failed"
+  if mpi "$np" run "$cfg" --output "$name.$np.h5" --steps 300 --quiet 2> err && same "$name.serial.h5" "$name.$np.h5"; then ok
+  else bad "$name: $np ranks: failed or differs from the serial run"; cat err; head -20 diff.txt; fi
+  built_part "$n"
+done
 
 if mpi 2 run "$src/tests/mpi/crosses_shear.yaml" --output shear.h5 --steps 50 --quiet 2> err &&
   grep -q 'capdem: MPI set-up: every rank built all' err; then ok

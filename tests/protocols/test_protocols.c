@@ -349,8 +349,7 @@ static void start_preset(cd_sim *sim, cd_config *cfg, const char *name)
     if (cd_config_load(preset(name), cfg, err, sizeof err)) fail_msg("%s", err);
     if (cd_sim_setup(sim, cfg, err, sizeof err)) fail_msg("%s", err);
     if (cd_sim_use_backend(sim, cdt_backend(), NULL, err, sizeof err)) fail_msg("%s", err);
-    cd_protocol_begin(sim);
-    if (cd_sim_start(sim, 1, err, sizeof err)) fail_msg("%s", err);
+    if (cd_protocol_begin(sim, err, sizeof err) || cd_sim_start(sim, 1, err, sizeof err)) fail_msg("%s", err);
 }
 
 /* protocol.piston_start = packing: when the settling ends, the piston is
