@@ -43,6 +43,10 @@ around the timed run, cpu_stamp.sh, x ranks), which other jobs on a shared
 machine disturb much less; with 2 ranks LAMMPS's CPU time includes MPI's
 busy waiting, so that ratio is clean with --threads 1 only.
 
+--repeat 0 settles (tiles, converts) each case's packings and times
+nothing: a long settle made ahead (while the machine is busy), and the
+timing later with --reuse on the same --work folder.
+
 --baseline OTHER_BUILD times that build's capdem-bench too, right after
 capdem in every round on the same packing (a change measured against the
 build before it, beside the peers; the table's last row per case).
@@ -174,6 +178,8 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
     nwarm = args.peer_warm  # a data file keeps no tangential history: let the springs build up again
     peers = [p for p in args.peers.split(",") if p and (p == "lammps" or case == "spheres")]
     lig_meta = liggghts_bench.convert(capdem_to_lammps.read_run(settled), w + "_liggghts") if "liggghts" in peers else None
+    if args.repeat == 0:  # prepared only, for a later --reuse
+        return {"case": case, "settled_N": n, "tile": "%dx%d" % tile, "prepared": settled}
     base_rates, base_ratios, base_cpu = [], [], []
     capdem, rates, ratios, builds, cpu_ratios, lig_cpu, z = [], {p: [] for p in peers}, {p: [] for p in peers}, {p: [] for p in peers}, [], [], {}
     for r in range(args.repeat):
@@ -242,7 +248,8 @@ def main():
     ap.add_argument("--peers", default="lammps,liggghts", help="lammps, liggghts (spheres only) or both")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--steps", type=int, default=1000)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="rounds; 0 settles, tiles and converts the packings only (time them later with --reuse)")
     ap.add_argument("--relax-steps", type=int, default=None,
                     help="steps a tiled packing relaxes (capdem) before timing (default: 20 ms, RELAX)")
     ap.add_argument("--peer-warm", type=int, default=200, help="untimed steps of a peer before each timed segment")
