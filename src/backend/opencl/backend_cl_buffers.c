@@ -276,7 +276,18 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
     return cl->status ? -1 : 0;
 }
 
-int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
+/* Is column f among the n fields at offsets only (NULL: every column)? */
+static int wanted(int f, const size_t *only, size_t n)
+{
+    if (!only) return 1;
+    for (size_t k = 0; k < n; k++)
+        if (cd_fields[f].offset == only[k]) return 1;
+    return 0;
+}
+
+int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim) { return cd_cl_buffers_download_cols(cl, sim, NULL, 0); }
+
+int cd_cl_buffers_download_cols(cd_cl *cl, cd_sim *sim, const size_t *only, size_t n_only)
 {
     cd_state *s = &sim->s;
     if (cl->status) return -1;
@@ -287,7 +298,7 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
     s->n_pairs = cl->n_pairs;
     for (int f = 0; f < CD_CL_N_FIELDS && !cl->status; f++) {
         size_t bytes = cd_state_rows(s, cd_fields[f].group) * cd_fields[f].elem_size;
-        if (bytes == 0) continue;
+        if (bytes == 0 || !wanted(f, only, n_only)) continue;
         void *host = *cd_field_ptr(s, &cd_fields[f]);
         cl_int rc = clEnqueueReadBuffer(cl->queue, cd_cl_col(cl, f), CL_FALSE, 0, bytes, host, 0, NULL, NULL);
         cd_cl_check(cl, rc, "downloading the state");
@@ -341,8 +352,10 @@ void cd_cl_buffers_release(cd_cl *cl)
                        &cl->cell_cursor, &cl->cell_parts,   &cl->pair_count,    &cl->pair_offset,   &cl->block_sum,
                        &cl->cand,        &cl->gather_count, &cl->gather_start,  &cl->gather_cursor, &cl->gather_rows,
                        &cl->wall_count,  &cl->wall_start,   &cl->wall_rows,     &cl->obs_touch,     &cl->obs_part,
-                       &cl->obs_total,   &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out};
+                       &cl->obs_total,   &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out,
+                       &cl->halo_send_list, &cl->halo_recv_list, &cl->halo_send,  &cl->halo_recv,     &cl->wall_fn};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
     cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
     cl->cap_wall_rows = cl->cap_old_wall_rows = 0;
+    cl->halo_ns = cl->halo_nr = 0;
 }
