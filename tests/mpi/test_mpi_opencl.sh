@@ -26,11 +26,7 @@ for case in hexapod_pile crosses_2d; do
     if ! mpi "$np" run "$cfg" --output "mpi$np.h5" "${cl[@]}" 2> err; then bad "$case: $np OpenCL ranks: the run failed"; tail -5 err; continue; fi
     if same serial.h5 "mpi$np.h5"; then ok
     else bad "$case: $np OpenCL ranks: the run file differs from the serial OpenCL one"; head -20 diff.txt; fi
-    line=$(grep 'capdem: MPI:' err)
-    migrations=$(sed -n 's/.* \([0-9]*\) migrations.*/\1/p' <<< "$line")
-    ghosts=$(sed -n 's/.*and [0-9]*\.\.\([0-9]*\) ghosts.*/\1/p' <<< "$line")
-    if [ "${migrations:-0}" -ge 10 ] && [ "${ghosts:-0}" -ge 1 ]; then ok
-    else bad "$case: $np OpenCL ranks: expected migrations and ghosts, got: $line"; fi
+    migrated_with_ghosts "$case: $np OpenCL ranks"
     # "rank r: OpenCL device i of n '...' (node-local rank r)" for every rank
     first=$(head -1 err) named=0
     for ((r = 0; r < np; r++)); do
@@ -62,13 +58,6 @@ else bad "pile: 3 OpenCL ranks to step 6000, resumed with 2: failed or differs f
 
 # A blow-up (dt far above t_col/5, forced): exit status 3 and the serial
 # diagnosis, once, on 3 OpenCL ranks.
-sed 's/^  dt: .*/  dt: 1.5e-4\n  force_dt: true/' "$src/tests/mpi/crosses_2d.yaml" > blowup.yaml
-rm -f ./*.h5
-"$capdem" run blowup.yaml --output serial.h5 "${cl[@]}" 2> serial.err
-mpi 3 run blowup.yaml --output mpi3.h5 "${cl[@]}" > out 2> err
-rc=$?
-stop_serial=$(grep 'run stopped' serial.err) stop_mpi=$(grep 'run stopped' err)
-if [ $rc -eq 3 ] && [ -n "$stop_serial" ] && [ "$stop_serial" = "$stop_mpi" ]; then ok
-else bad "blowup: 3 OpenCL ranks: exit status $rc (expected 3), serial says '$stop_serial', 3 ranks say '$stop_mpi'"; fi
+blows_up_as_serial "blowup: 3 OpenCL ranks" 3 --backend opencl
 echo "test_mpi_opencl: $pass passed, $fails failed"
 [ $fails -eq 0 ]

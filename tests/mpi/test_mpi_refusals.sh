@@ -56,12 +56,6 @@ if "$capdem" run too_many_ranks.yaml --output one.h5 --steps 10 --quiet 2> err; 
 else bad "too_many_ranks.yaml: refused on one process too"; fi
 # A run that blows up (dt far above t_col/5, forced) stops on every rank
 # at once with the serial program's exit status 3 and its diagnosis, once.
-sed 's/^  dt: .*/  dt: 1.5e-4\n  force_dt: true/' "$base" > blowup.yaml
-"$capdem" run blowup.yaml --output serial.h5 --quiet 2> serial.err
-mpi 3 run blowup.yaml --output mpi3.h5 --quiet > out 2> err
-rc=$?
-stop_serial=$(grep 'run stopped' serial.err) stop_mpi=$(grep 'run stopped' err)
-if [ $rc -eq 3 ] && [ -n "$stop_serial" ] && [ "$stop_serial" = "$stop_mpi" ]; then ok
-else bad "blowup: exit status $rc (expected 3), serial says '$stop_serial', 3 ranks say '$stop_mpi'"; fi
+blows_up_as_serial blowup 3
 echo "test_mpi_refusals: $pass passed, $fails failed"
 [ $fails -eq 0 ]
