@@ -9,8 +9,9 @@
 # deposit protocol (its piston fed back by the wall load every step) on 3;
 # the pile written with 3 ranks and continued with 2.  The ranks must have
 # migrated particles and held ghosts, and the first line must name each
-# rank's OpenCL device.  A run that blows up stops on every rank with the
-# serial program's exit status and diagnosis.  Registered in builds with
+# rank's OpenCL device.  No OpenCL platform: refused once, exit 2.  A run
+# that blows up stops on every rank with the serial program's exit status
+# and diagnosis.  Registered in builds with
 # OpenCL only; POCL_CACHE_DIR (set by CTest) keeps the compiled kernels:
 # the serial run compiles them, the ranks find them.
 # usage: test_mpi_opencl.sh CAPDEM SOURCE_DIR
@@ -55,6 +56,14 @@ rm -f ./*.h5
 if mpi 3 run "$pile" --output from3.h5 --steps 6000 "${cl[@]}" 2> err &&
    mpi 2 run "$pile" --resume from3.h5 "${cl[@]}" 2> err && same serial.h5 from3.h5; then ok
 else bad "pile: 3 OpenCL ranks to step 6000, resumed with 2: failed or differs from the serial OpenCL resume"; head -20 diff.txt; fi
+
+# No OpenCL device for the ranks (docs/opencl.md, "Messages"): refused on
+# every rank at the start, exit 2, the message once, no run file.
+rm -f ./*.h5
+CAPDEM_OPENCL_PLATFORM=nonexistent mpi 2 run "$pile" --output none.h5 "${cl[@]}" > out 2> err
+rc=$?
+if [ $rc -eq 2 ] && [ "$(grep -c 'CAPDEM_OPENCL_PLATFORM=nonexistent matches no platform' err)" -eq 1 ] && [ ! -e none.h5 ]; then ok
+else bad "no platform on 2 ranks: exit status $rc (expected 2), the message once and no file: $(head -3 err)"; fi
 
 # A blow-up (dt far above t_col/5, forced): exit status 3 and the serial
 # diagnosis, once, on 3 OpenCL ranks.
