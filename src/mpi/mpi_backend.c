@@ -1,6 +1,6 @@
 /* The MPI run as a backend (docs/mpi.md): cd_backend_mpi wraps the omp
- * backend.  Every rank sets the run up from the same config (the global
- * state, the same bits everywhere); start cuts each rank's local state
+ * or the OpenCL backend.  Every rank sets the run up from the same config
+ * (the global state, the same bits everywhere); start cuts each rank's local state
  * from it; step runs the serial step on the local state, with the
  * rebuild decided by all ranks together (the serial program's decision)
  * and the particles migrating to their new owners right before each
@@ -195,8 +195,8 @@ static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
     x->t_decide += t1 - t0;
     if (!any) return 0;
     /* The wall contacts' history lives in the inner step's candidate lists:
-     * into the local rows first (a sync; on an offload device
-     * cd_mpi_dev_leave syncs the whole state back to the host), so that it
+     * into the local rows first (a sync; on a device cd_mpi_dev_leave
+     * syncs the whole state back to the host), so that it
      * moves with its particles, and back into candidates at the build that
      * follows (from the rows). */
     int left = cd_mpi_dev_leave(x, err, errlen);
@@ -457,7 +457,7 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
 static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    /* on an offload device the columns the sums read alone come back */
+    /* on a device (offload, OpenCL) the columns the sums read alone come back */
     int dev = cd_mpi_dev_observe_cols(x, err, errlen);
     int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
     if (agree_failure(x, rc, err, errlen)) return -1;
@@ -469,15 +469,15 @@ static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 /* The load a protocol asks for at every control call: the nonzero wall
  * rows only, summed in the serial order (cd_mpi_wall_load).  The step
  * keeps the rows' F_n per wall candidate (kernels/fields.def WALLC_OUT):
- * on an offload device they are read there, one double per local
+ * on a device (offload, OpenCL) they are read there, one double per local
  * primitive copied back (cd_mpi_dev_wall_fn); on the host the local
  * state's wall rows come from the inner backend's sync.  Every rank calls
  * it, so a failure stops all. */
 static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    /* on an offload device the rows' F_n alone come back (every rank
-     * agrees either way: some ranks may hold their state on the host) */
+    /* on a device (offload, OpenCL) the rows' F_n alone come back (every
+     * rank agrees either way: some ranks may hold their state on the host) */
     double *fn = malloc((x->loc.s.n_prims + 1) * sizeof *fn); /* [N] */
     int dev = fn ? cd_mpi_dev_wall_fn(x, w, fn, err, errlen) : -1;
     int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
