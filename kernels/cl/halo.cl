@@ -36,5 +36,6 @@ __kernel void cd_cl_wall_fn(
 {
 #include "col_bind.h"
     cd_int i = (cd_int)get_global_id(0);
-    if (i < n_prims) fn[i] = cd_item_wall_fn(c, i, n_walls, w, (__global const cd_int *)0, wall_start, wall_rows, wall_out);
+    if (i < n_prims)
+        fn[i] = cd_item_wall_fn(c, i, n_walls, w, (__global const cd_int *)0, wall_start, wall_rows, wall_out);
 }

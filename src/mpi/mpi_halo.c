@@ -501,7 +501,8 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
     for (int k = 0; host && k < x->n_neighbors; k++) {
         int r = x->neighbors[k];
         for (int e = 0; e < x->recv_count[r]; e++)
-            cd_item_ghost_io(c, x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G, 0);
+            cd_item_ghost_io(c, x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G,
+                             0);
     }
     x->refreshes++;
     return first;

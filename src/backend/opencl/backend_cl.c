@@ -218,8 +218,7 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
         }
         /* an MPI run decides the rebuild with all ranks and migrates the
          * particles first (src/mpi/mpi_backend.c; cd_cl_reload) */
-        if (sim->rebuild_hook && !cl->status && (rebuild = sim->rebuild_hook(sim, rebuild, err, errlen)) < 0)
-            return -1;
+        if (sim->rebuild_hook && !cl->status && (rebuild = sim->rebuild_hook(sim, rebuild, err, errlen)) < 0) return -1;
         forces(cl, sim, rebuild, it + 1 == n ? 1 : 2);
         s->step++;
         s->time += sim->p.dt;

@@ -347,13 +347,14 @@ void cd_cl_buffers_release(cd_cl *cl)
         release(&cl->hist[h].keys);
         cl->hist[h].cap = 0;
     }
-    cl_mem *other[] = {&cl->walls,       &cl->flags,        &cl->scratch_real,  &cl->load_part,     &cl->partial,
-                       &cl->grid,        &cl->part_cell,    &cl->part_bound,    &cl->cell_count,    &cl->cell_start,
-                       &cl->cell_cursor, &cl->cell_parts,   &cl->pair_count,    &cl->pair_offset,   &cl->block_sum,
-                       &cl->cand,        &cl->gather_count, &cl->gather_start,  &cl->gather_cursor, &cl->gather_rows,
-                       &cl->wall_count,  &cl->wall_start,   &cl->wall_rows,     &cl->obs_touch,     &cl->obs_part,
-                       &cl->obs_total,   &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out,
-                       &cl->halo_send_list, &cl->halo_recv_list, &cl->halo_send,  &cl->halo_recv,     &cl->wall_fn};
+    cl_mem *other[] = {
+        &cl->walls,          &cl->flags,        &cl->scratch_real,  &cl->load_part,     &cl->partial,
+        &cl->grid,           &cl->part_cell,    &cl->part_bound,    &cl->cell_count,    &cl->cell_start,
+        &cl->cell_cursor,    &cl->cell_parts,   &cl->pair_count,    &cl->pair_offset,   &cl->block_sum,
+        &cl->cand,           &cl->gather_count, &cl->gather_start,  &cl->gather_cursor, &cl->gather_rows,
+        &cl->wall_count,     &cl->wall_start,   &cl->wall_rows,     &cl->obs_touch,     &cl->obs_part,
+        &cl->obs_total,      &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out,  &cl->halo_send_list,
+        &cl->halo_recv_list, &cl->halo_send,    &cl->halo_recv,     &cl->wall_fn};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
     cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
     cl->cap_wall_rows = cl->cap_old_wall_rows = 0;

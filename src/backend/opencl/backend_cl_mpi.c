@@ -131,11 +131,10 @@ int cd_cl_observe_cols(cd_sim *sim, char *err, size_t errlen)
     if (!cl) return 0;
     /* (the pair rows' overlaps come from the primitives' stored ends:
      * prim_a, and the arms for end b, kernels/step_items.h) */
-    static const size_t read[] = {offsetof(cd_state, position),    offsetof(cd_state, velocity),
-                                  offsetof(cd_state, angmom),      offsetof(cd_state, orientation),
-                                  offsetof(cd_state, prim_a),      offsetof(cd_state, pair_prim_i),
-                                  offsetof(cd_state, pair_prim_j), offsetof(cd_state, pair_active),
-                                  offsetof(cd_state, pair_shear)};
+    static const size_t read[] = {
+        offsetof(cd_state, position),    offsetof(cd_state, velocity),    offsetof(cd_state, angmom),
+        offsetof(cd_state, orientation), offsetof(cd_state, prim_a),      offsetof(cd_state, pair_prim_i),
+        offsetof(cd_state, pair_prim_j), offsetof(cd_state, pair_active), offsetof(cd_state, pair_shear)};
     if (!cd_cl_buffers_download_cols(cl, sim, read, sizeof read / sizeof read[0])) return 0;
     cd_cl_report(cl, err, errlen);
     return -1;
