@@ -230,11 +230,15 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     return cd_cl_bind_cols(cl);
 }
 
+/* Enqueues a copy of bytes from src into buf; src must stay as it is until
+ * the queue is finished (cd_cl_buffers_upload finishes it once at its end:
+ * one wait for every column instead of one each, which an MPI rank pays at
+ * every migration, docs/mpi.md "OpenCL ranks"). */
 static int write(cd_cl *cl, cl_mem buf, size_t bytes, const void *src, const char *what)
 {
     if (cl->status) return -1;
     if (bytes == 0) return 0;
-    cl_int rc = clEnqueueWriteBuffer(cl->queue, buf, CL_TRUE, 0, bytes, src, 0, NULL, NULL);
+    cl_int rc = clEnqueueWriteBuffer(cl->queue, buf, CL_FALSE, 0, bytes, src, 0, NULL, NULL);
     return cd_cl_check(cl, rc, what) ? -1 : 0;
 }
 
@@ -271,6 +275,8 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
         write(cl, cl->wall_out, nw * sizeof *ent, ent, "uploading the wall contacts");
         cl->n_wall_rows = (cd_int)nw;
     }
+    cl_int finished = clFinish(cl->queue); /* (before rows, ent and flags go, whatever failed) */
+    cd_cl_check(cl, finished, "uploading the state");
     free(rows);
     free(ent);
     return cl->status ? -1 : 0;
