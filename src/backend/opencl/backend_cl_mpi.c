@@ -34,7 +34,9 @@ void cd_cl_device_slot(const cd_sim *sim, char *name, size_t len, int *index, in
 }
 
 /* A new buffer of bytes in *buf (the old one let go), filled from src
- * (NULL: left as it is). */
+ * (NULL: left as it is) without waiting: src must stay until the queue
+ * drains (the halo's lists live until the next migration, whose download
+ * finishes the queue; the pack's read and the unpack's write wait before). */
 static int put(cd_cl *cl, cl_mem *buf, size_t bytes, const void *src, const char *what)
 {
     if (cl->status) return -1;
