@@ -1,6 +1,6 @@
 /* The MPI run as a backend (docs/mpi.md): cd_backend_mpi wraps the omp
- * backend.  Every rank sets the run up from the same config (the global
- * state, the same bits everywhere); start cuts each rank's local state
+ * or the OpenCL backend.  Every rank sets the run up from the same config
+ * (the global state, the same bits everywhere); start cuts each rank's local state
  * from it; step runs the serial step on the local state, with the
  * rebuild decided by all ranks together (the serial program's decision)
  * and the particles migrating to their new owners right before each
@@ -28,6 +28,7 @@ static int began_here; /* MPI_Init was called by cd_mpi_begin */
 static cd_mpi_ctx *the_ctx;
 static int parallel_output; /* every rank writes the run file (mpi.output = parallel) */
 static void report(const cd_mpi_ctx *x);
+static void devices_started(cd_mpi_ctx *x);
 static int agree_failure(cd_mpi_ctx *x, int rc, char *err, size_t errlen);
 
 /* The heap's free memory back to the system after the exchanges that
@@ -167,6 +168,16 @@ static int agree_failure(cd_mpi_ctx *x, int rc, char *err, size_t errlen)
     return failure_of(x, first, err, errlen);
 }
 
+/* A failure that leaves the other ranks waiting in an exchange: the
+ * message (seen where the rank's stderr is: rank 0's), and every rank
+ * stops. */
+static void abort_run(cd_mpi_ctx *x, const char *err)
+{
+    fprintf(stderr, "capdem: MPI rank %d: %s\n", x->rank, err);
+    fflush(stderr);
+    MPI_Abort(x->comm, 1);
+}
+
 /* The step's rebuild decision for all ranks (the serial program's: some
  * primitive of some particle or a wall moved more than half the skin), and
  * with it the migration: particles go to their owners by their centre now,
@@ -184,17 +195,17 @@ static int rebuild_hook(cd_sim *loc, int rebuild, char *err, size_t errlen)
     x->t_decide += t1 - t0;
     if (!any) return 0;
     /* The wall contacts' history lives in the inner step's candidate lists:
-     * into the local rows first (a sync; on an offload device
-     * cd_mpi_dev_leave syncs the whole state back to the host), so that it
+     * into the local rows first (a sync; on a device cd_mpi_dev_leave
+     * syncs the whole state back to the host), so that it
      * moves with its particles, and back into candidates at the build that
      * follows (from the rows). */
     int left = cd_mpi_dev_leave(x, err, errlen);
     if (!left && agree_failure(x, x->inner->sync(loc, err, errlen), err, errlen)) return -1;
     if (left < 0 || cd_mpi_migrate(x)) {
         if (left >= 0) snprintf(err, errlen, "out of memory while moving particles to their new MPI ranks");
-        MPI_Abort(x->comm, 1); /* the other ranks wait in the exchange */
+        abort_run(x, err); /* the other ranks wait in the exchange */
     }
-    if (left && cd_mpi_dev_return(x, err, errlen)) MPI_Abort(x->comm, 1);
+    if (left && cd_mpi_dev_return(x, err, errlen)) abort_run(x, err);
     give_back_memory();
     loc->nb.walls_from_host = 1;
     x->t_migrate += MPI_Wtime() - t1;
@@ -391,7 +402,10 @@ static int mpi_start(cd_sim *sim, int compute, char *err, size_t errlen)
     /* (a rank without particles has no list to build and no forces) */
     if (!rc) rc = x->inner->start(loc, compute && loc->s.n_particles > 0, err, errlen);
     if (agree_failure(x, rc, err, errlen)) return -1;
-    if (!x->ran) x->start_owned = (long)x->n_owned;
+    if (!x->ran) {
+        x->start_owned = (long)x->n_owned;
+        devices_started(x);
+    }
     x->started = x->ran = 1;
     /* the ghosts' forces from their owners (a start computes them from
      * the pairs this rank sees) */
@@ -443,10 +457,9 @@ static int mpi_sync(cd_sim *sim, char *err, size_t errlen)
 static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    /* on an offload device the columns the sums read alone come back */
-    int dev = cd_mpi_dev_observe_cols(x);
+    /* on a device (offload, OpenCL) the columns the sums read alone come back */
+    int dev = cd_mpi_dev_observe_cols(x, err, errlen);
     int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
-    if (dev < 0) snprintf(err, errlen, "out of memory while summing the observables");
     if (agree_failure(x, rc, err, errlen)) return -1;
     rc = cd_mpi_observe_slots(x, sim, slots);
     give_back_memory();
@@ -456,19 +469,19 @@ static int mpi_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
 /* The load a protocol asks for at every control call: the nonzero wall
  * rows only, summed in the serial order (cd_mpi_wall_load).  The step
  * keeps the rows' F_n per wall candidate (kernels/fields.def WALLC_OUT):
- * on an offload device they are read there, one double per local
+ * on a device (offload, OpenCL) they are read there, one double per local
  * primitive copied back (cd_mpi_dev_wall_fn); on the host the local
  * state's wall rows come from the inner backend's sync.  Every rank calls
  * it, so a failure stops all. */
 static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
 {
     cd_mpi_ctx *x = sim->backend_data;
-    /* on an offload device the rows' F_n alone come back (every rank
-     * agrees either way: some ranks may hold their state on the host) */
+    /* on a device (offload, OpenCL) the rows' F_n alone come back (every
+     * rank agrees either way: some ranks may hold their state on the host) */
     double *fn = malloc((x->loc.s.n_prims + 1) * sizeof *fn); /* [N] */
-    int dev = fn ? cd_mpi_dev_wall_fn(x, w, fn) : -1;
+    int dev = fn ? cd_mpi_dev_wall_fn(x, w, fn, err, errlen) : -1;
     int rc = dev < 0 ? -1 : dev == 1 ? x->inner->sync(&x->loc, err, errlen) : 0;
-    if (dev < 0) snprintf(err, errlen, "out of memory while summing the load on wall %d", w);
+    if (!fn) snprintf(err, errlen, "out of memory while summing the load on wall %d", w);
     if (agree_failure(x, rc, err, errlen)) {
         free(fn);
         return -1;
@@ -478,15 +491,16 @@ static int mpi_wall_load(cd_sim *sim, int w, double *load, char *err, size_t err
     return 0;
 }
 
-/* Each rank's device (cd_mpi_dev_choose: made its default device), on
- * rank 0 in rank order, "rank 0: ...; rank 1: ..." (with the node's name
- * when node is set), into a new string (NULL on the other ranks, or out
- * of memory).  Collective. */
-static char *devices_of_ranks(cd_mpi_ctx *x, int node)
+/* Each rank's device (taken: this rank's in words, after the start; NULL:
+ * cd_mpi_dev_choose's, made its default device), on rank 0 in rank order,
+ * "rank 0: ...; rank 1: ..." (with the node's name when node is set), into
+ * a new string (NULL on the other ranks, or out of memory).  Collective. */
+static char *devices_of_ranks(cd_mpi_ctx *x, const char *taken, int node)
 {
     enum { LEN = 256 };
     char mine[LEN] = "", name[MPI_MAX_PROCESSOR_NAME] = "", *all = x->rank == 0 ? calloc((size_t)x->size, LEN) : NULL;
-    cd_mpi_dev_choose(x, mine, sizeof mine);
+    if (taken) snprintf(mine, sizeof mine, "%s", taken);
+    else cd_mpi_dev_choose(x, mine, sizeof mine);
     int n = 0;
     if (node && MPI_Get_processor_name(name, &n) == MPI_SUCCESS && n > 0) {
         char with[LEN];
@@ -504,17 +518,28 @@ static char *devices_of_ranks(cd_mpi_ctx *x, int node)
     return line;
 }
 
-/* The devices the ranks took, for the run's first line; empty in a
- * build without offload (every rank: host threads). */
-static char rank_devices[1024];
+/* The devices the ranks took, for the run's first line; empty on host
+ * threads. */
+static char rank_devices[4096];
 
 static void devices_taken(cd_mpi_ctx *x)
 {
-    char *line = devices_of_ranks(x, 0); /* (every rank takes its device here, before anything is mapped) */
+    char *line = devices_of_ranks(x, NULL, 0); /* (every rank takes its device here, before anything is mapped) */
     rank_devices[0] = 0;
 #if defined(CAPDEM_OFFLOAD_TARGET)
     if (line) snprintf(rank_devices, sizeof rank_devices, "%s", line);
 #endif
+    free(line);
+}
+
+/* The OpenCL devices the ranks opened at their first start, for the run's
+ * first line.  Collective. */
+static void devices_started(cd_mpi_ctx *x)
+{
+    char mine[256];
+    if (!cd_mpi_dev_started(x, mine, sizeof mine)) return; /* (every rank the same inner backend) */
+    char *line = devices_of_ranks(x, mine, 0);
+    if (line) snprintf(rank_devices, sizeof rank_devices, "%s", line);
     free(line);
 }
 
@@ -526,7 +551,7 @@ int cd_mpi_version(void)
     if (!on) return 0; /* not under an MPI launcher */
     cd_mpi_ctx x = {.comm = MPI_COMM_WORLD, .rank = rank, .size = size};
     fflush(stdout);
-    char *line = devices_of_ranks(&x, 1);
+    char *line = devices_of_ranks(&x, NULL, 1);
     if (rank == 0)
         printf("MPI: %d rank%s, each with the device it takes in a run: %s\n", size, size == 1 ? "" : "s",
                line ? line : "(out of memory)");
@@ -536,7 +561,7 @@ int cd_mpi_version(void)
 
 static const char *mpi_device(const cd_sim *sim)
 {
-    static char buf[1280];
+    static char buf[4352];
     const cd_mpi_ctx *x = sim->backend_data;
     char grid[96];
     if (x->grid.kind == CD_DECOMP_RCB) snprintf(grid, sizeof grid, "sub-domains by recursive coordinate bisection");
@@ -552,10 +577,7 @@ static const cd_backend cd_backend_mpi = {"mpi",    mpi_start,  mpi_step,      m
 int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
 {
     if (!cd_mpi_decomposed()) return 0;
-    if (strcmp(backend, "omp")) {
-        snprintf(err, errlen, "--backend %s: several MPI ranks run the omp backend only so far (docs/mpi.md)", backend);
-        return -1;
-    }
+    (void)backend; /* (omp or opencl: cd_sim_use_backend chose it, sim->backend) */
     cd_mpi_ctx *x = calloc(1, sizeof *x);
     if (!x) {
         snprintf(err, errlen, "out of memory");
@@ -564,7 +586,8 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
     x->comm = MPI_COMM_WORLD;
     MPI_Comm_rank(x->comm, &x->rank);
     MPI_Comm_size(x->comm, &x->size);
-    devices_taken(x); /* an offload build: each rank its device, before anything is mapped */
+    x->inner = sim->backend ? sim->backend : &cd_backend_omp;
+    devices_taken(x); /* an offload build: each rank its device, before anything is mapped; OpenCL: at the start */
     const char *all = getenv("CAPDEM_MPI_ALL_RANKS"); /* the fallback path of a migration, for its test */
     x->all_ranks = all && !strcmp(all, "1");
     /* one run file, every rank writing its particles' rows (docs/mpi.md,
@@ -575,7 +598,6 @@ int cd_mpi_wrap(cd_sim *sim, const char *backend, char *err, size_t errlen)
         free(x);
         return -1;
     }
-    x->inner = sim->backend ? sim->backend : &cd_backend_omp;
     sim->backend = &cd_backend_mpi;
     sim->backend_data = x;
     free(the_ctx);

@@ -188,8 +188,8 @@ static int plan_refresh(cd_mpi_ctx *x)
             x->send_list = malloc(((size_t)ns + 1) * sizeof(int));
             x->recv_list = malloc(((size_t)nr + 1) * sizeof(int));
             x->dev_stale = 1; /* (the device's copies follow at the next refresh) */
-            x->send_buf = malloc(((size_t)ns * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
-            x->recv_buf = malloc(((size_t)nr * CD_MPI_GHOST_DOUBLES + 1) * sizeof(double));
+            x->send_buf = malloc(((size_t)ns * CD_HALO_REALS + 1) * sizeof(double));
+            x->recv_buf = malloc(((size_t)nr * CD_HALO_REALS + 1) * sizeof(double));
             if (!x->send_list || !x->recv_list || !x->send_buf || !x->recv_buf) {
                 free(ranks);
                 return -1;
@@ -460,10 +460,20 @@ int cd_mpi_exchange_bytes(cd_mpi_ctx *x, const char *send, const int *sc, char *
     return *recv ? 0 : -1;
 }
 
+/* The halo could not be packed or unpacked on the device (out of its
+ * memory, an OpenCL error): the other ranks wait in the exchange. */
+static void device_failed(cd_mpi_ctx *x)
+{
+    fprintf(stderr, "capdem: MPI rank %d: the ghost refresh failed on the device (%s)\n", x->rank,
+            x->loc.backend ? x->loc.backend->device(&x->loc) : "?");
+    fflush(stderr);
+    MPI_Abort(x->comm, 1);
+}
+
 int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
 {
     cd_state *s = &x->loc.s;
-    int G = CD_MPI_GHOST_DOUBLES, n = 0, who = failed ? x->rank : x->size, first = x->size;
+    int G = CD_HALO_REALS, n = 0, who = failed ? x->rank : x->size, first = x->size;
     MPI_Iallreduce(&who, &first, 1, MPI_INT, MPI_MIN, x->comm, &x->requests[n++]);
     /* the ghosts of a neighbour here, the owned particles it has ghosts of
      * (the counts known on both sides since the last migration) */
@@ -475,23 +485,24 @@ int cd_mpi_refresh_ghosts(cd_mpi_ctx *x, int failed)
     }
     cd_cols c = cd_sim_host_cols(s);
     int host = cd_mpi_dev_pack(x); /* on an offload device: every send row packed there */
-    if (host < 0) MPI_Abort(x->comm, 1);
+    if (host < 0) device_failed(x);
     for (int k = 0; k < x->n_neighbors; k++) {
         int r = x->neighbors[k];
         if (!x->send_count[r]) continue;
         double *b = x->send_buf + (size_t)x->send_displ[r] * G;
         for (int e = 0; host && e < x->send_count[r]; e++)
-            cd_mpi_ghost_io(c, x->send_list[x->send_displ[r] + e], b + (size_t)e * G, 1);
+            cd_item_ghost_io(c, x->send_list[x->send_displ[r] + e], b + (size_t)e * G, 1);
         MPI_Isend(b, x->send_count[r] * G, MPI_DOUBLE, r, CD_MPI_TAG_GHOSTS, x->comm, &x->requests[n++]);
         x->refresh_msgs++;
         x->refresh_bytes += (long long)x->send_count[r] * G * (long long)sizeof(double);
     }
     MPI_Waitall(n, x->requests, MPI_STATUSES_IGNORE);
-    if (!host && cd_mpi_dev_unpack(x)) MPI_Abort(x->comm, 1); /* the ghosts' rows written there */
+    if (!host && cd_mpi_dev_unpack(x)) device_failed(x); /* the ghosts' rows written there */
     for (int k = 0; host && k < x->n_neighbors; k++) {
         int r = x->neighbors[k];
         for (int e = 0; e < x->recv_count[r]; e++)
-            cd_mpi_ghost_io(c, x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G, 0);
+            cd_item_ghost_io(c, x->recv_list[x->recv_displ[r] + e], x->recv_buf + (size_t)(x->recv_displ[r] + e) * G,
+                             0);
     }
     x->refreshes++;
     return first;

@@ -6,12 +6,14 @@
 #include "core/sim.h"
 #include "mpi/mpi_decomp.h"
 #include "io/io_h5.h"
+#include "halo_items.h" /* the ghost rows packed and unpacked: cd_item_ghost_io, CD_HALO_REALS */
 
 typedef struct {
     MPI_Comm comm;
     int rank, size;
+    int node_rank; /* among the ranks of its node (an OpenCL rank's device: cd_mpi_dev_choose) */
     cd_decomp_grid grid;
-    const cd_backend *inner; /* the backend that steps the local state (omp) */
+    const cd_backend *inner; /* the backend that steps the local state (omp or opencl) */
     cd_sim loc;              /* owned particles and ghosts, in ascending global id */
     /* per local particle and primitive, the global ids (ascending) */
     long long *gid, *gprim;
@@ -57,58 +59,43 @@ typedef struct {
     long long gathers; /* times sync gathered the whole state on every rank (protocols, diagnoses; no snapshot) */
 } cd_mpi_ctx;
 
-/* Doubles per particle of the ghost refresh: position 3, orientation 4,
- * velocity 3, angmom 3, angvel 3, force 3, torque 3. */
-#define CD_MPI_GHOST_DOUBLES 22
-
-/* The ghost columns of local particle q (c: host or device columns) to
- * (pack) or from the CD_MPI_GHOST_DOUBLES doubles at b: one function for
- * the host's refresh and the device's (src/mpi/mpi_device.c). */
-CD_DEVICE_BEGIN
-static inline void cd_mpi_ghost_io(cd_cols c, cd_int q, double *b, int pack)
-{
-    double *cols[7] = {&c.position[q].x, &c.orientation[q].w, &c.velocity[q].x, &c.angmom[q].x,
-                       &c.angvel[q].x,   &c.force[q].x,       &c.torque[q].x};
-    const int len[7] = {3, 4, 3, 3, 3, 3, 3};
-    for (int k = 0; k < 7; k++) {
-        for (int e = 0; e < len[k]; e++) {
-            if (pack) b[e] = cols[k][e];
-            else cols[k][e] = b[e];
-        }
-        b += len[k];
-    }
-}
-CD_DEVICE_END
-
-/* The ghost refresh's packing where the local state runs: on the offload
- * device (offload builds, the state mapped there) the send rows packed
- * there into x->send_buf, or the received x->recv_buf unpacked there into
- * the ghosts' rows; only the halo's bytes cross.  Returns 1 when the state
- * is on the host (the caller packs), 0 done, -1 out of device memory. */
+/* Where the local state runs on a device (src/mpi/mpi_device.c): the
+ * offload variant's device (offload builds, the state mapped there) or
+ * the OpenCL backend's.  The ghost refresh's packing: the send rows
+ * packed there into x->send_buf, or the received x->recv_buf unpacked
+ * there into the ghosts' rows; only the halo's bytes cross.  Returns 1
+ * when the state is on the host (the caller packs), 0 done, -1 failed
+ * (out of device memory, an OpenCL error). */
 int cd_mpi_dev_pack(cd_mpi_ctx *x);
 int cd_mpi_dev_unpack(cd_mpi_ctx *x);
 void cd_mpi_dev_free(cd_mpi_ctx *x);
-/* The offload device of this rank: its node-local rank (MPI_COMM_TYPE_SHARED)
- * modulo the node's devices, made the default device before anything is
- * mapped; what it took, in words, into desc.  Collective. */
+/* The device of this rank: its node-local rank (MPI_COMM_TYPE_SHARED)
+ * modulo the node's devices, made the default offload device before
+ * anything is mapped, or the device the OpenCL backend opens at the
+ * start; what it took, in words, into desc.  Collective. */
 void cd_mpi_dev_choose(cd_mpi_ctx *x, char *desc, size_t len);
+/* After the start: the OpenCL device this rank's state is on, in words,
+ * into desc, and 1 (0: the offload variant or host threads, which
+ * cd_mpi_dev_choose named). */
+int cd_mpi_dev_started(cd_mpi_ctx *x, char *desc, size_t len);
 /* F_n [N] on wall w of every local primitive (0 where it touches none)
- * into fn, from the step's wall-candidate entries on the offload device:
- * one double per primitive crosses instead of the local state (a wall
- * load, at every step of a protocol).  1 when the state is on the host
- * (the caller reads its columns), 0 done, -1 out of device memory. */
-int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn);
+ * into fn, from the step's wall-candidate entries on the device: one
+ * double per primitive crosses instead of the local state (a wall load,
+ * at every step of a protocol).  1 when the state is on the host (the
+ * caller reads its columns), 0 done, -1 with err set. */
+int cd_mpi_dev_wall_fn(cd_mpi_ctx *x, int w, double *fn, char *err, size_t errlen);
 /* The columns of the local state that an observation reads
  * (src/mpi/mpi_reduce.c: the particles' pose, velocity and angular
  * momentum, the pair rows' primitives, flag, overlap and spring) and its
- * wall rows (from the step's candidate entries) from the offload device
- * to the host, instead of every column.  1 when the state is on the host
- * (the caller syncs), 0 done, -1 out of memory. */
-int cd_mpi_dev_observe_cols(cd_mpi_ctx *x);
+ * wall rows (from the step's candidate entries) from the device to the
+ * host, instead of every column.  1 when the state is on the host (the
+ * caller syncs), 0 done, -1 with err set. */
+int cd_mpi_dev_observe_cols(cd_mpi_ctx *x, char *err, size_t errlen);
 /* Around a migration, which rebuilds the local state on the host: the
- * device's state copied back and let go (leave: 1, or 0 when the state is
- * on the host, -1 with err set), mapped again (return, after a leave that
- * returned 1: 0, or -1 with err set). */
+ * device's state copied back (and let go by the offload variant; leave:
+ * 1, or 0 when the state is on the host, -1 with err set), put on the
+ * device again (return, after a leave that returned 1: 0, or -1 with err
+ * set). */
 int cd_mpi_dev_leave(cd_mpi_ctx *x, char *err, size_t errlen);
 int cd_mpi_dev_return(cd_mpi_ctx *x, char *err, size_t errlen);
 

@@ -22,3 +22,30 @@ same() {
 last_rows() {
   h5dump -d "/$2/offset" "$1" | sed -n 's/^ *([0-9]*): *//p' | head -1 | tr -d ' ' | awk -F, '{print $NF - $(NF-1)}'
 }
+# migrated_with_ghosts LABEL: rank 0's closing line in err says that the
+# run migrated particles (at least 10 times) and had ghosts, or the
+# comparison of its file proves little
+migrated_with_ghosts() {
+  local line migrations ghosts
+  line=$(grep 'capdem: MPI:' err)
+  # "capdem: MPI: R ranks, M migrations ...; per rank now a..b owned particles and c..d ghosts"
+  migrations=$(sed -n 's/.* \([0-9]*\) migrations.*/\1/p' <<< "$line")
+  ghosts=$(sed -n 's/.*and [0-9]*\.\.\([0-9]*\) ghosts.*/\1/p' <<< "$line")
+  if [ "${migrations:-0}" -ge 10 ] && [ "${ghosts:-0}" -ge 1 ]; then ok
+  else bad "$1: expected migrations and ghosts, got: $line"; fi
+}
+# blows_up_as_serial LABEL NP ARGS...: the 2D crosses with a dt far above
+# t_col/5 (forced) blow up on NP ranks as on one process: exit status 3
+# and the serial program's diagnosis, once
+blows_up_as_serial() {
+  local label=$1 np=$2 rc stop_serial stop_mpi
+  shift 2
+  sed 's/^  dt: .*/  dt: 1.5e-4\n  force_dt: true/' "$src/tests/mpi/crosses_2d.yaml" > blowup.yaml
+  rm -f blowup1.h5 blowup$np.h5
+  "$capdem" run blowup.yaml --output blowup1.h5 --quiet "$@" 2> serial.err
+  mpi "$np" run blowup.yaml --output "blowup$np.h5" --quiet "$@" > out 2> err
+  rc=$?
+  stop_serial=$(grep 'run stopped' serial.err) stop_mpi=$(grep 'run stopped' err)
+  if [ $rc -eq 3 ] && [ -n "$stop_serial" ] && [ "$stop_serial" = "$stop_mpi" ]; then ok
+  else bad "$label: exit status $rc (expected 3), serial says '$stop_serial', $np ranks say '$stop_mpi'"; fi
+}

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "backend/opencl/backend_cl.h"
+#include "backend/opencl/backend_cl_mpi.h"
 #include "observe_items.h"
 #include "broadphase.h"
 #include "step_items.h"
@@ -142,6 +143,36 @@ static int cl_start(cd_sim *sim, int compute_forces, char *err, size_t errlen)
     return cl->status ? fail(sim, err, errlen) : 0;
 }
 
+int cd_cl_reload(cd_sim *sim, char *err, size_t errlen)
+{
+    cd_cl *cl = sim->backend_data;
+    if (cd_state_arms_derive(&sim->s)) {
+        snprintf(err, errlen, "out of memory while setting up the primitives' arms");
+        return -1;
+    }
+    /* The walls as the device moved them this step (the host's columns
+     * hold them as the last call of step ended). */
+    cd_wall walls[CD_MAX_WALLS];
+    size_t W = sim->s.n_walls;
+    if (W && !cl->status)
+        cd_cl_check(cl,
+                    clEnqueueReadBuffer(cl->queue, cl->walls, CL_TRUE, 0, W * sizeof(cd_wall), walls, 0, NULL, NULL),
+                    "reading the walls");
+    if (!cl->status) cd_cl_buffers_release(cl);
+    if (cl->status || cd_cl_buffers_create(cl, sim) || cd_cl_buffers_upload(cl, sim)) return fail(sim, err, errlen);
+    if (W)
+        cd_cl_check(cl,
+                    clEnqueueWriteBuffer(cl->queue, cl->walls, CL_TRUE, 0, W * sizeof(cd_wall), walls, 0, NULL, NULL),
+                    "uploading the walls");
+    set_step_args(cl, sim);
+    set_list_args(cl);
+    /* the candidates are the host's wall rows in contact, which the build
+     * that follows carries over (the forces of the last step are the
+     * host's: no wall load reads the device before it) */
+    cl->wall_out_valid = cl->wall_out_pending = 0;
+    return cl->status ? fail(sim, err, errlen) : 0;
+}
+
 static int cl_sync(cd_sim *sim, char *err, size_t errlen)
 {
     cd_cl *cl = sim->backend_data;
@@ -185,6 +216,9 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
                         "reading the skin flag");
             rebuild = moved != 0;
         }
+        /* an MPI run decides the rebuild with all ranks and migrates the
+         * particles first (src/mpi/mpi_backend.c; cd_cl_reload) */
+        if (sim->rebuild_hook && !cl->status && (rebuild = sim->rebuild_hook(sim, rebuild, err, errlen)) < 0) return -1;
         forces(cl, sim, rebuild, it + 1 == n ? 1 : 2);
         s->step++;
         s->time += sim->p.dt;

@@ -230,11 +230,15 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     return cd_cl_bind_cols(cl);
 }
 
+/* Enqueues a copy of bytes from src into buf; src must stay as it is until
+ * the queue is finished (cd_cl_buffers_upload finishes it once at its end:
+ * one wait for every column instead of one each, which an MPI rank pays at
+ * every migration, docs/mpi.md "OpenCL ranks"). */
 static int write(cd_cl *cl, cl_mem buf, size_t bytes, const void *src, const char *what)
 {
     if (cl->status) return -1;
     if (bytes == 0) return 0;
-    cl_int rc = clEnqueueWriteBuffer(cl->queue, buf, CL_TRUE, 0, bytes, src, 0, NULL, NULL);
+    cl_int rc = clEnqueueWriteBuffer(cl->queue, buf, CL_FALSE, 0, bytes, src, 0, NULL, NULL);
     return cd_cl_check(cl, rc, what) ? -1 : 0;
 }
 
@@ -271,12 +275,25 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
         write(cl, cl->wall_out, nw * sizeof *ent, ent, "uploading the wall contacts");
         cl->n_wall_rows = (cd_int)nw;
     }
+    cl_int finished = clFinish(cl->queue); /* (before rows, ent and flags go, whatever failed) */
+    cd_cl_check(cl, finished, "uploading the state");
     free(rows);
     free(ent);
     return cl->status ? -1 : 0;
 }
 
-int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
+/* Is column f among the n fields at offsets only (NULL: every column)? */
+static int wanted(int f, const size_t *only, size_t n)
+{
+    if (!only) return 1;
+    for (size_t k = 0; k < n; k++)
+        if (cd_fields[f].offset == only[k]) return 1;
+    return 0;
+}
+
+int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim) { return cd_cl_buffers_download_cols(cl, sim, NULL, 0); }
+
+int cd_cl_buffers_download_cols(cd_cl *cl, cd_sim *sim, const size_t *only, size_t n_only)
 {
     cd_state *s = &sim->s;
     if (cl->status) return -1;
@@ -287,7 +304,7 @@ int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim)
     s->n_pairs = cl->n_pairs;
     for (int f = 0; f < CD_CL_N_FIELDS && !cl->status; f++) {
         size_t bytes = cd_state_rows(s, cd_fields[f].group) * cd_fields[f].elem_size;
-        if (bytes == 0) continue;
+        if (bytes == 0 || !wanted(f, only, n_only)) continue;
         void *host = *cd_field_ptr(s, &cd_fields[f]);
         cl_int rc = clEnqueueReadBuffer(cl->queue, cd_cl_col(cl, f), CL_FALSE, 0, bytes, host, 0, NULL, NULL);
         cd_cl_check(cl, rc, "downloading the state");
@@ -336,13 +353,16 @@ void cd_cl_buffers_release(cd_cl *cl)
         release(&cl->hist[h].keys);
         cl->hist[h].cap = 0;
     }
-    cl_mem *other[] = {&cl->walls,       &cl->flags,        &cl->scratch_real,  &cl->load_part,     &cl->partial,
-                       &cl->grid,        &cl->part_cell,    &cl->part_bound,    &cl->cell_count,    &cl->cell_start,
-                       &cl->cell_cursor, &cl->cell_parts,   &cl->pair_count,    &cl->pair_offset,   &cl->block_sum,
-                       &cl->cand,        &cl->gather_count, &cl->gather_start,  &cl->gather_cursor, &cl->gather_rows,
-                       &cl->wall_count,  &cl->wall_start,   &cl->wall_rows,     &cl->obs_touch,     &cl->obs_part,
-                       &cl->obs_total,   &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out};
+    cl_mem *other[] = {
+        &cl->walls,          &cl->flags,        &cl->scratch_real,  &cl->load_part,     &cl->partial,
+        &cl->grid,           &cl->part_cell,    &cl->part_bound,    &cl->cell_count,    &cl->cell_start,
+        &cl->cell_cursor,    &cl->cell_parts,   &cl->pair_count,    &cl->pair_offset,   &cl->block_sum,
+        &cl->cand,           &cl->gather_count, &cl->gather_start,  &cl->gather_cursor, &cl->gather_rows,
+        &cl->wall_count,     &cl->wall_start,   &cl->wall_rows,     &cl->obs_touch,     &cl->obs_part,
+        &cl->obs_total,      &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out,  &cl->halo_send_list,
+        &cl->halo_recv_list, &cl->halo_send,    &cl->halo_recv,     &cl->wall_fn};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
     cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
     cl->cap_wall_rows = cl->cap_old_wall_rows = 0;
+    cl->halo_ns = cl->halo_nr = 0;
 }

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <strings.h>
 #include "backend/opencl/backend_cl.h"
+#include "backend/opencl/backend_cl_mpi.h"
 
 /* Kernel names, in enum cd_cl_kernel order, and whether each takes the
  * columns first (col_params.h). */
@@ -51,6 +52,9 @@ static const struct {
     {"cd_cl_obs_pairs", 1},
     {"cd_cl_obs_walls", 1},
     {"cd_cl_obs_merge", 0},
+    {"cd_cl_halo_pack", 1},
+    {"cd_cl_halo_unpack", 1},
+    {"cd_cl_wall_fn", 1},
 };
 
 int cd_cl_kernel_takes_cols(enum cd_cl_kernel k) { return kernel_table[k].cols; }
@@ -294,9 +298,15 @@ static int contains_nocase(const char *hay, const char *needle)
     return n == 0;
 }
 
+static int nth_device; /* cd_cl_use_nth_device */
+
+void cd_cl_use_nth_device(int n) { nth_device = n > 0 ? n : 0; }
+
 /* Picks the device: the request cpu | gpu | auto (CAPDEM_OPENCL_DEVICE
  * overrides it), among the platforms whose name contains
- * CAPDEM_OPENCL_PLATFORM (case-insensitive) if set.  auto prefers a GPU. */
+ * CAPDEM_OPENCL_PLATFORM (case-insensitive) if set.  auto prefers a GPU.
+ * Of the eligible devices (the preferred type, with fp64) the first, or
+ * under MPI the one of the rank's node-local rank (cd_cl_use_nth_device). */
 static int choose_device(cd_cl *cl, const char *request, char *err, size_t errlen)
 {
     const char *env = getenv("CAPDEM_OPENCL_DEVICE");
@@ -346,21 +356,33 @@ static int choose_device(cd_cl *cl, const char *request, char *err, size_t errle
         n_types = 1;
     }
     char first_no_fp64[256] = "";
-    for (int t = 0; t < n_types; t++)
+    for (int t = 0; t < n_types; t++) {
+        /* the devices of the first type that has any with fp64, over the
+         * platforms in order; the n-th of them (an MPI rank's) */
+        cl_platform_id on[64];
+        cl_device_id ok[64];
+        int n_ok = 0;
         for (cl_uint i = 0; i < nk; i++) {
             cl_device_id dev[16];
             cl_uint nd = 0;
             if (clGetDeviceIDs(keep[i], order[t], 16, dev, &nd) != CL_SUCCESS) continue;
-            for (cl_uint j = 0; j < nd && j < 16; j++) {
+            for (cl_uint j = 0; j < nd && j < 16 && n_ok < 64; j++) {
                 if (!has_fp64(dev[j])) {
                     if (!first_no_fp64[0]) info_string(dev[j], CL_DEVICE_NAME, first_no_fp64, sizeof first_no_fp64);
                     continue;
                 }
-                cl->platform = keep[i];
-                cl->device = dev[j];
-                return 0;
+                on[n_ok] = keep[i];
+                ok[n_ok++] = dev[j];
             }
         }
+        if (n_ok) {
+            cl->device_index = nth_device % n_ok;
+            cl->device_count = n_ok;
+            cl->platform = on[cl->device_index];
+            cl->device = ok[cl->device_index];
+            return 0;
+        }
+    }
     if (first_no_fp64[0]) {
         snprintf(err, errlen,
                  "OpenCL: device '%s' has no double precision (cl_khr_fp64), which capdem needs; "
