@@ -53,11 +53,20 @@ expect 2 'folder no_such_dir does not exist' "missing folder" -- run a.yaml --qu
 # The first run is stopped (SIGSTOP) as soon as its file exists, so that the
 # second one surely meets it running, then continued to its end.
 printf '%s\nrun: {steps: 100000, snapshot_every: 20000}\n' "$base" > long.yaml
-# start_first FILE [ENV=VALUE]: the first run, stopped once FILE exists
+# marked FILE: capdem's read lock on FILE (io_h5_target.c cdh5_mark: an
+# open file description lock, or a POSIX one) shows in /proc/locks
+marked() {
+  local ino
+  ino=$(stat -c %i "$1" 2> /dev/null) || return 1
+  grep -Eq "(OFDLCK|POSIX) +ADVISORY +READ .*:$ino " /proc/locks
+}
+# start_first FILE [ENV=VALUE]: the first run, stopped once FILE exists and
+# carries its mark (a fixed pause after the file appeared was too short on
+# a loaded machine: the run could be stopped between creating and marking)
 start_first() {
   env ${2:-} "$capdem" run long.yaml --quiet --output "$1" 2> err1 &
   pid1=$!
-  for _ in $(seq 1000); do [ -f "$1" ] && break; sleep 0.01; done
+  for _ in $(seq 6000); do marked "$1" && break; sleep 0.01; done
   kill -STOP "$pid1" 2> /dev/null
   sleep 0.05 # past HDF5's open-then-flock
 }
