@@ -80,7 +80,14 @@ CD_INLINE cd_wall cd_wall_advanced(cd_wall w, cd_real dt)
  * body-frame ends at the body origin) has both ends at x: the rotation of
  * a zero vector is a zero, and x plus a zero is x (but for the sign of a
  * zero coordinate of x), so the two rotations are skipped
- * (docs/performance.md, "The sphere step"). */
+ * (docs/performance.md, "The sphere step").  An arm through the body's
+ * centre (b_body = -a_body, every arm of the named shapes: rods, crosses,
+ * hexapods) is rotated once: the rotation (cd_q_rotate) of -v is minus
+ * the rotation of v, operation by operation (negation commutes with
+ * rounding to nearest), so x - R a equals x + R b but for the sign of a
+ * zero coordinate where x has a -0 (a zero coordinate of b_body may be +0
+ * where -a_body's is -0, which changes only the signs of zero terms);
+ * docs/performance.md, "Session 17, hexapods". */
 CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd_vec3 *a, cd_vec3 *b)
 {
     cd_int r = cd_prim_arm_of(c, i);
@@ -89,8 +96,11 @@ CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd
         *b = x;
         return;
     }
-    *a = cd_rigid_to_world(x, o, c.arm[r].a_body);
-    *b = cd_rigid_to_world(x, o, c.arm[r].b_body);
+    cd_vec3 ea = c.arm[r].a_body, eb = c.arm[r].b_body; /* [m] */
+    cd_vec3 ra = cd_q_rotate(o, ea);
+    *a = cd_v3_add(x, ra);
+    if (eb.x == -ea.x && eb.y == -ea.y && eb.z == -ea.z) *b = cd_v3_sub(x, ra);
+    else *b = cd_rigid_to_world(x, o, eb);
 }
 
 /* Primitive i's world ends a, b into its columns (end b: its arm's, where

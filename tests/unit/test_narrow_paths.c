@@ -2,7 +2,8 @@
  * sphere-sphere (cd_segseg_point_contact), sphere-arm
  * (cd_segseg_point_segment_contact) and arm-arm (cd_segseg_axes_contact)
  * give the bits of the general segment-segment path on random pairs, so
- * choosing one per row changes no trajectory. */
+ * choosing one per row changes no trajectory; an arm through its body's
+ * centre rotated once (cd_prim_ends_at) gives the ends of two rotations. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -13,6 +14,7 @@
 #include <string.h>
 
 #include "segseg.h"
+#include "quat.h"
 #include "unit/segseg_rng.h"
 
 /* The general path of the pair kernel (closest points, pre-test, contact
@@ -196,12 +198,41 @@ static void test_arm_pair_contact_equals_general_path(void **state)
     assert_true(overlapping > 1000 && parallel > 100 && ramp > 100 && inside > 100 && ends > 1000);
 }
 
+/* An arm through its body's centre (b_body = -a_body, the zero
+ * coordinates +0 in both, as src/shapes/shapes.c makes them): its end b
+ * from the one rotation of a (x - R a, cd_prim_ends_at) has the bits of
+ * the rotation of b (x + R b), for random orientations, centres (with +0
+ * coordinates among them) and arms along a body axis or in any direction. */
+static void test_symmetric_arm_one_rotation(void **state)
+{
+    (void)state;
+    rng_state = 2718;
+    for (int k = 0; k < 100000; k++) {
+        cd_quat o = cd_q_normalize(cd_q(rng_sym(), rng_sym(), rng_sym(), rng_sym()));
+        if (k % 7 == 0) o = cd_q_normalize(cd_q(rng_sym(), 0.0, 0.0, rng_sym())); /* about z (2D) */
+        cd_vec3 x = rng_vec(0.1);
+        if (k % 11 == 0) x.z = 0.0;
+        double h = 0.01 * rng_u(), ea[3] = {0, 0, 0}, eb[3] = {0, 0, 0};
+        ea[k % 3] = -h;
+        eb[k % 3] = h;
+        cd_vec3 a_body = cd_v3(ea[0], ea[1], ea[2]), b_body = cd_v3(eb[0], eb[1], eb[2]);
+        if (k % 4 == 3) {
+            a_body = rng_vec(0.01);
+            b_body = cd_v3_neg(a_body);
+        }
+        cd_vec3 want = cd_v3_add(x, cd_q_rotate(o, b_body));
+        cd_vec3 got = cd_v3_sub(x, cd_q_rotate(o, a_body));
+        assert_memory_equal(&got, &want, sizeof got);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_contact_equals_general_path),
         cmocka_unit_test(test_point_segment_contact_equals_general_path),
         cmocka_unit_test(test_arm_pair_contact_equals_general_path),
+        cmocka_unit_test(test_symmetric_arm_one_rotation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
