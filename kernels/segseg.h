@@ -273,8 +273,8 @@ CD_INLINE void cd_segseg_contact_closest(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_
  * non-zero length (aa = |d1|^2, ee = |d2|^2 > 0 [m^2]) whose rule weight
  * wpar (cd_parallel_weight) is > 0: g->point moves to (or towards) the
  * middle of the overlapping section. */
-CD_INLINE void cd_segseg_parallel_point(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1, cd_vec3 d1, cd_vec3 d2, cd_real aa,
-                                        cd_real ee, cd_real wpar, cd_contact_geom *g)
+CD_INLINE void cd_segseg_parallel_point(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1, cd_vec3 d1, cd_vec3 d2,
+                                        cd_real aa, cd_real ee, cd_real wpar, cd_contact_geom *g)
 {
     /* section of axis i covered by j, and of axis j covered by i */
     cd_real u0 = cd_v3_dot(cd_v3_sub(q0, p0), d1) / aa;

@@ -328,9 +328,10 @@ CD_INLINE_ALWAYS int cd_pair_narrow(cd_cols c, cd_prim_id i, cd_prim_id j, cd_re
         cd_prim_world_ends(c, j, &aj, &bj);
         cd_vec3 d1 = cd_v3_sub(bi, ai), d2 = cd_v3_sub(bj, aj);
         cd_real a = cd_v3_dot(d1, d1), e = cd_v3_dot(d2, d2); /* [m^2] */
-        if (a > CD_R(0) && e > CD_R(0))
+        if (a > CD_R(0) && e > CD_R(0)) {
             /* two arms (neither is a point: bi - ai is not zero) */
             return cd_segseg_axes_contact(ai, bi, ri, aj, bj, rj, d1, d2, a, e, sin_parallel, parallel_blend, g);
+        }
         int point_i = cd_segseg_is_point(ai, bi), point_j = cd_segseg_is_point(aj, bj);
         if (point_i && point_j) {
             /* two points (balls with an arm of zero length): the same

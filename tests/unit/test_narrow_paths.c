@@ -161,7 +161,7 @@ static void test_arm_pair_contact_equals_general_path(void **state)
         cd_vec3 q0 = cd_v3_add(p0, rng_vec(0.008)), q1 = cd_v3_add(q0, rng_vec(0.008));
         cd_vec3 d1 = cd_v3_sub(p1, p0);
         if (k % 5 == 1) q1 = cd_v3_add(q0, cd_v3_scale(d1, -0.7)); /* exactly parallel (antiparallel) */
-        if (k % 5 == 2) {                                             /* nearly parallel: up to 4 sp */
+        if (k % 5 == 2) {                                          /* nearly parallel: up to 4 sp */
             cd_vec3 n = cd_v3_cross(d1, rng_vec(1.0));
             double dn = sqrt(cd_v3_dot(n, n)), l1 = sqrt(cd_v3_dot(d1, d1));
             q1 = cd_v3_add(q0, cd_v3_add(cd_v3_scale(d1, 0.9), cd_v3_scale(n, 4.0 * sp * rng_u() * 0.9 * l1 / dn)));
