@@ -84,10 +84,12 @@ CD_INLINE cd_wall cd_wall_advanced(cd_wall w, cd_real dt)
  * centre (b_body = -a_body, every arm of the named shapes: rods, crosses,
  * hexapods) is rotated once: the rotation (cd_q_rotate) of -v is minus
  * the rotation of v, operation by operation (negation commutes with
- * rounding to nearest), so x - R a equals x + R b but for the sign of a
- * zero coordinate where x has a -0 (a zero coordinate of b_body may be +0
- * where -a_body's is -0, which changes only the signs of zero terms);
- * docs/performance.md, "Session 17, hexapods". */
+ * rounding to nearest), so x + -(R a) equals x + R b but for the sign of
+ * a zero coordinate where x has a -0 (a zero coordinate of b_body may be
+ * +0 where -a_body's is -0, which changes only the signs of zero terms);
+ * docs/performance.md, "Session 17, hexapods".  (Written as one select
+ * of R b, which GCC compiles to fewer instructions around a sphere's
+ * early return than two stores on two paths.) */
 CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd_vec3 *a, cd_vec3 *b)
 {
     cd_int r = cd_prim_arm_of(c, i);
@@ -98,9 +100,9 @@ CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd
     }
     cd_vec3 ea = c.arm[r].a_body, eb = c.arm[r].b_body; /* [m] */
     cd_vec3 ra = cd_q_rotate(o, ea);
+    cd_vec3 rb = eb.x == -ea.x && eb.y == -ea.y && eb.z == -ea.z ? cd_v3_neg(ra) : cd_q_rotate(o, eb);
     *a = cd_v3_add(x, ra);
-    if (eb.x == -ea.x && eb.y == -ea.y && eb.z == -ea.z) *b = cd_v3_sub(x, ra);
-    else *b = cd_rigid_to_world(x, o, eb);
+    *b = cd_v3_add(x, rb);
 }
 
 /* Primitive i's world ends a, b into its columns (end b: its arm's, where

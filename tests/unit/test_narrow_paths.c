@@ -200,7 +200,7 @@ static void test_arm_pair_contact_equals_general_path(void **state)
 
 /* An arm through its body's centre (b_body = -a_body, the zero
  * coordinates +0 in both, as src/shapes/shapes.c makes them): its end b
- * from the one rotation of a (x - R a, cd_prim_ends_at) has the bits of
+ * from the one rotation of a (x + -(R a), cd_prim_ends_at) has the bits of
  * the rotation of b (x + R b), for random orientations, centres (with +0
  * coordinates among them) and arms along a body axis or in any direction. */
 static void test_symmetric_arm_one_rotation(void **state)
@@ -221,7 +221,7 @@ static void test_symmetric_arm_one_rotation(void **state)
             b_body = cd_v3_neg(a_body);
         }
         cd_vec3 want = cd_v3_add(x, cd_q_rotate(o, b_body));
-        cd_vec3 got = cd_v3_sub(x, cd_q_rotate(o, a_body));
+        cd_vec3 got = cd_v3_add(x, cd_v3_neg(cd_q_rotate(o, a_body)));
         assert_memory_equal(&got, &want, sizeof got);
     }
 }
