@@ -34,6 +34,38 @@
 
 CD_DEVICE_BEGIN
 
+/* cd_segseg_closest for two axes of non-zero length (a = |d1|^2 > 0, e =
+ * |d2|^2 > 0 [m^2]) with d1 = p1 - p0, d2 = q1 - q0, w = q0 - p0 [m] and
+ * m = d1 x d2, m2 = |m|^2 [m^4] at hand (the pair pass has them already,
+ * cd_pair_narrow): steps 1-3 of cd_segseg_closest. */
+CD_INLINE void cd_segseg_closest_axes(cd_vec3 p0, cd_vec3 q0, cd_vec3 q1, cd_vec3 d1, cd_vec3 d2, cd_vec3 w, cd_real a,
+                                      cd_real e, cd_vec3 m, cd_real m2, cd_real *s, cd_real *t)
+{
+    cd_real ss, tt;
+    if (m2 > CD_SEGSEG_PARALLEL_SIN2 * a * e) {
+        ss = cd_v3_dot(cd_v3_cross(w, d2), m) / m2;
+    } else {
+        cd_real u0 = cd_v3_dot(w, d1) / a;
+        cd_real u1 = cd_v3_dot(cd_v3_sub(q1, p0), d1) / a;
+        cd_real lo = u0 < u1 ? u0 : u1;
+        cd_real hi = u0 < u1 ? u1 : u0;
+        lo = lo > CD_R(0) ? lo : CD_R(0);
+        hi = hi < CD_R(1) ? hi : CD_R(1);
+        ss = CD_R(0.5) * (lo + hi);
+    }
+    ss = cd_clamp01(ss);
+    tt = cd_v3_dot(cd_v3_sub(cd_v3_axpy(p0, ss, d1), q0), d2) / e;
+    if (tt < CD_R(0)) {
+        tt = CD_R(0);
+        ss = cd_clamp01(cd_v3_dot(w, d1) / a);
+    } else if (tt > CD_R(1)) {
+        tt = CD_R(1);
+        ss = cd_clamp01(cd_v3_dot(cd_v3_sub(q1, p0), d1) / a);
+    }
+    *s = ss;
+    *t = tt;
+}
+
 /* Closest points of two segments (docs/references.md, Contacts, narrow phase).
  * Inputs: end points p0, p1 of segment i and q0, q1 of segment j [m].
  * Outputs: *s, *t in [0, 1] [1], parameters of a closest pair P(s), Q(t).
@@ -78,27 +110,7 @@ CD_INLINE void cd_segseg_closest(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1,
         ss = cd_clamp01(cd_v3_dot(w, d1) / a);
     } else {
         cd_vec3 m = cd_v3_cross(d1, d2);
-        cd_real m2 = cd_v3_dot(m, m); /* a e sin^2(angle) [m^4] */
-        if (m2 > CD_SEGSEG_PARALLEL_SIN2 * a * e) {
-            ss = cd_v3_dot(cd_v3_cross(w, d2), m) / m2;
-        } else {
-            cd_real u0 = cd_v3_dot(w, d1) / a;
-            cd_real u1 = cd_v3_dot(cd_v3_sub(q1, p0), d1) / a;
-            cd_real lo = u0 < u1 ? u0 : u1;
-            cd_real hi = u0 < u1 ? u1 : u0;
-            lo = lo > CD_R(0) ? lo : CD_R(0);
-            hi = hi < CD_R(1) ? hi : CD_R(1);
-            ss = CD_R(0.5) * (lo + hi);
-        }
-        ss = cd_clamp01(ss);
-        tt = cd_v3_dot(cd_v3_sub(cd_v3_axpy(p0, ss, d1), q0), d2) / e;
-        if (tt < CD_R(0)) {
-            tt = CD_R(0);
-            ss = cd_clamp01(cd_v3_dot(w, d1) / a);
-        } else if (tt > CD_R(1)) {
-            tt = CD_R(1);
-            ss = cd_clamp01(cd_v3_dot(cd_v3_sub(q1, p0), d1) / a);
-        }
+        cd_segseg_closest_axes(p0, q0, q1, d1, d2, w, a, e, m, cd_v3_dot(m, m), &ss, &tt);
     }
     *s = ss;
     *t = tt;
@@ -257,6 +269,33 @@ CD_INLINE void cd_segseg_contact_closest(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_
     g->parallel = 0;
 }
 
+/* The parallel rule's part of cd_segseg_contact_at for two axes of
+ * non-zero length (aa = |d1|^2, ee = |d2|^2 > 0 [m^2]) whose rule weight
+ * wpar (cd_parallel_weight) is > 0: g->point moves to (or towards) the
+ * middle of the overlapping section. */
+CD_INLINE void cd_segseg_parallel_point(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1, cd_vec3 d1, cd_vec3 d2,
+                                        cd_real aa, cd_real ee, cd_real wpar, cd_contact_geom *g)
+{
+    /* section of axis i covered by j, and of axis j covered by i */
+    cd_real u0 = cd_v3_dot(cd_v3_sub(q0, p0), d1) / aa;
+    cd_real u1 = cd_v3_dot(cd_v3_sub(q1, p0), d1) / aa;
+    cd_real v0 = cd_v3_dot(cd_v3_sub(p0, q0), d2) / ee;
+    cd_real v1 = cd_v3_dot(cd_v3_sub(p1, q0), d2) / ee;
+    cd_real loi = u0 < u1 ? u0 : u1, hii = u0 < u1 ? u1 : u0;
+    cd_real loj = v0 < v1 ? v0 : v1, hij = v0 < v1 ? v1 : v0;
+    loi = loi > CD_R(0) ? loi : CD_R(0);
+    hii = hii < CD_R(1) ? hii : CD_R(1);
+    loj = loj > CD_R(0) ? loj : CD_R(0);
+    hij = hij < CD_R(1) ? hij : CD_R(1);
+    if (loi <= hii && loj <= hij) {
+        cd_vec3 A = cd_v3_axpy(p0, CD_R(0.5) * (loi + hii), d1);
+        cd_vec3 B = cd_v3_axpy(q0, CD_R(0.5) * (loj + hij), d2);
+        cd_vec3 mid = cd_v3_scale(cd_v3_add(A, B), CD_R(0.5));
+        g->parallel = wpar == CD_R(1);
+        g->point = g->parallel ? mid : cd_v3_lerp(g->point, mid, wpar);
+    }
+}
+
 CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj, cd_real s,
                                     cd_real t, cd_real sin_parallel, cd_int blend, cd_contact_geom *g)
 {
@@ -269,26 +308,7 @@ CD_INLINE void cd_segseg_contact_at(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 
         cd_vec3 m = cd_v3_cross(d1, d2);
         cd_real wpar =
             aa > CD_R(0) && ee > CD_R(0) ? cd_parallel_weight(cd_v3_dot(m, m), aa * ee, sin_parallel, blend) : CD_R(0);
-        if (wpar > CD_R(0)) {
-            /* section of axis i covered by j, and of axis j covered by i */
-            cd_real u0 = cd_v3_dot(cd_v3_sub(q0, p0), d1) / aa;
-            cd_real u1 = cd_v3_dot(cd_v3_sub(q1, p0), d1) / aa;
-            cd_real v0 = cd_v3_dot(cd_v3_sub(p0, q0), d2) / ee;
-            cd_real v1 = cd_v3_dot(cd_v3_sub(p1, q0), d2) / ee;
-            cd_real loi = u0 < u1 ? u0 : u1, hii = u0 < u1 ? u1 : u0;
-            cd_real loj = v0 < v1 ? v0 : v1, hij = v0 < v1 ? v1 : v0;
-            loi = loi > CD_R(0) ? loi : CD_R(0);
-            hii = hii < CD_R(1) ? hii : CD_R(1);
-            loj = loj > CD_R(0) ? loj : CD_R(0);
-            hij = hij < CD_R(1) ? hij : CD_R(1);
-            if (loi <= hii && loj <= hij) {
-                cd_vec3 A = cd_v3_axpy(p0, CD_R(0.5) * (loi + hii), d1);
-                cd_vec3 B = cd_v3_axpy(q0, CD_R(0.5) * (loj + hij), d2);
-                cd_vec3 mid = cd_v3_scale(cd_v3_add(A, B), CD_R(0.5));
-                g->parallel = wpar == CD_R(1);
-                g->point = g->parallel ? mid : cd_v3_lerp(g->point, mid, wpar);
-            }
-        }
+        if (wpar > CD_R(0)) cd_segseg_parallel_point(p0, p1, q0, q1, d1, d2, aa, ee, wpar, g);
     }
 }
 
@@ -350,6 +370,30 @@ CD_INLINE int cd_segseg_clearly_apart(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec
     cd_vec3 ab = cd_v3_sub(b, a);
     cd_real reach = ri + rj; /* [m] */
     return cd_v3_dot(ab, ab) > reach * reach * CD_R(1.000000001);
+}
+
+/* The narrow phase of two arms (axes of non-zero length: a = |p1 - p0|^2
+ * > 0 and e = |q1 - q0|^2 > 0 [m^2], with d1 = p1 - p0 and d2 = q1 - q0
+ * [m] at hand): cd_segseg_closest's branch for two segments,
+ * cd_segseg_clearly_apart and cd_segseg_contact_at with the same
+ * operations on the same values, so the same bits; the axes' cross
+ * product and the squared lengths are formed once for the closest points
+ * and the parallel rule.  Returns 1 when the two are clearly apart (g is
+ * then not filled), 0 after filling g. */
+CD_INLINE int cd_segseg_axes_contact(cd_vec3 p0, cd_vec3 p1, cd_real ri, cd_vec3 q0, cd_vec3 q1, cd_real rj, cd_vec3 d1,
+                                     cd_vec3 d2, cd_real a, cd_real e, cd_real sin_parallel, cd_int blend,
+                                     cd_contact_geom *g)
+{
+    cd_vec3 m = cd_v3_cross(d1, d2);
+    cd_real m2 = cd_v3_dot(m, m), s, t; /* [m^4], [1], [1] */
+    cd_segseg_closest_axes(p0, q0, q1, d1, d2, cd_v3_sub(q0, p0), a, e, m, m2, &s, &t);
+    if (cd_segseg_clearly_apart(p0, p1, ri, q0, q1, rj, s, t)) return 1;
+    cd_segseg_contact_closest(p0, p1, ri, q0, q1, rj, s, t, g);
+    if (sin_parallel > CD_R(0)) {
+        cd_real wpar = cd_parallel_weight(m2, a * e, sin_parallel, blend);
+        if (wpar > CD_R(0)) cd_segseg_parallel_point(p0, p1, q0, q1, d1, d2, a, e, wpar, g);
+    }
+    return 0;
 }
 
 /* The narrow phase of a point and a segment (a sphere and an arm: p0 ==

@@ -80,7 +80,16 @@ CD_INLINE cd_wall cd_wall_advanced(cd_wall w, cd_real dt)
  * body-frame ends at the body origin) has both ends at x: the rotation of
  * a zero vector is a zero, and x plus a zero is x (but for the sign of a
  * zero coordinate of x), so the two rotations are skipped
- * (docs/performance.md, "The sphere step"). */
+ * (docs/performance.md, "The sphere step").  An arm through the body's
+ * centre (b_body = -a_body, every arm of the named shapes: rods, crosses,
+ * hexapods) is rotated once: the rotation (cd_q_rotate) of -v is minus
+ * the rotation of v, operation by operation (negation commutes with
+ * rounding to nearest), so x + -(R a) equals x + R b but for the sign of
+ * a zero coordinate where x has a -0 (a zero coordinate of b_body may be
+ * +0 where -a_body's is -0, which changes only the signs of zero terms);
+ * docs/performance.md, "Session 17, hexapods".  (Written as one select
+ * of R b, which GCC compiles to fewer instructions around a sphere's
+ * early return than two stores on two paths.) */
 CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd_vec3 *a, cd_vec3 *b)
 {
     cd_int r = cd_prim_arm_of(c, i);
@@ -89,8 +98,11 @@ CD_INLINE void cd_prim_ends_at(cd_cols c, cd_prim_id i, cd_vec3 x, cd_quat o, cd
         *b = x;
         return;
     }
-    *a = cd_rigid_to_world(x, o, c.arm[r].a_body);
-    *b = cd_rigid_to_world(x, o, c.arm[r].b_body);
+    cd_vec3 ea = c.arm[r].a_body, eb = c.arm[r].b_body; /* [m] */
+    cd_vec3 ra = cd_q_rotate(o, ea);
+    cd_vec3 rb = eb.x == -ea.x && eb.y == -ea.y && eb.z == -ea.z ? cd_v3_neg(ra) : cd_q_rotate(o, eb);
+    *a = cd_v3_add(x, ra);
+    *b = cd_v3_add(x, rb);
 }
 
 /* Primitive i's world ends a, b into its columns (end b: its arm's, where
@@ -316,6 +328,12 @@ CD_INLINE_ALWAYS int cd_pair_narrow(cd_cols c, cd_prim_id i, cd_prim_id j, cd_re
         cd_vec3 ai, bi, aj, bj;
         cd_prim_world_ends(c, i, &ai, &bi);
         cd_prim_world_ends(c, j, &aj, &bj);
+        cd_vec3 d1 = cd_v3_sub(bi, ai), d2 = cd_v3_sub(bj, aj);
+        cd_real a = cd_v3_dot(d1, d1), e = cd_v3_dot(d2, d2); /* [m^2] */
+        if (a > CD_R(0) && e > CD_R(0)) {
+            /* two arms (neither is a point: bi - ai is not zero) */
+            return cd_segseg_axes_contact(ai, bi, ri, aj, bj, rj, d1, d2, a, e, sin_parallel, parallel_blend, g);
+        }
         int point_i = cd_segseg_is_point(ai, bi), point_j = cd_segseg_is_point(aj, bj);
         if (point_i && point_j) {
             /* two points (balls with an arm of zero length): the same

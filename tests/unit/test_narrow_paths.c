@@ -1,8 +1,9 @@
 /* The specialised narrow phases of the pair kernel (kernels/segseg.h):
- * sphere-sphere (cd_segseg_point_contact) and sphere-arm
- * (cd_segseg_point_segment_contact) give the bits of the general
- * segment-segment path on random pairs, so choosing one per row changes
- * no trajectory. */
+ * sphere-sphere (cd_segseg_point_contact), sphere-arm
+ * (cd_segseg_point_segment_contact) and arm-arm (cd_segseg_axes_contact)
+ * give the bits of the general segment-segment path on random pairs, so
+ * choosing one per row changes no trajectory; an arm through its body's
+ * centre rotated once (cd_prim_ends_at) gives the ends of two rotations. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -13,6 +14,7 @@
 #include <string.h>
 
 #include "segseg.h"
+#include "quat.h"
 #include "unit/segseg_rng.h"
 
 /* The general path of the pair kernel (closest points, pre-test, contact
@@ -98,11 +100,139 @@ static void test_point_segment_contact_equals_general_path(void **state)
     assert_true(overlapping > 1000 && ends > 100);
 }
 
+/* cd_segseg_closest as it was before session 17 split out its
+ * segment-segment part (cd_segseg_closest_axes), kept here verbatim as the
+ * reference of the bits. */
+static void reference_closest(cd_vec3 p0, cd_vec3 p1, cd_vec3 q0, cd_vec3 q1, double *s, double *t)
+{
+    cd_vec3 d1 = cd_v3_sub(p1, p0), d2 = cd_v3_sub(q1, q0), w = cd_v3_sub(q0, p0);
+    double a = cd_v3_dot(d1, d1), e = cd_v3_dot(d2, d2), ss, tt;
+    if (a <= 0 && e <= 0) {
+        ss = 0;
+        tt = 0;
+    } else if (a <= 0) {
+        ss = 0;
+        tt = cd_clamp01(-cd_v3_dot(w, d2) / e);
+    } else if (e <= 0) {
+        tt = 0;
+        ss = cd_clamp01(cd_v3_dot(w, d1) / a);
+    } else {
+        cd_vec3 m = cd_v3_cross(d1, d2);
+        double m2 = cd_v3_dot(m, m);
+        if (m2 > CD_SEGSEG_PARALLEL_SIN2 * a * e) {
+            ss = cd_v3_dot(cd_v3_cross(w, d2), m) / m2;
+        } else {
+            double u0 = cd_v3_dot(w, d1) / a, u1 = cd_v3_dot(cd_v3_sub(q1, p0), d1) / a;
+            double lo = u0 < u1 ? u0 : u1, hi = u0 < u1 ? u1 : u0;
+            lo = lo > 0 ? lo : 0;
+            hi = hi < 1 ? hi : 1;
+            ss = 0.5 * (lo + hi);
+        }
+        ss = cd_clamp01(ss);
+        tt = cd_v3_dot(cd_v3_sub(cd_v3_axpy(p0, ss, d1), q0), d2) / e;
+        if (tt < 0) {
+            tt = 0;
+            ss = cd_clamp01(cd_v3_dot(w, d1) / a);
+        } else if (tt > 1) {
+            tt = 1;
+            ss = cd_clamp01(cd_v3_dot(cd_v3_sub(q1, p0), d1) / a);
+        }
+    }
+    *s = ss;
+    *t = tt;
+}
+
+/* Two arms (axes of non-zero length): cd_segseg_closest gives the bits of
+ * the reference, and the arm-arm path of the pair kernel
+ * (cd_segseg_axes_contact: the cross product and squared lengths formed
+ * once) the bits of the general path on the reference's closest points,
+ * for random pairs apart, touching and overlapping, crossing axes (the
+ * touch normal), nearly parallel ones (the blended parallel rule: inside
+ * the cut-off, on the ramp and exactly parallel) and closest points at
+ * the ends and inside. */
+static void test_arm_pair_contact_equals_general_path(void **state)
+{
+    (void)state;
+    double sp = sin(2.0 * CD_PI / 180.0);
+    int overlapping = 0, parallel = 0, ramp = 0, inside = 0, ends = 0;
+    rng_state = 31337;
+    for (int k = 0; k < 60000; k++) {
+        cd_vec3 p0 = rng_vec(0.01), p1 = cd_v3_add(p0, rng_vec(0.008));
+        cd_vec3 q0 = cd_v3_add(p0, rng_vec(0.008)), q1 = cd_v3_add(q0, rng_vec(0.008));
+        cd_vec3 d1 = cd_v3_sub(p1, p0);
+        if (k % 5 == 1) q1 = cd_v3_add(q0, cd_v3_scale(d1, -0.7)); /* exactly parallel (antiparallel) */
+        if (k % 5 == 2) {                                          /* nearly parallel: up to 4 sp */
+            cd_vec3 n = cd_v3_cross(d1, rng_vec(1.0));
+            double dn = sqrt(cd_v3_dot(n, n)), l1 = sqrt(cd_v3_dot(d1, d1));
+            q1 = cd_v3_add(q0, cd_v3_add(cd_v3_scale(d1, 0.9), cd_v3_scale(n, 4.0 * sp * rng_u() * 0.9 * l1 / dn)));
+        }
+        if (k % 97 == 0) { /* crossing axes: the closest points coincide */
+            cd_vec3 mid = cd_v3_lerp(p0, p1, 0.4);
+            q0 = cd_v3_sub(mid, cd_v3_scale(cd_v3_sub(q1, q0), 0.5));
+            q1 = cd_v3_add(q0, cd_v3_scale(cd_v3_sub(mid, q0), 2.0));
+        }
+        double ri = 0.001 + 0.002 * rng_u(), rj = 0.001 + 0.002 * rng_u();
+        double s, t, rs, rt;
+        cd_segseg_closest(p0, p1, q0, q1, &s, &t);
+        reference_closest(p0, p1, q0, q1, &rs, &rt);
+        assert_memory_equal(&s, &rs, sizeof s);
+        assert_memory_equal(&t, &rt, sizeof t);
+        cd_contact_geom want, got;
+        memset(&want, 0, sizeof want);
+        memset(&got, 0, sizeof got);
+        int apart = cd_segseg_clearly_apart(p0, p1, ri, q0, q1, rj, rs, rt);
+        if (!apart) cd_segseg_contact_at(p0, p1, ri, q0, q1, rj, rs, rt, sp, 1, &want);
+        cd_vec3 d2 = cd_v3_sub(q1, q0);
+        double a = cd_v3_dot(d1, d1), e = cd_v3_dot(d2, d2);
+        assert_int_equal(cd_segseg_axes_contact(p0, p1, ri, q0, q1, rj, d1, d2, a, e, sp, 1, &got), apart);
+        if (apart) continue;
+        overlapping += want.overlap > 0;
+        parallel += want.parallel;
+        cd_vec3 m = cd_v3_cross(d1, d2);
+        double w = cd_parallel_weight(cd_v3_dot(m, m), a * e, sp, 1);
+        ramp += w > 0 && w < 1;
+        inside += rs > 0 && rs < 1 && rt > 0 && rt < 1;
+        ends += !(rs > 0 && rs < 1 && rt > 0 && rt < 1);
+        assert_same_geometry(&got, &want);
+    }
+    assert_true(overlapping > 1000 && parallel > 100 && ramp > 100 && inside > 100 && ends > 1000);
+}
+
+/* An arm through its body's centre (b_body = -a_body, the zero
+ * coordinates +0 in both, as src/shapes/shapes.c makes them): its end b
+ * from the one rotation of a (x + -(R a), cd_prim_ends_at) has the bits of
+ * the rotation of b (x + R b), for random orientations, centres (with +0
+ * coordinates among them) and arms along a body axis or in any direction. */
+static void test_symmetric_arm_one_rotation(void **state)
+{
+    (void)state;
+    rng_state = 2718;
+    for (int k = 0; k < 100000; k++) {
+        cd_quat o = cd_q_normalize(cd_q(rng_sym(), rng_sym(), rng_sym(), rng_sym()));
+        if (k % 7 == 0) o = cd_q_normalize(cd_q(rng_sym(), 0.0, 0.0, rng_sym())); /* about z (2D) */
+        cd_vec3 x = rng_vec(0.1);
+        if (k % 11 == 0) x.z = 0.0;
+        double h = 0.01 * rng_u(), ea[3] = {0, 0, 0}, eb[3] = {0, 0, 0};
+        ea[k % 3] = -h;
+        eb[k % 3] = h;
+        cd_vec3 a_body = cd_v3(ea[0], ea[1], ea[2]), b_body = cd_v3(eb[0], eb[1], eb[2]);
+        if (k % 4 == 3) {
+            a_body = rng_vec(0.01);
+            b_body = cd_v3_neg(a_body);
+        }
+        cd_vec3 want = cd_v3_add(x, cd_q_rotate(o, b_body));
+        cd_vec3 got = cd_v3_add(x, cd_v3_neg(cd_q_rotate(o, a_body)));
+        assert_memory_equal(&got, &want, sizeof got);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_contact_equals_general_path),
         cmocka_unit_test(test_point_segment_contact_equals_general_path),
+        cmocka_unit_test(test_arm_pair_contact_equals_general_path),
+        cmocka_unit_test(test_symmetric_arm_one_rotation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
