@@ -73,9 +73,10 @@ static void net_motion(const double *rows, size_t n, cd_vec3 centre, double out[
         double A[3][3];
         memcpy(A, I, sizeof A);
         for (int a = 0; a < 3; a++) A[a][c] = L[a];
-        out[3 + c] = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) -
-                      A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) + A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) /
-                     det;
+        out[3 + c] =
+            (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+             A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) /
+            det;
     }
     out[6] = 1;
 }
@@ -98,7 +99,8 @@ static int remove_net_motion(cd_sim *sim, cd_vec3 centre, char *err, size_t errl
     cd_vec3 vcm = cd_v3(motion[0], motion[1], motion[2]), omega = cd_v3(motion[3], motion[4], motion[5]);
     for (size_t q = 0; q < s->n_particles; q++) {
         s->velocity[q] = cd_v3_sub(s->velocity[q], vcm);
-        if (motion[6]) s->velocity[q] = cd_v3_sub(s->velocity[q], cd_v3_cross(omega, cd_v3_sub(s->position[q], centre)));
+        if (motion[6])
+            s->velocity[q] = cd_v3_sub(s->velocity[q], cd_v3_cross(omega, cd_v3_sub(s->position[q], centre)));
     }
     return 0;
 }

@@ -33,7 +33,7 @@ static int remove_axial_rotation(cd_sim *sim, char *err, size_t errlen)
     double *rows, w[2] = {0, 0}; /* the rotation [1/s], and 1 where it is defined */
     size_t n;
     if (cd_proto_motion_rows(sim, &rows, &n, err, errlen)) return -1;
-    if (rows) { /* the sums in particle order: the serial bits at any MPI rank count */
+    if (rows) {              /* the sums in particle order: the serial bits at any MPI rank count */
         double L = 0, I = 0; /* [kg m^2/s], [kg m^2] */
         for (size_t q = 0; q < n; q++) {
             const double *row = rows + q * CD_MOTION_WIDTH, m = row[CD_MOTION_MASS];
