@@ -9,6 +9,8 @@
 #define CD_GROUP_OF_PARTICLE CD_GROUP_PARTICLE
 #define CD_GROUP_OF_PRIM     CD_GROUP_PRIM
 #define CD_GROUP_OF_PAIR     CD_GROUP_PAIR
+/* PARTICLE_HOST: rows of PARTICLE on the host; no device holds them. */
+#define CD_GROUP_OF_PARTICLE_HOST CD_GROUP_PARTICLE
 /* PRIM_ARM: rows of PRIM on the host; a device holds them per arm (cd_arm,
  * cd_state_arms_derive below). */
 #define CD_GROUP_OF_PRIM_ARM CD_GROUP_PRIM

@@ -329,6 +329,9 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
     for (size_t f = 0; f < cd_n_fields; f++) {
         enum cd_field_group grp = cd_fields[f].group;
         if (grp == CD_GROUP_PAIR_OUT) continue;
+        /* the particles' host-only columns (fields.def, PARTICLE_HOST):
+         * no step moves them, so they are in user order always */
+        if (grp == CD_GROUP_PARTICLE && !cd_fields[f].on_device) continue;
         const cd_int *map = grp == CD_GROUP_PARTICLE ? part : grp == CD_GROUP_PAIR ? pair : prim;
         size_t rows = cd_state_rows(s, grp), stride = grp == CD_GROUP_WALLC ? s->n_walls : 1;
         cd_long n = (cd_long)(stride * cd_fields[f].elem_size / sizeof(cd_int));
