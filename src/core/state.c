@@ -201,17 +201,23 @@ static int inertia_derive(cd_state *s)
     size_t N = s->n_particles;
     int iso = 1;
     for (size_t q = 0; q < N && iso; q++) iso = cd_rigid_isotropic(s->inertia[q]);
-    free(s->step_inertia);
-    free(s->inertia_iso);
-    s->step_inertia = NULL;
-    s->inertia_iso = NULL;
+    /* realloc, as for the arms: a state derived again with the same
+     * particles keeps its arrays (and an offload mapping of them) */
     if (iso) {
-        if (!(s->inertia_iso = malloc((N + 1) * sizeof *s->inertia_iso))) return -1;
-        for (size_t q = 0; q < N; q++) s->inertia_iso[q] = s->inertia[q].x;
+        free(s->step_inertia);
+        s->step_inertia = NULL;
+        cd_real *one = realloc(s->inertia_iso, (N + 1) * sizeof *one);
+        if (!one) return -1;
+        s->inertia_iso = one;
+        for (size_t q = 0; q < N; q++) one[q] = s->inertia[q].x;
         return 0;
     }
-    if (!(s->step_inertia = malloc((N + 1) * sizeof *s->step_inertia))) return -1;
-    memcpy(s->step_inertia, s->inertia, N * sizeof *s->step_inertia);
+    free(s->inertia_iso);
+    s->inertia_iso = NULL;
+    cd_vec3 *three = realloc(s->step_inertia, (N + 1) * sizeof *three);
+    if (!three) return -1;
+    s->step_inertia = three;
+    memcpy(three, s->inertia, N * sizeof *three);
     return 0;
 }
 
