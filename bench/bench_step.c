@@ -78,6 +78,9 @@ static size_t state_bytes(const cd_sim *sim)
     }
     /* the primitives' arm indices and arms (kernels/cols.h) */
     b += (cd_state_arms_all(&sim->s) ? 0 : sim->s.n_prims * sizeof(cd_int)) + sim->s.n_arms * sizeof(cd_arm);
+    /* the step's inertia (kernels/cols.h, cd_inertia_of): one value a
+     * particle where every particle is isotropic, else three */
+    b += sim->s.n_particles * (sim->s.inertia_iso ? sizeof(cd_real) : sizeof(cd_vec3));
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->nb.cap_rows * sizeof(cd_pair_id);
     /* the wall candidates: CSR starts, rows and their entries (cd_wall_entry:
      * history and outputs); the build before's, which only a build's

@@ -45,13 +45,17 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * end a at the last build (24), an arm's b too (24); its world ends from
      * the pose: an arm's body-frame ends (48). */
     double idx = cd_state_arms_all(s) ? 0 : 4;
+    /* The moments of inertia a pass reads: one value a particle where
+     * every particle is isotropic (cd_inertia_of, kernels/cols.h: 16 B
+     * less than the three counted below) */
+    double iso = s->inertia_iso ? 16 : 0;
     double ends = P * (24 + idx) + Arms * 24, advance_prims = P * (idx + 24) + Arms * (48 + 24);
     double advance_writes = P * 24 + Arms * 24;
     /* advance (cd_item_advance: kick, drift, primitive ends, skin test):
      * reads v, L, F, T, x (24 each), m (8), q (32), I (24) and per primitive
      * advance_prims; writes x, q, v, L, omega and the primitives' world
      * ends (advance_writes). */
-    cd_traffic advance = {"advance", N * 184 + advance_prims, N * 128 + advance_writes};
+    cd_traffic advance = {"advance", N * (184 - iso) + advance_prims, N * 128 + advance_writes};
     /* CD_ENDS_FROM_POSE (the offload variants, step_items.h): no world ends
      * written and no primitive read by the skin test, which reads the pose
      * at the last build (64 B a particle) and its primitives only when its
@@ -59,7 +63,7 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * that use the ends read the particle's orientation (32) besides an
      * arm's body-frame ends (48) in place of the world ends (end a and an
      * arm's b). */
-    if (CD_ENDS_FROM_POSE) advance = (cd_traffic){"advance", N * (184 + 64), N * 128};
+    if (CD_ENDS_FROM_POSE) advance = (cd_traffic){"advance", N * (184 - iso + 64), N * 128};
     double pose = CD_ENDS_FROM_POSE ? 32 : 0; /* the orientation, per particle a pass reads */
     if (CD_ENDS_FROM_POSE) ends = P * idx + Arms * 48;
     /* cd_item_pair_force: every row its primitives and flag (12); the
@@ -97,13 +101,13 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * and F, T (48) at the last step of a call only.  The advance of its
      * own runs once per call of the step. */
     double force_writes = N * 48 / steps_per_call;
-    out[2] = (cd_traffic){"gather_kick_advance", N * 152 + advance_prims + gather_rows,
+    out[2] = (cd_traffic){"gather_kick_advance", N * (152 - iso) + advance_prims + gather_rows,
                           N * 128 + force_writes + advance_writes};
     /* with CD_ENDS_FROM_POSE: the pose at the build (64) instead of the
      * primitive range and the primitives' ends (8 + advance_prims), no ends
      * written */
     if (CD_ENDS_FROM_POSE)
-        out[2] = (cd_traffic){"gather_kick_advance", N * (144 + 64) + gather_rows, N * 128 + force_writes};
+        out[2] = (cd_traffic){"gather_kick_advance", N * (144 - iso + 64) + gather_rows, N * 128 + force_writes};
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};

@@ -9,6 +9,7 @@
 #define CD_COLS_H
 #include "defs.h"
 #include "geom_types.h"
+#include "vec3.h"
 #include "field_groups.h"
 
 /* A column of ctype is a cd_col_<ctype>: a pointer known to be aligned as
@@ -33,6 +34,12 @@ typedef struct {
 #undef CD_FIELD
     cd_col_cd_int prim_arm;
     cd_col_cd_arm arm;
+    /* The particles' principal moments of inertia [kg m^2] (the host's
+     * column inertia, kernels/fields.def), as the step holds them: null
+     * inertia where every particle is isotropic, and then one value a
+     * particle in inertia_iso (16 B a sphere less; cd_inertia_of). */
+    cd_col_cd_vec3 inertia;
+    cd_col_cd_real inertia_iso;
 } cd_cols;
 
 CD_DEVICE_BEGIN
@@ -51,6 +58,17 @@ CD_INLINE int cd_ends_at_origin(cd_vec3 a, cd_vec3 b)
  * column is neither held nor read; the test is the same for every item,
  * so it does not diverge on a GPU). */
 CD_INLINE cd_int cd_prim_arm_of(cd_cols c, cd_prim_id i) { return c.prim_arm ? c.prim_arm[i] : i; }
+
+/* Principal moments of inertia of particle q [kg m^2]: its row of
+ * inertia, or where that is null (every particle isotropic) its one value
+ * three times, the three equal values the host's row holds (the same
+ * bits).  The test is the same for every item (no divergence on a GPU). */
+CD_INLINE cd_vec3 cd_inertia_of(cd_cols c, cd_particle_id q)
+{
+    if (c.inertia) return c.inertia[q];
+    cd_real I = c.inertia_iso[q];
+    return cd_v3(I, I, I);
+}
 
 /* World axis end b of primitive i [m]: its arm's, or prim_a[i] for a ball
  * without one (both ends at the particle's centre: the same value the

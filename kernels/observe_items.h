@@ -118,7 +118,7 @@ CD_INLINE void cd_obs_block_particles(cd_cols c, cd_long b, cd_long n, cd_vec3 g
         cd_vec3 v = c.velocity[q];
         cd_real m = c.mass[q];
         cd_real kt = CD_R(0.5) * m * cd_v3_norm2(v),
-                kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], c.inertia[q]);
+                kr = cd_rigid_rot_energy(c.orientation[q], c.angmom[q], cd_inertia_of(c, q));
         sum_kt += kt;
         sum_kr += kr;
         if (touch[q]) sum_kc += kt + kr;

@@ -52,7 +52,7 @@ CD_INLINE void cd_item_kick(cd_cols c, cd_particle_id q, cd_real h)
     cd_rigid_kick(&v, &L, c.force[q], c.torque[q], c.mass[q], h);
     c.velocity[q] = v;
     c.angmom[q] = L;
-    c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, c.inertia[q]);
+    c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, cd_inertia_of(c, q));
 }
 
 /* Drift of particle q over dt [s]: position and free rotation (docs/references.md, Motion). */
@@ -60,7 +60,7 @@ CD_INLINE void cd_item_drift(cd_cols c, cd_particle_id q, cd_real dt)
 {
     cd_vec3 x = c.position[q], w;
     cd_quat o = c.orientation[q];
-    cd_rigid_drift_angvel(&x, &o, &w, c.velocity[q], c.angmom[q], c.inertia[q], dt);
+    cd_rigid_drift_angvel(&x, &o, &w, c.velocity[q], c.angmom[q], cd_inertia_of(c, q), dt);
     c.position[q] = x;
     c.orientation[q] = o;
     c.angvel[q] = w;
@@ -257,7 +257,7 @@ CD_INLINE_ALWAYS int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_
     cd_vec3 x = c.position[q], w;
     cd_quat o = c.orientation[q];
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
-    cd_rigid_drift_angvel(&x, &o, &w, v, L, c.inertia[q], dt);
+    cd_rigid_drift_angvel(&x, &o, &w, v, L, cd_inertia_of(c, q), dt);
     c.velocity[q] = v;
     c.angmom[q] = L;
     c.position[q] = x;
@@ -630,7 +630,7 @@ CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, co
     if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2, ref_pose);
     c.velocity[q] = v;
     c.angmom[q] = L;
-    c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, c.inertia[q]);
+    c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, cd_inertia_of(c, q));
     return 0;
 }
 

@@ -6,3 +6,5 @@ cd_cols c;
 #undef CD_FIELD
 c.prim_arm = prim_arm;
 c.arm = arm;
+c.inertia = inertia;
+c.inertia_iso = inertia_iso;

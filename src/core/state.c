@@ -1,6 +1,7 @@
 #include "core/state.h"
 #include "field_groups.h"
 #include "cols.h"
+#include "rigid.h"
 #include "vec3.h"
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +10,8 @@
 #define CD_GROUP_OF_PARTICLE CD_GROUP_PARTICLE
 #define CD_GROUP_OF_PRIM     CD_GROUP_PRIM
 #define CD_GROUP_OF_PAIR     CD_GROUP_PAIR
+/* PARTICLE_HOST: rows of PARTICLE on the host; no device holds them. */
+#define CD_GROUP_OF_PARTICLE_HOST CD_GROUP_PARTICLE
 /* PRIM_ARM: rows of PRIM on the host; a device holds them per arm (cd_arm,
  * cd_state_arms_derive below). */
 #define CD_GROUP_OF_PRIM_ARM CD_GROUP_PRIM
@@ -103,9 +106,30 @@ void cd_state_free(cd_state *s)
     }
     free(s->prim_arm);
     free(s->arm);
+    free(s->step_inertia);
+    free(s->inertia_iso);
     s->prim_arm = NULL;
     s->arm = NULL;
+    s->step_inertia = NULL;
+    s->inertia_iso = NULL;
     s->n_arms = 0;
+}
+
+/* dst's step inertia as src's (dst's own arrays, step_inertia and
+ * inertia_iso, are the ones given: reused or freed). */
+static int copy_inertia(cd_state *dst, const cd_state *src, cd_vec3 *full, cd_real *iso)
+{
+    size_t n = src->n_particles + 1;
+    dst->step_inertia = src->step_inertia ? realloc(full, n * sizeof *full) : (free(full), NULL);
+    if (src->step_inertia && !dst->step_inertia) {
+        dst->inertia_iso = iso;
+        return -1;
+    }
+    dst->inertia_iso = src->inertia_iso ? realloc(iso, n * sizeof *iso) : (free(iso), NULL);
+    if (src->inertia_iso && !dst->inertia_iso) return -1;
+    if (src->step_inertia) memcpy(dst->step_inertia, src->step_inertia, src->n_particles * sizeof *full);
+    if (src->inertia_iso) memcpy(dst->inertia_iso, src->inertia_iso, src->n_particles * sizeof *iso);
+    return 0;
 }
 
 /* dst's arms the size of src's, holding src's (dst's own arrays). */
@@ -147,7 +171,8 @@ int cd_state_copy(cd_state *dst, const cd_state *src)
         memcpy(*slot, *cd_field_ptr((cd_state *)src, &cd_fields[k]),
                cd_state_rows(src, cd_fields[k].group) * cd_fields[k].elem_size);
     }
-    return copy_arms(dst, src, keep.prim_arm, keep.arm);
+    int rc = copy_arms(dst, src, keep.prim_arm, keep.arm);
+    return copy_inertia(dst, src, keep.step_inertia, keep.inertia_iso) || rc ? -1 : 0;
 }
 
 /* A ball's body ends are zeros of either sign (a sphere's a = -0 in the
@@ -167,8 +192,38 @@ static cd_vec3 signed_zeros(cd_int bits)
     return cd_v3(bits & 1 ? -0.0 : 0.0, bits & 2 ? -0.0 : 0.0, bits & 4 ? -0.0 : 0.0);
 }
 
+/* The step's inertia of s from its column inertia (cd_state_arms_derive):
+ * one value a particle where all three of every particle's are equal (==:
+ * an isotropic body, the test the integrator makes, kernels/rigid.h),
+ * else the three. */
+static int inertia_derive(cd_state *s)
+{
+    size_t N = s->n_particles;
+    int iso = 1;
+    for (size_t q = 0; q < N && iso; q++) iso = cd_rigid_isotropic(s->inertia[q]);
+    /* realloc, as for the arms: a state derived again with the same
+     * particles keeps its arrays (and an offload mapping of them) */
+    if (iso) {
+        free(s->step_inertia);
+        s->step_inertia = NULL;
+        cd_real *one = realloc(s->inertia_iso, (N + 1) * sizeof *one);
+        if (!one) return -1;
+        s->inertia_iso = one;
+        for (size_t q = 0; q < N; q++) one[q] = s->inertia[q].x;
+        return 0;
+    }
+    free(s->inertia_iso);
+    s->inertia_iso = NULL;
+    cd_vec3 *three = realloc(s->step_inertia, (N + 1) * sizeof *three);
+    if (!three) return -1;
+    s->step_inertia = three;
+    memcpy(three, s->inertia, N * sizeof *three);
+    return 0;
+}
+
 int cd_state_arms_derive(cd_state *s)
 {
+    if (inertia_derive(s)) return -1;
     size_t P = s->n_prims, n = 0;
     cd_int *pa = realloc(s->prim_arm, (P + 1) * sizeof *pa);
     if (pa) s->prim_arm = pa;

@@ -36,6 +36,12 @@ typedef struct cd_state {
     size_t n_arms;
     cd_int *prim_arm;
     cd_arm *arm;
+    /* The principal moments as the step holds them (kernels/cols.h,
+     * cd_inertia_of), derived with the arms from the host's column
+     * inertia: inertia_iso, one value a particle, where every particle is
+     * isotropic (step_inertia null), else step_inertia, the three. */
+    cd_vec3 *step_inertia;
+    cd_real *inertia_iso;
     cd_wall walls[CD_MAX_WALLS]; /* current wall positions and motion */
     /* State of the protocol driving the run (phase, wall dynamics,
      * convergence checks): doubles saved with every snapshot, so that a
@@ -78,7 +84,9 @@ int cd_state_copy(cd_state *dst, const cd_state *src);
 /* The arms of s (n_arms, prim_arm, arm) anew from its host columns
  * prim_a_body, prim_b_body, prim_b, prim_b_ref: a primitive has an arm
  * unless both its body-frame ends are the body origin (cd_ends_at_origin),
- * in primitive order.  Returns 0, or -1 (out of memory). */
+ * in primitive order; and the step's inertia (step_inertia or
+ * inertia_iso) from the column inertia, in particle order.  Returns 0, or
+ * -1 (out of memory). */
 int cd_state_arms_derive(cd_state *s);
 /* Has every primitive of s an arm, its own row (prim_arm the identity)?
  * Then a device neither holds nor reads prim_arm (kernels/cols.h). */

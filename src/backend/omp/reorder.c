@@ -248,6 +248,10 @@ int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
     if (cd_state_arms_all(s))
         move_rows(sim, (cd_int *)c.arm, (size_t)P, sizeof(cd_arm) / word, sizeof(cd_arm) / word, d.prim_src);
     else move_rows(sim, c.prim_arm, (size_t)P, 1, 1, d.prim_src);
+    /* the step's inertia (kernels/cols.h, cd_inertia_of) with its particles */
+    size_t iw = (s->inertia_iso ? sizeof(cd_real) : sizeof(cd_vec3)) / word;
+    cd_int *inertia = s->inertia_iso ? (cd_int *)c.inertia_iso : s->step_inertia ? (cd_int *)c.inertia : NULL;
+    if (inertia) move_rows(sim, inertia, (size_t)N, iw, iw, d.part_src);
     move_rows(sim, (cd_int *)d.part_bound, (size_t)N, sizeof(cd_real) / word, sizeof(cd_real) / word, d.part_src);
     move_rows(sim, d.part_uid, (size_t)N, 1, 1, d.part_src);
     move_rows(sim, d.prim_uid, (size_t)P, 1, 1, d.prim_src);
@@ -329,6 +333,9 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
     for (size_t f = 0; f < cd_n_fields; f++) {
         enum cd_field_group grp = cd_fields[f].group;
         if (grp == CD_GROUP_PAIR_OUT) continue;
+        /* the particles' host-only columns (fields.def, PARTICLE_HOST):
+         * no step moves them, so they are in user order always */
+        if (grp == CD_GROUP_PARTICLE && !cd_fields[f].on_device) continue;
         const cd_int *map = grp == CD_GROUP_PARTICLE ? part : grp == CD_GROUP_PAIR ? pair : prim;
         size_t rows = cd_state_rows(s, grp), stride = grp == CD_GROUP_WALLC ? s->n_walls : 1;
         cd_long n = (cd_long)(stride * cd_fields[f].elem_size / sizeof(cd_int));
@@ -350,6 +357,13 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
     CD_HOST_FOR(P, firstprivate(tmp, col, prim, nw))
     for (size_t i = 0; i < P; i++) cd_reorder_item_move(tmp, nw, col, nw, prim, (cd_long)i, nw, 0);
     if (P) memcpy(col, tmp, P * (size_t)nw * sizeof(cd_int));
+    /* the step's inertia with its particles, as at the reorder's build */
+    cd_int *icol = s->inertia_iso ? (cd_int *)s->inertia_iso : (cd_int *)s->step_inertia;
+    cd_long iw = (cd_long)((s->inertia_iso ? sizeof(cd_real) : sizeof(cd_vec3)) / sizeof(cd_int));
+    size_t N = icol ? s->n_particles : 0;
+    CD_HOST_FOR(N, firstprivate(tmp, icol, part, iw))
+    for (size_t q = 0; q < N; q++) cd_reorder_item_move(tmp, iw, icol, iw, part, (cd_long)q, iw, 0);
+    if (N) memcpy(icol, tmp, N * (size_t)iw * sizeof(cd_int));
     free(tmp);
     size_t K = s->n_pairs;
     CD_HOST_FOR(K, firstprivate(s, prim_ids))

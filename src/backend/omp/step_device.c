@@ -33,6 +33,10 @@ cd_cols cd_sim_host_cols(cd_state *s)
 #undef CD_FIELD
     c.prim_arm = cd_state_arms_all(s) ? NULL : s->prim_arm; /* kernels/cols.h, cd_prim_arm_of */
     c.arm = s->arm;
+    /* the step's inertia (cd_inertia_of); a state whose was never derived
+     * (set up by hand, not started) the host's column, in its order */
+    c.inertia = s->inertia_iso ? NULL : s->step_inertia ? s->step_inertia : s->inertia;
+    c.inertia_iso = s->inertia_iso;
     return c;
 }
 
@@ -86,6 +90,8 @@ static void off_refresh_cols(cd_sim *sim, cd_off *o)
     }
     d.prim_arm = o->arm_host[0] ? off_devptr(o->arm_host[0]) : NULL;
     d.arm = off_devptr(o->arm_host[1]);
+    d.step_inertia = o->arm_host[2] ? off_devptr(o->arm_host[2]) : NULL;
+    d.inertia_iso = o->arm_host[3] ? off_devptr(o->arm_host[3]) : NULL;
     o->dev = cd_sim_host_cols(&d);
 }
 
@@ -105,7 +111,7 @@ void cd_off_release(cd_sim *sim)
     cd_off *o = sim->backend_data;
     if (!o) return;
     for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
-    for (int k = 0; k < 2; k++) off_unmap(o->arm_host[k], o->arm_bytes[k]);
+    for (int k = 0; k < CD_OFF_DERIVED; k++) off_unmap(o->arm_host[k], o->arm_bytes[k]);
     off_unmap(o->part, o->part_n * sizeof(double));
     free(o->part);
     free(o->host);
@@ -165,7 +171,13 @@ int cd_off_acquire(cd_sim *sim, char *err, size_t errlen)
     o->arm_bytes[0] = all ? 0 : (sim->s.n_prims + 1) * sizeof(cd_int);
     o->arm_host[1] = sim->s.arm;
     o->arm_bytes[1] = (sim->s.n_arms + 1) * sizeof(cd_arm);
-    for (int k = 0; k < 2; k++) off_map(o->arm_host[k], o->arm_bytes[k]);
+    /* the step's inertia (cd_state_arms_derive): one of the two */
+    size_t n1 = sim->s.n_particles + 1;
+    o->arm_host[2] = sim->s.step_inertia;
+    o->arm_bytes[2] = sim->s.step_inertia ? n1 * sizeof(cd_vec3) : 0;
+    o->arm_host[3] = sim->s.inertia_iso;
+    o->arm_bytes[3] = sim->s.inertia_iso ? n1 * sizeof(cd_real) : 0;
+    for (int k = 0; k < CD_OFF_DERIVED; k++) off_map(o->arm_host[k], o->arm_bytes[k]);
     off_map(o->part, o->part_n * sizeof(double));
     off_refresh_cols(sim, o);
     return 0;

@@ -30,13 +30,17 @@ typedef struct {
 } cd_step_args;
 
 #if CD_OFFLOAD
+/* The state's derived step rows mapped beside the columns (cd_off). */
+#define CD_OFF_DERIVED 4
 /* What the offload variant keeps in sim->backend_data. */
 typedef struct {
-    void **host;         /* per field of cd_fields: host address mapped (NULL: none) */
-    size_t *bytes;       /* per field: bytes mapped */
-    void *arm_host[2];   /* the state's prim_arm and arm, mapped (kernels/cols.h) */
-    size_t arm_bytes[2]; /* their bytes mapped */
-    double *part;        /* per-chunk partial sums of the wall load (mapped) */
+    void **host;   /* per field of cd_fields: host address mapped (NULL: none) */
+    size_t *bytes; /* per field: bytes mapped */
+    /* the state's prim_arm, arm, step_inertia and inertia_iso, mapped
+     * (kernels/cols.h; NULL: none) */
+    void *arm_host[CD_OFF_DERIVED];
+    size_t arm_bytes[CD_OFF_DERIVED]; /* their bytes mapped */
+    double *part;                     /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;              /* device addresses of the columns */
     long long args_copies[2]; /* copies of the block's head and of its walls since start */

@@ -477,7 +477,7 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
     }
 #endif
     /* a state stepped without a start (tests): its arms from its columns */
-    if (!s->prim_arm && arms_from_host(sim, err, errlen)) return -1;
+    if ((!s->prim_arm || (!s->inertia_iso && !s->step_inertia)) && arms_from_host(sim, err, errlen)) return -1;
     /* host threads after a sync: the columns back in the lists' order */
     if (cd_reorder_to_memory(sim)) {
         snprintf(err, errlen, "out of memory putting the particles in memory order");
@@ -524,8 +524,10 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
                 cd_off_from(*cd_field_ptr(&sim->s, &cd_fields[f]),
                             cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size);
         }
-    if (o) /* the arms in the step's order: expanded below (arms_to_host) */
-        for (int k = 0; k < 2; k++) cd_off_from(o->arm_host[k], o->arm_bytes[k]);
+    /* the arms in the step's order: expanded below (arms_to_host); the
+     * step's inertia too, which cd_reorder_to_user moves with the rows */
+    if (o)
+        for (int k = 0; k < CD_OFF_DERIVED; k++) cd_off_from(o->arm_host[k], o->arm_bytes[k]);
     /* The host's wall rows anew as well, whenever the step has entries:
      * cd_reorder_to_user below moves every host column from memory order
      * at every sync, so rows not written again (a second sync without a

@@ -64,8 +64,9 @@ enum {
     CD_CL_N_FIELDS
 };
 /* Kernel arguments taken by the columns: the fields', then the
- * primitives' arms (prim_arm, arm: kernels/cl/col_params.h). */
-#define CD_CL_N_COLS (CD_CL_N_FIELDS + 2)
+ * primitives' arms (prim_arm, arm) and the step's inertia (inertia,
+ * inertia_iso: kernels/cl/col_params.h). */
+#define CD_CL_N_COLS (CD_CL_N_FIELDS + 4)
 
 /* The pair columns that carry history across a rebuild exist twice: the
  * new list is filled from the old one.  One such set, with its keys. */
@@ -94,6 +95,9 @@ typedef struct cd_cl {
     cl_mem col[CD_CL_N_FIELDS];
     cl_mem prim_arm, arm; /* the primitives' arms (kernels/cols.h; no reorder: the host's rows) */
     int arms_all;         /* every primitive has an arm: prim_arm is bound as null (cd_prim_arm_of) */
+    /* the step's inertia (kernels/cols.h, cd_inertia_of): one of the two,
+     * the other bound as null */
+    cl_mem inertia, inertia_iso;
     size_t cap_pairs;
     cd_cl_pairset hist[2];
     int cur;

@@ -85,7 +85,9 @@ int cd_cl_bind_cols(cd_cl *cl)
         /* a null prim_arm where every primitive has an arm (kernels/cols.h) */
         cl_mem arm_of = cl->arms_all ? NULL : cl->prim_arm;
         if (cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS, sizeof arm_of, &arm_of) ||
-            cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 1, sizeof cl->arm, &cl->arm))
+            cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 1, sizeof cl->arm, &cl->arm) ||
+            cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 2, sizeof cl->inertia, &cl->inertia) ||
+            cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 3, sizeof cl->inertia_iso, &cl->inertia_iso))
             return -1;
     }
     cl->cols_dirty = 0;
@@ -187,6 +189,8 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->arms_all = cd_state_arms_all(s);
     cl->prim_arm = cd_cl_buffer(cl, (cl->arms_all ? 1 : P + 1) * sizeof(cd_int), "allocating the state");
     cl->arm = cd_cl_buffer(cl, (s->n_arms + 1) * sizeof(cd_arm), "allocating the state");
+    cl->inertia = s->step_inertia ? cd_cl_buffer(cl, (N + 1) * sizeof(cd_vec3), "allocating the state") : NULL;
+    cl->inertia_iso = s->inertia_iso ? cd_cl_buffer(cl, (N + 1) * sizeof(cd_real), "allocating the state") : NULL;
     cl->walls = cd_cl_buffer(cl, (W > 0 ? W : 1) * sizeof(cd_wall), "allocating the walls");
     cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
     cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
@@ -252,6 +256,9 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
     }
     if (!cl->arms_all) write(cl, cl->prim_arm, s->n_prims * sizeof(cd_int), s->prim_arm, "uploading the state");
     write(cl, cl->arm, s->n_arms * sizeof(cd_arm), s->arm, "uploading the state");
+    if (cl->inertia) write(cl, cl->inertia, s->n_particles * sizeof(cd_vec3), s->step_inertia, "uploading the state");
+    if (cl->inertia_iso)
+        write(cl, cl->inertia_iso, s->n_particles * sizeof(cd_real), s->inertia_iso, "uploading the state");
     write(cl, cl->walls, s->n_walls * sizeof(cd_wall), s->walls, "uploading the walls");
     cd_int flags[3] = {0, -1, 0};
     write(cl, cl->flags, sizeof flags, flags, "uploading the flags");
@@ -347,6 +354,8 @@ void cd_cl_buffers_release(cd_cl *cl)
     for (int f = 0; f < CD_CL_N_FIELDS; f++) release(&cl->col[f]);
     release(&cl->prim_arm);
     release(&cl->arm);
+    release(&cl->inertia);
+    release(&cl->inertia_iso);
     for (int h = 0; h < 2; h++) {
         release(&cl->hist[h].active);
         release(&cl->hist[h].shear);
