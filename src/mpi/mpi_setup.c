@@ -29,6 +29,8 @@ int cd_mpi_setup_grid(cd_decomp_grid *g)
     if (!setup_grid_made) return 0;
     *g = setup_grid;
     setup_grid_made = 0;
+    free(setup_owns); /* the start cuts the local state: the set-up's rows are gone */
+    setup_owns = NULL;
     return 1;
 }
 
@@ -74,8 +76,13 @@ static int decompose(const cd_sim *sim, const double *xyz, size_t n, double rang
     }
     free(setup_owns);
     setup_owns = malloc(n + 1);
-    int rc = setup_owns ? cd_decomp_make(&setup_grid, &sim->cfg, size, xyz, n, range, 0, err, errlen) : -1;
-    if (!setup_owns) snprintf(err, errlen, "out of memory while cutting the domain for %d MPI ranks", size);
+    if (cd_mpi_agree(!setup_owns)) { /* (a shortage on one rank stops all, no hang) */
+        free(ranks);
+        free(mine);
+        snprintf(err, errlen, "out of memory while cutting the domain for %d MPI ranks", size);
+        return -1;
+    }
+    int rc = cd_decomp_make(&setup_grid, &sim->cfg, size, xyz, n, range, 0, err, errlen);
     size_t m = 0;
     for (size_t q = 0; !rc && q < n; q++) {
         int o = cd_decomp_owner(&setup_grid, xyz + 3 * q), here = o == rank;
@@ -85,7 +92,7 @@ static int decompose(const cd_sim *sim, const double *xyz, size_t n, double rang
         if (here) mine[m++] = (long long)q;
     }
     free(ranks);
-    if (rc) { /* every rank: the same data, the same refusal (out of memory: agreed by the caller) */
+    if (rc) { /* every rank: the same data, the same refusal */
         free(mine);
         return -1;
     }
