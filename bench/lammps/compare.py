@@ -9,7 +9,7 @@ For each case:N[:PEER_STEPS][@KXxKZ], in one invocation (PEER_STEPS: the
 length of the peers' timed segments, default --steps; shorter ones for the
 hexapods keep the segments of a round about as long, so that they see the
 same load; @KXxKZ: the settled packing of N particles tiled KX x KZ times,
-capdem-bench --tile, relaxed by capdem for 20 ms (--relax-steps) and saved, and that one
+capdem-bench --tile, relaxed by capdem (--relax-steps; default 20 ms spheres, 200 ms hexapods) and saved, and that one
 packing timed by every code):
   spheres      capdem-bench writes the initial lattice deposit (seed, N) and
                settles it under 50 g; LAMMPS reads the same initial state
@@ -75,8 +75,12 @@ MATERIAL = dict(kn=1e5, kt=5e4, eta_n=0.2, eta_t=0.2, mu=0.5)  # docs/references
 SETTLE = {"spheres": 30000, "hexapods_a3": 15000, "hexapods_a9": 15000}
 # A tiled packing has lost its tangential springs (bench_tile.c): it slips and
 # springs back, and needs about 20 ms to find its contacts again (spheres: Z
-# 4.46 settled, 3.5 after 0.6 ms, 4.50 after 20 ms; hexapods 7.54, 7.12, 7.48)
-RELAX = {"spheres": 10000, "hexapods_a3": 2000, "hexapods_a9": 2000}  # steps of 20 ms
+# 4.46 settled, 3.5 after 0.6 ms, 4.50 after 20 ms; hexapods 7.54, 7.12, 7.48).
+# Hexapods need 200 ms to come to rest: after 20 ms a 5 x 2 tile of 1,000
+# still rebuilt its lists at every step (alpha 3) or every other (alpha 9)
+# while timed; after 200 ms one build in 1,000 steps (alpha 3) and 3 in 500
+# (alpha 9) (docs/performance.md, "On the quiet machine, session 17/18").
+RELAX = {"spheres": 10000, "hexapods_a3": 20000, "hexapods_a9": 20000}  # steps: 20 ms (dt 2e-6 s), 200 ms (1e-5 s)
 
 
 def ensure_lammps():
@@ -251,7 +255,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=3,
                     help="rounds; 0 settles, tiles and converts the packings only (time them later with --reuse)")
     ap.add_argument("--relax-steps", type=int, default=None,
-                    help="steps a tiled packing relaxes (capdem) before timing (default: 20 ms, RELAX)")
+                    help="steps a tiled packing relaxes (capdem) before timing (default: RELAX, 20 ms spheres, 200 ms hexapods)")
     ap.add_argument("--peer-warm", type=int, default=200, help="untimed steps of a peer before each timed segment")
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--baseline", default=None,
