@@ -319,8 +319,16 @@ int main(int argc, char **argv)
             cd_sim_observe(&sim, &after);
             cd_traffic tr[CD_TRAFFIC_KERNELS];
             cd_bench_traffic(&sim, (double)steps, tr);
-            double kinds[3], mixed, warps;
-            cd_bench_row_kinds(&sim, kinds, &mixed, &warps);
+            /* the warps of 32 rows in row order, and in the pair pass's
+             * visiting order (a mixture's rows grouped by kind; else the
+             * same) */
+            double kinds[3], mixed, warps, mixed_visited = 0, warps_visited = 0;
+            cd_bench_row_kinds(&sim, NULL, kinds, &mixed, &warps);
+            cd_int *visit = malloc((sim.s.n_pairs + 1) * sizeof *visit);
+            if (!visit) return fail("out of memory", 3);
+            size_t n_visit = cd_neighbors_pair_visit(&sim, visit);
+            cd_bench_row_kinds(&sim, n_visit ? visit : NULL, kinds, &mixed_visited, &warps_visited);
+            free(visit);
             double moved = 0;
             char kernels[768];
             int at = 0;
@@ -338,13 +346,14 @@ int main(int argc, char **argv)
                    "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}, "
                    "\"rows\": {\"prims\": %zu, \"arms\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, "
                    "\"walls\": %zu, \"wall_contacts\": %.0f, \"pair_rows_by_kind\": [%.0f, %.0f, %.0f], "
-                   "\"mixed_warps\": [%.0f, %.0f]}}\n",
+                   "\"mixed_warps\": [%.0f, %.0f], \"mixed_warps_visited\": [%.0f, %.0f], \"visit_order\": %s}}\n",
                    case_label, n, sim.backend->name, sim.backend->device(&sim), round_threads[k], steps, wall, cpu,
                    (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n, sim.s.n_pairs,
                    (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
                    sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
                    moved / (double)n, kernels, sim.s.n_prims, sim.s.n_arms, sim.s.n_pairs, after.n_contacts,
-                   sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps);
+                   sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps, mixed_visited,
+                   warps_visited, n_visit ? "true" : "false");
             fflush(stdout);
         }
     }
