@@ -34,7 +34,7 @@ int cd_bench_case_yaml(const cd_bench_case *c, long n, unsigned seed, const char
                        size_t len)
 {
     double aspect = c->shape2 && c->aspect2 > c->aspect ? c->aspect2 : c->aspect; /* the largest particle's */
-    double tip = aspect * c->diameter;                                             /* tip-to-tip length L [m] */
+    double tip = aspect * c->diameter;                                            /* tip-to-tip length L [m] */
     double size = tip * (1 + c->polydispersity) * 1.1; /* lattice spacing [m] (clearance 1.1) */
     double width, thickness, height;
     if (c->dimension == 2) {

@@ -53,6 +53,7 @@
 #include <time.h>
 #include <omp.h>
 #include "core/sim.h"
+#include "../kernels/neighbor_items.h"
 #include "io/io_h5.h"
 #include "config/config.h"
 #include "bench_cases.h"
@@ -86,6 +87,13 @@ static size_t state_bytes(const cd_sim *sim)
      * history and outputs); the build before's, which only a build's
      * carry-over reads, are freed after it (neighbors.c, particle_lists) */
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + sim->nb.cap_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_entry));
+    /* a mixture: the pair pass's visiting order (a row index a row, with
+     * the spare rows) and its counting sort's starts (kernels/neighbor_items.h,
+     * pass 11) */
+    if (cd_neighbors_pair_visit(sim, NULL)) {
+        cd_long rows = (cd_long)sim->s.n_pairs;
+        b += (size_t)(cd_nb_room(rows) + cd_nb_room(CD_ROW_KINDS * cd_nb_visit_chunks(rows) + 1)) * sizeof(cd_int);
+    }
     return b;
 }
 

@@ -32,8 +32,9 @@ static inline const char *cdt_visit_order_defect(const cd_int *visit, const cd_i
             snprintf(msg, sizeof msg, "entry %zu: row %d out of range or seen twice: not a permutation", v, (int)r);
             bad = msg;
         } else if (v && (kind[r] < kind[prev] || (ascending && kind[r] == kind[prev] && r < prev))) {
-            snprintf(msg, sizeof msg, "entry %zu: row %d (kind %d) after row %d (kind %d): not grouped by kind in row order",
-                     v, (int)r, (int)kind[r], (int)prev, (int)kind[prev]);
+            snprintf(msg, sizeof msg,
+                     "entry %zu: row %d (kind %d) after row %d (kind %d): not grouped by kind in row order", v, (int)r,
+                     (int)kind[r], (int)prev, (int)kind[prev]);
             bad = msg;
         }
         if (!bad) seen[r] = 1;

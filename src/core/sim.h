@@ -107,7 +107,8 @@ typedef struct {
     long long reorders;              /* rebuilds that moved particles */
     size_t pair_at_cap;              /* rows d.pair_at holds */
     size_t n_visit;                  /* rows of the visiting order of the last build (0: none, the direct loop) */
-    size_t cap_visit, cap_visit_starts; /* entries d.pair_visit and d.visit_starts hold */
+    /* entries d.pair_visit and d.visit_starts hold */
+    size_t cap_visit, cap_visit_starts;
     /* the visiting order where a backend other than omp keeps it (OpenCL), copied to out: its rows; NULL: d */
     size_t (*visit_get)(const struct cd_sim *sim, cd_int *out);
 } cd_neighbors;

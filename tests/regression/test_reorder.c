@@ -92,7 +92,8 @@ static int check_visit_order(cd_sim *sim, int mixed)
         assert_int_equal(got, n);
         for (size_t k = 0; k < n; k++) {
             cd_int i = s->pair_prim_i[k], j = s->pair_prim_j[k];
-            kind[k] = 2 - cd_segseg_is_point(s->prim_a[i], s->prim_b[i]) - cd_segseg_is_point(s->prim_a[j], s->prim_b[j]);
+            kind[k] =
+                2 - cd_segseg_is_point(s->prim_a[i], s->prim_b[i]) - cd_segseg_is_point(s->prim_a[j], s->prim_b[j]);
         }
         /* (in row order within a kind where the order was made in the
          * same row order: without a memory order) */
@@ -121,7 +122,8 @@ static void check_reorder(int reorder, const char *cfg)
     assert_int_equal(cd_sim_initial_forces(&a), 0);
     assert_int_equal(cd_sim_initial_forces(&b), 0);
     double contacts = 0, wall_contacts = 0, springs = 0; /* springs: wall contacts with a loaded spring */
-    int boundaries = 0; /* kind boundaries of the visiting orders seen (a mixture) */
+    /* kind boundaries of the visiting orders seen (a mixture) */
+    int boundaries = 0;
     for (int k = 0; k < 16; k++) {
         cd_sim *sims[2] = {&a, &b};
         cd_observables o[2];

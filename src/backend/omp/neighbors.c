@@ -43,9 +43,11 @@ void cd_neighbors_free(cd_neighbors *nb)
                    d->pair_count, d->pair_offset,  d->cand,        d->keys,       d->old_keys,   d->old_active,
                    d->old_shear,  d->count,        d->chunk_sum,   d->part_uid,   d->part_at,    d->prim_uid,
                    d->prim_at,    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
-                   d->sort_keys,  d->sort_vals,    d->hist,        d->move,       d->skin_flag,  d->ref_pose,
-                   d->pair_visit, d->visit_starts, d->visit_scratch};
+                   d->sort_keys,  d->sort_vals,    d->hist,        d->move,       d->skin_flag,  d->ref_pose};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
+    cd_dev_free(d->pair_visit);
+    cd_dev_free(d->visit_starts);
+    cd_dev_free(d->visit_scratch);
     memset(nb, 0, sizeof(*nb));
 }
 

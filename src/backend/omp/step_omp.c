@@ -122,8 +122,7 @@ static void pair_forces(cd_sim *sim, cd_int outputs)
     if (visit_by_kind(sim)) {
         CD_STEP_FOR(n, CD_ARGS_IN)
         for (size_t v = 0; v < n; v++)
-            cd_item_pair_force(CD_A.c, CD_A.d.pair_visit[v], CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend,
-                               outputs);
+            cd_item_pair_force(CD_A.c, CD_A.d.pair_visit[v], CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
         return;
     }
     CD_STEP_FOR(n, CD_ARGS_IN)

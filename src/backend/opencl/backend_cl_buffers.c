@@ -369,9 +369,10 @@ void cd_cl_buffers_release(cd_cl *cl)
         &cl->cand,           &cl->gather_count, &cl->gather_start,  &cl->gather_cursor, &cl->gather_rows,
         &cl->wall_count,     &cl->wall_start,   &cl->wall_rows,     &cl->obs_touch,     &cl->obs_part,
         &cl->obs_total,      &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out,  &cl->halo_send_list,
-        &cl->halo_recv_list, &cl->halo_send,    &cl->halo_recv,     &cl->wall_fn,       &cl->pair_visit,
-        &cl->visit_starts};
+        &cl->halo_recv_list, &cl->halo_send,    &cl->halo_recv,     &cl->wall_fn};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
+    release(&cl->pair_visit);
+    release(&cl->visit_starts);
     cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
     cl->cap_visit = cl->cap_visit_starts = cl->n_visit = cl->block_sum_cap = 0;
     cl->cap_wall_rows = cl->cap_old_wall_rows = 0;

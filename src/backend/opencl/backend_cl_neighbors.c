@@ -187,7 +187,8 @@ static void visit_order(cd_cl *cl, cd_sim *sim, cd_int n_pairs)
     cl->n_visit = 0;
     if (n_pairs <= 0 || !cd_nb_prims_of_both_kinds(s->prim_a_body, s->prim_b_body, s->n_prims)) return;
     cd_int m = (cd_int)cd_nb_visit_chunks(n_pairs), entries = CD_ROW_KINDS * m;
-    reserve_entries(cl, &cl->pair_visit, &cl->cap_visit, (size_t)n_pairs, sizeof(cd_int), "allocating the visiting order");
+    reserve_entries(cl, &cl->pair_visit, &cl->cap_visit, (size_t)n_pairs, sizeof(cd_int),
+                    "allocating the visiting order");
     reserve_entries(cl, &cl->visit_starts, &cl->cap_visit_starts, (size_t)entries + 1, sizeof(cd_int),
                     "allocating the visiting order");
     /* the scan's levels (block_sum is sized for the cells' scan, which is
