@@ -7,9 +7,11 @@
 #include <stddef.h>
 
 typedef struct {
-    const char *name;      /* spheres | crosses2d | hexapods_a3 | hexapods_a9 */
+    const char *name;      /* spheres | crosses2d | hexapods_a3 | hexapods_a9 | mix_spheres_hexapods */
     const char *shape;     /* config particles[].shape */
     double aspect;         /* alpha (1 for spheres) */
+    const char *shape2;    /* a mixture: the shape of the second half of the particles (NULL: one shape) */
+    double aspect2;        /* its alpha */
     double diameter;       /* arm diameter d_p [m] */
     double polydispersity; /* p: sizes uniform in [1-p, 1+p] */
     int dimension;         /* 3, or 2 (motion in the x-y plane) */

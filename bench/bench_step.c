@@ -53,6 +53,7 @@
 #include <time.h>
 #include <omp.h>
 #include "core/sim.h"
+#include "../kernels/neighbor_items.h"
 #include "io/io_h5.h"
 #include "config/config.h"
 #include "bench_cases.h"
@@ -86,6 +87,13 @@ static size_t state_bytes(const cd_sim *sim)
      * history and outputs); the build before's, which only a build's
      * carry-over reads, are freed after it (neighbors.c, particle_lists) */
     b += (sim->s.n_particles + 1) * sizeof(cd_int) + sim->nb.cap_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_entry));
+    /* a mixture: the pair pass's visiting order (a row index a row, with
+     * the spare rows) and its counting sort's starts (kernels/neighbor_items.h,
+     * pass 11) */
+    if (cd_neighbors_pair_visit(sim, NULL)) {
+        cd_long rows = (cd_long)sim->s.n_pairs;
+        b += (size_t)(cd_nb_room(rows) + cd_nb_room(CD_ROW_KINDS * cd_nb_visit_chunks(rows) + 1)) * sizeof(cd_int);
+    }
     return b;
 }
 
@@ -319,8 +327,16 @@ int main(int argc, char **argv)
             cd_sim_observe(&sim, &after);
             cd_traffic tr[CD_TRAFFIC_KERNELS];
             cd_bench_traffic(&sim, (double)steps, tr);
-            double kinds[3], mixed, warps;
-            cd_bench_row_kinds(&sim, kinds, &mixed, &warps);
+            /* the warps of 32 rows in row order, and in the pair pass's
+             * visiting order (a mixture's rows grouped by kind; else the
+             * same) */
+            double kinds[3], mixed, warps, mixed_visited = 0, warps_visited = 0;
+            cd_bench_row_kinds(&sim, NULL, kinds, &mixed, &warps);
+            cd_int *visit = malloc((sim.s.n_pairs + 1) * sizeof *visit);
+            if (!visit) return fail("out of memory", 3);
+            size_t n_visit = cd_neighbors_pair_visit(&sim, visit);
+            cd_bench_row_kinds(&sim, n_visit ? visit : NULL, kinds, &mixed_visited, &warps_visited);
+            free(visit);
             double moved = 0;
             char kernels[768];
             int at = 0;
@@ -338,13 +354,14 @@ int main(int argc, char **argv)
                    "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}, "
                    "\"rows\": {\"prims\": %zu, \"arms\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, "
                    "\"walls\": %zu, \"wall_contacts\": %.0f, \"pair_rows_by_kind\": [%.0f, %.0f, %.0f], "
-                   "\"mixed_warps\": [%.0f, %.0f]}}\n",
+                   "\"mixed_warps\": [%.0f, %.0f], \"mixed_warps_visited\": [%.0f, %.0f], \"visit_order\": %s}}\n",
                    case_label, n, sim.backend->name, sim.backend->device(&sim), round_threads[k], steps, wall, cpu,
                    (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n, sim.s.n_pairs,
                    (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
                    sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
                    moved / (double)n, kernels, sim.s.n_prims, sim.s.n_arms, sim.s.n_pairs, after.n_contacts,
-                   sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps);
+                   sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps, mixed_visited,
+                   warps_visited, n_visit ? "true" : "false");
             fflush(stdout);
         }
     }

@@ -73,7 +73,10 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * too); writes flag, history, point, force (76; the flag only when it
      * changes with CD_ENDS_FROM_POSE: 72), and F_n (8) at the last step of
      * a call only (the overlap is derived where it is read). */
-    out[0] = (cd_traffic){"pair_forces", R * 12 + P * 12 + ends + A * 24 + N * (80 + pose),
+    /* In a mixture the rows are visited kind by kind: 4 B a row read for
+     * the visiting order (kernels/neighbor_items.h, pass 11). */
+    double visit = cd_neighbors_pair_visit(sim, NULL) ? 4 : 0;
+    out[0] = (cd_traffic){"pair_forces", R * (12 + visit) + P * 12 + ends + A * 24 + N * (80 + pose),
                           A * (CD_ENDS_FROM_POSE ? 72 : 76) + A * 8 / steps_per_call};
     /* cd_item_wall_row over the wall candidates: per candidate its row,
      * its entry's flag and its primitive (particle, radius, end a, arm
@@ -113,17 +116,18 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};
 }
 
-void cd_bench_row_kinds(const cd_sim *sim, double kinds[3], double *mixed, double *groups)
+void cd_bench_row_kinds(const cd_sim *sim, const cd_int *visit, double kinds[3], double *mixed, double *groups)
 {
     const cd_state *s = &sim->s;
     kinds[0] = kinds[1] = kinds[2] = *mixed = *groups = 0;
     int seen = 0; /* bit k: kind k in the current group */
-    for (size_t k = 0; k < s->n_pairs; k++) {
+    for (size_t v = 0; v < s->n_pairs; v++) {
+        size_t k = visit ? (size_t)visit[v] : v;
         cd_prim_id i = s->pair_prim_i[k], j = s->pair_prim_j[k];
         int kind = 2 - cd_segseg_is_point(s->prim_a[i], s->prim_b[i]) - cd_segseg_is_point(s->prim_a[j], s->prim_b[j]);
         kinds[kind]++;
         seen |= 1 << kind;
-        if ((k + 1) % CD_BENCH_WARP == 0 || k + 1 == s->n_pairs) {
+        if ((v + 1) % CD_BENCH_WARP == 0 || v + 1 == s->n_pairs) {
             *groups += 1;
             *mixed += (seen & (seen - 1)) != 0; /* more than one bit */
             seen = 0;

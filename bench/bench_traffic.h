@@ -26,8 +26,9 @@ enum { CD_BENCH_WARP = 32 };
  * cd_item_pair_force (kernels/step_items.h; sim->s synced): kinds[0] two
  * points (sphere-sphere), kinds[1] a point and a segment, kinds[2] two
  * segments; and how many groups of CD_BENCH_WARP consecutive rows in the
- * row order at hand hold more than one kind (*mixed of *groups): the
- * groups whose items would diverge on a GPU (issue 21 item 5). */
-void cd_bench_row_kinds(const cd_sim *sim, double kinds[3], double *mixed, double *groups);
+ * order visit gives (the pair pass's visiting order, cd_neighbors_pair_visit;
+ * NULL: the row order at hand) hold more than one kind (*mixed of *groups):
+ * the groups whose items would diverge on a GPU (issue 21 item 5). */
+void cd_bench_row_kinds(const cd_sim *sim, const cd_int *visit, double kinds[3], double *mixed, double *groups);
 
 #endif

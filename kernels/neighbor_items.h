@@ -17,6 +17,8 @@
  *   9. gather    per row: counted and filled into its two particles' lists
  *                (atomic), then per particle sorted ascending
  *  10. walls     per particle: wall candidates counted, scanned, filled
+ *  11. visit     (mixtures only) per chunk of rows: the pair pass's
+ *                visiting order, rows grouped by kind (counting sort)
  *
  * Integer atomics only fill counting sorts; whatever they leave out of
  * order is sorted again (rows by insertion in pass 5, gather lists in pass
@@ -430,5 +432,68 @@ CD_INLINE void cd_scan_item_copy(const CD_GLOBAL cd_int *out, cd_long n, cd_long
     if (end == n) copy[n] = out[n];
 }
 
+/* Pass 11, only where the primitives are of both kinds (points: balls,
+ * arms of zero length; segments: arms), so that rows of several kinds
+ * exist: the order in which the pair pass visits the rows, grouped by
+ * kind (cd_nb_row_kind: the three narrow phases of cd_pair_narrow), each
+ * group in ascending row order, so that a GPU warp (32 consecutive items)
+ * runs one narrow phase but at the two group boundaries.  The rows stay
+ * in key order (the carry-over's binary search, the gather lists, the
+ * reorder's user order and the MPI leaves read them so); only the pair
+ * pass reads the order, and a row's result does not depend on when it is
+ * computed (it reads the particles and writes its own row only), so the
+ * bits are those of the direct loop (docs/contacts.md, "Rows visited by
+ * kind").  A counting sort without atomics, the same on every backend:
+ *
+ *   count   per chunk g of CD_SCAN_CHUNK rows: its rows of each kind t
+ *           into starts[t n_chunks + g] (kind-major: one scan then gives
+ *           every (kind, chunk) its first place);
+ *   scan    starts in place (cd_scan_item_*; 3 n_chunks entries);
+ *   fill    per chunk g: its rows, in row order, to the places of their
+ *           kind from starts[t n_chunks + g] on. */
+#define CD_ROW_KINDS 3
+
+/* Kind of pair row k: 0 two points, 1 a point and a segment, 2 two
+ * segments (rows.pair_rows_by_kind of capdem-bench). */
+CD_INLINE cd_int cd_nb_row_kind(cd_cols c, cd_long k)
+{
+    cd_prim_id i = c.pair_prim_i[k], j = c.pair_prim_j[k];
+    return 2 - cd_segseg_is_point(c.prim_a[i], cd_prim_b(c, i)) - cd_segseg_is_point(c.prim_a[j], cd_prim_b(c, j));
+}
+
+/* Chunks of the visiting order's counting sort over n rows. */
+CD_INLINE cd_long cd_nb_visit_chunks(cd_long n) { return (n + CD_SCAN_CHUNK - 1) / CD_SCAN_CHUNK; }
+
+/* Count: the rows of each kind in chunk g of the n rows. */
+CD_INLINE void cd_nb_item_visit_count(cd_cols c, cd_long g, cd_long n, CD_GLOBAL cd_int *starts)
+{
+    cd_int count[CD_ROW_KINDS] = {0, 0, 0};
+    for (cd_long k = g * CD_SCAN_CHUNK; k < cd_scan_chunk_end(g, n); k++) count[cd_nb_row_kind(c, k)]++;
+    cd_long m = cd_nb_visit_chunks(n);
+    for (int t = 0; t < CD_ROW_KINDS; t++) starts[t * m + g] = count[t];
+}
+
+/* Fill: chunk g's rows into their kinds' places (starts scanned). */
+CD_INLINE void cd_nb_item_visit_fill(cd_cols c, cd_long g, cd_long n, const CD_GLOBAL cd_int *starts,
+                                     CD_GLOBAL cd_int *visit)
+{
+    cd_long m = cd_nb_visit_chunks(n);
+    cd_int at[CD_ROW_KINDS];
+    for (int t = 0; t < CD_ROW_KINDS; t++) at[t] = starts[t * m + g];
+    for (cd_long k = g * CD_SCAN_CHUNK; k < cd_scan_chunk_end(g, n); k++) visit[at[cd_nb_row_kind(c, k)]++] = (cd_int)k;
+}
+
 CD_DEVICE_END
+
+#ifndef __OPENCL_VERSION__
+/* Host (both backends): are the n primitives of both kinds, points (both
+ * body-frame ends the same) and segments?  Then a build makes the visiting
+ * order (pass 11); a packing of one shape keeps the direct loop. */
+static inline int cd_nb_prims_of_both_kinds(const cd_vec3 *a_body, const cd_vec3 *b_body, size_t n)
+{
+    int seen = 0; /* bit 0: a point, bit 1: a segment */
+    for (size_t i = 0; i < n && seen != 3; i++) seen |= cd_segseg_is_point(a_body[i], b_body[i]) ? 1 : 2;
+    return seen == 3;
+}
+#endif
 #endif

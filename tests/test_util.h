@@ -13,6 +13,36 @@
 #include "core/sim.h"
 #include "../kernels/rigid.h"
 
+/* What is wrong with visit (n entries) as the pair pass's visiting order
+ * (kernels/neighbor_items.h, pass 11), kind[k] being the kind of row k
+ * (0..2): NULL when it is a permutation of 0 .. n-1 that takes the rows
+ * kind by kind (kinds ascending), with ascending = 1 each kind's rows in
+ * ascending order (0: rows indexed in another order than the one the
+ * order was made in, the user order of rows kept in a memory order);
+ * else a message (static storage). */
+static inline const char *cdt_visit_order_defect(const cd_int *visit, const cd_int *kind, size_t n, int ascending)
+{
+    static char msg[160];
+    unsigned char *seen = calloc(n + 1, 1);
+    if (!seen) return "out of memory";
+    const char *bad = NULL;
+    for (size_t v = 0; v < n && !bad; v++) {
+        cd_int r = visit[v], prev = v ? visit[v - 1] : -1;
+        if (r < 0 || (size_t)r >= n || seen[r]) {
+            snprintf(msg, sizeof msg, "entry %zu: row %d out of range or seen twice: not a permutation", v, (int)r);
+            bad = msg;
+        } else if (v && (kind[r] < kind[prev] || (ascending && kind[r] == kind[prev] && r < prev))) {
+            snprintf(msg, sizeof msg,
+                     "entry %zu: row %d (kind %d) after row %d (kind %d): not grouped by kind in row order", v, (int)r,
+                     (int)kind[r], (int)prev, (int)kind[prev]);
+            bad = msg;
+        }
+        if (!bad) seen[r] = 1;
+    }
+    free(seen);
+    return bad;
+}
+
 /* The backend under test: CAPDEM_TEST_BACKEND (CTest runs the physics and
  * regression tests once per backend), omp by default. */
 static inline const char *cdt_backend(void)

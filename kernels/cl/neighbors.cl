@@ -202,3 +202,23 @@ __kernel void cd_cl_wall_carry(cd_int n_rows, __global const cd_int *wall_rows, 
     if (e < n_rows)
         cd_item_wall_carry(e, wall_rows, wall_out, old_rows, n_old, old_out, (__global const cd_int *)0, n_walls);
 }
+
+/* Pass 11 (mixtures only): the pair pass's visiting order, rows grouped
+ * by kind -- count per chunk of rows, then (after the scan of starts) fill. */
+__kernel void cd_cl_visit_count(
+#include "col_params.h"
+    cd_int n_pairs, __global cd_int *starts)
+{
+#include "col_bind.h"
+    cd_long g = (cd_long)get_global_id(0);
+    if (g < cd_nb_visit_chunks(n_pairs)) cd_nb_item_visit_count(c, g, n_pairs, starts);
+}
+
+__kernel void cd_cl_visit_fill(
+#include "col_params.h"
+    cd_int n_pairs, __global const cd_int *starts, __global cd_int *visit)
+{
+#include "col_bind.h"
+    cd_long g = (cd_long)get_global_id(0);
+    if (g < cd_nb_visit_chunks(n_pairs)) cd_nb_item_visit_fill(c, g, n_pairs, starts, visit);
+}

@@ -21,14 +21,18 @@ __kernel void cd_cl_advance(
 }
 
 /* Step 5: narrow phase and contact law of pair row k (outputs: 1 at the
- * last step of a call, when the rows' F_n is written too). */
+ * last step of a call, when the rows' F_n is written too); item v takes
+ * row visit[v] where a mixture has a visiting order (rows grouped by kind,
+ * kernels/neighbor_items.h pass 11: one narrow phase a warp), row v where
+ * visit is null (one kind of row).  The same bits either way. */
 __kernel void cd_cl_pair_forces(
 #include "col_params.h"
-    cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend, cd_int outputs)
+    cd_int n_pairs, cd_law_params law, cd_real dt, cd_real sin_parallel, cd_int parallel_blend, cd_int outputs,
+    __global const cd_int *visit)
 {
 #include "col_bind.h"
-    cd_int k = (cd_int)get_global_id(0);
-    if (k < n_pairs) cd_item_pair_force(c, k, law, dt, sin_parallel, parallel_blend, outputs);
+    cd_int v = (cd_int)get_global_id(0);
+    if (v < n_pairs) cd_item_pair_force(c, visit ? visit[v] : v, law, dt, sin_parallel, parallel_blend, outputs);
 }
 
 /* Step 6: wall candidate e of the last build (its wall-contact row; its

@@ -29,6 +29,8 @@ typedef struct {
     cd_int dimension;       /* 3, or 2: motion in the x-y plane only */
 } cd_step_params;
 
+struct cd_sim;
+
 /* The neighbour lists and the build's scratch (kernels/neighbor_items.h),
  * in the memory the step loops run on: the offload device's in the offload
  * variant (device addresses: never dereferenced on the host), host memory
@@ -72,6 +74,10 @@ typedef struct {
     cd_int *sort_vals;           /* their slots, twice n_particles */
     cd_int *hist;                /* radix sort: digit counts per chunk, then cursors */
     void *move;                  /* scratch of one column while it moves */
+    /* the pair pass's visiting order, rows grouped by kind (kernels/neighbor_items.h,
+     * pass 11): made only where the primitives are of both kinds, else null (the
+     * direct loop); its counting sort's starts and their scan's levels */
+    cd_int *pair_visit, *visit_starts, *visit_scratch;
 } cd_nb_lists;
 
 #define CD_NB_REORDER_ALWAYS 2
@@ -100,6 +106,11 @@ typedef struct {
                                  (src/backend/omp/reorder.c) */
     long long reorders;              /* rebuilds that moved particles */
     size_t pair_at_cap;              /* rows d.pair_at holds */
+    size_t n_visit;                  /* rows of the visiting order of the last build (0: none, the direct loop) */
+    /* entries d.pair_visit and d.visit_starts hold */
+    size_t cap_visit, cap_visit_starts;
+    /* the visiting order where a backend other than omp keeps it (OpenCL), copied to out: its rows; NULL: d */
+    size_t (*visit_get)(const struct cd_sim *sim, cd_int *out);
 } cd_neighbors;
 
 /* Scratch of the observables' reductions where the steps run (the offload
@@ -251,6 +262,12 @@ int cd_neighbors_build(cd_sim *sim);
 /* The bounding radii [m] of the last build, copied to out (n_particles,
  * user order); 0, or -1 before the first build.  For tests. */
 int cd_neighbors_part_bounds(const cd_sim *sim, double *out);
+/* The pair pass's visiting order of the last build (kernels/neighbor_items.h, pass 11) copied to
+ * out (room for n_pairs entries) as indices of the host's pair rows after a sync (user order where
+ * the omp backend keeps a memory order; out NULL: nothing copied): returns its rows (n_pairs), or 0
+ * where the build made none (the rows are visited in order: one kind of row, or before the first
+ * build).  For tests and capdem-bench. */
+size_t cd_neighbors_pair_visit(const struct cd_sim *sim, cd_int *out);
 /* The host's wall-contact outputs (fields.def, WALLC_OUT) from the step's
  * per-candidate ones, when these are newer (nb.wall_out_pending), in the
  * memory order of the step's columns: call after the other columns came

@@ -39,11 +39,20 @@ for l in lines:
     total = sum(v[0] + v[1] for v in kb.values())
     assert abs(total - r["bytes_moved_per_particle_step"]) <= 2 * len(kb), l
     assert 200 < r["bytes_moved_per_particle_step"] < 2e4, l
+    # the pair rows' kinds: in the pair pass's visiting order (a mixture's
+    # rows grouped by kind) at most the two kind boundaries split a warp
+    rows = r["rows"]
+    assert sum(rows["pair_rows_by_kind"]) == rows["pair_rows"], l
+    assert rows["mixed_warps_visited"][1] == rows["mixed_warps"][1], l
+    if rows["visit_order"]:
+        assert rows["mixed_warps_visited"][0] <= 2, l
+    else:
+        assert rows["mixed_warps_visited"] == rows["mixed_warps"], l
 print("ok", case, len(lines), "lines")
 PY
 }
 
-for case in spheres crosses2d hexapods_a3 hexapods_a9; do
+for case in spheres crosses2d hexapods_a3 hexapods_a9 mix_spheres_hexapods; do
   "$bench" --case "$case" --n 40 --settle-steps 300 --steps 20 --repeat 2 --threads 1 > "$dir/$case.jsonl" 2> "$dir/$case.err"
   check "$case" 40 20 "$dir/$case.jsonl"
 done

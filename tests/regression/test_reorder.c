@@ -72,6 +72,40 @@ static void assert_same_group(const cd_state *a, const cd_state *b, enum cd_fiel
     }
 }
 
+/* The pair pass's visiting order of sim's last build (sim synced): in a
+ * pile of spheres and hexapods (mixed) a permutation of the rows grouped
+ * by kind, in memory row order within a kind (kernels/neighbor_items.h, pass 11;
+ * the kinds from the host's ends, as capdem-bench counts them); in a pile
+ * of one shape none (the direct loop).  Returns the kind boundaries. */
+static int check_visit_order(cd_sim *sim, int mixed)
+{
+    const cd_state *s = &sim->s;
+    size_t n = s->n_pairs;
+    cd_int *visit = calloc(n + 1, sizeof *visit), *kind = calloc(n + 1, sizeof *kind);
+    assert_non_null(visit);
+    assert_non_null(kind);
+    size_t got = cd_neighbors_pair_visit(sim, visit);
+    int boundaries = 0;
+    if (!mixed) {
+        assert_int_equal(got, 0);
+    } else {
+        assert_int_equal(got, n);
+        for (size_t k = 0; k < n; k++) {
+            cd_int i = s->pair_prim_i[k], j = s->pair_prim_j[k];
+            kind[k] =
+                2 - cd_segseg_is_point(s->prim_a[i], s->prim_b[i]) - cd_segseg_is_point(s->prim_a[j], s->prim_b[j]);
+        }
+        /* (in row order within a kind where the order was made in the
+         * same row order: without a memory order) */
+        const char *defect = cdt_visit_order_defect(visit, kind, n, !sim->nb.ordered);
+        if (defect) fail_msg("step %lld: visiting order: %s", s->step, defect);
+        for (size_t v = 1; v < n; v++) boundaries += kind[visit[v]] != kind[visit[v - 1]];
+    }
+    free(visit);
+    free(kind);
+    return boundaries;
+}
+
 /* Runs the pile (config text cfg) with reorder setting `reorder` in a and
  * none in b. */
 static void check_reorder(int reorder, const char *cfg)
@@ -88,6 +122,8 @@ static void check_reorder(int reorder, const char *cfg)
     assert_int_equal(cd_sim_initial_forces(&a), 0);
     assert_int_equal(cd_sim_initial_forces(&b), 0);
     double contacts = 0, wall_contacts = 0, springs = 0; /* springs: wall contacts with a loaded spring */
+    /* kind boundaries of the visiting orders seen (a mixture) */
+    int boundaries = 0;
     for (int k = 0; k < 16; k++) {
         cd_sim *sims[2] = {&a, &b};
         cd_observables o[2];
@@ -110,6 +146,7 @@ static void check_reorder(int reorder, const char *cfg)
             if (k % 3 == 2) sims[s]->s.velocity[7] = cd_v3(0, 0.1, 0);
         }
         assert_int_equal(a.s.n_pairs, b.s.n_pairs);
+        for (int s = 0; s < 2; s++) boundaries += check_visit_order(sims[s], cfg == pile_mixed);
         assert_same_group(&a.s, &b.s, CD_GROUP_PARTICLE, a.s.n_particles, a.s.step);
         assert_same_group(&a.s, &b.s, CD_GROUP_PRIM, a.s.n_prims, a.s.step);
         assert_same_group(&a.s, &b.s, CD_GROUP_PAIR, a.s.n_pairs, a.s.step);
@@ -134,6 +171,8 @@ static void check_reorder(int reorder, const char *cfg)
     if (cfg == pile_frictional_walls) assert_true(springs > 300);
     assert_int_equal(b.nb.reorders, 0);
     if (cfg == pile_mixed) assert_true(a.s.n_arms > 0 && a.s.n_arms < a.s.n_prims);
+    /* the mixed pile's rows are of more than one kind most of the time */
+    if (cfg == pile_mixed) assert_true(boundaries >= 16);
     /* the particles did move in memory: once for the default (the random
      * placement's order, then the cells', which the pile keeps), at
      * every rebuild that changes the cells' order when forced */

@@ -45,6 +45,9 @@ void cd_neighbors_free(cd_neighbors *nb)
                    d->prim_at,    d->pair_at,      d->pair_ustart, d->part_src,   d->prim_src,   d->new_first,
                    d->sort_keys,  d->sort_vals,    d->hist,        d->move,       d->skin_flag,  d->ref_pose};
     for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) cd_dev_free(all[k]);
+    cd_dev_free(d->pair_visit);
+    cd_dev_free(d->visit_starts);
+    cd_dev_free(d->visit_scratch);
     memset(nb, 0, sizeof(*nb));
 }
 
@@ -388,6 +391,75 @@ static int particle_lists(cd_sim *sim, const cd_int *prim_src)
     return 0;
 }
 
+/* Pass 11 (kernels/neighbor_items.h): the pair pass's visiting order,
+ * rows grouped by kind, where the primitives are of both kinds; else none
+ * (d.pair_visit null: the pair pass's direct loop, and no bytes held). */
+static int visit_order(cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    cd_neighbors *nb = &sim->nb;
+    cd_nb_lists *dl = &nb->d;
+    size_t n = s->n_pairs;
+    nb->n_visit = 0;
+    if (!n || !cd_nb_prims_of_both_kinds(s->prim_a_body, s->prim_b_body, s->n_prims)) {
+        cd_dev_free(dl->pair_visit);
+        cd_dev_free(dl->visit_starts);
+        cd_dev_free(dl->visit_scratch);
+        dl->pair_visit = dl->visit_starts = dl->visit_scratch = NULL;
+        nb->cap_visit = nb->cap_visit_starts = 0;
+        return 0;
+    }
+    cd_long m = cd_nb_visit_chunks((cd_long)n), entries = CD_ROW_KINDS * m;
+    if (n > nb->cap_visit || !dl->pair_visit) {
+        size_t cap = (size_t)cd_nb_room((cd_long)n);
+        if (realloc_dev((void **)&dl->pair_visit, cap, sizeof(cd_int))) return -1;
+        nb->cap_visit = cap;
+    }
+    if ((size_t)entries + 1 > nb->cap_visit_starts || !dl->visit_starts) {
+        size_t cap = (size_t)cd_nb_room(entries + 1);
+        if (realloc_dev((void **)&dl->visit_starts, cap, sizeof(cd_int)) ||
+            realloc_dev((void **)&dl->visit_scratch, (size_t)cd_scan_scratch((cd_long)cap), sizeof(cd_int)))
+            return -1;
+        nb->cap_visit_starts = cap;
+    }
+    cd_long rows = (cd_long)n;
+    CD_WIDE_MIN
+    {
+        CD_BUILD_ARGS(sim)
+        CD_STEP_FOR(m, CD_BUILD_IN)
+        for (cd_long g = 0; g < m; g++) cd_nb_item_visit_count(CD_B.c, g, rows, CD_B.d.visit_starts);
+    }
+    cd_nb_scan(dl->visit_starts, (cd_int)entries, dl->visit_starts, dl->visit_scratch);
+    {
+        CD_BUILD_ARGS(sim)
+        CD_STEP_FOR(m, CD_BUILD_IN)
+        for (cd_long g = 0; g < m; g++) cd_nb_item_visit_fill(CD_B.c, g, rows, CD_B.d.visit_starts, CD_B.d.pair_visit);
+    }
+    nb->n_visit = n;
+    return 0;
+}
+
+size_t cd_neighbors_pair_visit(const cd_sim *sim, cd_int *out)
+{
+    if (sim->nb.visit_get) return sim->nb.visit_get(sim, out);
+    size_t n = sim->nb.n_visit;
+    if (!n || n != sim->s.n_pairs) return 0;
+    if (!out) return n;
+    if (cd_dev_get(out, sim->nb.d.pair_visit, n * sizeof *out)) return 0;
+    if (!sim->nb.ordered) return n;
+    /* memory rows -> the host's rows after a sync (user order: pair_at
+     * names the memory row of each) */
+    cd_int *at = malloc(n * sizeof *at), *user = malloc(n * sizeof *user);
+    int rc = at && user ? cd_dev_get(at, sim->nb.d.pair_at, n * sizeof *at) : -1;
+    if (!rc) {
+        for (size_t u = 0; u < n; u++) user[at[u]] = (cd_int)u;
+        for (size_t v = 0; v < n; v++) out[v] = user[out[v]];
+    }
+    free(at);
+    free(user);
+    return rc ? 0 : n;
+}
+
 /* The candidate pairs (i, j), i < j, of primitives of different particles
  * whose axes come within r_i + r_j + skin, sorted by i then j, with their
  * history carried over; the gather and wall lists; the primitive ends
@@ -460,7 +532,7 @@ int cd_neighbors_build(cd_sim *sim)
             cd_nb_item_gather_count(CD_B.c, k, CD_B.d.count);
         }
     }
-    if (particle_lists(sim, prim_src) || cd_reorder_pair_rows(sim)) return -1;
+    if (particle_lists(sim, prim_src) || cd_reorder_pair_rows(sim) || visit_order(sim)) return -1;
     nb->force_rebuild = 0;
     nb->builds++;
     return 0;

@@ -106,12 +106,25 @@ static int advance_walls(cd_sim *sim, int moved)
     return moved || sim->nb.force_rebuild;
 }
 
-/* One work item per pair of the Verlet list: narrow phase + contact law. */
+/* Does the pair pass visit the rows through the build's visiting order
+ * (rows grouped by kind: a mixture; kernels/neighbor_items.h, pass 11)?
+ * Else the direct loop.  Either way each row is computed once by the same
+ * item: the same bits. */
+static int visit_by_kind(const cd_sim *sim) { return sim->nb.n_visit && sim->nb.n_visit == sim->s.n_pairs; }
+
+/* One work item per pair of the Verlet list: narrow phase + contact law;
+ * in a mixture the items visit the rows kind by kind (d.pair_visit). */
 static void pair_forces(cd_sim *sim, cd_int outputs)
 {
     size_t n = sim->s.n_pairs;
     CD_WIDE_MIN
     CD_ARGS(sim)
+    if (visit_by_kind(sim)) {
+        CD_STEP_FOR(n, CD_ARGS_IN)
+        for (size_t v = 0; v < n; v++)
+            cd_item_pair_force(CD_A.c, CD_A.d.pair_visit[v], CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
+        return;
+    }
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t k = 0; k < n; k++)
         cd_item_pair_force(CD_A.c, (cd_pair_id)k, CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
@@ -161,9 +174,14 @@ static void compute_forces(cd_sim *sim)
  * region, and the separate loops of the start), and GCC then called
  * them instead of inlining them, 1.15x the instructions of the step
  * (callgrind). */
-__attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, cd_law_params law, cd_real dt,
-                                                         cd_real sin_parallel, cd_int blend, cd_int outputs)
+__attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, const cd_int *visit, cd_law_params law,
+                                                         cd_real dt, cd_real sin_parallel, cd_int blend, cd_int outputs)
 {
+    if (visit) { /* a mixture: the rows kind by kind (the same for every thread of the region) */
+#pragma omp for schedule(static) nowait
+        for (size_t v = 0; v < n; v++) cd_item_pair_force(c, visit[v], law, dt, sin_parallel, blend, outputs);
+        return;
+    }
 #pragma omp for schedule(static) nowait
     for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend, outputs);
 }
@@ -234,14 +252,15 @@ static void forces_and_advance_one_team(cd_sim *sim, int next, int flagged)
     size_t n_pairs = sim->s.n_pairs, n_walls = sim->s.n_walls ? sim->nb.n_wall_rows : 0, n = sim->s.n_particles;
     size_t most = n_pairs > n ? n_pairs : n;
     most = n_walls > most ? n_walls : most;
-    cd_int outputs = !next;
+    cd_int outputs = !next, visit = visit_by_kind(sim);
     CD_WIDE_MIN
     CD_ARGS(sim)
     CD_ONE_TEAM(most, CD_ARGS_IN)
     {
         CD_TEAM_FOR(nowait) /* the wall rows write other rows and read only the particles */
         for (size_t k = 0; k < n_pairs; k++)
-            cd_item_pair_force(CD_A.c, (cd_pair_id)k, CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
+            cd_item_pair_force(CD_A.c, visit ? CD_A.d.pair_visit[k] : (cd_pair_id)k, CD_A.law, CD_A.dt,
+                               CD_A.sin_parallel, CD_A.blend, outputs);
         CD_TEAM_FOR()
         for (size_t e = 0; e < n_walls; e++)
             cd_item_wall_row(CD_A.c, CD_A.d.wall_rows[e], CD_A.d.wall_out + e, CD_A.walls, CD_A.n_walls, CD_A.wall_law,
@@ -296,10 +315,11 @@ static int forces_and_advance(cd_sim *sim, int next)
     const cd_wall *walls = sim->s.walls;
     size_t n_pairs = sim->s.n_pairs, n_walls = W ? sim->nb.n_wall_rows : 0, n = sim->s.n_particles;
     size_t most = n_pairs > n ? n_pairs : n;
+    const cd_int *visit = visit_by_kind(sim) ? d.pair_visit : NULL; /* a mixture: the rows kind by kind */
     int moved = 0;
 #pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
     {
-        pair_rows(c, n_pairs, law, dt, sin_parallel, blend, !next);
+        pair_rows(c, n_pairs, visit, law, dt, sin_parallel, blend, !next);
         wall_rows(c, d.wall_rows, d.wall_out, n_walls, walls, W, wall_law, dt, sin_parallel, blend);
         moved |= gather_kick_advance(c, d, n, g, dim, dt, limit2, next);
     }

@@ -60,6 +60,9 @@ static void set_list_args(cd_cl *cl)
     cd_int n = (cd_int)cl->n_pairs;
     if (cl->cols_dirty) cd_cl_bind_cols(cl);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F, sizeof n, &n);
+    /* a mixture: the rows kind by kind (pass 11); else null, the rows in order */
+    cl_mem visit = cl->n_visit && cl->n_visit == cl->n_pairs ? cl->pair_visit : NULL;
+    cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 6, sizeof visit, &visit);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F, sizeof cl->n_wall_rows, &cl->n_wall_rows);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 2, sizeof cl->gather_rows, &cl->gather_rows);
     /* the wall candidates' lists, sized by the last build */
@@ -92,6 +95,7 @@ static int forces(cd_cl *cl, cd_sim *sim, int rebuild, cd_int mode)
 static void cl_stop(cd_sim *sim)
 {
     cd_cl *cl = sim->backend_data;
+    sim->nb.visit_get = NULL; /* the visiting order goes with the buffers */
     if (!cl) return;
     if (cl->queue) clFinish(cl->queue);
     cd_cl_buffers_release(cl);

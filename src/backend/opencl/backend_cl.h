@@ -51,6 +51,8 @@ enum cd_cl_kernel {
     CD_CLK_HALO_PACK,
     CD_CLK_HALO_UNPACK,
     CD_CLK_WALL_FN,
+    CD_CLK_VISIT_COUNT,
+    CD_CLK_VISIT_FILL,
     CD_CLK_COUNT
 };
 
@@ -116,6 +118,11 @@ typedef struct cd_cl {
     cl_mem part_cell, part_bound, cell_count, cell_start, cell_cursor, cell_parts;
     size_t cell_cap; /* cells the grid may have: 8 n_prims + 64 */
     cl_mem pair_count, pair_offset, block_sum;
+    size_t block_sum_cap; /* entries block_sum holds (the levels of the longest scan) */
+    /* the pair pass's visiting order, rows grouped by kind (kernels/neighbor_items.h,
+     * pass 11; mixtures only, else none: the direct order), its counting sort's starts */
+    cl_mem pair_visit, visit_starts;
+    size_t cap_visit, cap_visit_starts, n_visit;
     cl_mem cand; /* candidates per primitive, slot entries each */
     cd_int slot;
     cl_mem gather_count, gather_start, gather_cursor, gather_rows;

@@ -220,8 +220,8 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->slot = slots && atoi(slots) > 0 ? atoi(slots) : 32;
     cl->cand = cd_cl_buffer(cl, P * (size_t)cl->slot * sizeof(cd_prim_id), "allocating the neighbour list");
     /* the longest scan: the cells */
-    cl->block_sum =
-        cd_cl_buffer(cl, (size_t)cd_scan_scratch((cd_long)cl->cell_cap) * sizeof(cd_int), "allocating the scan");
+    cl->block_sum_cap = (size_t)cd_scan_scratch((cd_long)cl->cell_cap);
+    cl->block_sum = cd_cl_buffer(cl, cl->block_sum_cap * sizeof(cd_int), "allocating the scan");
     cl->gather_count = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_cursor = cd_cl_buffer(cl, N * sizeof(cd_int), "allocating the gather lists");
     cl->gather_start = cd_cl_buffer(cl, (N + 1) * sizeof(cd_int), "allocating the gather lists");
@@ -371,7 +371,10 @@ void cd_cl_buffers_release(cd_cl *cl)
         &cl->obs_total,      &cl->wall_out,     &cl->old_wall_rows, &cl->old_wall_out,  &cl->halo_send_list,
         &cl->halo_recv_list, &cl->halo_send,    &cl->halo_recv,     &cl->wall_fn};
     for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) release(other[i]);
+    release(&cl->pair_visit);
+    release(&cl->visit_starts);
     cl->cap_pairs = cl->gather_cap = cl->obs_cap_blocks = 0;
+    cl->cap_visit = cl->cap_visit_starts = cl->n_visit = cl->block_sum_cap = 0;
     cl->cap_wall_rows = cl->cap_old_wall_rows = 0;
     cl->halo_ns = cl->halo_nr = 0;
 }

@@ -55,6 +55,8 @@ static const struct {
     {"cd_cl_halo_pack", 1},
     {"cd_cl_halo_unpack", 1},
     {"cd_cl_wall_fn", 1},
+    {"cd_cl_visit_count", 1},
+    {"cd_cl_visit_fill", 1},
 };
 
 int cd_cl_kernel_takes_cols(enum cd_cl_kernel k) { return kernel_table[k].cols; }

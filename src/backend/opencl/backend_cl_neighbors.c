@@ -154,6 +154,58 @@ static void wall_lists(cd_cl *cl, cd_sim *sim, cd_int N)
     memcpy(sim->nb.walls_ref, cl->host_walls, sizeof sim->nb.walls_ref);
 }
 
+/* A buffer of at least n entries of elem bytes in *buf (*cap entries):
+ * made anew, contents dropped, when it is smaller (released after the
+ * kernels queued before that use it: in-order queue). */
+static void reserve_entries(cd_cl *cl, cl_mem *buf, size_t *cap, size_t n, size_t elem, const char *what)
+{
+    if (cl->status || (*buf && *cap >= n)) return;
+    if (*buf) clReleaseMemObject(*buf);
+    *cap = (size_t)cd_nb_room((cd_long)n);
+    *buf = cd_cl_buffer(cl, *cap * elem, what);
+}
+
+/* The visiting order of the last build, copied to out (nb.visit_get). */
+static size_t visit_get(const cd_sim *sim, cd_int *out)
+{
+    cd_cl *cl = sim->backend_data;
+    size_t n = cl ? cl->n_visit : 0;
+    if (!n || n != cl->n_pairs || cl->status) return 0;
+    if (!out) return n;
+    cl_int rc = clEnqueueReadBuffer(cl->queue, cl->pair_visit, CL_TRUE, 0, n * sizeof *out, out, 0, NULL, NULL);
+    return cd_cl_check(cl, rc, "reading the visiting order") ? 0 : n;
+}
+
+/* Pass 11 (kernels/neighbor_items.h): the pair pass's visiting order,
+ * rows grouped by kind, where the primitives are of both kinds (the host's
+ * body-frame ends say so); else none, and the pair kernel takes the rows
+ * in order (its visit argument null; set_list_args). */
+static void visit_order(cd_cl *cl, cd_sim *sim, cd_int n_pairs)
+{
+    const cd_state *s = &sim->s;
+    sim->nb.visit_get = visit_get;
+    cl->n_visit = 0;
+    if (n_pairs <= 0 || !cd_nb_prims_of_both_kinds(s->prim_a_body, s->prim_b_body, s->n_prims)) return;
+    cd_int m = (cd_int)cd_nb_visit_chunks(n_pairs), entries = CD_ROW_KINDS * m;
+    reserve_entries(cl, &cl->pair_visit, &cl->cap_visit, (size_t)n_pairs, sizeof(cd_int),
+                    "allocating the visiting order");
+    reserve_entries(cl, &cl->visit_starts, &cl->cap_visit_starts, (size_t)entries + 1, sizeof(cd_int),
+                    "allocating the visiting order");
+    /* the scan's levels (block_sum is sized for the cells' scan, which is
+     * usually the longer) */
+    reserve_entries(cl, &cl->block_sum, &cl->block_sum_cap, (size_t)cd_scan_scratch(entries), sizeof(cd_int),
+                    "allocating the scan");
+    cd_cl_arg(cl, CD_CLK_VISIT_COUNT, F, sizeof n_pairs, &n_pairs);
+    cd_cl_arg(cl, CD_CLK_VISIT_COUNT, F + 1, sizeof cl->visit_starts, &cl->visit_starts);
+    cd_cl_run(cl, CD_CLK_VISIT_COUNT, (size_t)m);
+    cd_cl_scan(cl, cl->visit_starts, (size_t)entries, cl->visit_starts);
+    cd_cl_arg(cl, CD_CLK_VISIT_FILL, F, sizeof n_pairs, &n_pairs);
+    cd_cl_arg(cl, CD_CLK_VISIT_FILL, F + 1, sizeof cl->visit_starts, &cl->visit_starts);
+    cd_cl_arg(cl, CD_CLK_VISIT_FILL, F + 2, sizeof cl->pair_visit, &cl->pair_visit);
+    cd_cl_run(cl, CD_CLK_VISIT_FILL, (size_t)m);
+    if (!cl->status) cl->n_visit = (size_t)n_pairs;
+}
+
 int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
 {
     const cd_state *s = &sim->s;
@@ -222,6 +274,7 @@ int cd_cl_neighbors_build(cd_cl *cl, cd_sim *sim)
     }
     gather_lists(cl, N, n_new);
     wall_lists(cl, sim, N);
+    visit_order(cl, sim, n_new);
 
     /* Reference ends for the skin criterion (its flag was cleared above). */
     cd_cl_arg(cl, CD_CLK_PRIM_REFS, F, sizeof P, &P);
