@@ -40,6 +40,11 @@ typedef struct {
      * (kernels/cols.h; NULL: none) */
     void *arm_host[CD_OFF_DERIVED];
     size_t arm_bytes[CD_OFF_DERIVED]; /* their bytes mapped */
+    /* the host's force and torque columns, mapped where the step holds
+     * them (kernels/cols.h: an MPI rank; from a start to its first
+     * advance), else NULL */
+    void *force_host[2];
+    size_t force_bytes;
     double *part;                     /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;              /* device addresses of the columns */
@@ -54,6 +59,11 @@ int cd_off_acquire(cd_sim *sim, char *err, size_t errlen);
 void cd_off_release(cd_sim *sim);
 /* Copies bytes at host address p back from the device. */
 void cd_off_from(void *p, size_t bytes);
+/* Maps (map = 1: copied to the device) or unmaps the host's force and
+ * torque columns, the step's while mapped (kernels/cols.h, cd_cols.force). */
+void cd_off_force_map(cd_sim *sim, int map);
+/* The mapped force and torque back into the host's columns. */
+void cd_off_force_from(cd_sim *sim);
 /* Brings the device's argument block (cd_step_block) up to date for this
  * state (`target update`: a copy the device refuses stops the run in the
  * OpenMP runtime, which has no error return for it). */

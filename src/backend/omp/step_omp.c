@@ -58,11 +58,24 @@ static int skin_flag_read(cd_sim *sim)
 }
 #endif
 
+/* After the first advance of a call: the next one sums the force and
+ * torque from the rows (kernels/cols.h), and a device lets go of the
+ * host's copy it held since the start (an MPI rank keeps its columns). */
+static void host_force_used(cd_sim *sim)
+{
+    sim->nb.force_summed = 1;
+#if CD_OFFLOAD
+    if (!cd_sim_keeps_force(sim)) cd_off_force_map(sim, 0);
+#endif
+}
+
 /* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
  * world ends of its primitives and the skin test.  Returns 1 when some end
  * moved more than half the skin; on the offload device one int comes
  * back.  (Run once per call of the step; the next steps' advance is fused
- * into the gather: gather_kick_advance.) */
+ * into the gather: gather_kick_advance.)  Its force and torque: summed
+ * from the rows of the last force evaluation, or where the step holds
+ * them (a start's first advance, an MPI rank) read (cd_item_advance). */
 static int advance_particles(cd_sim *sim)
 {
     size_t n = sim->s.n_particles;
@@ -77,7 +90,8 @@ static int advance_particles(cd_sim *sim)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN)
     for (size_t q = 0; q < n; q++)
-        if (cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose)) {
+        if (cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose)) {
 #pragma omp atomic write
             CD_A.d.skin_flag[0] = 1;
         }
@@ -86,8 +100,10 @@ static int advance_particles(cd_sim *sim)
     CD_ARGS(sim)
     CD_STEP_FOR(n, CD_ARGS_IN reduction(| : moved))
     for (size_t q = 0; q < n; q++)
-        moved |= cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
+        moved |= cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                                 CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
 #endif
+    host_force_used(sim);
     return moved;
 }
 
@@ -146,12 +162,54 @@ static void gather(cd_sim *sim)
 }
 
 /* Forces for the current positions (neighbour list up to date), without
- * a kick (a start). */
+ * a kick (a start): into the step's force and torque (the host's columns,
+ * or a device's copy of them: the start maps them), which the first
+ * advance need not read: it sums them again from the rows. */
 static void compute_forces(cd_sim *sim)
 {
     pair_forces(sim, 1);
     wall_forces(sim);
     gather(sim);
+    host_force_used(sim);
+}
+
+/* The particles' force and torque into the host's columns, in user order,
+ * summed from the rows as the next call's first advance sums them
+ * (cd_item_gather_to): at sync, where the step holds none (one process)
+ * and the rows hold a force evaluation since the start (else the host's
+ * columns are current: a start without forces).  Host memory: once after
+ * steps (a second sync finds the columns in user order, host_user, and
+ * the force written); an offload device: at every sync, into a copy
+ * mapped for it (the host's columns, which every sync moves to user
+ * order, are written anew each time as the wall rows are). */
+static void force_to_host(cd_sim *sim)
+{
+    size_t n = sim->s.n_particles;
+    if (cd_sim_keeps_force(sim) || !sim->nb.force_summed || !n) return;
+#if CD_OFFLOAD
+    if (!cd_step_memory_is_host()) {
+        cd_off_force_map(sim, 1);
+        cd_off *o = sim->backend_data;
+        cd_vec3 *F = o->dev.force, *T = o->dev.torque;
+        CD_WIDE_MIN
+        CD_ARGS(sim)
+        CD_STEP_FOR(n, CD_ARGS_IN is_device_ptr(F, T))
+        for (size_t q = 0; q < n; q++)
+            cd_item_gather_to(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                              CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.order.part_uid, F, T);
+        cd_off_force_from(sim);
+        cd_off_force_map(sim, 0);
+        return;
+    }
+#endif
+    if (sim->nb.host_user) return;
+    cd_vec3 *F = sim->s.force, *T = sim->s.torque;
+    CD_WIDE_MIN
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN firstprivate(F, T))
+    for (size_t q = 0; q < n; q++)
+        cd_item_gather_to(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                          CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.order.part_uid, F, T);
 }
 
 #if !CD_OFFLOAD
@@ -420,6 +478,7 @@ static void omp_stop(cd_sim *sim)
     cd_off_release(sim);
 #endif
     sim->nb.wall_out_valid = sim->nb.wall_out_pending = 0;
+    sim->nb.force_summed = 0; /* the next first advance: the host's force and torque */
 }
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen);
@@ -509,6 +568,7 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 static int omp_sync(cd_sim *sim, char *err, size_t errlen)
 {
     store_ends(sim);
+    force_to_host(sim); /* (one process; an MPI rank's below, with the columns) */
 #if CD_OFFLOAD
     /* The only full copy back: every device column, rows in use. */
     cd_off *o = sim->backend_data;
@@ -528,6 +588,9 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
      * step's inertia too, which cd_reorder_to_user moves with the rows */
     if (o)
         for (int k = 0; k < CD_OFF_DERIVED; k++) cd_off_from(o->arm_host[k], o->arm_bytes[k]);
+    /* an MPI rank's force and torque (kernels/cols.h; its local state is
+     * never reordered: user order) */
+    if (cd_sim_keeps_force(sim)) cd_off_force_from(sim);
     /* The host's wall rows anew as well, whenever the step has entries:
      * cd_reorder_to_user below moves every host column from memory order
      * at every sync, so rows not written again (a second sync without a
