@@ -104,13 +104,12 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * no F, T (one process holds none between calls: kernels/cols.h; an
      * MPI rank writes them at its last step).  The advance of its own runs
      * once per call of the step. */
-    out[2] = (cd_traffic){"gather_kick_advance", N * (152 - iso) + advance_prims + gather_rows,
-                          N * 128 + advance_writes};
+    out[2] =
+        (cd_traffic){"gather_kick_advance", N * (152 - iso) + advance_prims + gather_rows, N * 128 + advance_writes};
     /* with CD_ENDS_FROM_POSE: the pose at the build (64) instead of the
      * primitive range and the primitives' ends (8 + advance_prims), no ends
      * written */
-    if (CD_ENDS_FROM_POSE)
-        out[2] = (cd_traffic){"gather_kick_advance", N * (144 - iso + 64) + gather_rows, N * 128};
+    if (CD_ENDS_FROM_POSE) out[2] = (cd_traffic){"gather_kick_advance", N * (144 - iso + 64) + gather_rows, N * 128};
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};

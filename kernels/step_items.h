@@ -600,23 +600,26 @@ CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
  * the last neighbour-list build.  The same arithmetic as the four items
  * one after the other: fused because each reads what the one before wrote
  * (docs/performance.md, "Bytes per step").
- * The kick's force and torque: particle q's rows of c.force, c.torque
- * where the step holds them (an MPI rank; from a start to its first
- * advance, the host's), else summed again from the pair rows and wall
- * entries of the last force evaluation with the gather's arguments
- * (cd_gather_sum: the sum the last step's gather made, the same rows in
- * the same order at the same positions, so the same bits;
+ * The kick's force and torque: where the step holds them (c.force not
+ * null), particle q's rows cd_map(uid, q) of c.force, c.torque (an MPI
+ * rank's, uid null; the host's, in user order: uid each memory slot's user
+ * id, after a start or a build between calls); else summed again from the
+ * pair rows and wall entries of the last force evaluation with the
+ * gather's arguments (cd_gather_sum: the sum the last step's gather made,
+ * the same rows in the same order at the same positions, so the same bits;
  * docs/performance.md, "Session 18, force and torque not held"). */
 CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                               const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                              const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension, cd_real dt,
-                              cd_real limit2, const CD_GLOBAL cd_real *ref_pose)
+                              const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
+                              const CD_GLOBAL cd_int *uid, cd_real dt, cd_real limit2,
+                              const CD_GLOBAL cd_real *ref_pose)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T;
     if (c.force) {
-        F = c.force[q];
-        T = c.torque[q];
+        cd_long r = cd_map(uid, q);
+        F = c.force[r];
+        T = c.torque[r];
     } else {
         cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F,
                       &T);

@@ -22,7 +22,7 @@ __kernel void cd_cl_advance(
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
     if (q < n_particles &&
-        cd_item_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, dt, limit2, 0))
+        cd_item_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, 0, dt, limit2, 0))
         flags[0] = 1;
     if (q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
 }

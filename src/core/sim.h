@@ -89,7 +89,9 @@ typedef struct {
     int wall_out_pending;            /* ... newer than the host's columns (expanded at sync) */
     int force_summed;                /* 1: the first advance of a call sums the force and torque from the
                                         rows (a force evaluation since the start, cd_item_advance); 0 (a
-                                        start without forces, a state never started): it reads the host's */
+                                        start without forces, a state never started, a build between calls:
+                                        cd_sim_force_before_build): it reads the host's */
+    int in_step;                     /* 1 while a call of the step runs (its builds keep no force) */
     cd_nb_lists d;                   /* lists and scratch, where the loops run */
     size_t cap_rows;                 /* rows that keys and gather_rows (twice) hold */
     size_t cap_old;                  /* rows that old_keys, old_active, old_shear hold */

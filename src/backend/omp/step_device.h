@@ -45,7 +45,7 @@ typedef struct {
      * advance), else NULL */
     void *force_host[2];
     size_t force_bytes;
-    double *part;                     /* per-chunk partial sums of the wall load (mapped) */
+    double *part; /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;              /* device addresses of the columns */
     long long args_copies[2]; /* copies of the block's head and of its walls since start */
@@ -89,6 +89,15 @@ extern cd_step_args cd_step_block;
 /* The block for the state as it is now, padding zeroed (blocks are
  * compared byte by byte). */
 void cd_step_args_fill(cd_sim *sim, cd_step_args *a);
+
+/* Called by a neighbour-list build before it replaces the rows: a build
+ * between calls of the step (tests do it) takes away the rows the next
+ * call's first advance would sum the force and torque from, so these go
+ * to the host's columns first, where that advance then reads them (user
+ * order; kernels/cols.h).  Nothing inside a call (its first advance has
+ * used them), on an MPI rank (its step holds them) or after a start
+ * without forces (the host's are current). */
+void cd_sim_force_before_build(cd_sim *sim);
 
 /* A loop's arguments: `CD_ARGS(sim)` makes the block for the state as it
  * is now, `CD_ARGS_IN` hands it to a CD_STEP_FOR loop and `CD_A` names

@@ -58,6 +58,16 @@ static int skin_flag_read(cd_sim *sim)
 }
 #endif
 
+/* The rows of the host's force and torque for each memory slot where the
+ * first advance reads them (cd_item_advance): the host's columns are in
+ * user order (each slot's user id, where the loops run; null where memory
+ * order is user order, as always on an MPI rank, whose step's columns
+ * they are). */
+static const cd_int *host_force_order(cd_sim *sim)
+{
+    return cd_sim_keeps_force(sim) ? NULL : cd_sim_step_order(sim).part_uid;
+}
+
 /* After the first advance of a call: the next one sums the force and
  * torque from the rows (kernels/cols.h), and a device lets go of the
  * host's copy it held since the start (an MPI rank keeps its columns). */
@@ -88,20 +98,24 @@ static int advance_particles(cd_sim *sim)
      * way and a cross-team combine (docs/offload.md, "Per-step copies"). */
     if (!skin_flag(sim)) return 1; /* without the flag: a rebuild each step, still correct */
     CD_ARGS(sim)
-    CD_STEP_FOR(n, CD_ARGS_IN)
+    const cd_int *uid = host_force_order(sim);
+    CD_STEP_FOR(n, CD_ARGS_IN is_device_ptr(uid))
     for (size_t q = 0; q < n; q++)
         if (cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
-                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose)) {
+                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2,
+                            CD_A.d.ref_pose)) {
 #pragma omp atomic write
             CD_A.d.skin_flag[0] = 1;
         }
     moved = skin_flag_read(sim);
 #else
     CD_ARGS(sim)
-    CD_STEP_FOR(n, CD_ARGS_IN reduction(| : moved))
+    const cd_int *uid = host_force_order(sim);
+    CD_STEP_FOR(n, CD_ARGS_IN firstprivate(uid) reduction(| : moved))
     for (size_t q = 0; q < n; q++)
-        moved |= cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
-                                 CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
+        moved |=
+            cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
 #endif
     host_force_used(sim);
     return moved;
@@ -212,6 +226,16 @@ static void force_to_host(cd_sim *sim)
                           CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.order.part_uid, F, T);
 }
 
+void cd_sim_force_before_build(cd_sim *sim)
+{
+    if (sim->nb.in_step || !sim->nb.force_summed || cd_sim_keeps_force(sim)) return;
+    force_to_host(sim);
+    sim->nb.force_summed = 0;
+#if CD_OFFLOAD
+    cd_off_force_map(sim, 1);
+#endif
+}
+
 #if !CD_OFFLOAD
 /* The loops of forces_and_advance, each an orphaned `omp for` in a
  * function of its own (the region's threads share its rows) with every
@@ -238,10 +262,23 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
                                                                   cd_int dim, cd_real dt, cd_real limit2, int next)
 {
     int moved = 0;
+    /* next a constant in each loop (every thread takes the same one): the
+     * item's store of the force and torque at a call's last step, and its
+     * test of the columns (kernels/cols.h), leave the steps' loop, which
+     * otherwise tested them for every particle (callgrind, 10,000
+     * spheres: 11.6 instructions a particle-step; docs/performance.md,
+     * "Session 18, force and torque not held") */
+    if (next) {
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
-    for (size_t q = 0; q < n; q++)
-        moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                             d.wall_out, g, dim, dt, limit2, d.ref_pose, next);
+        for (size_t q = 0; q < n; q++)
+            moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
+                                                 d.wall_out, g, dim, dt, limit2, d.ref_pose, 1);
+    } else {
+#pragma omp for schedule(static) nowait
+        for (size_t q = 0; q < n; q++)
+            moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
+                                                 d.wall_out, g, dim, dt, limit2, d.ref_pose, 0);
+    }
     return moved;
 }
 #endif
@@ -524,6 +561,8 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
     return 0;
 }
 
+static int step_calls(cd_sim *sim, long long n, char *err, size_t errlen);
+
 static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
@@ -542,6 +581,18 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory putting the particles in memory order");
         return -1;
     }
+    /* (a build inside a call takes no force from the rows: the first
+     * advance has used them; cd_sim_force_before_build) */
+    sim->nb.in_step = 1;
+    int rc = step_calls(sim, n, err, errlen);
+    sim->nb.in_step = 0;
+    return rc ? rc : check_step_state(sim, err, errlen);
+}
+
+/* omp_step's steps, after the columns are in memory order. */
+static int step_calls(cd_sim *sim, long long n, char *err, size_t errlen)
+{
+    cd_state *s = &sim->s;
     int moved = n > 0 ? advance_particles(sim) : 0;
     for (long long it = 0; it < n; it++) {
         int rebuild = advance_walls(sim, moved);
@@ -562,7 +613,7 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
         s->step++;
         s->time += sim->p.dt;
     }
-    return check_step_state(sim, err, errlen);
+    return 0;
 }
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen)

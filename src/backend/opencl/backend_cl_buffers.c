@@ -341,7 +341,8 @@ static void force_summed_to_host(cd_cl *cl, cd_sim *sim)
     cd_state *s = &sim->s;
     size_t bytes = s->n_particles * sizeof(cd_vec3);
     if (cl->force || !cl->wall_out_valid || !bytes || cl->status) return;
-    cl_mem f = cd_cl_buffer(cl, bytes, "allocating the force sums"), t = cd_cl_buffer(cl, bytes, "allocating the force sums");
+    cl_mem f = cd_cl_buffer(cl, bytes, "allocating the force sums"),
+           t = cd_cl_buffer(cl, bytes, "allocating the force sums");
     cd_int mode = 0; /* (every call of forces sets the mode anew) */
     if (!cl->status && !cd_cl_bind_force(cl, f, t)) {
         cd_cl_arg(cl, CD_CLK_GATHER_KICK, CD_CL_N_COLS + 6, sizeof mode, &mode);
