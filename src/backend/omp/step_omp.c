@@ -199,31 +199,28 @@ static void compute_forces(cd_sim *sim)
 static void force_to_host(cd_sim *sim)
 {
     size_t n = sim->s.n_particles;
-    if (cd_sim_keeps_force(sim) || !sim->nb.force_summed || !n) return;
+    int device = !cd_step_memory_is_host();
+    if (cd_sim_keeps_force(sim) || !sim->nb.force_summed || !n || (!device && sim->nb.host_user)) return;
+    cd_vec3 *F = sim->s.force, *T = sim->s.torque;
 #if CD_OFFLOAD
-    if (!cd_step_memory_is_host()) {
+    if (device) {
         cd_off_force_map(sim, 1);
-        cd_off *o = sim->backend_data;
-        cd_vec3 *F = o->dev.force, *T = o->dev.torque;
-        CD_WIDE_MIN
-        CD_ARGS(sim)
-        CD_STEP_FOR(n, CD_ARGS_IN is_device_ptr(F, T))
-        for (size_t q = 0; q < n; q++)
-            cd_item_gather_to(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
-                              CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.order.part_uid, F, T);
-        cd_off_force_from(sim);
-        cd_off_force_map(sim, 0);
-        return;
+        F = ((cd_off *)sim->backend_data)->dev.force;
+        T = ((cd_off *)sim->backend_data)->dev.torque;
     }
 #endif
-    if (sim->nb.host_user) return;
-    cd_vec3 *F = sim->s.force, *T = sim->s.torque;
     CD_WIDE_MIN
     CD_ARGS(sim)
-    CD_STEP_FOR(n, CD_ARGS_IN firstprivate(F, T))
+    CD_STEP_FOR(n, CD_ARGS_IN CD_DEV(is_device_ptr(F, T)))
     for (size_t q = 0; q < n; q++)
         cd_item_gather_to(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
                           CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.order.part_uid, F, T);
+#if CD_OFFLOAD
+    if (device) {
+        cd_off_force_from(sim);
+        cd_off_force_map(sim, 0);
+    }
+#endif
 }
 
 void cd_sim_force_before_build(cd_sim *sim)
