@@ -119,6 +119,20 @@ void cd_off_force_map(cd_sim *sim, int map)
     off_refresh_cols(sim, o);
 }
 
+void cd_off_force_sums(cd_sim *sim, int map, cd_vec3 **F, cd_vec3 **T)
+{
+    size_t n = sim->s.n_particles;
+    cd_vec3 *f = sim->s.force, *t = sim->s.torque;
+    if (map) {
+#pragma omp target enter data map(alloc : f [0:n], t [0:n])
+        *F = off_devptr(f);
+        *T = off_devptr(t);
+        return;
+    }
+#pragma omp target update from(f [0:n], t [0:n])
+#pragma omp target exit data map(release : f [0:n], t [0:n])
+}
+
 /* The device's force and torque into the host's columns (where mapped). */
 void cd_off_force_from(cd_sim *sim)
 {

@@ -64,6 +64,12 @@ void cd_off_from(void *p, size_t bytes);
 void cd_off_force_map(cd_sim *sim, int map);
 /* The mapped force and torque back into the host's columns. */
 void cd_off_force_from(cd_sim *sim);
+/* Device copies of the host's force and torque columns for the sums of a
+ * sync, outside the step's columns (so the loops' argument block does
+ * not change: docs/offload.md, "Per-step copies"): map = 1 maps them
+ * (nothing copied) and gives their device addresses in *F, *T; map = 0
+ * copies them back into the host's columns and unmaps them. */
+void cd_off_force_sums(cd_sim *sim, int map, cd_vec3 **F, cd_vec3 **T);
 /* Brings the device's argument block (cd_step_block) up to date for this
  * state (`target update`: a copy the device refuses stops the run in the
  * OpenMP runtime, which has no error return for it). */

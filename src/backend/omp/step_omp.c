@@ -194,8 +194,9 @@ static void compute_forces(cd_sim *sim)
  * columns are current: a start without forces).  Host memory: once after
  * steps (a second sync finds the columns in user order, host_user, and
  * the force written); an offload device: at every sync, into a copy
- * mapped for it (the host's columns, which every sync moves to user
- * order, are written anew each time as the wall rows are). */
+ * mapped for it, outside the step's columns (the host's columns, which
+ * every sync moves to user order, are written anew each time as the wall
+ * rows are; the loops' argument block stays as it is). */
 static void force_to_host(cd_sim *sim)
 {
     size_t n = sim->s.n_particles;
@@ -203,11 +204,7 @@ static void force_to_host(cd_sim *sim)
     if (cd_sim_keeps_force(sim) || !sim->nb.force_summed || !n || (!device && sim->nb.host_user)) return;
     cd_vec3 *F = sim->s.force, *T = sim->s.torque;
 #if CD_OFFLOAD
-    if (device) {
-        cd_off_force_map(sim, 1);
-        F = ((cd_off *)sim->backend_data)->dev.force;
-        T = ((cd_off *)sim->backend_data)->dev.torque;
-    }
+    if (device) cd_off_force_sums(sim, 1, &F, &T);
 #endif
     CD_WIDE_MIN
     CD_ARGS(sim)
@@ -216,10 +213,7 @@ static void force_to_host(cd_sim *sim)
         cd_item_gather_to(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
                           CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.order.part_uid, F, T);
 #if CD_OFFLOAD
-    if (device) {
-        cd_off_force_from(sim);
-        cd_off_force_map(sim, 0);
-    }
+    if (device) cd_off_force_sums(sim, 0, &F, &T);
 #endif
 }
 
