@@ -51,11 +51,22 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
     double iso = s->inertia_iso ? 16 : 0;
     double ends = P * (24 + idx) + Arms * 24, advance_prims = P * (idx + 24) + Arms * (48 + 24);
     double advance_writes = P * 24 + Arms * 24;
+    /* the gather's part: per wall candidate its entry and flag (8), per
+     * active wall row force and torque (48); per pair row two entries (8)
+     * and, active or not (an inactive row adds its zero force: no branch),
+     * its force and point from each side (2 x 48); where the gather skips
+     * the rows out of contact (CD_GATHER_SKIPS_INACTIVE: the offload
+     * variants) the row's flag from each side (2 x 4) and the force and
+     * point of the active rows only */
+    double gather_rows = C * 8 + Aw * 48 + R * 8 + (CD_GATHER_SKIPS_INACTIVE ? R * 8 + A * 96 : R * 96);
     /* advance (cd_item_advance: kick, drift, primitive ends, skin test):
-     * reads v, L, F, T, x (24 each), m (8), q (32), I (24) and per primitive
-     * advance_prims; writes x, q, v, L, omega and the primitives' world
-     * ends (advance_writes). */
-    cd_traffic advance = {"advance", N * (184 - iso) + advance_prims, N * 128 + advance_writes};
+     * reads v, L, x (24 each), m (8), q (32), I (24) and per primitive
+     * advance_prims, and the force and torque summed from the rows as the
+     * gather sums them (the two CSR starts, 8, and gather_rows; one process
+     * holds no force and torque between calls, kernels/cols.h: an MPI rank
+     * reads its two columns, 48, instead); writes x, q, v, L, omega and the
+     * primitives' world ends (advance_writes). */
+    cd_traffic advance = {"advance", N * (136 - iso + 8) + advance_prims + gather_rows, N * 128 + advance_writes};
     /* CD_ENDS_FROM_POSE (the offload variants, step_items.h): no world ends
      * written and no primitive read by the skin test, which reads the pose
      * at the last build (64 B a particle) and its primitives only when its
@@ -63,7 +74,7 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * that use the ends read the particle's orientation (32) besides an
      * arm's body-frame ends (48) in place of the world ends (end a and an
      * arm's b). */
-    if (CD_ENDS_FROM_POSE) advance = (cd_traffic){"advance", N * (184 - iso + 64), N * 128};
+    if (CD_ENDS_FROM_POSE) advance = (cd_traffic){"advance", N * (136 - iso + 8 + 64) + gather_rows, N * 128};
     double pose = CD_ENDS_FROM_POSE ? 32 : 0; /* the orientation, per particle a pass reads */
     if (CD_ENDS_FROM_POSE) ends = P * idx + Arms * 48;
     /* cd_item_pair_force: every row its primitives and flag (12); the
@@ -87,30 +98,21 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * (80); writes flag, history, force, torque, overlap, F_n. */
     double wall_cand = CD_ENDS_FROM_POSE ? C * (20 + idx + 56) + Ca * 48 : C * (44 + idx) + Ca * 24;
     out[1] = (cd_traffic){"wall_forces", wall_cand + Aw * (24 + 80), Aw * 92};
-    /* the gather's part: per wall candidate its entry and flag (8), per
-     * active wall row force and torque (48); per pair row two entries (8)
-     * and, active or not (an inactive row adds its zero force: no branch),
-     * its force and point from each side (2 x 48); where the gather skips
-     * the rows out of contact (CD_GATHER_SKIPS_INACTIVE: the offload
-     * variants) the row's flag from each side (2 x 4) and the force and
-     * point of the active rows only */
-    double gather_rows = C * 8 + Aw * 48 + R * 8 + (CD_GATHER_SKIPS_INACTIVE ? R * 8 + A * 96 : R * 96);
     /* The gather, the second kick and the next step's advance in one item
      * (cd_item_gather_kick_advance; omp on host threads and offload, and
      * OpenCL's cd_cl_gather_kick in mode 2) reading the particle once: m,
      * x, the two CSR starts (40), v, L, q, I (104), its primitive range
      * (8), its primitives' as the advance (advance_prims); writes v, L, x,
-     * omega (96), q (32) and the primitives' world ends (advance_writes),
-     * and F, T (48) at the last step of a call only.  The advance of its
-     * own runs once per call of the step. */
-    double force_writes = N * 48 / steps_per_call;
-    out[2] = (cd_traffic){"gather_kick_advance", N * (152 - iso) + advance_prims + gather_rows,
-                          N * 128 + force_writes + advance_writes};
+     * omega (96), q (32) and the primitives' world ends (advance_writes);
+     * no F, T (one process holds none between calls: kernels/cols.h; an
+     * MPI rank writes them at its last step).  The advance of its own runs
+     * once per call of the step. */
+    out[2] =
+        (cd_traffic){"gather_kick_advance", N * (152 - iso) + advance_prims + gather_rows, N * 128 + advance_writes};
     /* with CD_ENDS_FROM_POSE: the pose at the build (64) instead of the
      * primitive range and the primitives' ends (8 + advance_prims), no ends
      * written */
-    if (CD_ENDS_FROM_POSE)
-        out[2] = (cd_traffic){"gather_kick_advance", N * (144 - iso + 64) + gather_rows, N * 128 + force_writes};
+    if (CD_ENDS_FROM_POSE) out[2] = (cd_traffic){"gather_kick_advance", N * (144 - iso + 64) + gather_rows, N * 128};
     out[3] = (cd_traffic){"advance", advance.read / steps_per_call, advance.write / steps_per_call};
     /* the blow-up check at the end of each call of the step (x, v, L) */
     out[4] = (cd_traffic){"finite_check", N * 72 / steps_per_call, 0};

@@ -40,6 +40,16 @@ typedef struct {
      * particle in inertia_iso (16 B a sphere less; cd_inertia_of). */
     cd_col_cd_vec3 inertia;
     cd_col_cd_real inertia_iso;
+    /* The particles' total force [N] and torque [N m] (the host's columns
+     * of fields.def group PARTICLE_OUT) where the step holds them: on an
+     * MPI rank (the ghosts' come from their owners between calls), and
+     * from a start to its first advance (the host's values); null
+     * otherwise, and then the first advance of a call sums them from the
+     * rows (cd_item_advance) and the last step writes none (48 B a
+     * particle less; docs/performance.md, "Session 18, force and torque
+     * not held").  The test is the same for every item. */
+    cd_col_cd_vec3 force;
+    cd_col_cd_vec3 torque;
 } cd_cols;
 
 CD_DEVICE_BEGIN

@@ -44,17 +44,6 @@ CD_DEVICE_BEGIN
  * largest distance of a body-frame end from the centre). */
 #define CD_REF_POSE 8
 
-/* Half kick of particle q over h = dt/2 [s] (docs/references.md, Motion), then its angular
- * velocity from the new angular momentum. */
-CD_INLINE void cd_item_kick(cd_cols c, cd_particle_id q, cd_real h)
-{
-    cd_vec3 v = c.velocity[q], L = c.angmom[q];
-    cd_rigid_kick(&v, &L, c.force[q], c.torque[q], c.mass[q], h);
-    c.velocity[q] = v;
-    c.angmom[q] = L;
-    c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, cd_inertia_of(c, q));
-}
-
 /* Drift of particle q over dt [s]: position and free rotation (docs/references.md, Motion). */
 CD_INLINE void cd_item_drift(cd_cols c, cd_particle_id q, cd_real dt)
 {
@@ -269,21 +258,6 @@ CD_INLINE_ALWAYS int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_
     (void)ref_pose;
     return cd_store_ends(c, q, x, o, 1, limit2);
 #endif
-}
-
-/* Steps 1-4 of particle q in one pass over its data: the first half kick
- * over dt/2, the drift over dt [s], the world ends of its primitives, and
- * the skin test of those ends (limit2 = (skin/2)^2 [m^2], broadphase.h;
- * ref_pose: the poses at the last build when CD_ENDS_FROM_POSE, which
- * stores no ends here, else unused).
- * Returns 1 when one of its primitives moved more than half the skin since
- * the last neighbour-list build.  The same arithmetic as the four items
- * one after the other: fused because each reads what the one before wrote
- * (docs/performance.md, "Bytes per step"). */
-CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, cd_real dt, cd_real limit2,
-                              const CD_GLOBAL cd_real *ref_pose)
-{
-    return cd_advance_from(c, q, c.velocity[q], c.angmom[q], c.force[q], c.torque[q], c.mass[q], dt, limit2, ref_pose);
 }
 
 /* Contact geometry of two primitives (axis ends ai, bi and aj, bj, radii
@@ -590,28 +564,80 @@ CD_INLINE void cd_gather_sum(cd_cols c, cd_particle_id q, cd_real m, cd_vec3 x, 
     *T_out = T;
 }
 
-/* cd_gather_sum for particle q, stored as its force and torque. */
-CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
-                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
-                              const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension)
+/* cd_gather_sum for particle q (a memory slot), stored in the rows
+ * cd_map(uid, q) of force [N] and torque [N m]: the sync's force and
+ * torque in user order (uid: each slot's user id; null where memory order
+ * is user order), the sums the first advance of the next call makes. */
+CD_INLINE void cd_item_gather_to(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
+                                 const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
+                                 const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
+                                 const CD_GLOBAL cd_int *uid, CD_GLOBAL cd_vec3 *force, CD_GLOBAL cd_vec3 *torque)
 {
     cd_vec3 F, T;
     cd_gather_sum(c, q, c.mass[q], c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension,
                   &F, &T);
-    c.force[q] = F;
-    c.torque[q] = T;
+    cd_long r = cd_map(uid, q);
+    force[r] = F;
+    torque[r] = T;
 }
 
-/* cd_item_gather, then the second half kick over dt/2 (cd_item_kick) and,
- * with next = 1, the next step's cd_item_advance (returns its skin test),
- * all on particle q's state read once (cd_advance_from): the same
- * arithmetic in the same order as the three items one after the other.
- * The force and torque go into their columns at the call's last step only
- * (next = 0): within a call only this item's advance reads them, from its
- * locals; the next call's first advance (cd_item_advance), output, the
- * observables and the protocols read the columns after a call (48 B
- * written a particle-step less; docs/performance.md, "Session 16, issue
- * 21"). */
+/* cd_gather_sum for particle q, stored as its force and torque where the
+ * step holds them (c.force, c.torque: not null; a start's forces). */
+CD_INLINE void cd_item_gather(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
+                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
+                              const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension)
+{
+    cd_item_gather_to(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension,
+                      (const CD_GLOBAL cd_int *)0, c.force, c.torque);
+}
+
+/* Steps 1-4 of particle q in one pass over its data: the first half kick
+ * over dt/2, the drift over dt [s], the world ends of its primitives, and
+ * the skin test of those ends (limit2 = (skin/2)^2 [m^2], broadphase.h;
+ * ref_pose: the poses at the last build when CD_ENDS_FROM_POSE, which
+ * stores no ends here, else unused).
+ * Returns 1 when one of its primitives moved more than half the skin since
+ * the last neighbour-list build.  The same arithmetic as the four items
+ * one after the other: fused because each reads what the one before wrote
+ * (docs/performance.md, "Bytes per step").
+ * The kick's force and torque: where the step holds them (c.force not
+ * null), particle q's rows cd_map(uid, q) of c.force, c.torque (an MPI
+ * rank's, uid null; the host's, in user order: uid each memory slot's user
+ * id, after a start or a build between calls); else summed again from the
+ * pair rows and wall entries of the last force evaluation with the
+ * gather's arguments (cd_gather_sum: the sum the last step's gather made,
+ * the same rows in the same order at the same positions, so the same bits;
+ * docs/performance.md, "Session 18, force and torque not held"). */
+CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
+                              const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
+                              const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
+                              const CD_GLOBAL cd_int *uid, cd_real dt, cd_real limit2,
+                              const CD_GLOBAL cd_real *ref_pose)
+{
+    cd_real m = c.mass[q];
+    cd_vec3 F, T;
+    if (c.force) {
+        cd_long r = cd_map(uid, q);
+        F = c.force[r];
+        T = c.torque[r];
+    } else {
+        cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F,
+                      &T);
+    }
+    return cd_advance_from(c, q, c.velocity[q], c.angmom[q], F, T, m, dt, limit2, ref_pose);
+}
+
+/* cd_gather_sum, then the second half kick over dt/2 (cd_rigid_kick and
+ * the angular velocity) and, with next = 1, the next step's
+ * cd_item_advance (returns its skin test), all on particle q's state read
+ * once (cd_advance_from): the same arithmetic in the same order as the
+ * three items one after the other.  The force and torque go into their
+ * columns at the call's last step only (next = 0), and only where the step
+ * holds them (c.force not null: an MPI rank, whose ghosts' come from their
+ * owners): within a call only this item's advance reads them, from its
+ * locals, and the next call's first advance and sync sum them again
+ * (docs/performance.md, "Session 16, issue 21" and "Session 18, force and
+ * torque not held"). */
 CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_int *gather_start,
                                                  const CD_GLOBAL cd_pair_id *gather_rows,
                                                  const CD_GLOBAL cd_int *wall_start,
@@ -622,7 +648,7 @@ CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, co
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
     cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F, &T);
-    if (!next) {
+    if (!next && c.force) {
         c.force[q] = F;
         c.torque[q] = T;
     }

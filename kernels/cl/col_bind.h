@@ -8,3 +8,5 @@ c.prim_arm = prim_arm;
 c.arm = arm;
 c.inertia = inertia;
 c.inertia_iso = inertia_iso;
+c.force = force;
+c.torque = torque;

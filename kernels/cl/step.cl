@@ -9,14 +9,21 @@
 /* Steps 1-4: first half kick, drift, world ends of the particle's
  * primitives and their skin test (cd_item_advance); any particle with a
  * primitive past half the skin raises flags[0] (every writer writes 1, so
- * the race is harmless); item w < n_walls also moves wall w. */
+ * the race is harmless); item w < n_walls also moves wall w.  The kick's
+ * force and torque: the columns where bound (not null: a start's, an MPI
+ * rank's), else summed from the rows with the gather's arguments
+ * (gather_start .. dimension, as cd_cl_gather_kick takes them). */
 __kernel void cd_cl_advance(
 #include "col_params.h"
-    __global cd_wall *walls, cd_int n_walls, cd_int n_particles, cd_real dt, cd_real limit2, __global cd_int *flags)
+    __global cd_wall *walls, cd_int n_walls, cd_int n_particles, cd_real dt, cd_real limit2, __global cd_int *flags,
+    __global const cd_int *gather_start, __global const cd_pair_id *gather_rows, __global const cd_int *wall_start,
+    __global const cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
-    if (q < n_particles && cd_item_advance(c, q, dt, limit2, 0)) flags[0] = 1;
+    if (q < n_particles &&
+        cd_item_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, 0, dt, limit2, 0))
+        flags[0] = 1;
     if (q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
 }
 

@@ -93,6 +93,11 @@ typedef struct {
     int walls_from_host;             /* the next build takes the wall history from the host's rows (a start) */
     int wall_out_valid;              /* d.wall_out holds the step's wall-contact outputs (forces since start) */
     int wall_out_pending;            /* ... newer than the host's columns (expanded at sync) */
+    int force_summed;                /* 1: the first advance of a call sums the force and torque from the
+                                        rows (a force evaluation since the start, cd_item_advance); 0 (a
+                                        start without forces, a state never started, a build between calls:
+                                        cd_sim_force_before_build): it reads the host's */
+    int in_step;                     /* 1 while a call of the step runs (its builds keep no force) */
     cd_nb_lists d;                   /* lists and scratch, where the loops run */
     size_t cap_rows;                 /* rows that keys and gather_rows (twice) hold */
     size_t cap_old;                  /* rows that old_keys, old_active, old_shear hold */
@@ -157,6 +162,15 @@ typedef struct cd_sim {
         size_t n_particles, n_prims;
     } part;
 } cd_sim;
+
+/* Does the step hold the particles' force and torque between calls
+ * (kernels/cols.h, cd_cols.force)?  On an MPI rank (its rebuild hook set,
+ * src/mpi/mpi_backend.c): each call is one step and the ghosts' force and
+ * torque come from their owners between calls (cd_item_ghost_io), so the
+ * step writes them at its last step and its first advance reads them.  In
+ * one process it holds none: the first advance and sync sum them from the
+ * rows (docs/performance.md, "Session 18, force and torque not held"). */
+static inline int cd_sim_keeps_force(const cd_sim *sim) { return sim->rebuild_hook != NULL; }
 
 /* Builds a simulation from a validated config: shapes, particles placed as
  * init.* says, walls of the domain, step parameters.  Checks the time step

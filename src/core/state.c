@@ -10,7 +10,9 @@
 #define CD_GROUP_OF_PARTICLE CD_GROUP_PARTICLE
 #define CD_GROUP_OF_PRIM     CD_GROUP_PRIM
 #define CD_GROUP_OF_PAIR     CD_GROUP_PAIR
-/* PARTICLE_HOST: rows of PARTICLE on the host; no device holds them. */
+/* PARTICLE_OUT, PARTICLE_HOST: rows of PARTICLE on the host; no device
+ * holds them as columns of the table (the force and torque: kernels/cols.h). */
+#define CD_GROUP_OF_PARTICLE_OUT  CD_GROUP_PARTICLE
 #define CD_GROUP_OF_PARTICLE_HOST CD_GROUP_PARTICLE
 /* PRIM_ARM: rows of PRIM on the host; a device holds them per arm (cd_arm,
  * cd_state_arms_derive below). */

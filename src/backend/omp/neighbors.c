@@ -469,7 +469,10 @@ int cd_neighbors_build(cd_sim *sim)
     cd_state *s = &sim->s;
     cd_neighbors *nb = &sim->nb;
     cd_int P = (cd_int)s->n_prims, N = (cd_int)s->n_particles;
-    /* host threads after a sync: the columns back in the lists' order */
+    /* a build between calls: the force and torque the rows hold to the host
+     * first (step_omp.c); host threads after a sync: the columns back in
+     * the lists' order */
+    cd_sim_force_before_build(sim);
     if (cd_reorder_to_memory(sim) || reserve(nb, s, s->n_pairs)) return -1;
     /* the old rows' history aside, keyed in the order they were made in */
     if (keep_history(sim) || keep_wall_history(sim)) return -1;

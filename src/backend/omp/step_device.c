@@ -37,6 +37,9 @@ cd_cols cd_sim_host_cols(cd_state *s)
      * (set up by hand, not started) the host's column, in its order */
     c.inertia = s->inertia_iso ? NULL : s->step_inertia ? s->step_inertia : s->inertia;
     c.inertia_iso = s->inertia_iso;
+    /* the host's force and torque (the step's: cd_sim_step_cols) */
+    c.force = s->force;
+    c.torque = s->torque;
     return c;
 }
 
@@ -92,7 +95,49 @@ static void off_refresh_cols(cd_sim *sim, cd_off *o)
     d.arm = off_devptr(o->arm_host[1]);
     d.step_inertia = o->arm_host[2] ? off_devptr(o->arm_host[2]) : NULL;
     d.inertia_iso = o->arm_host[3] ? off_devptr(o->arm_host[3]) : NULL;
+    d.force = o->force_host[0] ? off_devptr(o->force_host[0]) : NULL;
+    d.torque = o->force_host[1] ? off_devptr(o->force_host[1]) : NULL;
     o->dev = cd_sim_host_cols(&d);
+}
+
+/* The host's force and torque mapped (to the device: copied there) where
+ * the step holds them (kernels/cols.h: an MPI rank, or from a start to its
+ * first advance), or unmapped (nothing copied back: an MPI rank's sync
+ * copies them, cd_off_force_from); the step's columns follow. */
+void cd_off_force_map(cd_sim *sim, int map)
+{
+    cd_off *o = sim->backend_data;
+    if (!o || !map == !o->force_host[0]) return;
+    size_t bytes = sim->s.n_particles * sizeof(cd_vec3);
+    void *cols[2] = {sim->s.force, sim->s.torque};
+    for (int k = 0; k < 2; k++) {
+        if (map) off_map(cols[k], bytes);
+        else off_unmap(o->force_host[k], o->force_bytes);
+        o->force_host[k] = map && bytes ? cols[k] : NULL;
+    }
+    o->force_bytes = map ? bytes : 0;
+    off_refresh_cols(sim, o);
+}
+
+void cd_off_force_sums(cd_sim *sim, int map, cd_vec3 **F, cd_vec3 **T)
+{
+    size_t n = sim->s.n_particles;
+    cd_vec3 *f = sim->s.force, *t = sim->s.torque;
+    if (map) {
+#pragma omp target enter data map(alloc : f [0:n], t [0:n])
+        *F = off_devptr(f);
+        *T = off_devptr(t);
+        return;
+    }
+#pragma omp target update from(f [0:n], t [0:n])
+#pragma omp target exit data map(release : f [0:n], t [0:n])
+}
+
+/* The device's force and torque into the host's columns (where mapped). */
+void cd_off_force_from(cd_sim *sim)
+{
+    cd_off *o = sim->backend_data;
+    for (int k = 0; o && k < 2; k++) cd_off_from(o->force_host[k], o->force_bytes);
 }
 
 /* Maps field f at its current host address and size (none for the
@@ -112,6 +157,7 @@ void cd_off_release(cd_sim *sim)
     if (!o) return;
     for (size_t f = 0; f < cd_n_fields; f++) off_unmap(o->host[f], o->bytes[f]);
     for (int k = 0; k < CD_OFF_DERIVED; k++) off_unmap(o->arm_host[k], o->arm_bytes[k]);
+    for (int k = 0; k < 2; k++) off_unmap(o->force_host[k], o->force_bytes);
     off_unmap(o->part, o->part_n * sizeof(double));
     free(o->part);
     free(o->host);
@@ -180,6 +226,9 @@ int cd_off_acquire(cd_sim *sim, char *err, size_t errlen)
     for (int k = 0; k < CD_OFF_DERIVED; k++) off_map(o->arm_host[k], o->arm_bytes[k]);
     off_map(o->part, o->part_n * sizeof(double));
     off_refresh_cols(sim, o);
+    /* the host's force and torque for the first advance (a start), or for
+     * the whole run on an MPI rank (kernels/cols.h) */
+    cd_off_force_map(sim, 1);
     return 0;
 }
 
@@ -249,7 +298,12 @@ cd_cols cd_sim_step_cols(cd_sim *sim)
 #if CD_OFFLOAD
     if (sim->backend_data) return ((cd_off *)sim->backend_data)->dev;
 #endif
-    return cd_sim_host_cols(&sim->s);
+    cd_cols c = cd_sim_host_cols(&sim->s);
+    /* the force and torque where the step holds them (kernels/cols.h): the
+     * host's columns on an MPI rank, and until the first advance after a
+     * start; null once the rows hold a force evaluation (summed again) */
+    if (!cd_sim_keeps_force(sim) && sim->nb.force_summed) c.force = c.torque = NULL;
+    return c;
 }
 
 /* The block for the state as it is now, padding zeroed (blocks are

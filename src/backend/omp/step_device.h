@@ -40,7 +40,12 @@ typedef struct {
      * (kernels/cols.h; NULL: none) */
     void *arm_host[CD_OFF_DERIVED];
     size_t arm_bytes[CD_OFF_DERIVED]; /* their bytes mapped */
-    double *part;                     /* per-chunk partial sums of the wall load (mapped) */
+    /* the host's force and torque columns, mapped where the step holds
+     * them (kernels/cols.h: an MPI rank; from a start to its first
+     * advance), else NULL */
+    void *force_host[2];
+    size_t force_bytes;
+    double *part; /* per-chunk partial sums of the wall load (mapped) */
     size_t part_n;
     cd_cols dev;              /* device addresses of the columns */
     long long args_copies[2]; /* copies of the block's head and of its walls since start */
@@ -54,6 +59,17 @@ int cd_off_acquire(cd_sim *sim, char *err, size_t errlen);
 void cd_off_release(cd_sim *sim);
 /* Copies bytes at host address p back from the device. */
 void cd_off_from(void *p, size_t bytes);
+/* Maps (map = 1: copied to the device) or unmaps the host's force and
+ * torque columns, the step's while mapped (kernels/cols.h, cd_cols.force). */
+void cd_off_force_map(cd_sim *sim, int map);
+/* The mapped force and torque back into the host's columns. */
+void cd_off_force_from(cd_sim *sim);
+/* Device copies of the host's force and torque columns for the sums of a
+ * sync, outside the step's columns (so the loops' argument block does
+ * not change: docs/offload.md, "Per-step copies"): map = 1 maps them
+ * (nothing copied) and gives their device addresses in *F, *T; map = 0
+ * copies them back into the host's columns and unmaps them. */
+void cd_off_force_sums(cd_sim *sim, int map, cd_vec3 **F, cd_vec3 **T);
 /* Brings the device's argument block (cd_step_block) up to date for this
  * state (`target update`: a copy the device refuses stops the run in the
  * OpenMP runtime, which has no error return for it). */
@@ -79,6 +95,15 @@ extern cd_step_args cd_step_block;
 /* The block for the state as it is now, padding zeroed (blocks are
  * compared byte by byte). */
 void cd_step_args_fill(cd_sim *sim, cd_step_args *a);
+
+/* Called by a neighbour-list build before it replaces the rows: a build
+ * between calls of the step (tests do it) takes away the rows the next
+ * call's first advance would sum the force and torque from, so these go
+ * to the host's columns first, where that advance then reads them (user
+ * order; kernels/cols.h).  Nothing inside a call (its first advance has
+ * used them), on an MPI rank (its step holds them) or after a start
+ * without forces (the host's are current). */
+void cd_sim_force_before_build(cd_sim *sim);
 
 /* A loop's arguments: `CD_ARGS(sim)` makes the block for the state as it
  * is now, `CD_ARGS_IN` hands it to a CD_STEP_FOR loop and `CD_A` names

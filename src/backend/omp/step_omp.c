@@ -58,11 +58,34 @@ static int skin_flag_read(cd_sim *sim)
 }
 #endif
 
+/* The rows of the host's force and torque for each memory slot where the
+ * first advance reads them (cd_item_advance): the host's columns are in
+ * user order (each slot's user id, where the loops run; null where memory
+ * order is user order, as always on an MPI rank, whose step's columns
+ * they are). */
+static const cd_int *host_force_order(cd_sim *sim)
+{
+    return cd_sim_keeps_force(sim) ? NULL : cd_sim_step_order(sim).part_uid;
+}
+
+/* After the first advance of a call: the next one sums the force and
+ * torque from the rows (kernels/cols.h), and a device lets go of the
+ * host's copy it held since the start (an MPI rank keeps its columns). */
+static void host_force_used(cd_sim *sim)
+{
+    sim->nb.force_summed = 1;
+#if CD_OFFLOAD
+    if (!cd_sim_keeps_force(sim)) cd_off_force_map(sim, 0);
+#endif
+}
+
 /* Steps 1-4 in one pass per particle (cd_item_advance): half kick, drift,
  * world ends of its primitives and the skin test.  Returns 1 when some end
  * moved more than half the skin; on the offload device one int comes
  * back.  (Run once per call of the step; the next steps' advance is fused
- * into the gather: gather_kick_advance.) */
+ * into the gather: gather_kick_advance.)  Its force and torque: summed
+ * from the rows of the last force evaluation, or where the step holds
+ * them (a start's first advance, an MPI rank) read (cd_item_advance). */
 static int advance_particles(cd_sim *sim)
 {
     size_t n = sim->s.n_particles;
@@ -75,19 +98,26 @@ static int advance_particles(cd_sim *sim)
      * way and a cross-team combine (docs/offload.md, "Per-step copies"). */
     if (!skin_flag(sim)) return 1; /* without the flag: a rebuild each step, still correct */
     CD_ARGS(sim)
-    CD_STEP_FOR(n, CD_ARGS_IN)
+    const cd_int *uid = host_force_order(sim);
+    CD_STEP_FOR(n, CD_ARGS_IN is_device_ptr(uid))
     for (size_t q = 0; q < n; q++)
-        if (cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose)) {
+        if (cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2,
+                            CD_A.d.ref_pose)) {
 #pragma omp atomic write
             CD_A.d.skin_flag[0] = 1;
         }
     moved = skin_flag_read(sim);
 #else
     CD_ARGS(sim)
-    CD_STEP_FOR(n, CD_ARGS_IN reduction(| : moved))
+    const cd_int *uid = host_force_order(sim);
+    CD_STEP_FOR(n, CD_ARGS_IN firstprivate(uid) reduction(| : moved))
     for (size_t q = 0; q < n; q++)
-        moved |= cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
+        moved |=
+            cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
 #endif
+    host_force_used(sim);
     return moved;
 }
 
@@ -159,12 +189,55 @@ static void gather(cd_sim *sim)
 }
 
 /* Forces for the current positions (neighbour list up to date), without
- * a kick (a start). */
+ * a kick (a start): into the step's force and torque (the host's columns,
+ * or a device's copy of them: the start maps them), which the first
+ * advance need not read: it sums them again from the rows. */
 static void compute_forces(cd_sim *sim)
 {
     pair_forces(sim, 1);
     wall_forces(sim);
     gather(sim);
+    host_force_used(sim);
+}
+
+/* The particles' force and torque into the host's columns, in user order,
+ * summed from the rows as the next call's first advance sums them
+ * (cd_item_gather_to): at sync, where the step holds none (one process)
+ * and the rows hold a force evaluation since the start (else the host's
+ * columns are current: a start without forces).  Host memory: once after
+ * steps (a second sync finds the columns in user order, host_user, and
+ * the force written); an offload device: at every sync, into a copy
+ * mapped for it, outside the step's columns (the host's columns, which
+ * every sync moves to user order, are written anew each time as the wall
+ * rows are; the loops' argument block stays as it is). */
+static void force_to_host(cd_sim *sim)
+{
+    size_t n = sim->s.n_particles;
+    int device = !cd_step_memory_is_host();
+    if (cd_sim_keeps_force(sim) || !sim->nb.force_summed || !n || (!device && sim->nb.host_user)) return;
+    cd_vec3 *F = sim->s.force, *T = sim->s.torque;
+#if CD_OFFLOAD
+    if (device) cd_off_force_sums(sim, 1, &F, &T);
+#endif
+    CD_WIDE_MIN
+    CD_ARGS(sim)
+    CD_STEP_FOR(n, CD_ARGS_IN CD_DEV(is_device_ptr(F, T)))
+    for (size_t q = 0; q < n; q++)
+        cd_item_gather_to(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                          CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.order.part_uid, F, T);
+#if CD_OFFLOAD
+    if (device) cd_off_force_sums(sim, 0, &F, &T);
+#endif
+}
+
+void cd_sim_force_before_build(cd_sim *sim)
+{
+    if (sim->nb.in_step || !sim->nb.force_summed || cd_sim_keeps_force(sim)) return;
+    force_to_host(sim);
+    sim->nb.force_summed = 0;
+#if CD_OFFLOAD
+    cd_off_force_map(sim, 1);
+#endif
 }
 
 #if !CD_OFFLOAD
@@ -198,10 +271,23 @@ __attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_
                                                                   cd_int dim, cd_real dt, cd_real limit2, int next)
 {
     int moved = 0;
+    /* next a constant in each loop (every thread takes the same one): the
+     * item's store of the force and torque at a call's last step, and its
+     * test of the columns (kernels/cols.h), leave the steps' loop, which
+     * otherwise tested them for every particle (callgrind, 10,000
+     * spheres: 11.6 instructions a particle-step; docs/performance.md,
+     * "Session 18, force and torque not held") */
+    if (next) {
 #pragma omp for schedule(static) nowait /* the region's end is the barrier */
-    for (size_t q = 0; q < n; q++)
-        moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                             d.wall_out, g, dim, dt, limit2, d.ref_pose, next);
+        for (size_t q = 0; q < n; q++)
+            moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
+                                                 d.wall_out, g, dim, dt, limit2, d.ref_pose, 1);
+    } else {
+#pragma omp for schedule(static) nowait
+        for (size_t q = 0; q < n; q++)
+            moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
+                                                 d.wall_out, g, dim, dt, limit2, d.ref_pose, 0);
+    }
     return moved;
 }
 #endif
@@ -440,6 +526,7 @@ static void omp_stop(cd_sim *sim)
     cd_off_release(sim);
 #endif
     sim->nb.wall_out_valid = sim->nb.wall_out_pending = 0;
+    sim->nb.force_summed = 0; /* the next first advance: the host's force and torque */
 }
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen);
@@ -485,6 +572,8 @@ static int omp_start(cd_sim *sim, int compute, char *err, size_t errlen)
     return 0;
 }
 
+static int step_calls(cd_sim *sim, long long n, char *err, size_t errlen);
+
 static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
 {
     cd_state *s = &sim->s;
@@ -503,6 +592,18 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory putting the particles in memory order");
         return -1;
     }
+    /* (a build inside a call takes no force from the rows: the first
+     * advance has used them; cd_sim_force_before_build) */
+    sim->nb.in_step = 1;
+    int rc = step_calls(sim, n, err, errlen);
+    sim->nb.in_step = 0;
+    return rc ? rc : check_step_state(sim, err, errlen);
+}
+
+/* omp_step's steps, after the columns are in memory order. */
+static int step_calls(cd_sim *sim, long long n, char *err, size_t errlen)
+{
+    cd_state *s = &sim->s;
     int moved = n > 0 ? advance_particles(sim) : 0;
     for (long long it = 0; it < n; it++) {
         int rebuild = advance_walls(sim, moved);
@@ -523,12 +624,13 @@ static int omp_step(cd_sim *sim, long long n, char *err, size_t errlen)
         s->step++;
         s->time += sim->p.dt;
     }
-    return check_step_state(sim, err, errlen);
+    return 0;
 }
 
 static int omp_sync(cd_sim *sim, char *err, size_t errlen)
 {
     store_ends(sim);
+    force_to_host(sim); /* (one process; an MPI rank's below, with the columns) */
 #if CD_OFFLOAD
     /* The only full copy back: every device column, rows in use. */
     cd_off *o = sim->backend_data;
@@ -548,6 +650,9 @@ static int omp_sync(cd_sim *sim, char *err, size_t errlen)
      * step's inertia too, which cd_reorder_to_user moves with the rows */
     if (o)
         for (int k = 0; k < CD_OFF_DERIVED; k++) cd_off_from(o->arm_host[k], o->arm_bytes[k]);
+    /* an MPI rank's force and torque (kernels/cols.h; its local state is
+     * never reordered: user order) */
+    if (cd_sim_keeps_force(sim)) cd_off_force_from(sim);
     /* The host's wall rows anew as well, whenever the step has entries:
      * cd_reorder_to_user below moves every host column from memory order
      * at every sync, so rows not written again (a second sync without a

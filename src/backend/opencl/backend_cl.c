@@ -30,6 +30,12 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_ADVANCE, F + 3, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_ADVANCE, F + 4, sizeof limit2, &limit2);
     cd_cl_arg(cl, CD_CLK_ADVANCE, F + 5, sizeof cl->flags, &cl->flags);
+    /* the gather's, for the force and torque summed from the rows
+     * (cd_item_advance; gather_rows and wall_out: set_list_args) */
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 6, sizeof cl->gather_start, &cl->gather_start);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 8, sizeof cl->wall_start, &cl->wall_start);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 10, sizeof p->gravity, &p->gravity);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 11, sizeof p->dimension, &p->dimension);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 1, sizeof p->law, &p->law);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 2, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 3, sizeof p->sin_parallel, &p->sin_parallel);
@@ -69,6 +75,8 @@ static void set_list_args(cd_cl *cl)
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 1, sizeof cl->wall_rows, &cl->wall_rows);
     cd_cl_arg(cl, CD_CLK_WALL_FORCES, F + 8, sizeof cl->wall_out, &cl->wall_out);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 8, sizeof cl->wall_out, &cl->wall_out);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 7, sizeof cl->gather_rows, &cl->gather_rows);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 9, sizeof cl->wall_out, &cl->wall_out);
 }
 
 /* Rebuild of the list, then steps 5-8 (forces, gather, second kick) and
@@ -204,8 +212,11 @@ static int cl_step(cd_sim *sim, long long n, char *err, size_t errlen)
     memcpy(cl->host_walls, s->walls, sizeof cl->host_walls);
     size_t items = s->n_particles > s->n_walls ? s->n_particles : s->n_walls;
     /* the first step's advance; the next ones run inside the gather
-     * (mode 2 of cd_cl_gather_kick) */
+     * (mode 2 of cd_cl_gather_kick).  Its force and torque: the host's
+     * after a start (cl->force, then released: one process holds none
+     * after it), else summed from the rows (kernels/cols.h) */
     cd_cl_run(cl, CD_CLK_ADVANCE, items);
+    if (!cd_sim_keeps_force(sim)) cd_cl_force_release(cl);
     for (long long it = 0; it < n && !cl->status; it++) {
         /* the walls move on the device; their host mirror (the same
          * arithmetic) tells whether one moved far enough for a rebuild */

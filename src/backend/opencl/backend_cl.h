@@ -66,9 +66,10 @@ enum {
     CD_CL_N_FIELDS
 };
 /* Kernel arguments taken by the columns: the fields', then the
- * primitives' arms (prim_arm, arm) and the step's inertia (inertia,
- * inertia_iso: kernels/cl/col_params.h). */
-#define CD_CL_N_COLS (CD_CL_N_FIELDS + 4)
+ * primitives' arms (prim_arm, arm), the step's inertia (inertia,
+ * inertia_iso) and the force and torque where the step holds them (force,
+ * torque: kernels/cl/col_params.h). */
+#define CD_CL_N_COLS (CD_CL_N_FIELDS + 6)
 
 /* The pair columns that carry history across a rebuild exist twice: the
  * new list is filled from the old one.  One such set, with its keys. */
@@ -100,6 +101,11 @@ typedef struct cd_cl {
     /* the step's inertia (kernels/cols.h, cd_inertia_of): one of the two,
      * the other bound as null */
     cl_mem inertia, inertia_iso;
+    /* the particles' force and torque where the step holds them
+     * (kernels/cols.h, cd_cols.force): from a start to its first advance
+     * (the host's), for the whole run on an MPI rank; NULL otherwise (the
+     * first advance and the sync sum them from the rows), bound as null */
+    cl_mem force, torque;
     size_t cap_pairs;
     cd_cl_pairset hist[2];
     int cur;
@@ -208,6 +214,13 @@ cl_mem cd_cl_col(const cd_cl *cl, int f);
 /* Binds the column buffers to every kernel that takes them (after a buffer
  * was created or the history sets were swapped). */
 int cd_cl_bind_cols(cd_cl *cl);
+/* Binds force and torque (either may be NULL: bound as null) as the
+ * columns' force and torque of every kernel that takes the columns
+ * (kernels/cols.h, cd_cols.force). */
+int cd_cl_bind_force(cd_cl *cl, cl_mem force, cl_mem torque);
+/* Releases the host's force and torque that the step held since the start
+ * (after the first advance, in one process) and binds null in their place. */
+void cd_cl_force_release(cd_cl *cl);
 cl_mem cd_cl_buffer(cd_cl *cl, size_t bytes, const char *what);
 /* Sets count ints of buf from index first to value. */
 int cd_cl_fill_int(cd_cl *cl, cl_mem buf, cd_int value, size_t first, size_t count);

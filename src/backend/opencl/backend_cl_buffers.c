@@ -2,6 +2,7 @@
  * buffer, created once at start; only the pair columns grow (with
  * headroom) when the Verlet list outgrows them.  Uploads happen at start,
  * downloads at sync: between them the state lives on the device. */
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include "backend/opencl/backend_cl.h"
@@ -74,6 +75,25 @@ int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which)
     return cl->status ? -1 : 0;
 }
 
+int cd_cl_bind_force(cd_cl *cl, cl_mem force, cl_mem torque)
+{
+    for (int k = 0; k < CD_CLK_COUNT; k++) {
+        if (!cd_cl_kernel_takes_cols((enum cd_cl_kernel)k)) continue;
+        if (cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 4, sizeof force, &force) ||
+            cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 5, sizeof torque, &torque))
+            return -1;
+    }
+    return 0;
+}
+
+void cd_cl_force_release(cd_cl *cl)
+{
+    if (!cl->force && !cl->torque) return;
+    release(&cl->force);
+    release(&cl->torque);
+    cd_cl_bind_force(cl, NULL, NULL);
+}
+
 int cd_cl_bind_cols(cd_cl *cl)
 {
     for (int k = 0; k < CD_CLK_COUNT; k++) {
@@ -90,6 +110,7 @@ int cd_cl_bind_cols(cd_cl *cl)
             cd_cl_arg(cl, (enum cd_cl_kernel)k, CD_CL_N_FIELDS + 3, sizeof cl->inertia_iso, &cl->inertia_iso))
             return -1;
     }
+    if (cd_cl_bind_force(cl, cl->force, cl->torque)) return -1;
     cl->cols_dirty = 0;
     return 0;
 }
@@ -191,6 +212,10 @@ int cd_cl_buffers_create(cd_cl *cl, cd_sim *sim)
     cl->arm = cd_cl_buffer(cl, (s->n_arms + 1) * sizeof(cd_arm), "allocating the state");
     cl->inertia = s->step_inertia ? cd_cl_buffer(cl, (N + 1) * sizeof(cd_vec3), "allocating the state") : NULL;
     cl->inertia_iso = s->inertia_iso ? cd_cl_buffer(cl, (N + 1) * sizeof(cd_real), "allocating the state") : NULL;
+    /* the host's force and torque for the first advance (or the whole run
+     * on an MPI rank; kernels/cols.h): released after that advance */
+    cl->force = cd_cl_buffer(cl, (N + 1) * sizeof(cd_vec3), "allocating the state");
+    cl->torque = cd_cl_buffer(cl, (N + 1) * sizeof(cd_vec3), "allocating the state");
     cl->walls = cd_cl_buffer(cl, (W > 0 ? W : 1) * sizeof(cd_wall), "allocating the walls");
     cl->flags = cd_cl_buffer(cl, 3 * sizeof(cd_int), "allocating the flags");
     cl->scratch_real = cd_cl_buffer(cl, sizeof(cd_real), "allocating a result");
@@ -259,6 +284,8 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
     if (cl->inertia) write(cl, cl->inertia, s->n_particles * sizeof(cd_vec3), s->step_inertia, "uploading the state");
     if (cl->inertia_iso)
         write(cl, cl->inertia_iso, s->n_particles * sizeof(cd_real), s->inertia_iso, "uploading the state");
+    if (cl->force) write(cl, cl->force, s->n_particles * sizeof(cd_vec3), s->force, "uploading the state");
+    if (cl->torque) write(cl, cl->torque, s->n_particles * sizeof(cd_vec3), s->torque, "uploading the state");
     write(cl, cl->walls, s->n_walls * sizeof(cd_wall), s->walls, "uploading the walls");
     cd_int flags[3] = {0, -1, 0};
     write(cl, cl->flags, sizeof flags, flags, "uploading the flags");
@@ -289,16 +316,48 @@ int cd_cl_buffers_upload(cd_cl *cl, cd_sim *sim)
     return cl->status ? -1 : 0;
 }
 
-/* Is column f among the n fields at offsets only (NULL: every column)? */
-static int wanted(int f, const size_t *only, size_t n)
+/* Is the column at offset (in cd_state) among the n at offsets only
+ * (NULL: every column)? */
+static int wanted_at(size_t offset, const size_t *only, size_t n)
 {
     if (!only) return 1;
     for (size_t k = 0; k < n; k++)
-        if (cd_fields[f].offset == only[k]) return 1;
+        if (offset == only[k]) return 1;
     return 0;
 }
 
+/* Is column f among them? */
+static int wanted(int f, const size_t *only, size_t n) { return wanted_at(cd_fields[f].offset, only, n); }
+
 int cd_cl_buffers_download(cd_cl *cl, cd_sim *sim) { return cd_cl_buffers_download_cols(cl, sim, NULL, 0); }
+
+/* Where the step holds no force and torque (one process, after the first
+ * advance) and the rows hold a force evaluation: the two summed from the
+ * rows into the host's columns by the gather kernel (mode 0, cd_item_gather)
+ * in two buffers made for it, the sums the next call's first advance makes
+ * (kernels/cols.h); the OpenCL backend keeps the particles in user order. */
+static void force_summed_to_host(cd_cl *cl, cd_sim *sim)
+{
+    cd_state *s = &sim->s;
+    size_t bytes = s->n_particles * sizeof(cd_vec3);
+    if (cl->force || !cl->wall_out_valid || !bytes || cl->status) return;
+    cl_mem f = cd_cl_buffer(cl, bytes, "allocating the force sums"),
+           t = cd_cl_buffer(cl, bytes, "allocating the force sums");
+    cd_int mode = 0; /* (every call of forces sets the mode anew) */
+    if (!cl->status && !cd_cl_bind_force(cl, f, t)) {
+        cd_cl_arg(cl, CD_CLK_GATHER_KICK, CD_CL_N_COLS + 6, sizeof mode, &mode);
+        cd_cl_run(cl, CD_CLK_GATHER_KICK, s->n_particles);
+        if (!cl->status)
+            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, f, CL_FALSE, 0, bytes, s->force, 0, NULL, NULL),
+                        "downloading the force");
+        if (!cl->status)
+            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, t, CL_TRUE, 0, bytes, s->torque, 0, NULL, NULL),
+                        "downloading the torque");
+    }
+    cd_cl_bind_force(cl, NULL, NULL);
+    release(&f);
+    release(&t);
+}
 
 int cd_cl_buffers_download_cols(cd_cl *cl, cd_sim *sim, const size_t *only, size_t n_only)
 {
@@ -316,6 +375,17 @@ int cd_cl_buffers_download_cols(cd_cl *cl, cd_sim *sim, const size_t *only, size
         cl_int rc = clEnqueueReadBuffer(cl->queue, cd_cl_col(cl, f), CL_FALSE, 0, bytes, host, 0, NULL, NULL);
         cd_cl_check(cl, rc, "downloading the state");
     }
+    /* the force and torque: where the step holds them, theirs; else
+     * summed from the rows (a whole download only) */
+    size_t fb = s->n_particles * sizeof(cd_vec3);
+    if (!cl->status && cl->force && fb && wanted_at(offsetof(cd_state, force), only, n_only)) {
+        cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->force, CL_FALSE, 0, fb, s->force, 0, NULL, NULL),
+                    "downloading the state");
+        if (!cl->status)
+            cd_cl_check(cl, clEnqueueReadBuffer(cl->queue, cl->torque, CL_FALSE, 0, fb, s->torque, 0, NULL, NULL),
+                        "downloading the state");
+    }
+    if (!only) force_summed_to_host(cl, sim);
     if (!cl->status && s->n_arms) /* the arms, expanded into the host's rows below */
         cd_cl_check(
             cl, clEnqueueReadBuffer(cl->queue, cl->arm, CL_FALSE, 0, s->n_arms * sizeof(cd_arm), s->arm, 0, NULL, NULL),
@@ -356,6 +426,8 @@ void cd_cl_buffers_release(cd_cl *cl)
     release(&cl->arm);
     release(&cl->inertia);
     release(&cl->inertia_iso);
+    release(&cl->force);
+    release(&cl->torque);
     for (int h = 0; h < 2; h++) {
         release(&cl->hist[h].active);
         release(&cl->hist[h].shear);
