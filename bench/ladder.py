@@ -2,7 +2,7 @@
 """Cost per particle-step of capdem from 1e3 to 1e5 particles (issue 21).
 
     /usr/bin/python3 bench/ladder.py [--build build] [--cases spheres,hexapods_a3]
-        [--tiles 1x1,5x2,10x10] [--base 1000] [--base-file CASE=FILE] [--threads 1] [--rounds 3]
+        [--tiles 1x1,5x2,6x5,10x10] [--base 1000] [--base-file CASE=FILE] [--threads 1] [--rounds 3]
         [--relax CASE=STEPS] [--max-relax CASE=STEPS] [--counters auto|perf|cachegrind|none]
         [--work build/bench-work] [--reuse] [--reorder cells,none] > ladder.jsonl
     /usr/bin/python3 bench/ladder.py --plot ladder.jsonl -o ladder.png
@@ -202,7 +202,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", default="build")
     ap.add_argument("--cases", default="spheres,hexapods_a3")
-    ap.add_argument("--tiles", default="1x1,5x2,10x10")
+    ap.add_argument("--tiles", default="1x1,5x2,6x5,10x10")
     ap.add_argument("--base", type=int, default=1000)
     ap.add_argument("--base-file", default=None, help="CASE=FILE,...: a settled base packing to copy instead of settling")
     ap.add_argument("--relax", default=None, help="CASE=STEPS,...: relaxation steps after tiling (and per extra round)")
