@@ -237,7 +237,7 @@ int main(int argc, char **argv)
                 cd_sim_setup(&big, &big_cfg, err, sizeof err))
                 return fail(err, 2);
             if (cd_bench_tile_state(&big.s, &sim.s, tile_x, tile_z, w, t))
-                return fail("--tile: counts do not match", 2);
+                return fail("--tile: counts do not match, or out of memory", 2);
             cd_sim_free(&sim);
             cd_config_free(&cfg);
             sim = big; /* the tiled simulation replaces the loaded one */

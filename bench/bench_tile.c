@@ -58,7 +58,10 @@ int cd_bench_tile_state(cd_state *dst, const cd_state *src, int kx, int kz, doub
             }
         }
     dst->n_pairs = 0;
-    return 0;
+    /* the arms anew from the copied columns, as a reader does: a start
+     * first writes the state's arms back over them (omp_stop), and dst's
+     * are those of its own deposit, whose copies 1.. had other sizes */
+    return cd_state_arms_derive(dst);
 }
 
 /* Rows of the columns of group g moved by map (new row r = old row
@@ -115,6 +118,7 @@ int cd_bench_shuffle_state(cd_state *s, unsigned seed)
         for (size_t f = 0; f < cd_n_fields; f++)
             if (cd_fields[f].group == CD_GROUP_WALLC)
                 memset(*cd_field_ptr(s, &cd_fields[f]), 0, s->n_prims * s->n_walls * cd_fields[f].elem_size);
+        rc = cd_state_arms_derive(s); /* the arms with their primitives (see cd_bench_tile_state) */
     }
     free(map);
     free(first);

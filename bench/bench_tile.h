@@ -11,7 +11,8 @@ int cd_bench_tile_config(const char *text, int kx, int kz, char *out, size_t len
 
 /* Fills the particle and primitive columns of dst (set up from the tiled
  * config) with kx x kz copies of src, shifted by multiples of the small
- * box's width and thickness.  Returns 0, or -1 if the counts do not match. */
+ * box's width and thickness, and derives their arms (cd_state_arms_derive).
+ * Returns 0, or -1 if the counts do not match or memory runs out. */
 int cd_bench_tile_state(cd_state *dst, const cd_state *src, int kx, int kz, double width, double thickness);
 
 /* --shuffle SEED: the particles of s in a random order (a permutation of

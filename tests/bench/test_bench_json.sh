@@ -69,6 +69,21 @@ test "$(wc -l < "$dir/load.jsonl")" -eq 2
 "$bench" --load-settled "$dir/settled.h5" --tile 2,1 --relax-steps 50 --steps 10 --repeat 1 --threads 1 \
   > "$dir/tile.jsonl" 2> /dev/null
 check hexapods_a3 120 10 "$dir/tile.jsonl"
+# each copy keeps its particles' arms: the second copy's body-frame arm ends
+# equal the first's (they came from the tiled box's own deposit, of other
+# sizes, before bench_tile.c derived the arms anew)
+"$bench" --load-settled "$dir/settled.h5" --tile 2,1 --relax-steps 0 --repeat 0 --threads 1 \
+  --save-settled "$dir/tiled.h5" > /dev/null 2>&1
+for c in scale prim_a_body prim_b_body; do
+  g=all; [ "$c" = scale ] || g=prims
+  h5dump -y -w 0 -o "$dir/$c.txt" -d "/particles/$g/$c" "$dir/tiled.h5" > /dev/null
+  "$py" - "$dir/$c.txt" "$c" <<'PY'
+import sys
+v = open(sys.argv[1]).read().replace(",", " ").split()
+half = len(v) // 2
+assert half and v[:half] == v[half:], "%s: the second copy differs from the first" % sys.argv[2]
+PY
+done
 
 # bad input: exit status 2 and a message naming the cases
 # an unknown case: exit 2 exactly (a crash, 139 or 134, is not a refusal) naming the case and the known ones
