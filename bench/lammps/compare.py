@@ -76,10 +76,11 @@ SETTLE = {"spheres": 30000, "hexapods_a3": 15000, "hexapods_a9": 15000}
 # A tiled packing has lost its tangential springs (bench_tile.c): it slips and
 # springs back, and needs about 20 ms to find its contacts again (spheres: Z
 # 4.46 settled, 3.5 after 0.6 ms, 4.50 after 20 ms; hexapods 7.54, 7.12, 7.48).
-# Hexapods need 200 ms to come to rest: after 20 ms a 5 x 2 tile of 1,000
-# still rebuilt its lists at every step (alpha 3) or every other (alpha 9)
-# while timed; after 200 ms one build in 1,000 steps (alpha 3) and 3 in 500
-# (alpha 9) (docs/performance.md, "On the quiet machine, session 17/18").
+# Hexapod tiles relax 200 ms: before session 18's fix of --tile (its copies
+# had other particles' arm lengths and flew apart) they still flowed after
+# 20 ms; fixed, alpha-3 tiles of 1e4-1e5 came to rest (no list build in a
+# 200-step probe) after 40-80 ms (bench/ladder.py's records); 200 ms leaves
+# room for alpha 9 (docs/performance.md, "Session 18, cost against N").
 RELAX = {"spheres": 10000, "hexapods_a3": 20000, "hexapods_a9": 20000}  # steps: 20 ms (dt 2e-6 s), 200 ms (1e-5 s)
 
 
