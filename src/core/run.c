@@ -323,7 +323,7 @@ static int run(const cd_run_options *opt)
     int n_obs = cd_observable_series(&sim, info);
     double row[CD_OBS_ROW_MAX];
     cd_output *out = NULL;
-    int status = 0;
+    int status = 0, reopen_refused = 0;
     if (opt->resume_path) {
         /* (several MPI ranks cannot append to a serial writer's file: a
          * refusal of the input, on every rank before any reads) */
@@ -370,8 +370,9 @@ static int run(const cd_run_options *opt)
             goto done;
         }
         cdh5_guard_end();
-        out =
-            cd_mpi_opens_output() ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, err, sizeof err) : NULL;
+        out = cd_mpi_opens_output()
+                  ? cd_output_reopen(opt->resume_path, sim.s.step, info, n_obs, &reopen_refused, err, sizeof err)
+                  : NULL;
         if (out && cd_output_note_resume(out, sim.s.step, &cfg)) { /* (the writer says why) */
             cd_output_close(out);
             out = NULL;
@@ -397,7 +398,10 @@ static int run(const cd_run_options *opt)
     }
     if (cd_mpi_agree(cd_mpi_opens_output() &&
                      !out)) { /* the writer printed why (cd_output_* report every failure on stderr) */
-        status = 1;
+        /* a resumed file that cannot be appended to as it is (a dataset
+         * the writer appends to damaged, other observables) is refused
+         * like any bad input, nothing written to it; a failed write is 1 */
+        status = cd_mpi_agree(reopen_refused) ? 2 : 1;
         goto done;
     }
     fprintf(stderr,

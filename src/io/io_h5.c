@@ -283,12 +283,14 @@ static cd_output *open_begin(const char *path, cdh5_quiet *q, char *err, size_t 
 /* Their end: the observables' series set up and the first commit made
  * unless rc already failed; on failure the output is let go (the file
  * keeps its last commit; a resumed one stays as it was before) and NULL
- * returned with the reason in err.  Ends q. */
-static cd_output *open_end(cd_output *o, int rc, const cd_observable_info *obs, int n_obs, cdh5_quiet *q, char *err,
-                           size_t errlen)
+ * returned with the reason in err, and *refused (where not NULL) says
+ * whether the file's content was the cause (cd_output.refused).  Ends q. */
+static cd_output *open_end(cd_output *o, int rc, const cd_observable_info *obs, int n_obs, cdh5_quiet *q, int *refused,
+                           char *err, size_t errlen)
 {
     if (!rc) rc = obs_setup(o, obs, n_obs);
     if (!rc) rc = cdh5_commit_output(o);
+    if (refused) *refused = rc && o->refused;
     if (rc) {
         o->io_failed = 1;
         snprintf(err, errlen, "%s", o->err);
@@ -315,7 +317,7 @@ cd_output *cd_output_create_mode(const char *path, enum cd_output_mode how, cons
     int rc = create_file(o, path, how);
     if (!rc) rc = obs_check(o, obs, n_obs);
     if (!rc) rc = cdh5_write_header(o, cfg, shapes, n_shapes);
-    return open_end(o, rc, obs, n_obs, &q, err, errlen);
+    return open_end(o, rc, obs, n_obs, &q, NULL, err, errlen);
 }
 
 int cd_output_close(cd_output *o)
@@ -423,9 +425,10 @@ static int truncate_observables(cd_output *o, long long resume_step)
 }
 
 cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_observable_info *obs, int n_obs,
-                            char *err, size_t errlen)
+                            int *refused, char *err, size_t errlen)
 {
     cdh5_quiet q;
+    if (refused) *refused = 0;
     cd_output *o = open_begin(path, &q, err, errlen);
     if (!o) return NULL;
     int rc = 0;
@@ -447,11 +450,13 @@ cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_ob
         if (o->own_lock >= 0) cdh5_mark(o->own_lock);
         cdh5_par_lock(o->own_lock);
     }
+    if (rc) o->refused = 1; /* (the file cannot be opened for writing, or is a serial writer's on several ranks) */
     if (!rc && (!cdh5_exists(o->file, CDH5_PATH(H5MD)) || !cdh5_exists(o->file, CDH5_PATH(OBSERVABLES))))
         rc = FAIL("%s: not a capdem run file (no %s or %s)", path, CDH5_PATH(H5MD), CDH5_PATH(OBSERVABLES));
     if (!rc) rc = obs_check(o, obs, n_obs);
+    if (rc) o->refused = 1;
     if (!rc && cdh5_exists(o->file, CDH5_SNAP_STEP))
         rc = (cdh5_layout_open(o) || truncate_snapshots(o, resume_step)) ? -1 : 0;
     if (!rc) rc = truncate_observables(o, resume_step);
-    return open_end(o, rc, obs, n_obs, &q, err, errlen);
+    return open_end(o, rc, obs, n_obs, &q, refused, err, errlen);
 }

@@ -57,9 +57,12 @@ cd_output *cd_output_create(const char *path, const cd_config *cfg, const cd_sha
 /* Opens an existing run file to append to it after a resume: later snapshots
  * and time-series rows are added after the ones for steps <= resume_step, and
  * rows for steps > resume_step (written after that checkpoint by the
- * interrupted run) are discarded. */
+ * interrupted run) are discarded.  On failure (NULL) *refused, where not
+ * NULL, is 1 when the file as it is cannot be appended to (not a run file,
+ * other observables, a dataset the writer appends to missing or unreadable:
+ * a refusal of the input) and 0 when a write failed. */
 cd_output *cd_output_reopen(const char *path, long long resume_step, const cd_observable_info *obs, int n_obs,
-                            char *err, size_t errlen);
+                            int *refused, char *err, size_t errlen);
 
 /* Records, after cd_output_reopen, the config a resume from step `step`
  * runs with: /parameters/resumes/<k> (k = 0, 1, ... in the order of the

@@ -77,6 +77,10 @@ struct cd_output {
     unsigned long long old_dev, old_ino;
     int own_lock;  /* descriptor holding capdem's mark on the file (cdh5_mark), or -1 */
     int io_failed; /* a write failed or found no room: nothing more is written */
+    /* reopen: the file cannot be appended to as it is (not a run file,
+     * other observables, a dataset the writer appends to missing or
+     * unreadable): the input's fault, not a failed write (exit status 2) */
+    int refused;
     int writing;   /* inside a snapshot, past its checks */
     /* parallel output (io_h5_mpi.c): the rows of the write under way that
      * this rank writes, from its local state (cd_output_snapshot_part):

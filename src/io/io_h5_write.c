@@ -207,7 +207,10 @@ int cdh5_write_block(cd_output *o, hid_t d, const char *what, int rank, hsize_t 
 hid_t cdh5_open_dset(cd_output *o, const char *path)
 {
     hid_t d = H5Dopen2(o->file, path, H5P_DEFAULT);
-    if (d < 0) FAIL("%s: cannot open dataset %s (is this a capdem run file?)", o->path, path);
+    if (d < 0) {
+        o->refused = 1;
+        FAIL("%s: cannot open dataset %s (is this a capdem run file?)", o->path, path);
+    }
     return d;
 }
 

@@ -53,7 +53,7 @@ static void writer(enum scenario sc, const char *path, int fd)
     cd_output *o;
     int first = 0;
     if (sc == RESUME_RUN) {
-        o = cd_output_reopen(path, 100, OBS, 2, err, sizeof err);
+        o = cd_output_reopen(path, 100, OBS, 2, NULL, err, sizeof err);
         first = RESUME_KEEP;
     } else {
         cd_config cfg;

@@ -85,7 +85,7 @@ static void test_io_h5_reopen_truncates_after_resume_step(void **state)
     for (int j = 0; j < 4; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
     write_run(path, 3, s);
 
-    cd_output *o = cd_output_reopen(path, 100, OBS, 2, err, sizeof err);
+    cd_output *o = cd_output_reopen(path, 100, OBS, 2, NULL, err, sizeof err);
     if (!o) print_error("%s\n", err);
     assert_non_null(o);
     fill_state(&s[3], 3);
@@ -126,7 +126,7 @@ static void test_io_h5_reopen_before_first_snapshot(void **state)
     assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 0);
     assert_int_equal(cd_h5_read_snapshot(path, -1, &(cd_state){0}, err, sizeof err), -1);
     assert_non_null(strstr(err, "no complete snapshot"));
-    cd_output *o = cd_output_reopen(path, 0, OBS, 2, err, sizeof err);
+    cd_output *o = cd_output_reopen(path, 0, OBS, 2, NULL, err, sizeof err);
     assert_non_null(o);
     cd_state s;
     alloc_state(&s, NP, NPRIM, NW, NPAIR);
@@ -263,7 +263,7 @@ static void test_io_h5_wrong_counts_are_refused(void **state)
     cd_state_free(&g);
 
     /* appending a state of another size, or one whose fixed columns changed */
-    cd_output *o = cd_output_reopen(path, 1000, OBS, 2, err, sizeof err);
+    cd_output *o = cd_output_reopen(path, 1000, OBS, 2, NULL, err, sizeof err);
     assert_non_null(o);
     alloc_state(&g, NP + 1, NPRIM, NW, 4);
     assert_int_equal(cd_output_snapshot(o, &g), -1);
@@ -287,7 +287,7 @@ static void test_io_h5_missing_file_is_named(void **state)
     assert_non_null(strstr(err, path));
     assert_null(cd_h5_read_config_text(path, err, sizeof err));
     assert_non_null(strstr(err, path));
-    assert_null(cd_output_reopen(path, 0, NULL, 0, err, sizeof err));
+    assert_null(cd_output_reopen(path, 0, NULL, 0, NULL, err, sizeof err));
     assert_non_null(strstr(err, path));
     assert_null(cd_output_create(path, NULL, NULL, 0, NULL, 0, err, sizeof err));
     assert_non_null(strstr(err, path));
@@ -307,10 +307,39 @@ static void test_io_h5_bad_observables_are_refused(void **state)
     for (int j = 0; j < 2; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
     write_run(path, 2, s);
     static const cd_observable_info other[2] = {{"energy", "J", 1}, {"momentum", "kg m/s", 2}};
-    assert_null(cd_output_reopen(path, 0, other, 2, err, sizeof err));
+    int refused = 0;
+    assert_null(cd_output_reopen(path, 0, other, 2, &refused, err, sizeof err));
     assert_non_null(strstr(err, "/observables/momentum/value has 3 components per row, the run gives 2"));
-    assert_null(cd_output_reopen(path, 0, twice, 2, err, sizeof err));
+    assert_int_equal(refused, 1); /* the input's fault: capdem run exits 2 */
+    assert_null(cd_output_reopen(path, 0, twice, 2, NULL, err, sizeof err));
     assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 2); /* refused before truncating */
+    for (int j = 0; j < 2; j++) cd_state_free(&s[j]);
+    remove_run(path);
+}
+
+/* A dataset the writer appends to that a resume's checks do not read (an
+ * observable's value: a flipped byte in its link's name, test_corruption)
+ * is missing at the reopen: refused as the input's fault (*refused 1, so
+ * `capdem run --resume` exits 2, not 1 as for a failed write), with the
+ * dataset named, and the file keeps every snapshot. */
+static void test_io_h5_reopen_refuses_missing_dataset(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    test_path(path, sizeof path, "lnk");
+    cd_state s[2];
+    for (int j = 0; j < 2; j++) alloc_state(&s[j], NP, NPRIM, NW, NPAIR);
+    write_run(path, 2, s);
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(f >= 0);
+    assert_true(H5Lmove(f, "/observables/momentum/value", f, "/observables/momentum/valve", H5P_DEFAULT,
+                        H5P_DEFAULT) >= 0);
+    H5Fclose(f);
+    int refused = 0;
+    assert_null(cd_output_reopen(path, 100, OBS, 2, &refused, err, sizeof err));
+    assert_int_equal(refused, 1);
+    assert_non_null(strstr(err, "/observables/momentum/value"));
+    assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 2);
     for (int j = 0; j < 2; j++) cd_state_free(&s[j]);
     remove_run(path);
 }
@@ -505,6 +534,7 @@ int main(void)
         cmocka_unit_test(test_io_h5_wrong_counts_are_refused),
         cmocka_unit_test(test_io_h5_missing_file_is_named),
         cmocka_unit_test(test_io_h5_bad_observables_are_refused),
+        cmocka_unit_test(test_io_h5_reopen_refuses_missing_dataset),
         cmocka_unit_test(test_io_h5_replace_keeps_old_file_until_first_snapshot),
         cmocka_unit_test(test_io_h5_part_read_equals_whole_rows),
         cmocka_unit_test(test_io_h5_leaves_no_hdf5_object_open),
