@@ -81,7 +81,7 @@ struct cd_output {
      * other observables, a dataset the writer appends to missing or
      * unreadable): the input's fault, not a failed write (exit status 2) */
     int refused;
-    int writing;   /* inside a snapshot, past its checks */
+    int writing; /* inside a snapshot, past its checks */
     /* parallel output (io_h5_mpi.c): the rows of the write under way that
      * this rank writes, from its local state (cd_output_snapshot_part):
      * memory row r (of map_rows along dimension mask_dim) into row

@@ -332,8 +332,8 @@ static void test_io_h5_reopen_refuses_missing_dataset(void **state)
     write_run(path, 2, s);
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(f >= 0);
-    assert_true(H5Lmove(f, "/observables/momentum/value", f, "/observables/momentum/valve", H5P_DEFAULT,
-                        H5P_DEFAULT) >= 0);
+    assert_true(H5Lmove(f, "/observables/momentum/value", f, "/observables/momentum/valve", H5P_DEFAULT, H5P_DEFAULT) >=
+                0);
     H5Fclose(f);
     int refused = 0;
     assert_null(cd_output_reopen(path, 100, OBS, 2, &refused, err, sizeof err));
