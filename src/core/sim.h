@@ -260,9 +260,12 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o);
 int cd_sim_observe_step(cd_sim *sim, cd_observables *o, char *err, size_t errlen);
 void cd_sim_observe_free(cd_sim *sim);
 /* The merged slots (kernels/observe_items.h, CD_OBS_SLOTS) from the host
- * columns, and (offload variant) from the device: backends' observe. */
+ * columns: backends' observe. */
 void cd_observables_slots(const cd_sim *sim, double *slots);
-int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen);
+/* The omp backend's wall_load and observe (src/backend/omp/observe.c):
+ * where the steps run (the offload device, or host memory). */
+int cd_omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen);
+int cd_omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen);
 
 /* Neighbour list (neighbors.c). */
 /* reorder: 1 for neighbor.reorder: cells (src/backend/omp/reorder.c) */

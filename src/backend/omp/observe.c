@@ -160,7 +160,7 @@ void cd_sim_observe(const cd_sim *sim, cd_observables *o)
 /* The same reductions on the offload device (the omp backend's observe
  * operation in the offload variant); the scratch stays allocated there,
  * grown when the pair rows grow. */
-int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
+static int observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
 {
     const cd_state *s = &sim->s;
     /* not started, or no forces since the start: the host columns are
@@ -213,6 +213,98 @@ int cd_omp_observe_device(cd_sim *sim, double *slots, char *err, size_t errlen)
                            CD_A.d.wall_rows, CD_A.d.wall_out);
     merge_tree(part, leaves(nb), total, 1);
     return cd_dev_get(slots, total, CD_OBS_SLOTS * sizeof(double)) ? -1 : 0;
+}
+#endif
+
+/* Host memory (host threads, or an offload build's host fallback): the
+ * host columns are the step's, summed in user order whatever their memory
+ * order, without a sync (which would put them in user order and back); the
+ * wall contacts' F_n from the candidate lists while these are newer than
+ * the host's rows (steps since the last sync), in the same order. */
+static int host_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    (void)err;
+    (void)errlen;
+    if (!sim->nb.wall_out_pending) {
+        *load = cd_sim_wall_load_host(sim, w);
+        return 0;
+    }
+    cd_cols c = cd_sim_step_cols(sim);
+    cd_nb_lists d = sim->nb.d;
+    cd_long P = (cd_long)sim->s.n_prims;
+    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
+    double sum = 0;
+    for (cd_long ch = 0; ch * CD_LOAD_CHUNK < P; ch++)
+        sum += cd_item_wall_load_chunk(c, ch, P, (cd_int)sim->s.n_walls, w, prim_at, d.wall_start, d.wall_rows,
+                                       d.wall_out);
+    *load = sum;
+    return 0;
+}
+
+/* The host's columns, with the wall contacts' outputs of the last steps
+ * (in the columns' memory order). */
+static int host_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    if (cd_neighbors_wall_out_to_host(sim)) {
+        snprintf(err, errlen, "out of memory while summing the observables");
+        return -1;
+    }
+    cd_observables_slots(sim, slots);
+    return 0;
+}
+
+#if CD_OFFLOAD
+/* Normal load on wall w summed on the device: per-chunk partial sums in
+ * parallel, then the chunks in order (deterministic, one double back). */
+int cd_omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    cd_off *o = sim->backend_data;
+    if (cd_step_memory_is_host()) return host_wall_load(sim, w, load, err, errlen);
+    /* not started, or no forces since: the host columns are current */
+    if (!o || !sim->nb.wall_out_valid) {
+        *load = cd_sim_wall_load_host(sim, w);
+        return 0;
+    }
+    double *part = o->part;
+    size_t P = sim->s.n_prims, W = sim->s.n_walls, nch = (P + CD_LOAD_CHUNK - 1) / CD_LOAD_CHUNK;
+    size_t total = o->part_n - 1; /* the slot after the chunks' */
+    const cd_int *prim_at = cd_sim_step_order(sim).prim_at;
+    CD_WIDE_MIN
+    CD_ARGS(sim)
+    CD_STEP_FOR(nch, CD_ARGS_IN is_device_ptr(prim_at))
+    for (size_t ch = 0; ch < nch; ch++)
+        part[ch] = cd_item_wall_load_chunk(CD_A.c, (cd_long)ch, (cd_long)P, (cd_int)W, w, prim_at, CD_A.d.wall_start,
+                                           CD_A.d.wall_rows, CD_A.d.wall_out);
+        /* the chunks in order into the slot after them, which alone comes
+     * back: no mapping made per call, one double copied */
+#pragma omp target
+    {
+        double sum = 0;
+        for (size_t ch = 0; ch < nch; ch++) sum += part[ch];
+        part[total] = sum;
+    }
+#pragma omp target update from(part [total:1])
+    *load = part[total];
+    return 0;
+}
+
+/* The observables where the steps run: on the device (observe_device above),
+ * or, in the host fallback, as on host threads: the device's lists are in
+ * memory order while a sync has put the one set of columns in user order. */
+int cd_omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    if (cd_step_memory_is_host()) return host_observe(sim, slots, err, errlen);
+    return observe_device(sim, slots, err, errlen);
+}
+#else
+int cd_omp_wall_load(cd_sim *sim, int w, double *load, char *err, size_t errlen)
+{
+    return host_wall_load(sim, w, load, err, errlen);
+}
+
+int cd_omp_observe(cd_sim *sim, double *slots, char *err, size_t errlen)
+{
+    return host_observe(sim, slots, err, errlen);
 }
 #endif
 
