@@ -15,18 +15,28 @@
 
 int cd_bench_tile_config(const char *text, int kx, int kz, char *out, size_t len)
 {
-    const char *c = strstr(text, "count: "), *d = strstr(text, "domain: {type: box, width: ");
-    long n;
+    /* every species' "count: N" (they come before the domain line) times
+     * kx kz, and the box kx times as wide and kz times as deep */
+    const char *d = strstr(text, "domain: {type: box, width: ");
     double w, t, h;
-    if (!c || !d || sscanf(c, "count: %ld", &n) != 1 ||
-        sscanf(d, "domain: {type: box, width: %lf, thickness: %lf, height: %lf}", &w, &t, &h) != 3)
-        return -1;
+    if (!d || sscanf(d, "domain: {type: box, width: %lf, thickness: %lf, height: %lf}", &w, &t, &h) != 3) return -1;
     const char *d_end = strchr(d, '\n');
-    const char *c_end = c + strcspn(c, ",}");
-    if (!d_end || c > d) return -1; /* the particles line comes before the domain line */
-    int k = snprintf(out, len, "%.*scount: %ld%.*sdomain: {type: box, width: %.9g, thickness: %.9g, height: %.9g}%s",
-                     (int)(c - text), text, n * kx * kz, (int)(d - c_end), c_end, w * kx, t * kz, h, d_end);
-    return k < 0 || (size_t)k >= len ? -1 : 0;
+    if (!d_end) return -1;
+    size_t used = 0;
+    int counts = 0;
+    const char *at = text;
+    for (const char *c; (c = strstr(at, "count: ")) && c < d; at = c + strcspn(c, ",}")) {
+        long n;
+        if (sscanf(c, "count: %ld", &n) != 1) return -1;
+        int k = snprintf(out + used, len - used, "%.*scount: %ld", (int)(c - at), at, n * kx * kz);
+        if (k < 0 || (size_t)k >= len - used) return -1;
+        used += (size_t)k;
+        counts++;
+    }
+    if (!counts) return -1;
+    int k = snprintf(out + used, len - used, "%.*sdomain: {type: box, width: %.9g, thickness: %.9g, height: %.9g}%s",
+                     (int)(d - at), at, w * kx, t * kz, h, d_end);
+    return k < 0 || (size_t)k >= len - used ? -1 : 0;
 }
 
 int cd_bench_tile_state(cd_state *dst, const cd_state *src, int kx, int kz, double width, double thickness)

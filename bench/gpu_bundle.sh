@@ -128,7 +128,9 @@ fi
 SETTLED=$WORK/settled
 mkdir -p "$SETTLED"
 HOSTBIN=$WORK/${VARIANTS[-1]}/capdem-bench # GCC's host fallback runs 1 team x 2 threads
-for c in hexapods_a3 spheres; do
+# (mix_spheres_hexapods: half spheres, half hexapods, the ladder's rows
+# visited by kind, docs/performance.md "Session 18, rows visited by kind")
+for c in hexapods_a3 spheres mix_spheres_hexapods; do
     f=$SETTLED/${c}_n$SETTLED_N.h5
     if [ $RESETTLE = 1 ] || [ ! -s "$f" ]; then
         say "settling $SETTLED_N $c (once; niced; minutes)"

@@ -21,8 +21,9 @@
 #               (omp on the host and omp on the GPU against OpenCL) and
 #               test_drift_bound (host maths against the GPU's, bounded)
 #   ladder      throughput: settled hexapods alpha 3 at 1e4, 1e5 and 1e6
-#               (tiled) and spheres 1e6, Clang build, omp (and opencl when
-#               there): JSON lines in $OUT/ladder.jsonl
+#               (tiled), spheres 1e6 and the sphere-hexapod mixture 1e5,
+#               Clang build, omp (and opencl when there): JSON lines in
+#               $OUT/ladder.jsonl
 #   profile     time per launch kind on 1e6 hexapods: libomptarget's own
 #               profile (LIBOMPTARGET_PROFILE) summarised per kernel line,
 #               then nsys if on PATH, else ncu (kernel time, DRAM bytes)
@@ -424,10 +425,11 @@ ladder_entry() {
         sed "s/^{/{\"build\": \"$v\", \"gpu\": \"${gpu:-none}\", \"entry\": \"$name\", \"tile\": \"$tile\", \"relax_steps\": $relax, /" >>"$W/ladder.jsonl"
 }
 part_ladder() { # variant
-    local v=$1 e s hex sph
+    local v=$1 e s hex sph mix
     has "$v" || { note "SKIP ladder-$v: no $v build"; return 0; }
     hex=$(cd "$INPUTS" && ls hexapods_a3_n*.h5 | head -1)
     sph=$(cd "$INPUTS" && ls spheres_n*.h5 | head -1)
+    mix=$(cd "$INPUTS" && ls mix_spheres_hexapods_n*.h5 2>/dev/null | head -1) || true
     s=${CAPDEM_BUNDLE_STEPS:-200}
     # Copies of the settled packing (KX,KZ) for 1e4, 1e5 and 1e6 particles:
     # gpu_bundle.sh settles 1e3 (default) or 1e4.
@@ -439,13 +441,15 @@ part_ladder() { # variant
     *) [ -n "${CAPDEM_BUNDLE_TILES:-}" ] || { note "FAIL ladder-$v: no tile factors for settled packings of $n particles (1000 or 10000; or set CAPDEM_BUNDLE_TILES)"; return 0; } ;;
     esac
     [ -z "${CAPDEM_BUNDLE_TILES:-}" ] || read -r t4 t5 t6 <<<"$CAPDEM_BUNDLE_TILES"
-    for e in ${CAPDEM_BUNDLE_LADDER:-h1e4 h1e5 h1e6 s1e6}; do
+    for e in ${CAPDEM_BUNDLE_LADDER:-h1e4 h1e5 h1e6 s1e6 m1e5}; do
         case $e in
         h1e4) ladder_entry "$v" hex_1e4 "$hex" $t4 1000 "$s" 3 90 ;;
         h1e5) ladder_entry "$v" hex_1e5 "$hex" $t5 1000 "$s" 3 150 ;;
         h1e6) ladder_entry "$v" hex_1e6 "$hex" $t6 300 $((s / 2)) 2 240 ;;
         s1e6) ladder_entry "$v" sph_1e6 "$sph" $t6 300 $((s / 2)) 2 200 ;;
-        *) note "FAIL ladder: unknown entry '$e' (h1e4 h1e5 h1e6 s1e6)" ;;
+        m1e5) # the mixture: its rows visited by kind (a bundle made before session 18 has none)
+            if [ -n "$mix" ]; then ladder_entry "$v" mix_1e5 "$mix" $t5 1000 "$s" 3 150; else note "SKIP ladder-$v mix_1e5: no settled mixture among the inputs"; fi ;;
+        *) note "FAIL ladder: unknown entry '$e' (h1e4 h1e5 h1e6 s1e6 m1e5)" ;;
         esac
     done
 }

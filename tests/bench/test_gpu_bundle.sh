@@ -39,6 +39,7 @@ cp -r "$src/configs" "$src/kernels" "$B/src/"
 mkdir -p "$B/src/host" && cp "$src/host/capdem_h5.py" "$B/src/host/"
 "$bench" --case hexapods_a3 --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/hexapods_a3_n40.h5" >/dev/null 2>&1
 "$bench" --case spheres --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/spheres_n40.h5" >/dev/null 2>&1
+"$bench" --case mix_spheres_hexapods --n 40 --settle-steps 200 --repeat 0 --threads 1 --save-settled "$S/inputs/mix_spheres_hexapods_n40.h5" >/dev/null 2>&1
 tar -C "$S" -cf - lib lib.cxx | xz -0 -T2 >"$B/payload-lib.tar.xz"
 # part mpm's throughput input: here the CI deposit (12 disks) under the
 # full-size deposit's name
@@ -49,7 +50,7 @@ cp "$src/bench/gpu/run_on_gpu.sh" "$src/bench/gpu/kernel_profile.sh" "$src/bench
 echo "capdem GPU bundle (test fixture: host build as 'clang')" >"$B/MANIFEST.txt"
 
 out=$dir/out
-CHECK_OUT=$out CAPDEM_BUNDLE_LADDER="h1e4 s1e6" CAPDEM_BUNDLE_STEPS=4 CAPDEM_BUNDLE_BUDGET_S=240 \
+CHECK_OUT=$out CAPDEM_BUNDLE_LADDER="h1e4 s1e6 m1e5" CAPDEM_BUNDLE_STEPS=4 CAPDEM_BUNDLE_BUDGET_S=240 \
     CAPDEM_BUNDLE_TILES="1,1 2,1 2,2" CAPDEM_BUNDLE_MPM_BACKENDS=omp \
     bash "$src/bench/gpu/check_bundle.sh" "$B" info tests ladder kernels mpm
 n=$(ls "$out" | wc -l)
@@ -69,10 +70,10 @@ rows = [json.loads(l) for l in open(sys.argv[1])]
 mpm = [r for r in rows if r["entry"] == "mpm_packing_elastic"]
 rows = [r for r in rows if r not in mpm]
 entries = sorted({(r["entry"], r["N"]) for r in rows})
-assert entries == [("hex_1e4", 40), ("sph_1e6", 160)], entries
+assert entries == [("hex_1e4", 40), ("mix_1e5", 80), ("sph_1e6", 160)], entries
 assert len(mpm) == 1 and mpm[0]["backend"] == "omp" and mpm[0]["N"] > 1000 and mpm[0]["steps"] == 5, mpm
 assert mpm[0]["point_steps_per_s"] > 0 and mpm[0]["build"] == "clang", mpm
 for r in rows:
-    assert r["build"] == "clang" and r["steps"] == (4 if r["entry"] == "hex_1e4" else 2) and r["particle_steps_per_s"] > 0, r
+    assert r["build"] == "clang" and r["steps"] == (2 if r["entry"] == "sph_1e6" else 4) and r["particle_steps_per_s"] > 0, r
 print("ok: ladder", entries, len(rows), "lines")
 PY
