@@ -13,6 +13,17 @@
 #include "core/sim.h"
 #include "../kernels/rigid.h"
 
+/* 24 alpha-3 hexapods settling on the floor of a cylinder with friction
+ * (pair and wall contacts, tangential history, rebuilds): the config of
+ * test_wall_out and test_force_summed. */
+#define CDT_PILE_IN_CYLINDER                                                                                           \
+    "run: {dt: 1.0e-5, steps: 0, seed: 3}\n"                                                                           \
+    "physics: {gravity: [0, -98.1, 0]}\n"                                                                              \
+    "material: {density: 1000, kn: 1.0e5, kt: 5.0e4, damping_normal: 0.2, friction: 0.5, wall_friction: 0.4}\n"        \
+    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 24, polydispersity: 0.2}]\n"                      \
+    "domain: {type: cylinder, diameter: 0.06, height: 0.12}\n"                                                         \
+    "init: {placement: lattice, clearance: 1.0, speed: 0.3}\n"
+
 /* What is wrong with visit (n entries) as the pair pass's visiting order
  * (kernels/neighbor_items.h, pass 11), kind[k] being the kind of row k
  * (0..2): NULL when it is a permutation of 0 .. n-1 that takes the rows

@@ -11,13 +11,7 @@
 
 /* Hexapods settling in a cylinder on its floor: contacts with the floor
  * plane and the curved wall, a few rebuilds of the candidate lists. */
-static const char *pile_in_cylinder =
-    "run: {dt: 1.0e-5, steps: 0, seed: 3}\n"
-    "physics: {gravity: [0, -98.1, 0]}\n"
-    "material: {density: 1000, kn: 1.0e5, kt: 5.0e4, damping_normal: 0.2, friction: 0.5, wall_friction: 0.4}\n"
-    "particles: [{shape: hexapod, aspect: 3, diameter: 0.005, count: 24, polydispersity: 0.2}]\n"
-    "domain: {type: cylinder, diameter: 0.06, height: 0.12}\n"
-    "init: {placement: lattice, clearance: 1.0, speed: 0.3}\n";
+static const char *pile_in_cylinder = CDT_PILE_IN_CYLINDER;
 
 /* The wall observables of o (contacts, elastic energy, each wall's force,
  * largest overlap) equal, bit for bit, to those of p. */
