@@ -39,7 +39,8 @@ __kernel void cd_cl_pair_forces(
 {
 #include "col_bind.h"
     cd_int v = (cd_int)get_global_id(0);
-    if (v < n_pairs) cd_item_pair_force(c, visit ? visit[v] : v, law, dt, sin_parallel, parallel_blend, outputs);
+    if (v < n_pairs)
+        cd_item_pair_force(c, (cd_pair_id)cd_map(visit, v), law, dt, sin_parallel, parallel_blend, outputs);
 }
 
 /* Step 6: wall candidate e of the last build (its wall-contact row; its

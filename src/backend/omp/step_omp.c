@@ -149,15 +149,11 @@ static void pair_forces(cd_sim *sim, cd_int outputs)
     size_t n = sim->s.n_pairs;
     CD_WIDE_MIN
     CD_ARGS(sim)
-    if (visit_by_kind(sim)) {
-        CD_STEP_FOR(n, CD_ARGS_IN)
-        for (size_t v = 0; v < n; v++)
-            cd_item_pair_force(CD_A.c, CD_A.d.pair_visit[v], CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
-        return;
-    }
+    cd_int visit = visit_by_kind(sim);
     CD_STEP_FOR(n, CD_ARGS_IN)
-    for (size_t k = 0; k < n; k++)
-        cd_item_pair_force(CD_A.c, (cd_pair_id)k, CD_A.law, CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
+    for (size_t v = 0; v < n; v++)
+        cd_item_pair_force(CD_A.c, (cd_pair_id)cd_map(visit ? CD_A.d.pair_visit : NULL, (cd_long)v), CD_A.law, CD_A.dt,
+                           CD_A.sin_parallel, CD_A.blend, outputs);
 }
 
 /* One work item per wall candidate of the last build (cd_item_wall_row).
@@ -345,8 +341,8 @@ static void forces_and_advance_one_team(cd_sim *sim, int next, int flagged)
     {
         CD_TEAM_FOR(nowait) /* the wall rows write other rows and read only the particles */
         for (size_t k = 0; k < n_pairs; k++)
-            cd_item_pair_force(CD_A.c, visit ? CD_A.d.pair_visit[k] : (cd_pair_id)k, CD_A.law, CD_A.dt,
-                               CD_A.sin_parallel, CD_A.blend, outputs);
+            cd_item_pair_force(CD_A.c, (cd_pair_id)cd_map(visit ? CD_A.d.pair_visit : NULL, (cd_long)k), CD_A.law,
+                               CD_A.dt, CD_A.sin_parallel, CD_A.blend, outputs);
         CD_TEAM_FOR()
         for (size_t e = 0; e < n_walls; e++)
             cd_item_wall_row(CD_A.c, CD_A.d.wall_rows[e], CD_A.d.wall_out + e, CD_A.walls, CD_A.n_walls, CD_A.wall_law,
