@@ -116,6 +116,13 @@ typedef struct {
     size_t cap_visit, cap_visit_starts;
     /* the visiting order where a backend other than omp keeps it (OpenCL), copied to out: its rows; NULL: d */
     size_t (*visit_get)(const struct cd_sim *sim, cd_int *out);
+    /* host threads' sweep (src/backend/omp/step_omp.c): the largest distance in memory slots between the
+       particles of a row, and per particle 1 when one of its rows joins it to a particle of another
+       thread's range, for sweep_threads threads (0: not made since the last build) */
+    size_t sweep_lag;
+    unsigned char *sweep_edge;
+    size_t sweep_edge_cap;
+    int sweep_threads;
 } cd_neighbors;
 
 /* Scratch of the observables' reductions where the steps run (the offload

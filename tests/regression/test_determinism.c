@@ -62,6 +62,42 @@ static void test_same_bits_for_one_and_two_threads_and_twice(void **state)
     cd_config_free(&cc);
 }
 
+/* The host threads' sweep marks the particles its ranges share (their
+ * edges) for the thread count of the step's region, and marks them again
+ * when that count changes between calls (src/backend/omp/step_omp.c, "The
+ * sweep"): short calls of 2, 3, 1, 4 and 2 threads in turn have the bits
+ * of one thread throughout. */
+static void test_same_bits_when_the_thread_count_changes(void **state)
+{
+    (void)state;
+    static cd_sim a, b;
+    cd_config ca, cb;
+    run_case(1, 2500, &a, &ca);
+    omp_set_num_threads(2);
+    cdt_setup(&b, &cb, settling);
+    assert_int_equal(cd_sim_initial_forces(&b), 0);
+    /* calls of 1 to 7 steps without a sync between them (a sync may
+     * rebuild at the next call), most of them without a rebuild */
+    const int threads[] = {2, 3, 1, 4, 2};
+    char err[256];
+    long long steps = 0, calls = 0, builds = b.nb.builds, without = 0;
+    while (steps < 2500) {
+        long long n = 1 + calls % 7 < 2500 - steps ? 1 + calls % 7 : 2500 - steps, before = b.nb.builds;
+        omp_set_num_threads(threads[calls % 5]);
+        if (cd_sim_step(&b, n, err, sizeof err)) fail_msg("step: %s", err);
+        without += b.nb.builds == before;
+        steps += n;
+        calls++;
+    }
+    cdt_step(&b, 0);
+    assert_true(b.nb.builds - builds >= 5 && without > calls / 2);
+    assert_same_particles(&a.s, &b.s);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
+}
+
 /* The observables summed where the steps run (cd_sim_observe_step: on the
  * offload or OpenCL device, without a state copy) have the bits of those
  * summed on the host after a sync (cd_sim_observe): the same blocks in the
@@ -411,6 +447,7 @@ int main(void)
     cd_parallel_min_rows = 0;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bits_for_one_and_two_threads_and_twice),
+        cmocka_unit_test(test_same_bits_when_the_thread_count_changes),
         cmocka_unit_test(test_history_survives_forced_rebuilds),
         cmocka_unit_test(test_slot_overflow_changes_nothing),
         cmocka_unit_test(test_device_observables_equal_host_ones),

@@ -48,6 +48,7 @@ void cd_neighbors_free(cd_neighbors *nb)
     cd_dev_free(d->pair_visit);
     cd_dev_free(d->visit_starts);
     cd_dev_free(d->visit_scratch);
+    free(nb->sweep_edge);
     memset(nb, 0, sizeof(*nb));
 }
 
@@ -538,6 +539,7 @@ int cd_neighbors_build(cd_sim *sim)
     if (particle_lists(sim, prim_src) || cd_reorder_pair_rows(sim) || visit_order(sim)) return -1;
     nb->force_rebuild = 0;
     nb->builds++;
+    if (cd_omp_sweep_lists(sim)) return -1;
     return 0;
 }
 

@@ -126,6 +126,14 @@ static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
 /* Host-only loops (set-up work on the host columns). */
 #define CD_HOST_FOR(rows, ...) CD_PRAGMA(omp parallel for schedule(static) if (CD_PARALLEL(rows)) __VA_ARGS__)
 
+/* The host threads' sweep (src/backend/omp/sweep.c): steps 5-8 of a step
+ * and, with next = 1, steps 1-4 of the next one (returns its skin test),
+ * for host threads; and what it needs of a neighbour-list build, made at
+ * its end (0, or -1: out of memory, or rows out of memory order; nothing
+ * in the offload variant). */
+int cd_omp_sweep(cd_sim *sim, int next);
+int cd_omp_sweep_lists(cd_sim *sim);
+
 /* The columns the loops work on: device addresses in the offload variant
  * once the state is mapped, the host columns otherwise (src/backend/omp/step_omp.c). */
 cd_cols cd_sim_step_cols(cd_sim *sim);

@@ -177,6 +177,33 @@ static int moves(const cd_field_info *f)
     return f->on_device && strcmp(f->name, "prim_a_ref");
 }
 
+/* Would the order slot_of at least halve the largest distance in memory
+ * between a pair row's two particles, which the host threads' sweep waits
+ * for (src/backend/omp/step_omp.c, "The sweep")?  A tiled or deposited
+ * bed's order can keep most rows short, as the test above counts them,
+ * and still hold rows a whole layer of the bed apart.  Never on an
+ * offload device, whose step does not sweep. */
+static int halves_lag(cd_sim *sim, const cd_int *slot_of)
+{
+#if CD_OFFLOAD
+    (void)sim;
+    (void)slot_of;
+    return 0;
+#else
+    cd_cols c = cd_sim_step_cols(sim);
+    long now = 0, then = 0;
+    size_t K = sim->s.n_pairs;
+#pragma omp parallel for schedule(static) if (K >= (size_t)cd_parallel_min_rows) reduction(max : now, then)
+    for (size_t k = 0; k < K; k++) {
+        long a = c.prim_particle[c.pair_prim_i[k]], b = c.prim_particle[c.pair_prim_j[k]];
+        long d = a > b ? a - b : b - a, e = (long)slot_of[a] - (long)slot_of[b];
+        now = d > now ? d : now;
+        then = e > then ? e : -e > then ? -e : then;
+    }
+    return 2 * then <= now;
+#endif
+}
+
 int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
 {
     cd_state *s = &sim->s;
@@ -219,7 +246,7 @@ int cd_reorder_build(cd_sim *sim, const cd_grid *g, int *moved)
     for (size_t k = 0; k < K; k++)
         excess += 8L * cd_reorder_item_row_span(CD_B.c, (cd_long)k, slot_of) -
                   7L * cd_reorder_item_row_span(CD_B.c, (cd_long)k, NULL);
-    if (excess >= 0 && !forced) return 0;
+    if (excess >= 0 && !forced && !halves_lag(sim, slot_of)) return 0;
 
     /* the primitives follow their particles: new first primitives, and
      * the old slot of each new primitive (before prim_first moves) */

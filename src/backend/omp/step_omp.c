@@ -83,7 +83,7 @@ static void host_force_used(cd_sim *sim)
  * world ends of its primitives and the skin test.  Returns 1 when some end
  * moved more than half the skin; on the offload device one int comes
  * back.  (Run once per call of the step; the next steps' advance is fused
- * into the gather: gather_kick_advance.)  Its force and torque: summed
+ * into the gather: cd_item_gather_kick_advance.)  Its force and torque: summed
  * from the rows of the last force evaluation, or where the step holds
  * them (a start's first advance, an MPI rank) read (cd_item_advance). */
 static int advance_particles(cd_sim *sim)
@@ -236,58 +236,6 @@ void cd_sim_force_before_build(cd_sim *sim)
 #endif
 }
 
-#if !CD_OFFLOAD
-/* The loops of forces_and_advance, each an orphaned `omp for` in a
- * function of its own (the region's threads share its rows) with every
- * call inside inlined (flatten): the items have two callers each (this
- * region, and the separate loops of the start), and GCC then called
- * them instead of inlining them, 1.15x the instructions of the step
- * (callgrind). */
-__attribute__((noinline, flatten)) static void pair_rows(cd_cols c, size_t n, const cd_int *visit, cd_law_params law,
-                                                         cd_real dt, cd_real sin_parallel, cd_int blend, cd_int outputs)
-{
-    if (visit) { /* a mixture: the rows kind by kind (the same for every thread of the region) */
-#pragma omp for schedule(static) nowait
-        for (size_t v = 0; v < n; v++) cd_item_pair_force(c, visit[v], law, dt, sin_parallel, blend, outputs);
-        return;
-    }
-#pragma omp for schedule(static) nowait
-    for (size_t k = 0; k < n; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend, outputs);
-}
-
-__attribute__((noinline, flatten)) static void wall_rows(cd_cols c, const cd_int *rows, cd_wall_entry *out, size_t n,
-                                                         const cd_wall *walls, cd_int W, cd_law_params law, cd_real dt,
-                                                         cd_real sin_parallel, cd_int blend)
-{
-#pragma omp for schedule(static)
-    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], out + e, walls, W, law, dt, sin_parallel, blend);
-}
-
-__attribute__((noinline, flatten)) static int gather_kick_advance(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 g,
-                                                                  cd_int dim, cd_real dt, cd_real limit2, int next)
-{
-    int moved = 0;
-    /* next a constant in each loop (every thread takes the same one): the
-     * item's store of the force and torque at a call's last step, and its
-     * test of the columns (kernels/cols.h), leave the steps' loop, which
-     * otherwise tested them for every particle (callgrind, 10,000
-     * spheres: 11.6 instructions a particle-step; docs/performance.md,
-     * "Session 18, force and torque not held") */
-    if (next) {
-#pragma omp for schedule(static) nowait /* the region's end is the barrier */
-        for (size_t q = 0; q < n; q++)
-            moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                                 d.wall_out, g, dim, dt, limit2, d.ref_pose, 1);
-    } else {
-#pragma omp for schedule(static) nowait
-        for (size_t q = 0; q < n; q++)
-            moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                                 d.wall_out, g, dim, dt, limit2, d.ref_pose, 0);
-    }
-    return moved;
-}
-#endif
-
 #if CD_OFFLOAD
 /* Rows (the most of pair rows, wall candidates and particles) up to which
  * a step's three loops run as one launch of one team (CD_ONE_TEAM): the
@@ -357,14 +305,15 @@ static void forces_and_advance_one_team(cd_sim *sim, int next, int flagged)
 /* Steps 5-8 (forces, second half kick) and, with next = 1, steps 1-4 of
  * the next step (its advance; returns its skin test); next = 0 (the call's
  * last step): the pair rows' F_n is written too.
- * Host threads: one parallel region, where four loops used to fork and
- * join their threads each (docs/performance.md, "One parallel region per
- * step"): the pair loop without a barrier before the wall loop (they
- * write different rows and read only the particles' state), one barrier
- * before the gather, none after it but the region's end, and the next
- * step's advance of particle q in the same item as q's gather and kick
- * (it reads only q's own rows).  Each item does the arithmetic it did in
- * its own loop, in the same order: the same bits.  An offload device runs
+ * Host threads: one parallel region (docs/performance.md, "One parallel
+ * region per step"), in which each thread sweeps its range of particles
+ * (above, "The sweep") and, with two threads or more, after one barrier
+ * its range's edges; the next step's advance of particle q is in the same
+ * item as q's gather and kick (it reads only q's own rows).  Each item
+ * does the arithmetic it did in its own loop, in the same order: the same
+ * bits.  The edges are marked at the first step after a build, or when
+ * the region's thread count changes (every thread tests the same
+ * numbers, so all or none meet the barrier).  An offload device runs
  * three launches: pair rows, wall candidates, and the gather with the
  * kick and the next advance (the same item as on host threads; the skin
  * flag stays on the device, one int back); a small system (up to
@@ -388,25 +337,7 @@ static int forces_and_advance(cd_sim *sim, int next)
     if (!next) return 0;
     return flagged ? skin_flag_read(sim) : 1; /* without the flag: a rebuild, still correct */
 #else
-    cd_cols c = cd_sim_step_cols(sim);
-    cd_nb_lists d = sim->nb.d;
-    cd_law_params law = sim->p.law, wall_law = sim->p.wall_law;
-    cd_real dt = sim->p.dt, sin_parallel = sim->p.sin_parallel, limit2 = cd_bp_skin_limit2(sim->nb.skin);
-    cd_int blend = sim->p.parallel_blend, dim = sim->p.dimension, W = (cd_int)sim->s.n_walls;
-    cd_vec3 g = sim->p.gravity;
-    const cd_wall *walls = sim->s.walls;
-    size_t n_pairs = sim->s.n_pairs, n_walls = W ? sim->nb.n_wall_rows : 0, n = sim->s.n_particles;
-    size_t most = n_pairs > n ? n_pairs : n;
-    const cd_int *visit = visit_by_kind(sim) ? d.pair_visit : NULL; /* a mixture: the rows kind by kind */
-    int moved = 0;
-#pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
-    {
-        pair_rows(c, n_pairs, visit, law, dt, sin_parallel, blend, !next);
-        wall_rows(c, d.wall_rows, d.wall_out, n_walls, walls, W, wall_law, dt, sin_parallel, blend);
-        moved |= gather_kick_advance(c, d, n, g, dim, dt, limit2, next);
-    }
-    sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
-    return moved;
+    return cd_omp_sweep(sim, next);
 #endif
 }
 
