@@ -48,6 +48,11 @@ for l in lines:
         assert rows["mixed_warps_visited"][0] <= 2, l
     else:
         assert rows["mixed_warps_visited"] == rows["mixed_warps"], l
+    # the host threads' sweep waits this many slots (a row's two particles
+    # lie at most that far apart in memory); 0 where the step does not sweep
+    assert 0 <= rows["sweep_lag"] < r["N"], l
+    if r["device"].startswith("host, ") and rows["pair_rows"] > 0:  # host threads
+        assert rows["sweep_lag"] > 0, l
 print("ok", case, len(lines), "lines")
 PY
 }
