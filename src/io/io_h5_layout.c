@@ -81,6 +81,11 @@ hid_t cdh5_mem_type(const cd_field_info *f)
     return f->kind == CD_KIND_REAL ? H5T_NATIVE_DOUBLE : f->kind == CD_KIND_FLAG ? H5T_NATIVE_UINT8 : H5T_NATIVE_INT32;
 }
 
+size_t cdh5_file_row_bytes(const cd_field_info *f)
+{
+    return (size_t)f->ncomp * (f->kind == CD_KIND_REAL ? sizeof(double) : sizeof(int32_t));
+}
+
 int cdh5_field_check(const cd_field_info *f, char *err, size_t errlen)
 {
     size_t scalar = f->kind == CD_KIND_REAL ? sizeof(double) : f->kind == CD_KIND_FLAG ? sizeof(cd_flag) : sizeof(int32_t);

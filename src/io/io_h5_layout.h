@@ -54,6 +54,10 @@ const char *cdh5_column_path(const char *name, char *buf);
 /* H5T_NATIVE_DOUBLE, H5T_NATIVE_INT32, or H5T_NATIVE_UINT8 for a FLAG
  * column (an int32 in the file) (not to be closed). */
 hid_t cdh5_mem_type(const cd_field_info *f);
+/* Bytes of one row of column f in the file (a FLAG column's 4, its
+ * memory's 1): what its chunks are sized by, so that the file's layout
+ * does not follow the memory's. */
+size_t cdh5_file_row_bytes(const cd_field_info *f);
 /* Compound type of cd_wall in memory, as /walls/value stores it (the
  * members of runfile.def; caller closes). */
 hid_t cdh5_wall_mem_type(void);
