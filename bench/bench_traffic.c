@@ -23,7 +23,7 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
 {
     const cd_state *s = &sim->s;
     double N = (double)s->n_particles, P = (double)s->n_prims, R = (double)s->n_pairs;
-    double A = 0, Aw = 0; /* active pair rows, active wall rows */
+    double A = 0, Aw = 0;                /* active pair rows, active wall rows */
     const double flag = sizeof(cd_flag); /* a pair row's contact flag (1 B; kernels/defs.h) */
     for (size_t k = 0; k < s->n_pairs; k++) A += s->pair_active[k] != 0;
     for (size_t r = 0; r < s->n_prims * s->n_walls; r++) Aw += s->wallc_active[r] != 0;

@@ -88,7 +88,9 @@ size_t cdh5_file_row_bytes(const cd_field_info *f)
 
 int cdh5_field_check(const cd_field_info *f, char *err, size_t errlen)
 {
-    size_t scalar = f->kind == CD_KIND_REAL ? sizeof(double) : f->kind == CD_KIND_FLAG ? sizeof(cd_flag) : sizeof(int32_t);
+    size_t scalar = f->kind == CD_KIND_REAL   ? sizeof(double)
+                    : f->kind == CD_KIND_FLAG ? sizeof(cd_flag)
+                                              : sizeof(int32_t);
     if (f->ncomp < 1 || f->ncomp > 64 || f->elem_size != (size_t)f->ncomp * scalar) {
         snprintf(err, errlen,
                  "fields.def: column %s has %zu bytes per row, expected %d x %zu: HDF5 output "

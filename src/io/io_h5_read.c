@@ -299,9 +299,7 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
         switch (cdh5_store_of(f)) {
         case CDH5_FIXED:
             if (cd_state_rows(s, f->group))
-                e = cdh5_storage_fits(r->ds[i], 0, HSIZE_UNDEF)
-                        ? cdh5_read(r->ds[i], mt, H5S_ALL, H5S_ALL, col)
-                        : -1;
+                e = cdh5_storage_fits(r->ds[i], 0, HSIZE_UNDEF) ? cdh5_read(r->ds[i], mt, H5S_ALL, H5S_ALL, col) : -1;
             break;
         case CDH5_SERIES:
             e = cdh5_read_rows(r->ds[i], (hsize_t)k, 1, mt, col);

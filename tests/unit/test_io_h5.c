@@ -238,14 +238,20 @@ static void test_io_h5_killed_writer_leaves_readable_file(void **state)
     remove_run(path);
 }
 
+/* A run file of one snapshot of the fixture's state s, at path (named by tag). */
+static void write_one_snapshot(char *path, size_t len, const char *tag, cd_state *s)
+{
+    test_path(path, len, tag);
+    alloc_state(s, NP, NPRIM, NW, NPAIR);
+    write_run(path, 1, s);
+}
+
 static void test_io_h5_wrong_counts_are_refused(void **state)
 {
     (void)state;
     char path[128], err[1024] = "";
-    test_path(path, sizeof path, "counts");
     cd_state s[1];
-    alloc_state(&s[0], NP, NPRIM, NW, NPAIR);
-    write_run(path, 1, s);
+    write_one_snapshot(path, sizeof path, "counts", s);
     cd_state g;
     alloc_state(&g, NP + 1, NPRIM, NW, 4);
     assert_int_equal(cd_h5_read_snapshot(path, 0, &g, err, sizeof err), -1);
@@ -287,10 +293,8 @@ static void test_io_h5_flag_column_is_int32_in_file(void **state)
 {
     (void)state;
     char path[128], err[1024] = "";
-    test_path(path, sizeof path, "flag");
     cd_state s[1];
-    alloc_state(&s[0], NP, NPRIM, NW, NPAIR);
-    write_run(path, 1, s);
+    write_one_snapshot(path, sizeof path, "flag", s);
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(f >= 0);
     hid_t d = H5Dopen2(f, "/contacts/pair_active", H5P_DEFAULT), t = H5Dget_type(d);
