@@ -8,7 +8,8 @@
  * primitives, or a primitive's ends read by its pair rows, counts once, as
  * it would from a cache with good locality), except the pair rows' force
  * and point, which the gather reads once from each of the row's two
- * particles.  Sizes: cd_real 8 B, cd_int 4 B, cd_vec3 24 B, cd_quat 32 B.
+ * particles.  Sizes: cd_real 8 B, cd_int 4 B, cd_vec3 24 B, cd_quat 32 B,
+ * a pair row's flag (cd_flag) 1 B.
  * The amortised neighbour-list rebuild is not counted; what runs once per
  * call of the step (its first advance on omp, the blow-up check) is
  * divided by the steps of the call.  When a kernel of
@@ -22,7 +23,8 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
 {
     const cd_state *s = &sim->s;
     double N = (double)s->n_particles, P = (double)s->n_prims, R = (double)s->n_pairs;
-    double A = 0, Aw = 0; /* active pair rows, active wall rows */
+    double A = 0, Aw = 0;                /* active pair rows, active wall rows */
+    const double flag = sizeof(cd_flag); /* a pair row's contact flag (1 B; kernels/defs.h) */
     for (size_t k = 0; k < s->n_pairs; k++) A += s->pair_active[k] != 0;
     for (size_t r = 0; r < s->n_prims * s->n_walls; r++) Aw += s->wallc_active[r] != 0;
     /* wall candidates as the next build would choose them
@@ -56,9 +58,9 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
      * and, active or not (an inactive row adds its zero force: no branch),
      * its force and point from each side (2 x 48); where the gather skips
      * the rows out of contact (CD_GATHER_SKIPS_INACTIVE: the offload
-     * variants) the row's flag from each side (2 x 4) and the force and
+     * variants) the row's flag from each side (2 x 1) and the force and
      * point of the active rows only */
-    double gather_rows = C * 8 + Aw * 48 + R * 8 + (CD_GATHER_SKIPS_INACTIVE ? R * 8 + A * 96 : R * 96);
+    double gather_rows = C * 8 + Aw * 48 + R * 8 + (CD_GATHER_SKIPS_INACTIVE ? R * 2 * flag + A * 96 : R * 96);
     /* advance (cd_item_advance: kick, drift, primitive ends, skin test):
      * reads v, L, x (24 each), m (8), q (32), I (24) and per primitive
      * advance_prims, and the force and torque summed from the rows as the
@@ -77,18 +79,18 @@ void cd_bench_traffic(const cd_sim *sim, double steps_per_call, cd_traffic out[C
     if (CD_ENDS_FROM_POSE) advance = (cd_traffic){"advance", N * (136 - iso + 8 + 64) + gather_rows, N * 128};
     double pose = CD_ENDS_FROM_POSE ? 32 : 0; /* the orientation, per particle a pass reads */
     if (CD_ENDS_FROM_POSE) ends = P * idx + Arms * 48;
-    /* cd_item_pair_force: every row its primitives and flag (12); the
+    /* cd_item_pair_force: every row its primitives and flag (8 + 1); the
      * primitives' particle (4), ends and radius (8); an active row its
      * history (24) and its particles' x, v, omega, m (80 per particle,
      * counted for every particle; with CD_ENDS_FROM_POSE the orientation
-     * too); writes flag, history, point, force (76; the flag only when it
-     * changes with CD_ENDS_FROM_POSE: 72), and F_n (8) at the last step of
-     * a call only (the overlap is derived where it is read). */
+     * too); writes flag, history, point, force (1 + 72; the flag only when
+     * it changes with CD_ENDS_FROM_POSE: 72), and F_n (8) at the last step
+     * of a call only (the overlap is derived where it is read). */
     /* In a mixture the rows are visited kind by kind: 4 B a row read for
      * the visiting order (kernels/neighbor_items.h, pass 11). */
     double visit = cd_neighbors_pair_visit(sim, NULL) ? 4 : 0;
-    out[0] = (cd_traffic){"pair_forces", R * (12 + visit) + P * 12 + ends + A * 24 + N * (80 + pose),
-                          A * (CD_ENDS_FROM_POSE ? 72 : 76) + A * 8 / steps_per_call};
+    out[0] = (cd_traffic){"pair_forces", R * (8 + flag + visit) + P * 12 + ends + A * 24 + N * (80 + pose),
+                          A * (CD_ENDS_FROM_POSE ? 72 : 72 + flag) + A * 8 / steps_per_call};
     /* cd_item_wall_row over the wall candidates: per candidate its row,
      * its entry's flag and its primitive (particle, radius, end a, arm
      * index: 4 + 4 + 40; an arm's b: 24; an upper bound when a primitive

@@ -16,6 +16,7 @@
  * its element (defs.h, CD_ALIGN_VALUE; the element types of fields.def and
  * cd_arm). */
 typedef CD_GLOBAL cd_int *cd_col_cd_int CD_ALIGN_VALUE(cd_int);
+typedef CD_GLOBAL cd_flag *cd_col_cd_flag CD_ALIGN_VALUE(cd_flag);
 typedef CD_GLOBAL cd_real *cd_col_cd_real CD_ALIGN_VALUE(cd_real);
 typedef CD_GLOBAL cd_vec3 *cd_col_cd_vec3 CD_ALIGN_VALUE(cd_vec3);
 typedef CD_GLOBAL cd_quat *cd_col_cd_quat CD_ALIGN_VALUE(cd_quat);

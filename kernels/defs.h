@@ -5,6 +5,13 @@
 #ifndef CD_DEFS_H
 #define CD_DEFS_H
 
+/* cd_flag: a yes/no column of the step (0 or 1), one byte a row: a pair row's
+ * contact flag (kernels/fields.def, pair_active), 3 B a row less than a
+ * cd_int.  Every backend reads and writes it as a byte (OpenCL C 1.1 and
+ * later store bytes to __global memory without an extension); the run
+ * file keeps it as a 32-bit integer (h5type FLAG: HDF5 converts at write
+ * and read, src/io/io_h5_layout.c).  docs/performance.md, "Session 19, a
+ * byte a contact flag". */
 #ifdef __OPENCL_VERSION__
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 /* Bitwise agreement with the host build (-ffp-contract=off). */
@@ -14,6 +21,7 @@ typedef int cd_int;
 typedef uint cd_uint;
 typedef long cd_long;
 typedef ulong cd_ulong;
+typedef uchar cd_flag;
 #define CD_GLOBAL      __global
 #define CD_CONST_TABLE __constant
 #define CD_DEVICE_BEGIN
@@ -26,6 +34,7 @@ typedef int32_t cd_int;
 typedef uint32_t cd_uint;
 typedef int64_t cd_long;
 typedef uint64_t cd_ulong;
+typedef uint8_t cd_flag;
 #define CD_GLOBAL
 #define CD_CONST_TABLE static const
 #if defined(_OPENMP)

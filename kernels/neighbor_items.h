@@ -258,7 +258,7 @@ CD_INLINE cd_ulong cd_nb_row_key(cd_cols c, cd_long k, cd_order o)
 /* Before the rows are replaced: the key and history of old row k, kept for
  * the carry-over (pass 8). */
 CD_INLINE void cd_nb_item_keep(cd_cols c, cd_long k, cd_order o, CD_GLOBAL cd_ulong *old_keys,
-                               CD_GLOBAL cd_int *old_active, CD_GLOBAL cd_vec3 *old_shear)
+                               CD_GLOBAL cd_flag *old_active, CD_GLOBAL cd_vec3 *old_shear)
 {
     old_keys[k] = cd_nb_row_key(c, k, o);
     old_active[k] = c.pair_active[k];
@@ -288,7 +288,7 @@ CD_INLINE void cd_nb_item_place(cd_cols c, cd_prim_id i, const CD_GLOBAL cd_int 
  * old rows were made (null: the same; src/backend/omp/reorder.c), so that the key is
  * looked up as the old rows wrote it. */
 CD_INLINE void cd_nb_item_carry(cd_cols c, cd_long k, const CD_GLOBAL cd_ulong *keys,
-                                const CD_GLOBAL cd_ulong *old_keys, cd_long n_old, const CD_GLOBAL cd_int *old_active,
+                                const CD_GLOBAL cd_ulong *old_keys, cd_long n_old, const CD_GLOBAL cd_flag *old_active,
                                 const CD_GLOBAL cd_vec3 *old_shear, const CD_GLOBAL cd_int *prim_src)
 {
     cd_ulong key = keys[k];

@@ -134,7 +134,7 @@ __kernel void cd_cl_pair_keys(
 __kernel void cd_cl_pair_carry(
 #include "col_params.h"
     cd_int n_pairs, __global const cd_ulong *keys, __global const cd_ulong *old_keys, cd_int n_old,
-    __global const cd_int *old_active, __global const cd_vec3 *old_shear)
+    __global const cd_flag *old_active, __global const cd_vec3 *old_shear)
 {
 #include "col_bind.h"
     cd_int k = (cd_int)get_global_id(0);

@@ -56,7 +56,7 @@ typedef struct {
     cd_int *pair_count, *pair_offset;                         /* rows per primitive, their offsets (n_prims + 1) */
     cd_prim_id *cand;                                         /* candidate slots, slot per primitive */
     cd_ulong *keys, *old_keys;                                /* sorted keys of the new and the old rows */
-    cd_int *old_active;                                       /* history of the old rows */
+    cd_flag *old_active;                                      /* history of the old rows */
     cd_vec3 *old_shear;                                       /* [m] */
     cd_int *count;                                            /* per particle: gather and wall counts, then cursors */
     cd_int *chunk_sum;                                        /* prefix sums' levels (cd_scan_scratch) */

@@ -24,6 +24,7 @@
 #define CD_GROUP_OF_WALLC_OUT CD_GROUP_WALLC
 #define CD_KIND_OF_REAL       CD_KIND_REAL
 #define CD_KIND_OF_INT        CD_KIND_INT
+#define CD_KIND_OF_FLAG       CD_KIND_FLAG
 
 const cd_field_info cd_fields[] = {
 #define CD_FIELD(group, ctype, h5type, ncomp, name, unit, meaning)                                                     \

@@ -19,7 +19,9 @@ enum cd_field_group {
 
 /* Do the columns of group g have one row per pair row (PAIR, PAIR_OUT)? */
 static inline int cd_group_pair_rows(enum cd_field_group g) { return g == CD_GROUP_PAIR || g == CD_GROUP_PAIR_OUT; }
-enum cd_field_kind { CD_KIND_REAL, CD_KIND_INT };
+/* The scalar kind of a column (kernels/fields.def, h5type): REAL doubles,
+ * INT int32, FLAG a byte in memory (cd_flag) and an int32 in the file. */
+enum cd_field_kind { CD_KIND_REAL, CD_KIND_INT, CD_KIND_FLAG };
 
 typedef struct cd_state {
     /* rows in use and rows allocated per group */

@@ -72,15 +72,29 @@ void cdh5_field_path(const cd_field_info *f, char *buf, size_t len)
     snprintf(buf, len, "%s/%s%s", cdh5_group_path(f->group), f->name, cdh5_store_of(f) == CDH5_SERIES ? "/value" : "");
 }
 
-hid_t cdh5_mem_type(const cd_field_info *f) { return f->kind == CD_KIND_REAL ? H5T_NATIVE_DOUBLE : H5T_NATIVE_INT32; }
+/* A FLAG column is one byte a row in memory (cd_flag) and an int32 in the
+ * file, as it was when the step held it as a cd_int: HDF5 converts at
+ * write and read, so the file's layout did not change and old files
+ * resume (docs/output.md). */
+hid_t cdh5_mem_type(const cd_field_info *f)
+{
+    return f->kind == CD_KIND_REAL ? H5T_NATIVE_DOUBLE : f->kind == CD_KIND_FLAG ? H5T_NATIVE_UINT8 : H5T_NATIVE_INT32;
+}
+
+size_t cdh5_file_row_bytes(const cd_field_info *f)
+{
+    return (size_t)f->ncomp * (f->kind == CD_KIND_REAL ? sizeof(double) : sizeof(int32_t));
+}
 
 int cdh5_field_check(const cd_field_info *f, char *err, size_t errlen)
 {
-    size_t scalar = f->kind == CD_KIND_REAL ? sizeof(double) : sizeof(int32_t);
+    size_t scalar = f->kind == CD_KIND_REAL   ? sizeof(double)
+                    : f->kind == CD_KIND_FLAG ? sizeof(cd_flag)
+                                              : sizeof(int32_t);
     if (f->ncomp < 1 || f->ncomp > 64 || f->elem_size != (size_t)f->ncomp * scalar) {
         snprintf(err, errlen,
                  "fields.def: column %s has %zu bytes per row, expected %d x %zu: HDF5 output "
-                 "stores REAL columns as doubles and INT columns as int32",
+                 "stores REAL columns as doubles, INT columns as int32 and FLAG columns (a byte in memory) as int32",
                  f->name, f->elem_size, f->ncomp, scalar);
         return -1;
     }
@@ -171,6 +185,26 @@ int cdh5_dims(hid_t dset, hsize_t dims[3])
     return r;
 }
 
+/* HDF5 clips an integer outside the memory type's range when it converts
+ * (a flag of -1 or 256 in a file would read as 0 or 255): a read into a
+ * FLAG column's memory type refuses such a value instead. */
+static H5T_conv_ret_t refuse_out_of_range(H5T_conv_except_t e, hid_t src, hid_t dst, void *src_buf, void *dst_buf,
+                                          void *data)
+{
+    (void)src, (void)dst, (void)src_buf, (void)dst_buf, (void)data;
+    return e == H5T_CONV_EXCEPT_RANGE_HI || e == H5T_CONV_EXCEPT_RANGE_LOW ? H5T_CONV_ABORT : H5T_CONV_UNHANDLED;
+}
+
+herr_t cdh5_read(hid_t dset, hid_t memtype, hid_t ms, hid_t fs, void *buf)
+{
+    if (H5Tequal(memtype, H5T_NATIVE_UINT8) <= 0) return H5Dread(dset, memtype, ms, fs, H5P_DEFAULT, buf);
+    hid_t x = H5Pcreate(H5P_DATASET_XFER);
+    herr_t e = x < 0 || H5Pset_type_conv_cb(x, refuse_out_of_range, NULL) < 0 ? -1 : 0;
+    if (e >= 0) e = H5Dread(dset, memtype, ms, fs, x, buf);
+    if (x >= 0) H5Pclose(x);
+    return e;
+}
+
 herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype, void *buf)
 {
     hsize_t dims[3];
@@ -182,7 +216,7 @@ herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype,
     if (!cdh5_storage_fits(dset, start0, count0)) return -1;
     hid_t fs = H5Dget_space(dset), ms = H5Screate_simple(rank, cnt, NULL);
     herr_t e = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL);
-    if (e >= 0) e = H5Dread(dset, memtype, ms, fs, H5P_DEFAULT, buf);
+    if (e >= 0) e = cdh5_read(dset, memtype, ms, fs, buf);
     H5Sclose(fs);
     H5Sclose(ms);
     return e;

@@ -51,8 +51,13 @@ const cd_field_info *cdh5_column(const char *name);
 /* Path of the column called name into buf (CDH5_PATH_LEN bytes), which it
  * returns; a path that no file holds when fields.def has no such column. */
 const char *cdh5_column_path(const char *name, char *buf);
-/* H5T_NATIVE_DOUBLE or H5T_NATIVE_INT32 (not to be closed). */
+/* H5T_NATIVE_DOUBLE, H5T_NATIVE_INT32, or H5T_NATIVE_UINT8 for a FLAG
+ * column (an int32 in the file) (not to be closed). */
 hid_t cdh5_mem_type(const cd_field_info *f);
+/* Bytes of one row of column f in the file (a FLAG column's 4, its
+ * memory's 1): what its chunks are sized by, so that the file's layout
+ * does not follow the memory's. */
+size_t cdh5_file_row_bytes(const cd_field_info *f);
 /* Compound type of cd_wall in memory, as /walls/value stores it (the
  * members of runfile.def; caller closes). */
 hid_t cdh5_wall_mem_type(void);
@@ -85,6 +90,10 @@ int cdh5_exists(hid_t loc, const char *path);
 int cdh5_dims(hid_t dset, hsize_t dims[3]);
 /* Reads count0 rows from row start0 of a dataset of rank 1..3 into buf. */
 herr_t cdh5_read_rows(hid_t dset, hsize_t start0, hsize_t count0, hid_t memtype, void *buf);
+/* H5Dread of the selection fs of dset into ms: where memtype is
+ * H5T_NATIVE_UINT8 (a FLAG column), a value outside 0..255 fails the read
+ * instead of being clipped. */
+herr_t cdh5_read(hid_t dset, hid_t memtype, hid_t ms, hid_t fs, void *buf);
 /* Snapshots completely on disk: min(commit attribute, length of the
  * snapshot step and time); 0 when the file has no snapshot yet; -1 on error. */
 long long cdh5_committed(hid_t file, const char *path, char *err, size_t errlen);

@@ -77,7 +77,7 @@ static herr_t read_runs(reader *r, hid_t d, int w, int series, hsize_t k, hid_t 
     mdims[rd] = r->n_sel[w];
     hid_t ms = e < 0 ? -1 : H5Screate_simple(rank, mdims, NULL);
     if (ms < 0) e = -1;
-    if (e >= 0) e = H5Dread(d, mt, ms, fs, H5P_DEFAULT, buf);
+    if (e >= 0) e = cdh5_read(d, mt, ms, fs, buf);
     if (ms >= 0) H5Sclose(ms);
     if (fs >= 0) H5Sclose(fs);
     return e;
@@ -299,9 +299,7 @@ static int read_snapshot(reader *r, long long k, cd_state *s)
         switch (cdh5_store_of(f)) {
         case CDH5_FIXED:
             if (cd_state_rows(s, f->group))
-                e = cdh5_storage_fits(r->ds[i], 0, HSIZE_UNDEF)
-                        ? H5Dread(r->ds[i], mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, col)
-                        : -1;
+                e = cdh5_storage_fits(r->ds[i], 0, HSIZE_UNDEF) ? cdh5_read(r->ds[i], mt, H5S_ALL, H5S_ALL, col) : -1;
             break;
         case CDH5_SERIES:
             e = cdh5_read_rows(r->ds[i], (hsize_t)k, 1, mt, col);

@@ -96,7 +96,7 @@ static int create_col(cd_output *o, const cd_state *s, size_t k)
         size_t rows = rows_of(o, f->group);
         hsize_t d[2] = {rows, nc};
         /* chunked, so that it carries a checksum like the rest */
-        hsize_t ch[2] = {clamp(rows ? rows : 1, 1, CDH5_LARGE_CHUNK / f->elem_size), nc};
+        hsize_t ch[2] = {clamp(rows ? rows : 1, 1, CDH5_LARGE_CHUNK / cdh5_file_row_bytes(f)), nc};
         c->dset = cdh5_make_dset(o, p, ft, 1 + vec, d, NULL, ch, f->unit);
         const void *col = *cd_field_ptr((cd_state *)s, f);
         if (c->dset < 0) return -1;
@@ -121,8 +121,8 @@ static int create_col(cd_output *o, const cd_state *s, size_t k)
     case CDH5_SERIES: {
         hsize_t rows = rows_of(o, f->group), r1 = rows ? rows : 1;
         hsize_t d[3] = {0, rows, nc}, m[3] = {H5S_UNLIMITED, r1, nc}, ch[3] = {1, r1, nc};
-        size_t row_bytes = r1 * f->elem_size;
-        if (row_bytes > CDH5_LARGE_CHUNK) ch[1] = clamp(CDH5_LARGE_CHUNK / f->elem_size, 1, r1);
+        size_t row_bytes = r1 * cdh5_file_row_bytes(f);
+        if (row_bytes > CDH5_LARGE_CHUNK) ch[1] = clamp(CDH5_LARGE_CHUNK / cdh5_file_row_bytes(f), 1, r1);
         else ch[0] = clamp(CDH5_SMALL_CHUNK / row_bytes, 1, 64);
         char gp[CDH5_PATH_LEN];
         snprintf(gp, sizeof gp, "%s/%s", cdh5_group_path(f->group), f->name);
@@ -136,7 +136,7 @@ static int create_col(cd_output *o, const cd_state *s, size_t k)
     case CDH5_ROWS: {
         hsize_t hint = cd_group_pair_rows(f->group) ? 4 * o->n_prims : o->n_prims;
         hsize_t d[2] = {0, nc}, m[2] = {H5S_UNLIMITED, nc};
-        hsize_t ch[2] = {clamp(hint, 256, CDH5_LARGE_CHUNK / f->elem_size), nc};
+        hsize_t ch[2] = {clamp(hint, 256, CDH5_LARGE_CHUNK / cdh5_file_row_bytes(f)), nc};
         c->dset = cdh5_make_dset(o, p, ft, 1 + vec, d, m, ch, f->unit);
         return c->dset < 0 ? -1 : 0;
     }
@@ -418,7 +418,7 @@ static unsigned long long first_snapshot_bytes(const cd_output *o, const cd_stat
     unsigned long long b = 65536, P = s->n_prims, nw1 = s->n_walls ? s->n_walls : 1;
     for (size_t k = 0; k < cd_n_fields; k++) {
         const cd_field_info *f = &cd_fields[k];
-        unsigned long long e = f->elem_size, rows = cd_state_rows(s, f->group), row = rows * e;
+        unsigned long long e = cdh5_file_row_bytes(f), rows = cd_state_rows(s, f->group), row = rows * e;
         switch (cdh5_store_of(f)) {
         case CDH5_FIXED:
             b += row;

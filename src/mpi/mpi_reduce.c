@@ -485,8 +485,8 @@ static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
     /* (route let mine and dest go) */
     size_t m = len / sizeof(obs_pair);
     obs_pair *e = (obs_pair *)got;
-    cd_int *active = malloc((m + 1) * sizeof *active), *pi = malloc((m + 1) * sizeof *pi),
-           *pj = malloc((m + 1) * sizeof *pj);
+    cd_flag *active = malloc((m + 1) * sizeof *active);
+    cd_int *pi = malloc((m + 1) * sizeof *pi), *pj = malloc((m + 1) * sizeof *pj);
     double *overlap = malloc((m + 1) * sizeof *overlap), *radius = malloc((m + CD_OBS_BLOCK + 1) * sizeof *radius);
     cd_vec3 *shear = malloc((m + 1) * sizeof *shear);
     if (!active || !pi || !pj || !overlap || !shear || !radius) rc = -1;
@@ -503,7 +503,7 @@ static int pair_leaves(cd_mpi_ctx *x, const cd_sim *g, leaf_plan lp, partials *o
         if (leaf_rank(x, &lp, lp.pairs + b) != x->rank) continue;
         cd_long nb = 0; /* the leaf's rows */
         for (; k < m && e[k].gi < (b + 1) * CD_OBS_BLOCK; k++, nb++) {
-            active[nb] = (cd_int)e[k].active;
+            active[nb] = (cd_flag)e[k].active;
             pi[nb] = (cd_int)(e[k].gi - b * CD_OBS_BLOCK);
             pj[nb] = (cd_int)(CD_OBS_BLOCK + nb);
             overlap[nb] = e[k].overlap;

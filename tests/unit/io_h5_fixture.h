@@ -64,6 +64,7 @@ static inline void fill_random(void *col, size_t rows, const cd_field_info *f)
     size_t n = rows * (size_t)f->ncomp;
     for (size_t i = 0; i < n; i++) {
         if (f->kind == CD_KIND_REAL) ((double *)col)[i] = rand_double();
+        else if (f->kind == CD_KIND_FLAG) ((cd_flag *)col)[i] = (cd_flag)(next_u64() % 2);
         else ((int32_t *)col)[i] = (int32_t)next_u64();
     }
 }

@@ -238,14 +238,20 @@ static void test_io_h5_killed_writer_leaves_readable_file(void **state)
     remove_run(path);
 }
 
+/* A run file of one snapshot of the fixture's state s, at path (named by tag). */
+static void write_one_snapshot(char *path, size_t len, const char *tag, cd_state *s)
+{
+    test_path(path, len, tag);
+    alloc_state(s, NP, NPRIM, NW, NPAIR);
+    write_run(path, 1, s);
+}
+
 static void test_io_h5_wrong_counts_are_refused(void **state)
 {
     (void)state;
     char path[128], err[1024] = "";
-    test_path(path, sizeof path, "counts");
     cd_state s[1];
-    alloc_state(&s[0], NP, NPRIM, NW, NPAIR);
-    write_run(path, 1, s);
+    write_one_snapshot(path, sizeof path, "counts", s);
     cd_state g;
     alloc_state(&g, NP + 1, NPRIM, NW, 4);
     assert_int_equal(cd_h5_read_snapshot(path, 0, &g, err, sizeof err), -1);
@@ -274,6 +280,48 @@ static void test_io_h5_wrong_counts_are_refused(void **state)
     assert_non_null(strstr(cd_output_error(o), "column mass changed"));
     assert_int_equal(cd_output_close(o), 0);
     assert_int_equal(cd_h5_snapshot_count(path, err, sizeof err), 1);
+    cd_state_free(&s[0]);
+    remove_run(path);
+}
+
+/* A FLAG column (kernels/fields.def: pair_active, one byte a row in
+ * memory) is a 32-bit integer in the file, as when the step held it as a
+ * cd_int, so files of either kind resume; a value a byte cannot hold
+ * (-1, 256: HDF5 would clip it to 0 or 255) is refused at read with the
+ * column named, not turned into another flag. */
+static void test_io_h5_flag_column_is_int32_in_file(void **state)
+{
+    (void)state;
+    char path[128], err[1024] = "";
+    cd_state s[1];
+    write_one_snapshot(path, sizeof path, "flag", s);
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(f >= 0);
+    hid_t d = H5Dopen2(f, "/contacts/pair_active", H5P_DEFAULT), t = H5Dget_type(d);
+    assert_true(d >= 0 && t >= 0);
+    assert_int_equal(H5Tget_class(t), H5T_INTEGER);
+    assert_int_equal(H5Tget_size(t), 4);
+    H5Tclose(t);
+    H5Dclose(d);
+    H5Fclose(f);
+    check_snapshot(path, 0, &s[0]); /* the flags read back (the fixture's 0s and 1s) */
+    static const int bad[] = {-1, 256};
+    for (int b = 0; b < 2; b++) {
+        f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+        d = H5Dopen2(f, "/contacts/pair_active", H5P_DEFAULT);
+        hid_t fs = H5Dget_space(d), ms = H5Screate_simple(1, (hsize_t[]){1}, NULL);
+        assert_true(H5Sselect_hyperslab(fs, H5S_SELECT_SET, (hsize_t[]){0}, NULL, (hsize_t[]){1}, NULL) >= 0);
+        assert_true(H5Dwrite(d, H5T_NATIVE_INT, ms, fs, H5P_DEFAULT, &bad[b]) >= 0);
+        H5Sclose(ms);
+        H5Sclose(fs);
+        H5Dclose(d);
+        H5Fclose(f);
+        cd_state g;
+        alloc_state(&g, NP, NPRIM, NW, 4);
+        assert_int_equal(cd_h5_read_snapshot(path, 0, &g, err, sizeof err), -1);
+        assert_non_null(strstr(err, "pair_active"));
+        cd_state_free(&g);
+    }
     cd_state_free(&s[0]);
     remove_run(path);
 }
@@ -532,6 +580,7 @@ int main(void)
         cmocka_unit_test(test_io_h5_reopen_before_first_snapshot),
         cmocka_unit_test(test_io_h5_killed_writer_leaves_readable_file),
         cmocka_unit_test(test_io_h5_wrong_counts_are_refused),
+        cmocka_unit_test(test_io_h5_flag_column_is_int32_in_file),
         cmocka_unit_test(test_io_h5_missing_file_is_named),
         cmocka_unit_test(test_io_h5_bad_observables_are_refused),
         cmocka_unit_test(test_io_h5_reopen_refuses_missing_dataset),

@@ -10,7 +10,8 @@
 enum { PRIMS = 200, MAX_ROWS = 4000 };
 
 typedef struct {
-    cd_int active[MAX_ROWS], pi[MAX_ROWS], pj[MAX_ROWS];
+    cd_flag active[MAX_ROWS];
+    cd_int pi[MAX_ROWS], pj[MAX_ROWS];
     double overlap[MAX_ROWS]; /* [m] */
     cd_vec3 shear[MAX_ROWS];  /* [m] */
     long n;

@@ -266,7 +266,7 @@ static int keep_history(cd_sim *sim)
     if (n_old > nb->cap_old || !nb->d.old_keys) {
         size_t cap = (size_t)cd_nb_room((cd_long)n_old);
         if (realloc_dev((void **)&nb->d.old_keys, cap, sizeof(cd_ulong)) ||
-            realloc_dev((void **)&nb->d.old_active, cap, sizeof(cd_int)) ||
+            realloc_dev((void **)&nb->d.old_active, cap, sizeof(cd_flag)) ||
             realloc_dev((void **)&nb->d.old_shear, cap, sizeof(cd_vec3)))
             return -1;
         nb->cap_old = cap;

@@ -85,6 +85,18 @@ static size_t largest_column(const cd_state *s)
     return most;
 }
 
+/* move_host's move of a column whose rows are not whole cd_ints (a cd_flag,
+ * kernels/defs.h): rows of e bytes through the scratch tmp, as
+ * cd_reorder_item_move moves words. */
+static void move_bytes(void *tmp, void *col, size_t rows, size_t e, const cd_int *map, int scatter)
+{
+    unsigned char *dst = tmp;
+    const unsigned char *src = col;
+    for (size_t g = 0; g < rows; g++)
+        memcpy(dst + (scatter ? (size_t)map[g] : g) * e, src + (scatter ? g : (size_t)map[g]) * e, e);
+    memcpy(col, tmp, rows * e);
+}
+
 /* The maps at the first build: identity, and the sort's scratch. */
 static int begin(cd_sim *sim)
 {
@@ -370,6 +382,10 @@ static int move_host(cd_state *s, const cd_int *part, const cd_int *prim, const 
         int scatter = grp == CD_GROUP_PAIR && pair_scatter;
         cd_int *col = *cd_field_ptr(s, &cd_fields[f]);
         if (!groups) continue;
+        if (cd_fields[f].elem_size % sizeof(cd_int)) { /* a byte a row (cd_flag: pair_active) */
+            move_bytes(tmp, col, groups, stride * cd_fields[f].elem_size, map, scatter);
+            continue;
+        }
         CD_HOST_FOR(groups, firstprivate(tmp, col, map))
         for (size_t g = 0; g < groups; g++) cd_reorder_item_move(tmp, n, col, n, map, (cd_long)g, n, scatter);
         memcpy(col, tmp, rows * cd_fields[f].elem_size);

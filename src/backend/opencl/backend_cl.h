@@ -74,7 +74,7 @@ enum {
 /* The pair columns that carry history across a rebuild exist twice: the
  * new list is filled from the old one.  One such set, with its keys. */
 typedef struct {
-    cl_mem active, shear, keys; /* cd_int, cd_vec3 [m], cd_ulong */
+    cl_mem active, shear, keys; /* cd_flag, cd_vec3 [m], cd_ulong */
     size_t cap;                 /* rows */
 } cd_cl_pairset;
 

@@ -61,7 +61,7 @@ int cd_cl_reserve_pairs(cd_cl *cl, size_t n, int which)
         release(&h->active);
         release(&h->shear);
         release(&h->keys);
-        h->active = cd_cl_buffer(cl, want * sizeof(cd_int), "allocating the contact history");
+        h->active = cd_cl_buffer(cl, want * sizeof(cd_flag), "allocating the contact history");
         h->shear = cd_cl_buffer(cl, want * sizeof(cd_vec3), "allocating the contact history");
         h->keys = cd_cl_buffer(cl, want * sizeof(cd_ulong), "allocating the pair keys");
         h->cap = want;
