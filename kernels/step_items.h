@@ -365,7 +365,7 @@ CD_INLINE_ALWAYS void cd_item_pair_force(cd_cols c, cd_pair_id k, cd_law_params 
     cd_vec3 shear = c.pair_shear[k];
     cd_contact_force f = cd_contact_law(law, m_eff, cd_law_pair_radius(ri, rj), &g, cd_v3_sub(vj, vi), dt, &shear);
 #if CD_ENDS_FROM_POSE
-    if (!c.pair_active[k]) /* memory-bound variants: written when it changes (4 B a contact-step) */
+    if (!c.pair_active[k]) /* memory-bound variants: written when it changes (1 B a contact-step) */
 #endif
         c.pair_active[k] = 1;
     c.pair_shear[k] = shear;
