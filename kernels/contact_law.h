@@ -145,14 +145,14 @@ CD_INLINE cd_contact_force cd_contact_law(cd_law_params p, cd_real m_eff, cd_rea
 
     /* v_n is the rate of separation: negative while approaching. */
     cd_real vn = cd_v3_dot(vrel, n);
-    cd_vec3 vt = cd_v3_axpy(vrel, -vn, n);
+    cd_vec3 vt = cd_v3_sub(vrel, cd_v3_scale(n, vn));
     cd_real fn = k.kn_c * g->overlap - k.gamma_n * vn;
     if (p.clip_normal && fn < CD_R(0)) fn = CD_R(0);
 
     /* Keep the spring in the current tangent plane, with its length. */
     cd_vec3 s = *shear;
     cd_real len0 = cd_v3_norm(s);
-    s = cd_v3_axpy(s, -cd_v3_dot(s, n), n);
+    s = cd_v3_sub(s, cd_v3_scale(n, cd_v3_dot(s, n)));
     cd_real len1 = cd_v3_norm(s);
     if (len1 > CD_R(0)) s = cd_v3_scale(s, len0 / len1);
     s = cd_v3_axpy(s, dt, vt);

@@ -4,6 +4,7 @@
 #include "test_util.h"
 #include <math.h>
 #include "../kernels/contact_law.h"
+#include "unit/segseg_rng.h"
 
 static const double E = 7.0e10, nu = 0.22, R = 1.0e-3, m = 2.0e-5; /* glass: [Pa], [1], [m], [kg] */
 
@@ -125,6 +126,34 @@ static void test_hertz_elastic_energy(void **state)
     assert_true(fabs(u / expect - 1) < 1e-13);
 }
 
+/* The law forms v_t and the spring's projection onto the tangent plane as
+ * differences, v - n (v . n) (session 19; before: v + (-(v . n)) n, one
+ * negation more).  The same bits, because x + (-y) is x - y and (-a) b is
+ * -(a b) in IEEE arithmetic (rounding to nearest is symmetric) and a b is
+ * b a: checked here on random vectors and factors, with signed zeros,
+ * subnormals, huge and tiny magnitudes and exact cancellations. */
+static double special_or(double x, int k)
+{
+    static const double sp[] = {0.0, -0.0, 4.9e-324, -2.2e-308, 1e-300, -1e300, 1.0, -1.0};
+    return k < 8 ? sp[k] : x;
+}
+
+static void test_difference_form_same_bits(void **state)
+{
+    (void)state;
+    rng_state = 1919;
+    for (int i = 0; i < 1000000; i++) {
+        int k = (int)(rng_next() % 64);
+        cd_vec3 v = rng_vec(pow(10.0, 20 * rng_sym())), n = rng_vec(1.0);
+        double d = special_or(pow(10.0, 20 * rng_sym()) * rng_sym(), k);
+        if (i % 3 == 0) v.x = special_or(v.x, (int)(rng_next() % 16));
+        if (i % 5 == 0) n.y = special_or(n.y, (int)(rng_next() % 16));
+        if (i % 7 == 0) d = cd_v3_dot(v, n); /* the law's own factor */
+        cd_vec3 got = cd_v3_sub(v, cd_v3_scale(n, d)), want = cd_v3_axpy(v, -d, n);
+        assert_memory_equal(&got, &want, sizeof got);
+    }
+}
+
 /* The kernels receive the parameters by value (kernels/cl/step.cl): the
  * struct has no padding the OpenCL compiler could lay out differently. */
 static void test_params_layout(void **state)
@@ -139,7 +168,7 @@ int main(void)
         cmocka_unit_test(test_contact_moduli),      cmocka_unit_test(test_hertz_normal_force_at_rest),
         cmocka_unit_test(test_hertz_dashpot),       cmocka_unit_test(test_mindlin_tangential_stiffness),
         cmocka_unit_test(test_mindlin_coulomb_cap), cmocka_unit_test(test_hertz_elastic_energy),
-        cmocka_unit_test(test_params_layout),
+        cmocka_unit_test(test_params_layout),       cmocka_unit_test(test_difference_form_same_bits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
