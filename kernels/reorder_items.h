@@ -38,43 +38,17 @@ CD_INLINE cd_order cd_order_identity(void)
 /* map[x], or x for the identity (null map). */
 CD_INLINE cd_long cd_map(const CD_GLOBAL cd_int *map, cd_long x) { return map ? (cd_long)map[x] : x; }
 
-/* Key of particle q: the index of the grid cell of its centre, counted
- * with the grid's longest axis slowest and its shortest fastest (ties:
- * x before y before z), its memory slot the value to sort.  The cells' own
- * order, not a Morton or Hilbert curve: it keeps a particle's neighbours at
- * a few fixed strides in memory (the next cell, row and slab), which the
- * CPU's prefetchers follow; Morton's jumps made the step 0.67x as fast on a
- * 1e5 bed (docs/performance.md).  The longest axis slowest makes the slab
- * the smallest, and with it the largest distance in memory between a
- * row's two particles, which the host threads' sweep waits for (on a wide
- * flat bed of 1e5 spheres, 1,778 slots against 21,001 with z slowest:
- * docs/performance.md, "Session 19, the sweep"). */
+/* Key of particle q: the index of the grid cell of its centre (x fastest,
+ * then y, then z: cd_grid_cell_of), its memory slot the value to sort.
+ * The cells' own order, not a Morton or Hilbert curve: it keeps a
+ * particle's neighbours at a few fixed strides in memory (the next cell,
+ * row and layer), which the CPU's prefetchers follow; Morton's jumps made
+ * the step 0.67x as fast on a 1e5 bed (docs/performance.md). */
 CD_INLINE void cd_reorder_item_key(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_grid *grid, CD_GLOBAL cd_ulong *keys,
                                    CD_GLOBAL cd_int *vals)
 {
     cd_grid g = grid[0];
-    cd_vec3 x = c.position[q];
-    cd_long at[3];
-    at[0] = cd_grid_coord(&g, x.x, 0);
-    at[1] = cd_grid_coord(&g, x.y, 1);
-    at[2] = cd_grid_coord(&g, x.z, 2);
-    int a = 0, b = 1, e = 2, t; /* the axes by extent: a the slowest, e the fastest */
-    if (g.dim[b] > g.dim[a]) {
-        t = a;
-        a = b;
-        b = t;
-    }
-    if (g.dim[e] > g.dim[a]) {
-        t = a;
-        a = e;
-        e = t;
-    }
-    if (g.dim[e] > g.dim[b]) {
-        t = b;
-        b = e;
-        e = t;
-    }
-    keys[q] = (cd_ulong)((at[a] * g.dim[b] + at[b]) * g.dim[e] + at[e]);
+    keys[q] = (cd_ulong)cd_grid_cell_of(&g, c.position[q]);
     vals[q] = q;
 }
 

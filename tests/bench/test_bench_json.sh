@@ -48,11 +48,12 @@ for l in lines:
         assert rows["mixed_warps_visited"][0] <= 2, l
     else:
         assert rows["mixed_warps_visited"] == rows["mixed_warps"], l
-    # the host threads' sweep waits this many slots (a row's two particles
-    # lie at most that far apart in memory); 0 where the step does not sweep
-    assert 0 <= rows["sweep_lag"] < r["N"], l
+    # the host threads' sweep: a row's two particles lie at most sweep_span
+    # slots apart in memory; it waits sweep_lag slots, the span or (a state
+    # that fits the cache) N; both 0 where the step does not sweep
+    assert 0 <= rows["sweep_span"] < r["N"] and 0 <= rows["sweep_lag"] <= r["N"], l
     if r["device"].startswith("host, ") and rows["pair_rows"] > 0:  # host threads
-        assert rows["sweep_lag"] > 0, l
+        assert rows["sweep_span"] > 0 and rows["sweep_lag"] in (rows["sweep_span"], r["N"]), l
 print("ok", case, len(lines), "lines")
 PY
 }

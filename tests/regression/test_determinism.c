@@ -445,6 +445,10 @@ int main(void)
     /* Parallelise every loop, however small, so that 2 threads really split
      * the work of this small case. */
     cd_parallel_min_rows = 0;
+    /* and interleave the host threads' sweep (src/backend/omp/sweep.c) in
+     * blocks of 8 particles whatever the state's size */
+    cd_sweep_block = 8;
+    cd_sweep_min_bytes = 0;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bits_for_one_and_two_threads_and_twice),
         cmocka_unit_test(test_same_bits_when_the_thread_count_changes),

@@ -9,6 +9,9 @@
 #include "step_items.h"
 #include "broadphase.h"
 
+size_t cd_sweep_block = 512;
+long cd_sweep_min_bytes = -1;
+
 #if CD_OFFLOAD
 int cd_omp_sweep_lists(cd_sim *sim)
 {
@@ -23,7 +26,7 @@ int cd_omp_sweep_lists(cd_sim *sim)
  * loops of an offload device, each row and particle computed by the same
  * item on the same values, so the same bits.  The rows ascend by the slot
  * of their first particle; the sweep computes them block by block of
- * CD_SWEEP_BLOCK particles, with the wall candidates of the block, and
+ * cd_sweep_block particles, with the wall candidates of the block, and
  * then gathers, kicks and advances every particle q with q + lag below the
  * block's end (lag: the largest distance in slots between a row's two
  * particles, cd_omp_sweep_lists): by then every row of q has been computed, and
@@ -36,64 +39,75 @@ int cd_omp_sweep_lists(cd_sim *sim)
  * for a barrier, after which each thread gathers, kicks and advances its
  * own: until then nobody moves a particle that another thread's row
  * reads. */
-#define CD_SWEEP_BLOCK 512
+
+/* The sweep's three loops, each a function of its own with every item
+ * inlined (noinline, flatten: GCC otherwise called the items, 1.15x the
+ * instructions of the step), so that each compiles as it did as a loop
+ * over all rows: inlined into one function with the others, a hexapod's
+ * pair row lost about 5 % to register allocation (docs/performance.md,
+ * "Session 19, the sweep").  The pair rows k0 .. k1 - 1: */
+__attribute__((noinline, flatten)) static void sweep_rows(cd_cols c, size_t k0, size_t k1, cd_law_params law,
+                                                          cd_real dt, cd_real sin_parallel, cd_int blend,
+                                                          cd_int outputs)
+{
+    for (size_t k = k0; k < k1; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend, outputs);
+}
+
+/* the wall candidates e0 .. e1 - 1: */
+__attribute__((noinline, flatten)) static void sweep_walls(cd_cols c, const cd_int *rows, cd_wall_entry *out, cd_int e0,
+                                                           cd_int e1, const cd_wall *walls, cd_int W, cd_law_params law,
+                                                           cd_real dt, cd_real sin_parallel, cd_int blend)
+{
+    for (cd_int e = e0; e < e1; e++) cd_item_wall_row(c, rows[e], out + e, walls, W, law, dt, sin_parallel, blend);
+}
+
+/* the gathers, kicks and next advances of particles q0 .. q1 - 1 (only
+ * those with edge[q] == want where edge is not null), with next = 1 and
+ * with next = 0 (a call's last step): next a constant in each loop, so the
+ * gather's store of the force at the last step, and its test, leave the
+ * steps' loop (callgrind, 10,000 spheres: 11.6 instructions a
+ * particle-step). */
+#define CD_SWEEP_MOVE(name, next)                                                                                      \
+    __attribute__((noinline, flatten)) static int name(cd_cols c, cd_nb_lists d, size_t q0, size_t q1,                 \
+                                                       const unsigned char *edge, int want, cd_vec3 gravity,           \
+                                                       cd_int dimension, cd_real dt, cd_real limit2)                   \
+    {                                                                                                                  \
+        int moved = 0;                                                                                                 \
+        for (size_t q = q0; q < q1; q++)                                                                               \
+            if (!edge || edge[q] == want)                                                                              \
+                moved |=                                                                                               \
+                    cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,     \
+                                                d.wall_out, gravity, dimension, dt, limit2, d.ref_pose, next);         \
+        return moved;                                                                                                  \
+    }
+CD_SWEEP_MOVE(sweep_move_next, 1)
+CD_SWEEP_MOVE(sweep_move_last, 0)
 
 /* The sweep of particles q0 .. q1 - 1 (of n) and of their pair rows (the
  * rows of their primitives, d.pair_offset: the build's offsets, which the
  * rows keep until the next build); edge (null: none) marks the particles
- * left for sweep_edges.  next: a constant in each caller. */
-CD_INLINE_ALWAYS int sweep_range(cd_cols c, cd_nb_lists d, size_t q0, size_t q1, size_t n, size_t n_pairs, size_t lag,
-                                 const unsigned char *edge, cd_step_params p, const cd_wall *walls, cd_int W,
-                                 cd_real limit2, int next)
+ * left for after the barrier. */
+static int sweep_range(cd_cols c, const cd_nb_lists *d, size_t q0, size_t q1, size_t n, size_t n_pairs, size_t lag,
+                       const unsigned char *edge, const cd_step_params *p, const cd_wall *walls, cd_int W,
+                       cd_real limit2, int next)
 {
     int moved = 0;
     size_t done = q0; /* the next particle to move */
-    for (size_t x0 = q0; x0 < q1; x0 += CD_SWEEP_BLOCK) {
-        size_t x1 = x0 + CD_SWEEP_BLOCK < q1 ? x0 + CD_SWEEP_BLOCK : q1;
-        size_t k1 = x1 < n ? (size_t)d.pair_offset[c.prim_first[x1]] : n_pairs;
-        for (size_t k = (size_t)d.pair_offset[c.prim_first[x0]]; k < k1; k++)
-            cd_item_pair_force(c, (cd_pair_id)k, p.law, p.dt, p.sin_parallel, p.parallel_blend, !next);
-        for (cd_int w = d.wall_start[x0]; w < d.wall_start[x1]; w++)
-            cd_item_wall_row(c, d.wall_rows[w], d.wall_out + w, walls, W, p.wall_law, p.dt, p.sin_parallel,
-                             p.parallel_blend);
+    for (size_t x0 = q0; x0 < q1; x0 += cd_sweep_block) {
+        size_t x1 = x0 + cd_sweep_block < q1 ? x0 + cd_sweep_block : q1;
+        size_t k0 = (size_t)d->pair_offset[c.prim_first[x0]];
+        size_t k1 = x1 < n ? (size_t)d->pair_offset[c.prim_first[x1]] : n_pairs;
+        sweep_rows(c, k0, k1, p->law, p->dt, p->sin_parallel, p->parallel_blend, !next);
+        sweep_walls(c, d->wall_rows, d->wall_out, d->wall_start[x0], d->wall_start[x1], walls, W, p->wall_law, p->dt,
+                    p->sin_parallel, p->parallel_blend);
         size_t ready = x1 == q1 ? q1 : x1 > done + lag ? x1 - lag : done; /* rows up to x1 - 1 computed */
-        for (; done < ready; done++)
-            if (!edge || !edge[done])
-                moved |=
-                    cd_item_gather_kick_advance(c, (cd_particle_id)done, d.gather_start, d.gather_rows, d.wall_start,
-                                                d.wall_out, p.gravity, p.dimension, p.dt, limit2, d.ref_pose, next);
+        if (ready > done)
+            moved |= next ? sweep_move_next(c, *d, done, ready, edge, 0, p->gravity, p->dimension, p->dt, limit2)
+                          : sweep_move_last(c, *d, done, ready, edge, 0, p->gravity, p->dimension, p->dt, limit2);
+        done = ready > done ? ready : done;
     }
     return moved;
 }
-
-/* The edges of q0 .. q1 - 1, after the barrier. */
-CD_INLINE_ALWAYS int sweep_edges(cd_cols c, cd_nb_lists d, size_t q0, size_t q1, const unsigned char *edge,
-                                 cd_step_params p, cd_real limit2, int next)
-{
-    int moved = 0;
-    for (size_t q = q0; q < q1; q++)
-        if (edge[q])
-            moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,
-                                                 d.wall_out, p.gravity, p.dimension, p.dt, limit2, d.ref_pose, next);
-    return moved;
-}
-
-/* sweep_range (edges 0) or sweep_edges (1) with next = 1 and with next =
- * 0 (a call's last step): next a constant in each loop, so the gather's
- * store of the force at the last step, and its test, leave the steps'
- * loop (callgrind, 10,000 spheres: 11.6 instructions a particle-step).
- * noinline and flatten: every item inlined (GCC otherwise called them:
- * 1.15x the instructions of the step). */
-#define CD_SWEEP_FN(name, next)                                                                                        \
-    __attribute__((noinline, flatten)) static int name(                                                                \
-        cd_cols c, cd_nb_lists d, size_t q0, size_t q1, size_t n, size_t n_pairs, size_t lag,                          \
-        const unsigned char *edge, cd_step_params p, const cd_wall *walls, cd_int W, cd_real limit2, int edges)        \
-    {                                                                                                                  \
-        return edges ? sweep_edges(c, d, q0, q1, edge, p, limit2, next)                                                \
-                     : sweep_range(c, d, q0, q1, n, n_pairs, lag, edge, p, walls, W, limit2, next);                    \
-    }
-CD_SWEEP_FN(sweep_next, 1)
-CD_SWEEP_FN(sweep_last, 0)
 
 /* Marks the edges of the range q0 .. q1 - 1: the particles with a pair
  * row whose other particle is outside it. */
@@ -118,6 +132,18 @@ static void mark_edges(cd_cols c, cd_nb_lists d, size_t q0, size_t q1, unsigned 
  * ascend by the memory slot of their first particle (they ascend by the
  * slot of primitive i, pass 7, and a particle's primitives are
  * consecutive): checked here, since the sweep walks them so. */
+/* Bytes of the columns the step holds (kernels/fields.def, on_device),
+ * pair rows included, and of its gather lists and wall candidates: what
+ * its passes stream. */
+static size_t step_bytes(const cd_sim *sim)
+{
+    size_t b = 0;
+    for (size_t f = 0; f < cd_n_fields; f++)
+        if (cd_fields[f].on_device) b += cd_state_rows(&sim->s, cd_fields[f].group) * cd_fields[f].elem_size;
+    b += (sim->s.n_particles + 1) * sizeof(cd_int) + 2 * sim->s.n_pairs * sizeof(cd_pair_id);
+    return b + sim->nb.n_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_entry));
+}
+
 int cd_omp_sweep_lists(cd_sim *sim)
 {
     cd_neighbors *nb = &sim->nb;
@@ -144,7 +170,15 @@ int cd_omp_sweep_lists(cd_sim *sim)
                 unsorted);
         return -1;
     }
-    nb->sweep_lag = (size_t)lag;
+    /* Below about half the last-level cache the passes' data stays in it
+     * from one pass to the next, and interleaving them only costs (10,000
+     * hexapods, 13 MB: 0.94x; docs/performance.md, "Session 19, the
+     * sweep"): the lag is then the whole range, all rows first.  16 MiB:
+     * half the L3 of a core complex of the development machine's EPYC
+     * (the C library's sysconf reports the whole chip's 320 MiB there). */
+    size_t least = cd_sweep_min_bytes >= 0 ? (size_t)cd_sweep_min_bytes : (size_t)16 << 20;
+    nb->sweep_lag = step_bytes(sim) > least ? (size_t)lag : n;
+    nb->sweep_span = (size_t)lag;
     return 0;
 }
 
@@ -173,12 +207,11 @@ int cd_omp_sweep(cd_sim *sim, int next)
 #pragma omp barrier
         }
         const unsigned char *ed = T > 1 ? edge : NULL;
-        moved |= next ? sweep_next(c, d, q0, q1, n, n_pairs, lag, ed, p, walls, W, limit2, 0)
-                      : sweep_last(c, d, q0, q1, n, n_pairs, lag, ed, p, walls, W, limit2, 0);
+        moved |= sweep_range(c, &d, q0, q1, n, n_pairs, lag, ed, &p, walls, W, limit2, next);
         if (T > 1) {
 #pragma omp barrier
-            moved |= next ? sweep_next(c, d, q0, q1, n, n_pairs, lag, ed, p, walls, W, limit2, 1)
-                          : sweep_last(c, d, q0, q1, n, n_pairs, lag, ed, p, walls, W, limit2, 1);
+            moved |= next ? sweep_move_next(c, d, q0, q1, edge, 1, p.gravity, p.dimension, p.dt, limit2)
+                          : sweep_move_last(c, d, q0, q1, edge, 1, p.gravity, p.dimension, p.dt, limit2);
         }
         if (t == 0) used = T;
     }
