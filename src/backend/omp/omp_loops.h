@@ -133,6 +133,9 @@ static inline int cd_dev_put(void *dst, const void *src, size_t bytes)
  * in the offload variant). */
 int cd_omp_sweep(cd_sim *sim, int next);
 int cd_omp_sweep_lists(cd_sim *sim);
+/* Does the sweep interleave rows and moves (the step's state above
+ * cd_sweep_min_bytes; never in the offload variant)? */
+int cd_omp_sweep_interleaves(const cd_sim *sim);
 
 /* The columns the loops work on: device addresses in the offload variant
  * once the state is mapped, the host columns otherwise (src/backend/omp/step_omp.c). */

@@ -191,10 +191,13 @@ static int moves(const cd_field_info *f)
 
 /* Would the order slot_of at least halve the largest distance in memory
  * between a pair row's two particles, which the host threads' sweep waits
- * for (src/backend/omp/step_omp.c, "The sweep")?  A tiled or deposited
- * bed's order can keep most rows short, as the test above counts them,
- * and still hold rows a whole layer of the bed apart.  Never on an
- * offload device, whose step does not sweep. */
+ * for where it interleaves (src/backend/omp/sweep.c)?  A tiled or
+ * deposited bed's order can keep most rows short, as the test above
+ * counts them, and still hold rows a whole layer of the bed apart (1e5
+ * spheres tiled 10 x 10: 21,001 slots, 2,016 in the cells' order).  Not
+ * where the sweep does not interleave: there the passes run as loops, for
+ * which such a bed's order was as good (docs/performance.md, "Session 19,
+ * the sweep"); never on an offload device, whose step does not sweep. */
 static int halves_lag(cd_sim *sim, const cd_int *slot_of)
 {
 #if CD_OFFLOAD
@@ -202,6 +205,7 @@ static int halves_lag(cd_sim *sim, const cd_int *slot_of)
     (void)slot_of;
     return 0;
 #else
+    if (!cd_omp_sweep_interleaves(sim)) return 0;
     cd_cols c = cd_sim_step_cols(sim);
     long now = 0, then = 0;
     size_t K = sim->s.n_pairs;

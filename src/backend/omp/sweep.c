@@ -18,6 +18,12 @@ int cd_omp_sweep_lists(cd_sim *sim)
     (void)sim;
     return 0;
 }
+
+int cd_omp_sweep_interleaves(const cd_sim *sim)
+{
+    (void)sim;
+    return 0;
+}
 #else
 /* ---- the sweep: host threads' steps 5-8 and the next 1-4 ------------------
  *
@@ -109,6 +115,41 @@ static int sweep_range(cd_cols c, const cd_nb_lists *d, size_t q0, size_t q1, si
     return moved;
 }
 
+/* The passes as loops over all rows, where the sweep does not interleave
+ * (the step's state fits the cache): each an orphaned `omp for` of the
+ * caller's region, its rows shared by its threads as the loops were
+ * before the sweep (pair rows split evenly by rows, a mixture's visited
+ * kind by kind; the same bits either way). */
+__attribute__((noinline, flatten)) static void loop_rows(cd_cols c, size_t n, const cd_int *visit, cd_law_params law,
+                                                         cd_real dt, cd_real sin_parallel, cd_int blend, cd_int outputs)
+{
+#pragma omp for schedule(static) nowait /* the wall rows write other rows and read only the particles */
+    for (size_t v = 0; v < n; v++)
+        cd_item_pair_force(c, (cd_pair_id)cd_map(visit, (cd_long)v), law, dt, sin_parallel, blend, outputs);
+}
+
+__attribute__((noinline, flatten)) static void loop_walls(cd_cols c, const cd_int *rows, cd_wall_entry *out, size_t n,
+                                                          const cd_wall *walls, cd_int W, cd_law_params law, cd_real dt,
+                                                          cd_real sin_parallel, cd_int blend)
+{
+#pragma omp for schedule(static)
+    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], out + e, walls, W, law, dt, sin_parallel, blend);
+}
+
+#define CD_LOOP_MOVE(name, next)                                                                                       \
+    __attribute__((noinline, flatten)) static int name(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 gravity,            \
+                                                       cd_int dimension, cd_real dt, cd_real limit2)                   \
+    {                                                                                                                  \
+        int moved = 0;                                                                                                 \
+        _Pragma("omp for schedule(static) nowait") /* the region's end is the barrier */                               \
+            for (size_t q = 0; q < n; q++) moved |=                                                                    \
+            cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_out, \
+                                        gravity, dimension, dt, limit2, d.ref_pose, next);                             \
+        return moved;                                                                                                  \
+    }
+CD_LOOP_MOVE(loop_move_next, 1)
+CD_LOOP_MOVE(loop_move_last, 0)
+
 /* Marks the edges of the range q0 .. q1 - 1: the particles with a pair
  * row whose other particle is outside it. */
 static void mark_edges(cd_cols c, cd_nb_lists d, size_t q0, size_t q1, unsigned char *edge)
@@ -144,6 +185,17 @@ static size_t step_bytes(const cd_sim *sim)
     return b + sim->nb.n_wall_rows * (sizeof(cd_int) + sizeof(cd_wall_entry));
 }
 
+/* Below about half the last-level cache the passes' data stays in it
+ * from one pass to the next, and interleaving them only costs (10,000
+ * hexapods, 13 MB: 0.94x; docs/performance.md, "Session 19, the sweep"):
+ * the lag is then the whole range, all rows first.  16 MiB: half the L3
+ * of a core complex of the development machine's EPYC (the C library's
+ * sysconf reports the whole chip's 320 MiB there). */
+int cd_omp_sweep_interleaves(const cd_sim *sim)
+{
+    return step_bytes(sim) > (cd_sweep_min_bytes >= 0 ? (size_t)cd_sweep_min_bytes : (size_t)16 << 20);
+}
+
 int cd_omp_sweep_lists(cd_sim *sim)
 {
     cd_neighbors *nb = &sim->nb;
@@ -170,14 +222,7 @@ int cd_omp_sweep_lists(cd_sim *sim)
                 unsorted);
         return -1;
     }
-    /* Below about half the last-level cache the passes' data stays in it
-     * from one pass to the next, and interleaving them only costs (10,000
-     * hexapods, 13 MB: 0.94x; docs/performance.md, "Session 19, the
-     * sweep"): the lag is then the whole range, all rows first.  16 MiB:
-     * half the L3 of a core complex of the development machine's EPYC
-     * (the C library's sysconf reports the whole chip's 320 MiB there). */
-    size_t least = cd_sweep_min_bytes >= 0 ? (size_t)cd_sweep_min_bytes : (size_t)16 << 20;
-    nb->sweep_lag = step_bytes(sim) > least ? (size_t)lag : n;
+    nb->sweep_lag = cd_omp_sweep_interleaves(sim) ? (size_t)lag : n;
     nb->sweep_span = (size_t)lag;
     return 0;
 }
@@ -194,6 +239,20 @@ int cd_omp_sweep(cd_sim *sim, int next)
     unsigned char *edge = sim->nb.sweep_edge; /* n of them (each build makes room) */
     size_t lag = sim->nb.sweep_lag, n_pairs = sim->s.n_pairs;
     int made = sim->nb.sweep_threads, used = 1, moved = 0;
+    if (lag >= n) { /* not interleaved: the passes as loops */
+        const cd_int *visit = sim->nb.n_visit && sim->nb.n_visit == n_pairs ? d.pair_visit : NULL;
+        size_t n_walls = W ? sim->nb.n_wall_rows : 0;
+#pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
+        {
+            loop_rows(c, n_pairs, visit, p.law, p.dt, p.sin_parallel, p.parallel_blend, !next);
+            loop_walls(c, d.wall_rows, d.wall_out, n_walls, walls, W, p.wall_law, p.dt, p.sin_parallel,
+                       p.parallel_blend);
+            moved |= next ? loop_move_next(c, d, n, p.gravity, p.dimension, p.dt, limit2)
+                          : loop_move_last(c, d, n, p.gravity, p.dimension, p.dt, limit2);
+        }
+        sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
+        return moved;
+    }
 #pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
     {
 #ifdef _OPENMP
