@@ -35,8 +35,8 @@ int cd_omp_sweep_interleaves(const cd_sim *sim)
  * cd_sweep_block particles, with the wall candidates of the block, and
  * then gathers, kicks and advances every particle q with q + lag below the
  * block's end (lag: the largest distance in slots between a row's two
- * particles, cd_omp_sweep_lists): by then every row of q has been computed, and
- * no row computed later touches q, so none reads a moved q.  The rows a
+ * particles, cd_omp_sweep_lists): by then every row of q has been
+ * computed, and no row computed later touches q, so none reads a moved q.  The rows a
  * gather reads were written about lag particles before, not a whole pass
  * before, so they are still in the cache, and so is the particles' state
  * that the rows and the gather read (docs/performance.md, "Session 19,
@@ -44,7 +44,10 @@ int cd_omp_sweep_interleaves(const cd_sim *sim)
  * the particles with a row into another range (the range's edges) wait
  * for a barrier, after which each thread gathers, kicks and advances its
  * own: until then nobody moves a particle that another thread's row
- * reads. */
+ * reads.  Where the step's state fits the cache (cd_omp_sweep_interleaves
+ * says no) the step runs the three loops instead (loop_rows, loop_walls,
+ * loop_move_*), as it did before the sweep: the interleaving only costs
+ * there. */
 
 /* The sweep's three loops, each a function of its own with every item
  * inlined (noinline, flatten: GCC otherwise called the items, 1.15x the
