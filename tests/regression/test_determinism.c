@@ -98,6 +98,36 @@ static void test_same_bits_when_the_thread_count_changes(void **state)
     cd_config_free(&cb);
 }
 
+/* The sweep's interleaved rows and moves (every particle moved a span
+ * after its block) give the bits of the loops over all rows that run
+ * where the state fits the cache (src/backend/omp/sweep.c), at one and at
+ * two threads. */
+static void test_interleaved_sweep_equals_loops(void **state)
+{
+    (void)state;
+    static cd_sim a, b, c;
+    cd_config ca, cb, cc;
+    long keep = cd_sweep_min_bytes;
+    cd_sweep_min_bytes = -1; /* 60 hexapods, far below 16 MiB: the loops */
+    run_case(1, 2500, &a, &ca);
+    cd_sweep_min_bytes = 0; /* interleaved, in blocks of cd_sweep_block */
+    run_case(1, 2500, &b, &cb);
+    if (b.nb.sweep_span > 0) { /* host threads (OpenCL and offload devices do not sweep) */
+        assert_true(a.nb.sweep_lag == a.s.n_particles);
+        assert_true(b.nb.sweep_lag == b.nb.sweep_span && b.nb.sweep_lag < b.s.n_particles);
+    }
+    run_case(2, 2500, &c, &cc);
+    cd_sweep_min_bytes = keep;
+    assert_same_particles(&a.s, &b.s);
+    assert_same_particles(&a.s, &c.s);
+    cd_sim_free(&a);
+    cd_sim_free(&b);
+    cd_sim_free(&c);
+    cd_config_free(&ca);
+    cd_config_free(&cb);
+    cd_config_free(&cc);
+}
+
 /* The observables summed where the steps run (cd_sim_observe_step: on the
  * offload or OpenCL device, without a state copy) have the bits of those
  * summed on the host after a sync (cd_sim_observe): the same blocks in the
@@ -452,6 +482,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_bits_for_one_and_two_threads_and_twice),
         cmocka_unit_test(test_same_bits_when_the_thread_count_changes),
+        cmocka_unit_test(test_interleaved_sweep_equals_loops),
         cmocka_unit_test(test_history_survives_forced_rebuilds),
         cmocka_unit_test(test_slot_overflow_changes_nothing),
         cmocka_unit_test(test_device_observables_equal_host_ones),
