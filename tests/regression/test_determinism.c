@@ -43,6 +43,15 @@ static void assert_same_particles(const cd_state *a, const cd_state *b)
     }
 }
 
+/* Frees the n runs of sims[] and their configs. */
+static void free_runs(cd_sim *sims[], cd_config *cfgs[], int n)
+{
+    for (int k = 0; k < n; k++) {
+        cd_sim_free(sims[k]);
+        cd_config_free(cfgs[k]);
+    }
+}
+
 static void test_same_bits_for_one_and_two_threads_and_twice(void **state)
 {
     (void)state;
@@ -54,12 +63,7 @@ static void test_same_bits_for_one_and_two_threads_and_twice(void **state)
     assert_true(contacts > 10); /* the particles did collide */
     assert_same_particles(&a.s, &b.s);
     assert_same_particles(&b.s, &c.s);
-    cd_sim_free(&a);
-    cd_sim_free(&b);
-    cd_sim_free(&c);
-    cd_config_free(&ca);
-    cd_config_free(&cb);
-    cd_config_free(&cc);
+    free_runs((cd_sim *[]){&a, &b, &c}, (cd_config *[]){&ca, &cb, &cc}, 3);
 }
 
 /* The host threads' sweep marks the particles its ranges share (their
@@ -92,10 +96,7 @@ static void test_same_bits_when_the_thread_count_changes(void **state)
     cdt_step(&b, 0);
     assert_true(b.nb.builds - builds >= 5 && without > calls / 2);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a);
-    cd_sim_free(&b);
-    cd_config_free(&ca);
-    cd_config_free(&cb);
+    free_runs((cd_sim *[]){&a, &b}, (cd_config *[]){&ca, &cb}, 2);
 }
 
 /* The sweep's interleaved rows and moves (every particle moved a span
@@ -120,12 +121,7 @@ static void test_interleaved_sweep_equals_loops(void **state)
     cd_sweep_min_bytes = keep;
     assert_same_particles(&a.s, &b.s);
     assert_same_particles(&a.s, &c.s);
-    cd_sim_free(&a);
-    cd_sim_free(&b);
-    cd_sim_free(&c);
-    cd_config_free(&ca);
-    cd_config_free(&cb);
-    cd_config_free(&cc);
+    free_runs((cd_sim *[]){&a, &b, &c}, (cd_config *[]){&ca, &cb, &cc}, 3);
 }
 
 /* The observables summed where the steps run (cd_sim_observe_step: on the
@@ -190,10 +186,7 @@ static void test_slot_overflow_changes_nothing(void **state)
     print_message("slots grew from 1 to %d; %zu pair rows\n", (int)b.nb.slot, b.s.n_pairs);
     assert_true(b.nb.slot > 1 && b.s.n_pairs > 0);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a);
-    cd_sim_free(&b);
-    cd_config_free(&ca);
-    cd_config_free(&cb);
+    free_runs((cd_sim *[]){&a, &b}, (cd_config *[]){&ca, &cb}, 2);
 }
 
 /* Rebuilding the Verlet list every step instead of when the skin is used up
@@ -246,10 +239,7 @@ static void test_history_survives_forced_rebuilds(void **state)
     cdt_step(&a, 500);
     assert_true(b.nb.builds >= before + 500);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a);
-    cd_sim_free(&b);
-    cd_config_free(&ca);
-    cd_config_free(&cb);
+    free_runs((cd_sim *[]){&a, &b}, (cd_config *[]){&ca, &cb}, 2);
 }
 
 /* Writes the settling case to cfgpath, runs it to the end into full and
@@ -429,10 +419,7 @@ static void test_moving_walls_same_bits_with_rebuild_every_step(void **state)
     assert_true(a.nb.builds - builds0 > 4); /* the walls' motion alone asks for one every skin/2 */
     assert_true(a.nb.builds - builds0 < 4000);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a);
-    cd_sim_free(&b);
-    cd_config_free(&ca);
-    cd_config_free(&cb);
+    free_runs((cd_sim *[]){&a, &b}, (cd_config *[]){&ca, &cb}, 2);
 }
 
 /* Between syncs the wall contacts' flag and tangential spring live in the
@@ -464,10 +451,7 @@ static void test_wall_history_survives_a_restart(void **state)
     cdt_step(&a, 2000);
     cdt_step(&b, 2000);
     assert_same_particles(&a.s, &b.s);
-    cd_sim_free(&a);
-    cd_sim_free(&b);
-    cd_config_free(&ca);
-    cd_config_free(&cb);
+    free_runs((cd_sim *[]){&a, &b}, (cd_config *[]){&ca, &cb}, 2);
 }
 
 int main(void)

@@ -45,21 +45,23 @@ int cd_omp_sweep_interleaves(const cd_sim *sim)
  * for a barrier, after which each thread gathers, kicks and advances its
  * own: until then nobody moves a particle that another thread's row
  * reads.  Where the step's state fits the cache (cd_omp_sweep_interleaves
- * says no) the step runs the three loops instead (loop_rows, loop_walls,
- * loop_move_*), as it did before the sweep: the interleaving only costs
- * there. */
+ * says no) the same three loops run one after the other over all rows,
+ * each split evenly among the threads, as the step ran before the sweep:
+ * the interleaving only costs there. */
 
 /* The sweep's three loops, each a function of its own with every item
  * inlined (noinline, flatten: GCC otherwise called the items, 1.15x the
  * instructions of the step), so that each compiles as it did as a loop
  * over all rows: inlined into one function with the others, a hexapod's
  * pair row lost about 5 % to register allocation (docs/performance.md,
- * "Session 19, the sweep").  The pair rows k0 .. k1 - 1: */
-__attribute__((noinline, flatten)) static void sweep_rows(cd_cols c, size_t k0, size_t k1, cd_law_params law,
-                                                          cd_real dt, cd_real sin_parallel, cd_int blend,
-                                                          cd_int outputs)
+ * "Session 19, the sweep").  The pair rows k0 .. k1 - 1 (in the visiting
+ * order visit, null: the rows' order): */
+__attribute__((noinline, flatten)) static void sweep_rows(cd_cols c, const cd_int *visit, size_t k0, size_t k1,
+                                                          cd_law_params law, cd_real dt, cd_real sin_parallel,
+                                                          cd_int blend, cd_int outputs)
 {
-    for (size_t k = k0; k < k1; k++) cd_item_pair_force(c, (cd_pair_id)k, law, dt, sin_parallel, blend, outputs);
+    for (size_t k = k0; k < k1; k++)
+        cd_item_pair_force(c, (cd_pair_id)cd_map(visit, (cd_long)k), law, dt, sin_parallel, blend, outputs);
 }
 
 /* the wall candidates e0 .. e1 - 1: */
@@ -92,6 +94,13 @@ __attribute__((noinline, flatten)) static void sweep_walls(cd_cols c, const cd_i
 CD_SWEEP_MOVE(sweep_move_next, 1)
 CD_SWEEP_MOVE(sweep_move_last, 0)
 
+static int sweep_moves(int next, cd_cols c, cd_nb_lists d, size_t q0, size_t q1, const unsigned char *edge, int want,
+                       const cd_step_params *p, cd_real limit2)
+{
+    return next ? sweep_move_next(c, d, q0, q1, edge, want, p->gravity, p->dimension, p->dt, limit2)
+                : sweep_move_last(c, d, q0, q1, edge, want, p->gravity, p->dimension, p->dt, limit2);
+}
+
 /* The sweep of particles q0 .. q1 - 1 (of n) and of their pair rows (the
  * rows of their primitives, d.pair_offset: the build's offsets, which the
  * rows keep until the next build); edge (null: none) marks the particles
@@ -106,52 +115,17 @@ static int sweep_range(cd_cols c, const cd_nb_lists *d, size_t q0, size_t q1, si
         size_t x1 = x0 + cd_sweep_block < q1 ? x0 + cd_sweep_block : q1;
         size_t k0 = (size_t)d->pair_offset[c.prim_first[x0]];
         size_t k1 = x1 < n ? (size_t)d->pair_offset[c.prim_first[x1]] : n_pairs;
-        sweep_rows(c, k0, k1, p->law, p->dt, p->sin_parallel, p->parallel_blend, !next);
+        sweep_rows(c, NULL, k0, k1, p->law, p->dt, p->sin_parallel, p->parallel_blend, !next);
         sweep_walls(c, d->wall_rows, d->wall_out, d->wall_start[x0], d->wall_start[x1], walls, W, p->wall_law, p->dt,
                     p->sin_parallel, p->parallel_blend);
         size_t ready = x1 == q1 ? q1 : x1 > done + lag ? x1 - lag : done; /* rows up to x1 - 1 computed */
-        if (ready > done)
-            moved |= next ? sweep_move_next(c, *d, done, ready, edge, 0, p->gravity, p->dimension, p->dt, limit2)
-                          : sweep_move_last(c, *d, done, ready, edge, 0, p->gravity, p->dimension, p->dt, limit2);
-        done = ready > done ? ready : done;
+        if (ready > done) {
+            moved |= sweep_moves(next, c, *d, done, ready, edge, 0, p, limit2);
+            done = ready;
+        }
     }
     return moved;
 }
-
-/* The passes as loops over all rows, where the sweep does not interleave
- * (the step's state fits the cache): each an orphaned `omp for` of the
- * caller's region, its rows shared by its threads as the loops were
- * before the sweep (pair rows split evenly by rows, a mixture's visited
- * kind by kind; the same bits either way). */
-__attribute__((noinline, flatten)) static void loop_rows(cd_cols c, size_t n, const cd_int *visit, cd_law_params law,
-                                                         cd_real dt, cd_real sin_parallel, cd_int blend, cd_int outputs)
-{
-#pragma omp for schedule(static) nowait /* the wall rows write other rows and read only the particles */
-    for (size_t v = 0; v < n; v++)
-        cd_item_pair_force(c, (cd_pair_id)cd_map(visit, (cd_long)v), law, dt, sin_parallel, blend, outputs);
-}
-
-__attribute__((noinline, flatten)) static void loop_walls(cd_cols c, const cd_int *rows, cd_wall_entry *out, size_t n,
-                                                          const cd_wall *walls, cd_int W, cd_law_params law, cd_real dt,
-                                                          cd_real sin_parallel, cd_int blend)
-{
-#pragma omp for schedule(static)
-    for (size_t e = 0; e < n; e++) cd_item_wall_row(c, rows[e], out + e, walls, W, law, dt, sin_parallel, blend);
-}
-
-#define CD_LOOP_MOVE(name, next)                                                                                       \
-    __attribute__((noinline, flatten)) static int name(cd_cols c, cd_nb_lists d, size_t n, cd_vec3 gravity,            \
-                                                       cd_int dimension, cd_real dt, cd_real limit2)                   \
-    {                                                                                                                  \
-        int moved = 0;                                                                                                 \
-        _Pragma("omp for schedule(static) nowait") /* the region's end is the barrier */                               \
-            for (size_t q = 0; q < n; q++) moved |=                                                                    \
-            cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start, d.wall_out, \
-                                        gravity, dimension, dt, limit2, d.ref_pose, next);                             \
-        return moved;                                                                                                  \
-    }
-CD_LOOP_MOVE(loop_move_next, 1)
-CD_LOOP_MOVE(loop_move_last, 0)
 
 /* Marks the edges of the range q0 .. q1 - 1: the particles with a pair
  * row whose other particle is outside it. */
@@ -168,14 +142,6 @@ static void mark_edges(cd_cols c, cd_nb_lists d, size_t q0, size_t q1, unsigned 
     }
 }
 
-/* What the host threads' sweep (src/backend/omp/step_omp.c, "The sweep")
- * needs of new rows: its lag, the largest distance in memory slots between
- * the two particles of a row (a particle's rows are all computed once the
- * sweep's rows have passed its slot plus the lag), and room for the edges
- * of its threads' ranges, made again at the next step.  The rows must
- * ascend by the memory slot of their first particle (they ascend by the
- * slot of primitive i, pass 7, and a particle's primitives are
- * consecutive): checked here, since the sweep walks them so. */
 /* Bytes of the columns the step holds (kernels/fields.def, on_device),
  * pair rows included, and of its gather lists and wall candidates: what
  * its passes stream. */
@@ -199,6 +165,14 @@ int cd_omp_sweep_interleaves(const cd_sim *sim)
     return step_bytes(sim) > (cd_sweep_min_bytes >= 0 ? (size_t)cd_sweep_min_bytes : (size_t)16 << 20);
 }
 
+/* What the host threads' sweep (above)
+ * needs of new rows: its lag, the largest distance in memory slots between
+ * the two particles of a row (a particle's rows are all computed once the
+ * sweep's rows have passed its slot plus the lag), and room for the edges
+ * of its threads' ranges, made again at the next step.  The rows must
+ * ascend by the memory slot of their first particle (they ascend by the
+ * slot of primitive i, pass 7, and a particle's primitives are
+ * consecutive): checked here, since the sweep walks them so. */
 int cd_omp_sweep_lists(cd_sim *sim)
 {
     cd_neighbors *nb = &sim->nb;
@@ -241,45 +215,42 @@ int cd_omp_sweep(cd_sim *sim, int next)
     size_t n = sim->s.n_particles, most = sim->s.n_pairs > n ? sim->s.n_pairs : n;
     unsigned char *edge = sim->nb.sweep_edge; /* n of them (each build makes room) */
     size_t lag = sim->nb.sweep_lag, n_pairs = sim->s.n_pairs;
-    int made = sim->nb.sweep_threads, used = 1, moved = 0;
-    if (lag >= n) { /* not interleaved: the passes as loops */
-        const cd_int *visit = sim->nb.n_visit && sim->nb.n_visit == n_pairs ? d.pair_visit : NULL;
-        size_t n_walls = W ? sim->nb.n_wall_rows : 0;
-#pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
-        {
-            loop_rows(c, n_pairs, visit, p.law, p.dt, p.sin_parallel, p.parallel_blend, !next);
-            loop_walls(c, d.wall_rows, d.wall_out, n_walls, walls, W, p.wall_law, p.dt, p.sin_parallel,
-                       p.parallel_blend);
-            moved |= next ? loop_move_next(c, d, n, p.gravity, p.dimension, p.dt, limit2)
-                          : loop_move_last(c, d, n, p.gravity, p.dimension, p.dt, limit2);
-        }
-        sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
-        return moved;
-    }
+    int made = sim->nb.sweep_threads, used = 1, moved = 0, interleave = lag < n;
+    /* not interleaved: the passes as loops over all rows, each split evenly
+     * among the threads (a mixture's pair rows kind by kind), a barrier
+     * before the moves, as the step ran before the sweep */
+    const cd_int *visit = sim->nb.n_visit && sim->nb.n_visit == n_pairs ? d.pair_visit : NULL;
+    size_t n_walls = W ? sim->nb.n_wall_rows : 0;
 #pragma omp parallel if (CD_PARALLEL(most)) reduction(| : moved)
     {
 #ifdef _OPENMP
-        int T = omp_get_num_threads(), t = omp_get_thread_num();
+        size_t T = (size_t)omp_get_num_threads(), t = (size_t)omp_get_thread_num();
 #else
-        int T = 1, t = 0;
+        size_t T = 1, t = 0;
 #endif
-        size_t q0 = n * (size_t)t / (size_t)T, q1 = n * (size_t)(t + 1) / (size_t)T;
-        if (T > 1 && T != made) { /* the same test in every thread */
-            mark_edges(c, d, q0, q1, edge);
+        size_t q0 = n * t / T, q1 = n * (t + 1) / T;
+        if (!interleave) {
+            sweep_rows(c, visit, n_pairs * t / T, n_pairs * (t + 1) / T, p.law, p.dt, p.sin_parallel, p.parallel_blend,
+                       !next);
+            sweep_walls(c, d.wall_rows, d.wall_out, (cd_int)(n_walls * t / T), (cd_int)(n_walls * (t + 1) / T), walls,
+                        W, p.wall_law, p.dt, p.sin_parallel, p.parallel_blend);
 #pragma omp barrier
-        }
-        const unsigned char *ed = T > 1 ? edge : NULL;
-        moved |= sweep_range(c, &d, q0, q1, n, n_pairs, lag, ed, &p, walls, W, limit2, next);
-        if (T > 1) {
+            moved |= sweep_moves(next, c, d, q0, q1, NULL, 0, &p, limit2);
+        } else {
+            if (T > 1 && (int)T != made) { /* the same test in every thread */
+                mark_edges(c, d, q0, q1, edge);
 #pragma omp barrier
-            moved |= next ? sweep_move_next(c, d, q0, q1, edge, 1, p.gravity, p.dimension, p.dt, limit2)
-                          : sweep_move_last(c, d, q0, q1, edge, 1, p.gravity, p.dimension, p.dt, limit2);
+            }
+            moved |= sweep_range(c, &d, q0, q1, n, n_pairs, lag, T > 1 ? edge : NULL, &p, walls, W, limit2, next);
+            if (T > 1) {
+#pragma omp barrier
+                moved |= sweep_moves(next, c, d, q0, q1, edge, 1, &p, limit2);
+            }
+            if (t == 0) used = (int)T;
         }
-        if (t == 0) used = T;
     }
-    if (used > 1) sim->nb.sweep_threads = used;
+    if (interleave && used > 1) sim->nb.sweep_threads = used;
     sim->nb.wall_out_valid = sim->nb.wall_out_pending = 1;
     return moved;
 }
-
 #endif
