@@ -118,15 +118,22 @@ CD_INLINE int cd_reorder_item_descent(const CD_GLOBAL cd_ulong *keys, cd_particl
     return keys[m] < keys[m - 1];
 }
 
-/* How far apart in memory pair row k's two particles are, as the bit
- * length of the difference of their slots (slot_of: the slot each
- * particle would have, null for the present one).  Summed over the rows,
- * it compares two orders by what the step reads: a row's two particles. */
-CD_INLINE cd_int cd_reorder_item_row_span(cd_cols c, cd_long k, const CD_GLOBAL cd_int *slot_of)
+/* How far apart in memory pair row k's two particles are: the difference
+ * of their slots (slot_of: the slot each particle would have, null for the
+ * present one).  Its largest over the rows is the host threads' sweep's
+ * span (src/backend/omp/sweep.c). */
+CD_INLINE cd_ulong cd_reorder_item_row_distance(cd_cols c, cd_long k, const CD_GLOBAL cd_int *slot_of)
 {
     cd_long a = cd_map(slot_of, c.prim_particle[c.pair_prim_i[k]]);
     cd_long b = cd_map(slot_of, c.prim_particle[c.pair_prim_j[k]]);
-    cd_ulong d = (cd_ulong)(a > b ? a - b : b - a);
+    return (cd_ulong)(a > b ? a - b : b - a);
+}
+
+/* The same as the bit length of the difference.  Summed over the rows, it
+ * compares two orders by what the step reads: a row's two particles. */
+CD_INLINE cd_int cd_reorder_item_row_span(cd_cols c, cd_long k, const CD_GLOBAL cd_int *slot_of)
+{
+    cd_ulong d = cd_reorder_item_row_distance(c, k, slot_of);
     cd_int bits = 0;
     while (d) {
         bits++;

@@ -19,8 +19,8 @@ extern long cd_parallel_min_rows;
 #define CD_PARALLEL(rows) ((long)(rows) >= cd_parallel_min_rows)
 /* The host threads' sweep (src/backend/omp/sweep.c): particles a block
  * (512), and the step's bytes above which its rows and moves interleave
- * (-1: 16 MiB, about half a last-level cache; below it all rows come first); tests
- * set both small. */
+ * (-1: 16 MiB, about half a last-level cache; below it all rows come
+ * first); tests set both small. */
 extern size_t cd_sweep_block;
 extern long cd_sweep_min_bytes;
 
@@ -122,7 +122,7 @@ typedef struct {
     size_t cap_visit, cap_visit_starts;
     /* the visiting order where a backend other than omp keeps it (OpenCL), copied to out: its rows; NULL: d */
     size_t (*visit_get)(const struct cd_sim *sim, cd_int *out);
-    /* host threads' sweep (src/backend/omp/step_omp.c): the largest distance in memory slots between the
+    /* host threads' sweep (src/backend/omp/sweep.c): the largest distance in memory slots between the
        particles of a row, and per particle 1 when one of its rows joins it to a particle of another
        thread's range, for sweep_threads threads (0: not made since the last build) */
     size_t sweep_lag, sweep_span; /* the lag the sweep uses (n: all rows first, a small state), the span */

@@ -207,14 +207,14 @@ static int halves_lag(cd_sim *sim, const cd_int *slot_of)
 #else
     if (!cd_omp_sweep_interleaves(sim)) return 0;
     cd_cols c = cd_sim_step_cols(sim);
-    long now = 0, then = 0;
+    cd_ulong now = 0, then = 0;
     size_t K = sim->s.n_pairs;
 #pragma omp parallel for schedule(static) if (K >= (size_t)cd_parallel_min_rows) reduction(max : now, then)
     for (size_t k = 0; k < K; k++) {
-        long a = c.prim_particle[c.pair_prim_i[k]], b = c.prim_particle[c.pair_prim_j[k]];
-        long d = a > b ? a - b : b - a, e = (long)slot_of[a] - (long)slot_of[b];
+        cd_ulong d = cd_reorder_item_row_distance(c, (cd_long)k, NULL);
+        cd_ulong e = cd_reorder_item_row_distance(c, (cd_long)k, slot_of);
         now = d > now ? d : now;
-        then = e > then ? e : -e > then ? -e : then;
+        then = e > then ? e : then;
     }
     return 2 * then <= now;
 #endif

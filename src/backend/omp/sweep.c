@@ -8,6 +8,7 @@
 #include "backend/omp/omp_loops.h"
 #include "step_items.h"
 #include "broadphase.h"
+#include "reorder_items.h"
 
 size_t cd_sweep_block = 512;
 long cd_sweep_min_bytes = -1;
@@ -185,14 +186,14 @@ int cd_omp_sweep_lists(cd_sim *sim)
     }
     nb->sweep_threads = 0;
     cd_cols c = cd_sim_step_cols(sim);
-    const cd_int *pi = c.pair_prim_i, *pj = c.pair_prim_j, *part = c.prim_particle;
-    long lag = 0, unsorted = 0;
+    const cd_int *pi = c.pair_prim_i, *part = c.prim_particle;
+    cd_ulong lag = 0;
+    long unsorted = 0;
 #pragma omp parallel for schedule(static) if (R >= (size_t)cd_parallel_min_rows) reduction(max : lag) reduction(+ : unsorted)
     for (size_t k = 0; k < R; k++) {
-        long a = part[pi[k]], b = part[pj[k]];
-        long d = a > b ? a - b : b - a;
+        cd_ulong d = cd_reorder_item_row_distance(c, (cd_long)k, NULL);
         lag = d > lag ? d : lag;
-        unsorted += k > 0 && part[pi[k - 1]] > a;
+        unsorted += k > 0 && part[pi[k - 1]] > part[pi[k]];
     }
     if (unsorted) {
         fprintf(stderr, "capdem: internal error: %ld pair rows out of memory order after a neighbour-list build\n",
