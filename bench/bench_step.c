@@ -5,6 +5,7 @@
  *                [--backend omp|opencl|omp:2,omp:1,...] [--device cpu|gpu|auto] [--seed K]
  *                [--friction-limit elastic|total] [--save-settled F.h5] [--load-settled F.h5]
  *                [--tile KX,KZ] [--shuffle SEED] [--reorder cells|none]
+ *                [--sphere-orientation integrate|fixed]
  *
  * A case (bench_cases.c) is a shape, a size distribution, a dimension and a
  * time step, with the default material (docs/references.md, Contact law).  N particles are deposited from a
@@ -37,6 +38,11 @@
  *
  * --reorder overrides the case's neighbor.reorder (src/backend/omp/reorder.c: the
  * memory order of the omp backend; the same bits either way).
+ *
+ * --sphere-orientation fixed times the steps as physics.sphere_orientation:
+ * fixed runs them (spheres keep their orientation, the work of LAMMPS's
+ * and LIGGGHTS's nve/sphere; docs/motion.md); the settling integrates
+ * every orientation either way.
  *
  * --backend takes a comma-separated list (an entry "omp:1" runs that round
  * with 1 thread, so thread counts are compared on one packing): the packing is settled on the
@@ -116,7 +122,7 @@ static int save_settled(const char *path, cd_sim *sim, const cd_config *cfg, cha
 int main(int argc, char **argv)
 {
     const char *case_name = "hexapods_a3", *friction_limit = "elastic";
-    const char *save_path = NULL, *load_path = NULL, *reorder = NULL;
+    const char *save_path = NULL, *load_path = NULL, *reorder = NULL, *sphere_orientation = "integrate";
     int tile_x = 1, tile_z = 1;
     long shuffle = -1;
     long n = 10000, settle = -1, relax = 0, steps = 500, repeat = 3;
@@ -155,6 +161,7 @@ int main(int argc, char **argv)
         STRING_OPT("--backend", backends)
         STRING_OPT("--device", device)
         STRING_OPT("--friction-limit", friction_limit)
+        STRING_OPT("--sphere-orientation", sphere_orientation)
         STRING_OPT("--save-settled", save_path)
         STRING_OPT("--load-settled", load_path)
         if (!strcmp(argv[i], "--gravity")) {
@@ -190,6 +197,10 @@ int main(int argc, char **argv)
     }
 #undef STRING_OPT
 #undef INT_OPT
+    if (strcmp(sphere_orientation, "integrate") && strcmp(sphere_orientation, "fixed")) {
+        fprintf(stderr, "capdem-bench: --sphere-orientation %s: expected integrate or fixed\n", sphere_orientation);
+        return 2;
+    }
     /* the backend list is checked before anything is set up */
     char list[256], *save = NULL, *names[8];
     int n_backends = 0;
@@ -270,6 +281,9 @@ int main(int argc, char **argv)
     if (!load_path && cd_sim_step(&sim, settle, err, sizeof err)) return fail(err, 3);
     double t_settle = now() - t0;
     sim.p.gravity = cd_v3(0, -gravity, 0);
+    /* the timed steps' (settling integrates every orientation, as the
+     * packings saved before the option were made) */
+    sim.p.fixed_spheres = !strcmp(sphere_orientation, "fixed");
     if (relax > 0 && cd_sim_step(&sim, relax, err, sizeof err)) return fail(err, 3);
     if (cd_sim_sync(&sim, err, sizeof err)) return fail(err, 3);
     if (save_path && save_settled(save_path, &sim, &cfg, err, sizeof err)) return fail(err, 1);
@@ -350,7 +364,7 @@ int main(int argc, char **argv)
                    "\"contact_updates_per_s\": %.4g, "
                    "\"contacts_per_particle\": %.3f, \"pairs_in_list\": %zu, \"bytes_per_particle\": %.0f, "
                    "\"settle_wall_s\": %.2f, \"neighbor_builds\": %lld, \"neighbor_builds_timed\": %lld, \"dt\": %g, "
-                   "\"reorder\": \"%s\", \"reorders\": %lld, "
+                   "\"reorder\": \"%s\", \"reorders\": %lld, \"sphere_orientation\": \"%s\", "
                    "\"bytes_moved_per_particle_step\": %.0f, \"kernel_bytes_read_written\": {%s}, "
                    "\"rows\": {\"prims\": %zu, \"arms\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, "
                    "\"walls\": %zu, \"wall_contacts\": %.0f, \"pair_rows_by_kind\": [%.0f, %.0f, %.0f], "
@@ -360,9 +374,9 @@ int main(int argc, char **argv)
                    (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n, sim.s.n_pairs,
                    (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
                    sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
-                   moved / (double)n, kernels, sim.s.n_prims, sim.s.n_arms, sim.s.n_pairs, after.n_contacts,
-                   sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps, mixed_visited,
-                   warps_visited, n_visit ? "true" : "false", sim.nb.sweep_span, sim.nb.sweep_lag);
+                   sphere_orientation, moved / (double)n, kernels, sim.s.n_prims, sim.s.n_arms, sim.s.n_pairs,
+                   after.n_contacts, sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps,
+                   mixed_visited, warps_visited, n_visit ? "true" : "false", sim.nb.sweep_span, sim.nb.sweep_lag);
             fflush(stdout);
         }
     }

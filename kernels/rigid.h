@@ -105,13 +105,16 @@ CD_INLINE cd_quat cd_rigid_rotate_anisotropic(cd_quat q, cd_vec3 L, cd_vec3 iner
 }
 
 /* Drift: x += v dt and the free rotation of the orientation over dt; also
- * the angular velocity at the new orientation [rad/s]. */
+ * the angular velocity at the new orientation [rad/s].  keep = 1 leaves
+ * the orientation of an isotropic body as it is (a sphere, whose geometry
+ * does not depend on it: physics.sphere_orientation: fixed, docs/motion.md);
+ * its position and angular velocity are those of keep = 0, bit for bit. */
 CD_INLINE void cd_rigid_drift_angvel(cd_vec3 *pos, cd_quat *q, cd_vec3 *angvel, cd_vec3 vel, cd_vec3 angmom,
-                                     cd_vec3 inertia, cd_real dt)
+                                     cd_vec3 inertia, cd_real dt, int keep)
 {
     *pos = cd_v3_axpy(*pos, dt, vel);
     if (cd_rigid_isotropic(inertia)) {
-        *q = cd_rigid_rotate_isotropic(*q, angmom, inertia.x, dt);
+        if (!keep) *q = cd_rigid_rotate_isotropic(*q, angmom, inertia.x, dt);
         *angvel = cd_v3_scale(angmom, CD_R(1) / inertia.x);
     } else {
         cd_vec3 Lb;
@@ -124,7 +127,7 @@ CD_INLINE void cd_rigid_drift_angvel(cd_vec3 *pos, cd_quat *q, cd_vec3 *angvel, 
 CD_INLINE void cd_rigid_drift(cd_vec3 *pos, cd_quat *q, cd_vec3 vel, cd_vec3 angmom, cd_vec3 inertia, cd_real dt)
 {
     cd_vec3 w;
-    cd_rigid_drift_angvel(pos, q, &w, vel, angmom, inertia, dt);
+    cd_rigid_drift_angvel(pos, q, &w, vel, angmom, inertia, dt, 0);
 }
 
 /* Angular velocity in the world frame: omega = R I^-1 R^T L [rad/s];

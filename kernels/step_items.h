@@ -49,7 +49,7 @@ CD_INLINE void cd_item_drift(cd_cols c, cd_particle_id q, cd_real dt)
 {
     cd_vec3 x = c.position[q], w;
     cd_quat o = c.orientation[q];
-    cd_rigid_drift_angvel(&x, &o, &w, c.velocity[q], c.angmom[q], cd_inertia_of(c, q), dt);
+    cd_rigid_drift_angvel(&x, &o, &w, c.velocity[q], c.angmom[q], cd_inertia_of(c, q), dt, 0);
     c.position[q] = x;
     c.orientation[q] = o;
     c.angvel[q] = w;
@@ -171,6 +171,13 @@ CD_INLINE cd_vec3 cd_ball_world_point(cd_cols c, cd_prim_id i)
 #endif
 }
 
+/* Is particle q a sphere: one primitive, a ball at its centre (no arm,
+ * cd_prim_arm_of < 0)?  Its geometry does not depend on its orientation. */
+CD_INLINE int cd_particle_is_sphere(cd_cols c, cd_particle_id q)
+{
+    return c.prim_count[q] == 1 && cd_prim_arm_of(c, c.prim_first[q]) < 0;
+}
+
 /* At a build: particle q's pose and reach into ref_pose (CD_REF_POSE
  * reals a particle), for cd_pose_moved. */
 CD_INLINE void cd_item_ref_pose(cd_cols c, cd_particle_id q, CD_GLOBAL cd_real *ref_pose)
@@ -239,14 +246,16 @@ CD_INLINE int cd_pose_moved(cd_cols c, cd_particle_id q, cd_vec3 x, cd_quat o, c
  * already read (or just computed): the state is read once and written
  * once, in locals between, which the compiler cannot do across the
  * columns' stores (any column may alias any other for it).  The kick's own
- * angular velocity is not formed: the drift's replaces it. */
+ * angular velocity is not formed: the drift's replaces it.  fixed_spheres
+ * (physics.sphere_orientation: fixed): a sphere keeps its orientation. */
 CD_INLINE_ALWAYS int cd_advance_from(cd_cols c, cd_particle_id q, cd_vec3 v, cd_vec3 L, cd_vec3 F, cd_vec3 T, cd_real m,
-                                     cd_real dt, cd_real limit2, const CD_GLOBAL cd_real *ref_pose)
+                                     cd_real dt, cd_real limit2, const CD_GLOBAL cd_real *ref_pose,
+                                     cd_int fixed_spheres)
 {
     cd_vec3 x = c.position[q], w;
     cd_quat o = c.orientation[q];
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
-    cd_rigid_drift_angvel(&x, &o, &w, v, L, cd_inertia_of(c, q), dt);
+    cd_rigid_drift_angvel(&x, &o, &w, v, L, cd_inertia_of(c, q), dt, fixed_spheres && cd_particle_is_sphere(c, q));
     c.velocity[q] = v;
     c.angmom[q] = L;
     c.position[q] = x;
@@ -612,7 +621,7 @@ CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
                               const CD_GLOBAL cd_pair_id *gather_rows, const CD_GLOBAL cd_int *wall_start,
                               const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension,
                               const CD_GLOBAL cd_int *uid, cd_real dt, cd_real limit2,
-                              const CD_GLOBAL cd_real *ref_pose)
+                              const CD_GLOBAL cd_real *ref_pose, cd_int fixed_spheres)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T;
@@ -624,7 +633,7 @@ CD_INLINE int cd_item_advance(cd_cols c, cd_particle_id q, const CD_GLOBAL cd_in
         cd_gather_sum(c, q, m, c.position[q], gather_start, gather_rows, wall_start, wall_out, gravity, dimension, &F,
                       &T);
     }
-    return cd_advance_from(c, q, c.velocity[q], c.angmom[q], F, T, m, dt, limit2, ref_pose);
+    return cd_advance_from(c, q, c.velocity[q], c.angmom[q], F, T, m, dt, limit2, ref_pose, fixed_spheres);
 }
 
 /* cd_gather_sum, then the second half kick over dt/2 (cd_rigid_kick and
@@ -643,7 +652,7 @@ CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, co
                                                  const CD_GLOBAL cd_int *wall_start,
                                                  const CD_GLOBAL cd_wall_entry *wall_out, cd_vec3 gravity,
                                                  cd_int dimension, cd_real dt, cd_real limit2,
-                                                 const CD_GLOBAL cd_real *ref_pose, int next)
+                                                 const CD_GLOBAL cd_real *ref_pose, cd_int fixed_spheres, int next)
 {
     cd_real m = c.mass[q];
     cd_vec3 F, T, v = c.velocity[q], L = c.angmom[q];
@@ -653,7 +662,7 @@ CD_INLINE_ALWAYS int cd_item_gather_kick_advance(cd_cols c, cd_particle_id q, co
         c.torque[q] = T;
     }
     cd_rigid_kick(&v, &L, F, T, m, CD_R(0.5) * dt);
-    if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2, ref_pose);
+    if (next) return cd_advance_from(c, q, v, L, F, T, m, dt, limit2, ref_pose, fixed_spheres);
     c.velocity[q] = v;
     c.angmom[q] = L;
     c.angvel[q] = cd_rigid_angvel(c.orientation[q], L, cd_inertia_of(c, q));

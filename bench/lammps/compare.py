@@ -4,6 +4,7 @@
     /usr/bin/python3 bench/lammps/compare.py [--build build] [--cases spheres:1000,hexapods_a3:1000:100]
         [--peers lammps,liggghts] [--threads 2] [--steps 1000] [--repeat 3] [--peer-warm 200]
         [--relax-steps 200] [--work build/bench-work] [--reuse] [--baseline OTHER_BUILD]
+        [--sphere-orientation integrate[,fixed]] [--omp-wait-policy default|passive|active]
 
 For each case:N[:PEER_STEPS][@KXxKZ], in one invocation (PEER_STEPS: the
 length of the peers' timed segments, default --steps; shorter ones for the
@@ -50,6 +51,23 @@ timing later with --reuse on the same --work folder.
 --baseline OTHER_BUILD times that build's capdem-bench too, right after
 capdem in every round on the same packing (a change measured against the
 build before it, beside the peers; the table's last row per case).
+
+--sphere-orientation integrate,fixed times capdem on a sphere case once per
+value in every round: integrate (capdem's default: every sphere's
+orientation is integrated, as it is output) and fixed
+(physics.sphere_orientation: fixed: spheres keep their orientation, as
+LAMMPS's and LIGGGHTS's nve/sphere, which have none); the first value gives
+the `capdem_*` and `ratio_*` keys, the others `capdem_fixed_*` and
+`ratio_fixed_*` keys and rows of their own.  Hexapods ignore it.
+
+--omp-wait-policy: what capdem's idle OpenMP threads do at a barrier.
+default leaves OMP_WAIT_POLICY unset (libgomp spins a while, then
+sleeps: what a user gets), as the peers' MPI ranks poll while they wait
+(mpi_yield_when_idle yields the core between polls but never sleeps);
+passive (the setting until session 20) sleeps at once, which on a shared,
+oversubscribed machine keeps a waiting thread from starving the one it
+waits for, and on a quiet machine costs two threads about 1/8 of a sphere
+step's time (docs/performance.md, "Session 20").
 
 Installs LAMMPS (Debian package `lammps`) with apt-get if `lmp` is missing,
 and LIGGGHTS (`liggghts`) if `liggghts` is missing and a sphere case asks for it.
@@ -102,7 +120,10 @@ def lammps_version():
 
 def capdem_bench(args, extra, build=None):
     cmd = [os.path.join(build or args.build, "capdem-bench"), "--threads", str(args.threads)] + extra
-    env = dict(os.environ, OMP_WAIT_POLICY="PASSIVE")
+    env = dict(os.environ)
+    env.pop("OMP_WAIT_POLICY", None)
+    if args.omp_wait_policy != "default":
+        env["OMP_WAIT_POLICY"] = args.omp_wait_policy.upper()
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode:
         raise SystemExit("compare: %s failed (%d): %s" % (" ".join(cmd), p.returncode, p.stderr))
@@ -127,8 +148,8 @@ def run_lammps(args, data, meta, log, nsettle, nwarm, contacts=None, nsteps=None
         "nwarm": nwarm, "nsteps": args.steps if nsteps is None else nsteps,
         "nrepeat": args.repeat if nrepeat is None else nrepeat,
     }
-    # ranks yield the core while they wait (as capdem runs with OMP_WAIT_POLICY=PASSIVE): on a
-    # shared, oversubscribed machine a spinning rank starves the one it waits for
+    # ranks yield the core between polls while they wait: on a shared, oversubscribed machine a
+    # spinning rank starves the one it waits for (capdem: --omp-wait-policy)
     cmd = ["mpirun", "--allow-run-as-root", "--mca", "mpi_yield_when_idle", "1", "-np", str(args.threads), "lmp", "-in", os.path.join(HERE, "in.capdem.lmp"),
            "-log", log, "-screen", "none"]
     for k, v in var.items():
@@ -187,9 +208,15 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
         return {"case": case, "settled_N": n, "tile": "%dx%d" % tile, "prepared": settled}
     base_rates, base_ratios, base_cpu = [], [], []
     capdem, rates, ratios, builds, cpu_ratios, lig_cpu, z = [], {p: [] for p in peers}, {p: [] for p in peers}, {p: [] for p in peers}, [], [], {}
+    # the other sphere orientations: [(value, capdem rows)]
+    orient = args.sphere_orientation.split(",") if case == "spheres" else ["integrate"]
+    others = [(o, []) for o in orient[1:]]
+    timed_args = ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps), "--repeat", "1"]
     for r in range(args.repeat):
-        c = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps), "--repeat", "1"])[0]
+        c = capdem_bench(args, timed_args + (["--sphere-orientation", orient[0]] if orient[0] != "integrate" else []))[0]
         capdem.append(c)
+        for o, rows in others:
+            rows.append(capdem_bench(args, timed_args + ["--sphere-orientation", o])[0])
         if args.baseline:
             # another capdem build, timed in the same round on the same packing (capdem now / baseline)
             b0 = capdem_bench(args, ["--load-settled", settled, "--gravity", "490.5", "--steps", str(args.steps),
@@ -222,6 +249,15 @@ def one_case(args, case, n, lammps_steps, tile=(1, 1)):
         "packing": ("LAMMPS: its own, settled from capdem's initial lattice; LIGGGHTS: capdem's" if case == "spheres" and not tiled
                     else "capdem's settled packing" + (", tiled and relaxed" if tiled else "")),
     }
+    if orient[0] != "integrate":
+        out["capdem_sphere_orientation"] = orient[0]
+    for o, rows in others:
+        o_rates = [x["particle_steps_per_s"] for x in rows]
+        out.update({"capdem_%s_particle_steps_per_s" % o: statistics.median(o_rates), "capdem_%s_repeats" % o: o_rates,
+                    "capdem_%s_neighbor_builds" % o: [x["neighbor_builds_timed"] for x in rows]})
+        for peer in peers:
+            q = [x / p_ for x, p_ in zip(o_rates, rates[peer])]
+            out.update({"ratio_capdem_%s_over_%s" % (o, peer): statistics.median(q), "ratios_%s_%s" % (o, peer): q})
     if args.baseline:
         out.update(baseline_build=args.baseline, baseline_particle_steps_per_s=statistics.median(base_rates),
                    baseline_repeats=base_rates, ratio_capdem_over_baseline=statistics.median(base_ratios),
@@ -263,7 +299,15 @@ def main():
                     help="another build folder whose capdem-bench is timed after capdem in every round (same packing)")
     ap.add_argument("--work", default="build/bench-work")
     ap.add_argument("--reuse", action="store_true", help="time capdem on a settled packing left by an earlier run")
+    ap.add_argument("--sphere-orientation", default="integrate",
+                    help="integrate, fixed or both (integrate,fixed): capdem's physics.sphere_orientation on sphere "
+                         "cases, each timed in every round")
+    ap.add_argument("--omp-wait-policy", default="default", choices=("default", "passive", "active"),
+                    help="OMP_WAIT_POLICY of capdem's runs (default: unset, libgomp's own)")
     args = ap.parse_args()
+    if any(o not in ("integrate", "fixed") for o in args.sphere_orientation.split(",")):
+        raise SystemExit("compare: --sphere-orientation %s: expected integrate, fixed or integrate,fixed"
+                         % args.sphere_orientation)
     cases = []
     for item in args.cases.split(","):
         spec, _, tile = item.partition("@")
@@ -300,6 +344,15 @@ def main():
                 r["case"], r["N"], r["threads"], r["capdem_particle_steps_per_s"], peer, r[peer + "_particle_steps_per_s"],
                 r["ratio_capdem_over_" + peer], min(q), max(q), r["cpu_ratio_capdem_over_" + peer], min(qc), max(qc),
                 r["capdem_neighbor_builds"], r[peer + "_neighbor_builds"]))
+        for o in args.sphere_orientation.split(",")[1:]:
+            for peer in ("lammps", "liggghts"):
+                if "ratios_%s_%s" % (o, peer) not in r:
+                    continue
+                q = r["ratios_%s_%s" % (o, peer)]
+                print("| %s | %d | %d | %.3g (sphere_orientation %s) | %s | %.3g | %.2f (%.2f-%.2f) | | %s / %s |" % (
+                    r["case"], r["N"], r["threads"], r["capdem_%s_particle_steps_per_s" % o], o, peer,
+                    r[peer + "_particle_steps_per_s"], r["ratio_capdem_%s_over_%s" % (o, peer)], min(q), max(q),
+                    r["capdem_%s_neighbor_builds" % o], r[peer + "_neighbor_builds"]))
         if "ratios_baseline" in r:
             q, qc = r["ratios_baseline"], r["cpu_ratios_baseline"]
             print("| %s | %d | %d | %.3g | capdem %s | %.3g | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) | |" % (

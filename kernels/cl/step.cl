@@ -17,12 +17,12 @@ __kernel void cd_cl_advance(
 #include "col_params.h"
     __global cd_wall *walls, cd_int n_walls, cd_int n_particles, cd_real dt, cd_real limit2, __global cd_int *flags,
     __global const cd_int *gather_start, __global const cd_pair_id *gather_rows, __global const cd_int *wall_start,
-    __global const cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension)
+    __global const cd_wall_entry *wall_out, cd_vec3 gravity, cd_int dimension, cd_int fixed_spheres)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
-    if (q < n_particles &&
-        cd_item_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, 0, dt, limit2, 0))
+    if (q < n_particles && cd_item_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, 0,
+                                           dt, limit2, 0, fixed_spheres))
         flags[0] = 1;
     if (q < n_walls) walls[q] = cd_wall_advanced(walls[q], dt);
 }
@@ -68,7 +68,7 @@ __kernel void cd_cl_gather_kick(
     cd_int n_particles, __global const cd_int *gather_start, __global const cd_pair_id *gather_rows,
     __global const cd_int *wall_start, cd_vec3 gravity, cd_int dimension, cd_int mode, cd_real dt,
     __global const cd_wall_entry *wall_out, cd_real limit2, __global cd_wall *walls, cd_int n_walls,
-    __global cd_int *flags)
+    __global cd_int *flags, cd_int fixed_spheres)
 {
 #include "col_bind.h"
     cd_int q = (cd_int)get_global_id(0);
@@ -79,7 +79,7 @@ __kernel void cd_cl_gather_kick(
         return;
     }
     if (cd_item_gather_kick_advance(c, q, gather_start, gather_rows, wall_start, wall_out, gravity, dimension, dt,
-                                    limit2, 0, mode == 2))
+                                    limit2, 0, fixed_spheres, mode == 2))
         flags[0] = 1;
 }
 

@@ -54,13 +54,14 @@ typedef struct {
     double max_overlap;         /* stop when an overlap exceeds this fraction of the arm diameter [1] */
 
     /* physics */
-    int dimension;        /* 3, or 2 (x-y plane motion only) */
-    double gravity[3];    /* [m/s^2] */
-    double density;       /* rho [kg/m^3] */
-    double kn, kt;        /* particle stiffness [N/m] */
-    double eta_n, eta_t;  /* damping ratios [1] */
-    double friction;      /* mu between particles [1] */
-    double wall_friction; /* mu_w [1] */
+    int dimension;                /* 3, or 2 (x-y plane motion only) */
+    double gravity[3];            /* [m/s^2] */
+    int sphere_orientation_fixed; /* 1: spheres keep their orientation (physics.sphere_orientation: fixed) */
+    double density;               /* rho [kg/m^3] */
+    double kn, kt;                /* particle stiffness [N/m] */
+    double eta_n, eta_t;          /* damping ratios [1] */
+    double friction;              /* mu between particles [1] */
+    double wall_friction;         /* mu_w [1] */
     /* 0: mu F_n,elastic ((kn/2) delta_n, Conzelmann et al.); 1: mu F_n (Tran et al. 2024, LAMMPS) */
     int friction_limit_total;
     int law;                   /* material.law: CD_LAW_LINEAR | CD_LAW_HERTZ_MINDLIN (kernels/contact_law.h) */

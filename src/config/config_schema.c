@@ -79,6 +79,11 @@ const cd_key cd_config_keys[] = {
      .meaning = "3, or 2: motion in the x-y plane only (translation in x, y; rotation about z)"},
     {"physics.gravity", CD_KT_VEC3, "m/s^2", "[0, -9.81, 0]", CFG(gravity), .label = "gravity",
      .meaning = "gravity vector (y is up)"},
+    {"physics.sphere_orientation", CD_KT_ENUM, "-", "integrate", CFG(sphere_orientation_fixed),
+     .choices = "integrate|fixed", .label = "orientation of spheres",
+     .meaning = "integrate: every particle's orientation is integrated; fixed: spheres (one ball at the centre) keep "
+                "their initial orientation, which none of their forces depends on (as LAMMPS and LIGGGHTS do; "
+                "their angular velocity is integrated as before; docs/motion.md)"},
 
     /* material */
     {"material.law", CD_KT_ENUM, "-", "linear", CFG(law), .flags = CD_KF_SELECTOR, .choices = "linear|hertz_mindlin",

@@ -645,6 +645,7 @@ int cd_sim_setup_part(cd_sim *sim, const cd_config *cfg, cd_setup_keep_fn keep, 
     sp->dt = c->dt;
     sp->gravity = cd_v3(c->gravity[0], c->gravity[1], c->gravity[2]);
     sp->dimension = c->dimension;
+    sp->fixed_spheres = c->sphere_orientation_fixed;
     sp->sin_parallel = sin(c->parallel_angle_deg * CD_PI / 180);
     sp->parallel_blend = c->parallel_blend;
     sp->law.kn = c->kn;

@@ -33,6 +33,7 @@ typedef struct {
     cd_real sin_parallel;   /* sine of the parallel-contact cut-off angle [1] */
     cd_int parallel_blend;  /* 1: the continuous parallel rule (material.parallel_blend) */
     cd_int dimension;       /* 3, or 2: motion in the x-y plane only */
+    cd_int fixed_spheres;   /* 1: spheres keep their orientation (physics.sphere_orientation: fixed) */
 } cd_step_params;
 
 struct cd_sim;

@@ -89,6 +89,7 @@ static void test_defaults_are_the_documented_values(void **state)
     assert_close(c.friction, 0.5, 0);
     assert_close(c.wall_friction, 0, 0);
     assert_int_equal(c.friction_limit_total, 0);
+    assert_int_equal(c.sphere_orientation_fixed, 0);
     assert_close(c.parallel_angle_deg, 2, 0);
     assert_int_equal(c.n_species, 0);
     assert_string_equal(c.domain, "none");
@@ -488,6 +489,8 @@ static void test_bad_enum_is_refused_with_suggestion(void **state)
     expect_error(PARTICLES "domain: {type: cylindre}\n", "domain.type = cylindre", "did you mean cylinder?");
     expect_error(PARTICLES "material: {friction_limit: full}\n", "material.friction_limit = full",
                  "one of elastic, total");
+    expect_error(PARTICLES "physics: {sphere_orientation: frozen}\n", "physics.sphere_orientation = frozen",
+                 "one of integrate, fixed");
 }
 
 static void test_yaml_syntax_error_names_the_line(void **state)

@@ -322,6 +322,7 @@ void cd_step_args_fill(cd_sim *sim, cd_step_args *a)
     a->limit2 = cd_bp_skin_limit2(sim->nb.skin);
     a->blend = sim->p.parallel_blend;
     a->dimension = sim->p.dimension;
+    a->fixed_spheres = sim->p.fixed_spheres;
     a->n_walls = (cd_int)sim->s.n_walls;
     memcpy(a->walls, sim->s.walls, sim->s.n_walls * sizeof(cd_wall));
 }

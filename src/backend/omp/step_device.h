@@ -25,7 +25,7 @@ typedef struct {
     cd_vec3 gravity;                  /* [m/s^2] */
     cd_real dt, sin_parallel, limit2; /* [s], [1], (skin/2)^2 [m^2] */
     cd_int blend, dimension, n_walls; /* material.parallel_blend, 2 or 3, walls in use */
-    cd_int pad_;                      /* walls 8-byte aligned */
+    cd_int fixed_spheres;             /* physics.sphere_orientation: fixed (and walls 8-byte aligned) */
     cd_wall walls[CD_MAX_WALLS];      /* the first n_walls are in use */
 } cd_step_args;
 

@@ -102,8 +102,8 @@ static int advance_particles(cd_sim *sim)
     CD_STEP_FOR(n, CD_ARGS_IN is_device_ptr(uid))
     for (size_t q = 0; q < n; q++)
         if (cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
-                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2,
-                            CD_A.d.ref_pose)) {
+                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose,
+                            CD_A.fixed_spheres)) {
 #pragma omp atomic write
             CD_A.d.skin_flag[0] = 1;
         }
@@ -113,9 +113,9 @@ static int advance_particles(cd_sim *sim)
     const cd_int *uid = host_force_order(sim);
     CD_STEP_FOR(n, CD_ARGS_IN firstprivate(uid) reduction(| : moved))
     for (size_t q = 0; q < n; q++)
-        moved |=
-            cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
-                            CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2, CD_A.d.ref_pose);
+        moved |= cd_item_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows, CD_A.d.wall_start,
+                                 CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, uid, CD_A.dt, CD_A.limit2,
+                                 CD_A.d.ref_pose, CD_A.fixed_spheres);
 #endif
     host_force_used(sim);
     return moved;
@@ -264,7 +264,7 @@ CD_INLINE_ALWAYS void gather_kick_advance_item(size_t q, int next, int flagged)
 {
     if (cd_item_gather_kick_advance(CD_A.c, (cd_particle_id)q, CD_A.d.gather_start, CD_A.d.gather_rows,
                                     CD_A.d.wall_start, CD_A.d.wall_out, CD_A.gravity, CD_A.dimension, CD_A.dt,
-                                    CD_A.limit2, CD_A.d.ref_pose, next) &&
+                                    CD_A.limit2, CD_A.d.ref_pose, CD_A.fixed_spheres, next) &&
         flagged) {
 #pragma omp atomic write
         CD_A.d.skin_flag[0] = 1;

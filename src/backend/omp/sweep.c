@@ -80,16 +80,16 @@ __attribute__((noinline, flatten)) static void sweep_walls(cd_cols c, const cd_i
  * steps' loop (callgrind, 10,000 spheres: 11.6 instructions a
  * particle-step). */
 #define CD_SWEEP_MOVE(name, next)                                                                                      \
-    __attribute__((noinline, flatten)) static int name(cd_cols c, cd_nb_lists d, size_t q0, size_t q1,                 \
-                                                       const unsigned char *edge, int want, cd_vec3 gravity,           \
-                                                       cd_int dimension, cd_real dt, cd_real limit2)                   \
+    __attribute__((noinline, flatten)) static int name(                                                                \
+        cd_cols c, cd_nb_lists d, size_t q0, size_t q1, const unsigned char *edge, int want, cd_vec3 gravity,          \
+        cd_int dimension, cd_real dt, cd_real limit2, cd_int fixed_spheres)                                            \
     {                                                                                                                  \
         int moved = 0;                                                                                                 \
         for (size_t q = q0; q < q1; q++)                                                                               \
             if (!edge || edge[q] == want)                                                                              \
-                moved |=                                                                                               \
-                    cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows, d.wall_start,     \
-                                                d.wall_out, gravity, dimension, dt, limit2, d.ref_pose, next);         \
+                moved |= cd_item_gather_kick_advance(c, (cd_particle_id)q, d.gather_start, d.gather_rows,              \
+                                                     d.wall_start, d.wall_out, gravity, dimension, dt, limit2,         \
+                                                     d.ref_pose, fixed_spheres, next);                                 \
         return moved;                                                                                                  \
     }
 CD_SWEEP_MOVE(sweep_move_next, 1)
@@ -98,8 +98,8 @@ CD_SWEEP_MOVE(sweep_move_last, 0)
 static int sweep_moves(int next, cd_cols c, cd_nb_lists d, size_t q0, size_t q1, const unsigned char *edge, int want,
                        const cd_step_params *p, cd_real limit2)
 {
-    return next ? sweep_move_next(c, d, q0, q1, edge, want, p->gravity, p->dimension, p->dt, limit2)
-                : sweep_move_last(c, d, q0, q1, edge, want, p->gravity, p->dimension, p->dt, limit2);
+    return next ? sweep_move_next(c, d, q0, q1, edge, want, p->gravity, p->dimension, p->dt, limit2, p->fixed_spheres)
+                : sweep_move_last(c, d, q0, q1, edge, want, p->gravity, p->dimension, p->dt, limit2, p->fixed_spheres);
 }
 
 /* The sweep of particles q0 .. q1 - 1 (of n) and of their pair rows (the

@@ -36,6 +36,7 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_ADVANCE, F + 8, sizeof cl->wall_start, &cl->wall_start);
     cd_cl_arg(cl, CD_CLK_ADVANCE, F + 10, sizeof p->gravity, &p->gravity);
     cd_cl_arg(cl, CD_CLK_ADVANCE, F + 11, sizeof p->dimension, &p->dimension);
+    cd_cl_arg(cl, CD_CLK_ADVANCE, F + 12, sizeof p->fixed_spheres, &p->fixed_spheres);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 1, sizeof p->law, &p->law);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 2, sizeof dt, &dt);
     cd_cl_arg(cl, CD_CLK_PAIR_FORCES, F + 3, sizeof p->sin_parallel, &p->sin_parallel);
@@ -56,6 +57,7 @@ static void set_step_args(cd_cl *cl, const cd_sim *sim)
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 10, sizeof cl->walls, &cl->walls);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 11, sizeof W, &W);
     cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 12, sizeof cl->flags, &cl->flags);
+    cd_cl_arg(cl, CD_CLK_GATHER_KICK, F + 13, sizeof p->fixed_spheres, &p->fixed_spheres);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F, sizeof N, &N);
     cd_cl_arg(cl, CD_CLK_CHECK_FINITE, F + 1, sizeof cl->flags, &cl->flags);
 }
