@@ -129,6 +129,19 @@ CD_INLINE cd_contact_coeffs cd_contact_coefficients(cd_law_params p, cd_real m_e
     return k;
 }
 
+/* Is sqrt(x2) <= limit (x2, limit >= 0 or NaN) clear without the square
+ * root?  x2 < limit^2 (1 - 1e-15), with limit^2 and the product rounded
+ * (each at most half an ulp up, 2.2e-16 together), means x2 < limit^2
+ * exactly, so the rounded sqrt(x2) <= limit: the comparison sqrt(x2) >
+ * limit would be false, and the same bits follow without it (one square
+ * root of a contact's five saved wherever it does not slide).  limit above
+ * 1e-150 keeps limit^2 clear of the subnormals, where the rounding is not
+ * relative; NaN and the rest take the square root. */
+CD_INLINE int cd_law_clearly_below(cd_real x2, cd_real limit)
+{
+    return limit > CD_R(1e-150) && x2 < limit * limit * CD_R(0.999999999999999);
+}
+
 /* One contact update.
  *   m_eff  : effective mass [kg]
  *   r_eff  : effective radius of curvature [m] (Hertz-Mindlin only)
@@ -160,9 +173,11 @@ CD_INLINE cd_contact_force cd_contact_law(cd_law_params p, cd_real m_eff, cd_rea
     cd_vec3 ft = cd_v3_axpy(cd_v3_scale(s, -k.kt_c), -k.gamma_t, vt);
     cd_real limit = p.mu * (p.limit_total ? fn : k.kn_c * g->overlap);
     if (limit < CD_R(0)) limit = CD_R(0);
-    cd_real ftn = cd_v3_norm(ft);
     out.sliding = 0;
-    if (ftn > limit) {
+    cd_real ftn2 = cd_v3_norm2(ft); /* |F_t|^2 [N^2] */
+    int may_slide = !cd_law_clearly_below(ftn2, limit);
+    cd_real ftn = may_slide ? sqrt(ftn2) : CD_R(0); /* |F_t| [N], where needed */
+    if (may_slide && ftn > limit) {
         /* Sliding: cap the force and shorten the spring to match it, so that
          * no elastic energy is stored beyond the Coulomb limit. */
         ft = cd_v3_scale(ft, limit / ftn);

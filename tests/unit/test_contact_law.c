@@ -154,6 +154,47 @@ static void test_difference_form_same_bits(void **state)
     }
 }
 
+/* The Coulomb test without the square root (cd_law_clearly_below, session
+ * 20): wherever it says "clearly below", the law's former comparison
+ * sqrt(x2) > limit is false, so the law takes the same branch with the
+ * same bits.  Checked on limits over 1e-160 .. 1e160 (both sides of the
+ * 1e-150 cut) and x2 within a few ulps of limit^2 on either side, where a
+ * rounding could tip it, and far from it, where the shortcut must engage
+ * (x2 below 0.99 limit^2: a test that always took the root would pass the
+ * first check and save nothing); NaN and infinite x2 or limits never take
+ * the shortcut wrongly. */
+static void test_coulomb_shortcut_agrees_with_sqrt(void **state)
+{
+    (void)state;
+    rng_state = 2020;
+    long engaged = 0, far = 0;
+    for (int i = 0; i < 1000000; i++) {
+        double limit = pow(10.0, 160 * rng_sym()) * (1 + rng_sym() * 0.5);
+        double x2 = limit * limit;
+        int near = i % 2;
+        if (near) {
+            for (int k = (int)(rng_next() % 17) - 8; k != 0; k += k > 0 ? -1 : 1)
+                x2 = nextafter(x2, k > 0 ? INFINITY : 0.0);
+        } else {
+            x2 *= 1.5 * (rng_sym() + 1) / 2; /* 0 .. 1.5 limit^2 */
+        }
+        int clear = cd_law_clearly_below(x2, limit);
+        if (clear) assert_false(sqrt(x2) > limit);
+        engaged += clear;
+        if (!near && x2 < 0.99 * limit * limit && limit > 1e-140 && limit < 1e150) {
+            far++;
+            assert_true(clear);
+        }
+    }
+    assert_true(far > 100000);
+    assert_false(cd_law_clearly_below(NAN, 1.0));
+    assert_false(cd_law_clearly_below(1.0, NAN));
+    assert_false(cd_law_clearly_below(INFINITY, INFINITY));
+    assert_true(cd_law_clearly_below(1e300, INFINITY)); /* sqrt(1e300) > inf is false too */
+    assert_false(cd_law_clearly_below(0.0, 0.0));       /* a zero limit: the root decides */
+    print_message("shortcut taken in %ld of 1e6 cases (%ld far below the limit)\n", engaged, far);
+}
+
 /* The kernels receive the parameters by value (kernels/cl/step.cl): the
  * struct has no padding the OpenCL compiler could lay out differently. */
 static void test_params_layout(void **state)
@@ -165,10 +206,15 @@ static void test_params_layout(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_contact_moduli),      cmocka_unit_test(test_hertz_normal_force_at_rest),
-        cmocka_unit_test(test_hertz_dashpot),       cmocka_unit_test(test_mindlin_tangential_stiffness),
-        cmocka_unit_test(test_mindlin_coulomb_cap), cmocka_unit_test(test_hertz_elastic_energy),
-        cmocka_unit_test(test_params_layout),       cmocka_unit_test(test_difference_form_same_bits),
+        cmocka_unit_test(test_contact_moduli),
+        cmocka_unit_test(test_hertz_normal_force_at_rest),
+        cmocka_unit_test(test_hertz_dashpot),
+        cmocka_unit_test(test_mindlin_tangential_stiffness),
+        cmocka_unit_test(test_mindlin_coulomb_cap),
+        cmocka_unit_test(test_hertz_elastic_energy),
+        cmocka_unit_test(test_params_layout),
+        cmocka_unit_test(test_difference_form_same_bits),
+        cmocka_unit_test(test_coulomb_shortcut_agrees_with_sqrt),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
