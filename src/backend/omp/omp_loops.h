@@ -33,6 +33,16 @@ static inline size_t cd_wide_min(void)
 {
 #if defined(CAPDEM_OFFLOAD_HOSTDEV) && CAPDEM_OFFLOAD_HOSTDEV
     return (size_t)cd_parallel_min_rows;
+#elif defined(__clang__)
+    /* Clang's GPU build: 0 also without a device (a machine without a GPU,
+     * or OMP_TARGET_OFFLOAD=DISABLED: the target regions run on the host),
+     * where LLVM 16's libomp aborts (kmp_runtime.cpp(1128), th_task_team)
+     * once a process's host-run target regions mix a parallel inner region
+     * and a serialized one (if (parallel : 0)); every one parallel, it
+     * runs.  Found by bench/gpu_bundle.sh --no-gcc, whose settling runs
+     * this build here (1,000 hexapods on two threads aborted at the first
+     * neighbour-list build). */
+    return 0;
 #else
     static int devices = -1;
     if (devices < 0) devices = omp_get_num_devices();
