@@ -369,14 +369,15 @@ int main(int argc, char **argv)
                    "\"rows\": {\"prims\": %zu, \"arms\": %zu, \"pair_rows\": %zu, \"contacts\": %.0f, "
                    "\"walls\": %zu, \"wall_contacts\": %.0f, \"pair_rows_by_kind\": [%.0f, %.0f, %.0f], "
                    "\"mixed_warps\": [%.0f, %.0f], \"mixed_warps_visited\": [%.0f, %.0f], \"visit_order\": %s, "
-                   "\"sweep_span\": %zu, \"sweep_lag\": %zu}}\n",
+                   "\"sweep_span\": %zu, \"sweep_lag\": %zu, \"sweep_prefetch\": %s}}\n",
                    case_label, n, sim.backend->name, sim.backend->device(&sim), round_threads[k], steps, wall, cpu,
                    (double)n * steps / wall, contacts * steps / wall, 2 * o.n_contacts / (double)n, sim.s.n_pairs,
                    (double)state_bytes(&sim) / (double)n, t_settle, sim.nb.builds, sim.nb.builds - builds0, sim.p.dt,
                    sim.nb.reorder && !strcmp(sim.backend->name, "omp") ? "cells" : "none", sim.nb.reorders,
                    sphere_orientation, moved / (double)n, kernels, sim.s.n_prims, sim.s.n_arms, sim.s.n_pairs,
                    after.n_contacts, sim.s.n_walls, after.n_wall_contacts, kinds[0], kinds[1], kinds[2], mixed, warps,
-                   mixed_visited, warps_visited, n_visit ? "true" : "false", sim.nb.sweep_span, sim.nb.sweep_lag);
+                   mixed_visited, warps_visited, n_visit ? "true" : "false", sim.nb.sweep_span, sim.nb.sweep_lag,
+                   sim.nb.sweep_prefetch ? "true" : "false");
             fflush(stdout);
         }
     }

@@ -18,11 +18,13 @@
 extern long cd_parallel_min_rows;
 #define CD_PARALLEL(rows) ((long)(rows) >= cd_parallel_min_rows)
 /* The host threads' sweep (src/backend/omp/sweep.c): particles a block
- * (512), and the step's bytes above which its rows and moves interleave
+ * (512), the step's bytes above which its rows and moves interleave
  * (-1: 16 MiB, about half a last-level cache; below it all rows come
- * first); tests set both small. */
+ * first) and above which its rows' loop prefetches (-1: 4 MiB); tests set
+ * them small. */
 extern size_t cd_sweep_block;
 extern long cd_sweep_min_bytes;
+extern long cd_sweep_prefetch_min_bytes;
 
 /* Per-step constants handed to every kernel. */
 typedef struct {
@@ -127,6 +129,7 @@ typedef struct {
        particles of a row, and per particle 1 when one of its rows joins it to a particle of another
        thread's range, for sweep_threads threads (0: not made since the last build) */
     size_t sweep_lag, sweep_span; /* the lag the sweep uses (n: all rows first, a small state), the span */
+    int sweep_prefetch;           /* 1: the rows' loop asks for primitive j's data ahead (a large state) */
     unsigned char *sweep_edge;
     size_t sweep_edge_cap;
     int sweep_threads;

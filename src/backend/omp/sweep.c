@@ -12,6 +12,7 @@
 
 size_t cd_sweep_block = 512;
 long cd_sweep_min_bytes = -1;
+long cd_sweep_prefetch_min_bytes = -1;
 
 #if CD_OFFLOAD
 int cd_omp_sweep_lists(cd_sim *sim)
@@ -50,19 +51,60 @@ int cd_omp_sweep_interleaves(const cd_sim *sim)
  * each split evenly among the threads, as the step ran before the sweep:
  * the interleaving only costs there. */
 
+/* Rows ahead of the one computed whose primitive j's data the rows'
+ * loop asks the cache for (sweep_rows_prefetch). */
+#define CD_PREFETCH_ROWS 16
+
+/* Asks the cache for what pair row k reads of its primitive j and j's
+ * particle and will not find there: a row's primitive i is its loop's
+ * sequential stream, which the processor's own prefetcher follows, while
+ * j's slot jumps by up to the span, so beyond the L2 its reads wait on
+ * the L3 or memory (docs/performance.md, "Session 21, rows' reads asked
+ * for ahead").  Reads pair_prim_j[k], prim_particle[j] and prim_arm[j];
+ * a prefetch changes no value. */
+CD_INLINE_ALWAYS void prefetch_row_j(cd_cols c, cd_pair_id k)
+{
+    cd_prim_id j = c.pair_prim_j[k];
+    cd_particle_id pj = c.prim_particle[j];
+    cd_int r = cd_prim_arm_of(c, j);
+    __builtin_prefetch(&c.prim_a[j]);
+    if (r >= 0) __builtin_prefetch(&c.arm[r].b);
+    __builtin_prefetch(&c.position[pj]);
+    __builtin_prefetch(&c.velocity[pj]);
+    __builtin_prefetch(&c.angvel[pj]);
+    __builtin_prefetch(&c.mass[pj]);
+    __builtin_prefetch(&c.prim_radius[j]);
+}
+
 /* The sweep's three loops, each a function of its own with every item
  * inlined (noinline, flatten: GCC otherwise called the items, 1.15x the
  * instructions of the step), so that each compiles as it did as a loop
  * over all rows: inlined into one function with the others, a hexapod's
  * pair row lost about 5 % to register allocation (docs/performance.md,
  * "Session 19, the sweep").  The pair rows k0 .. k1 - 1 (in the visiting
- * order visit, null: the rows' order): */
-__attribute__((noinline, flatten)) static void sweep_rows(cd_cols c, const cd_int *visit, size_t k0, size_t k1,
-                                                          cd_law_params law, cd_real dt, cd_real sin_parallel,
-                                                          cd_int blend, cd_int outputs)
+ * order visit, null: the rows' order), without and with the prefetch of
+ * the row CD_PREFETCH_ROWS ahead (a constant of each loop: where the state
+ * fits a core's L2 the prefetch only costs, 0.97-0.98x on 1,000
+ * hexapods): */
+#define CD_SWEEP_ROWS(name, prefetch)                                                                                  \
+    __attribute__((noinline, flatten)) static void name(cd_cols c, const cd_int *visit, size_t k0, size_t k1,          \
+                                                        cd_law_params law, cd_real dt, cd_real sin_parallel,           \
+                                                        cd_int blend, cd_int outputs)                                  \
+    {                                                                                                                  \
+        for (size_t k = k0; k < k1; k++) {                                                                             \
+            if (prefetch && k + CD_PREFETCH_ROWS < k1)                                                                 \
+                prefetch_row_j(c, (cd_pair_id)cd_map(visit, (cd_long)(k + CD_PREFETCH_ROWS)));                         \
+            cd_item_pair_force(c, (cd_pair_id)cd_map(visit, (cd_long)k), law, dt, sin_parallel, blend, outputs);       \
+        }                                                                                                              \
+    }
+CD_SWEEP_ROWS(sweep_rows_plain, 0)
+CD_SWEEP_ROWS(sweep_rows_prefetch, 1)
+
+static void sweep_rows(int prefetch, cd_cols c, const cd_int *visit, size_t k0, size_t k1, const cd_step_params *p,
+                       cd_int outputs)
 {
-    for (size_t k = k0; k < k1; k++)
-        cd_item_pair_force(c, (cd_pair_id)cd_map(visit, (cd_long)k), law, dt, sin_parallel, blend, outputs);
+    if (prefetch) sweep_rows_prefetch(c, visit, k0, k1, p->law, p->dt, p->sin_parallel, p->parallel_blend, outputs);
+    else sweep_rows_plain(c, visit, k0, k1, p->law, p->dt, p->sin_parallel, p->parallel_blend, outputs);
 }
 
 /* the wall candidates e0 .. e1 - 1: */
@@ -112,7 +154,7 @@ static int sweep_moves(int next, cd_cols c, cd_nb_lists d, size_t q0, size_t q1,
  * left for after the barrier. */
 static int sweep_range(cd_cols c, const cd_nb_lists *d, size_t q0, size_t q1, size_t n, size_t n_pairs, size_t lag,
                        const unsigned char *edge, const cd_step_params *p, const cd_wall *walls, cd_int W,
-                       cd_real limit2, int next)
+                       cd_real limit2, int next, int prefetch)
 {
     int moved = 0;
     size_t done = q0; /* the next particle to move */
@@ -120,7 +162,7 @@ static int sweep_range(cd_cols c, const cd_nb_lists *d, size_t q0, size_t q1, si
         size_t x1 = x0 + cd_sweep_block < q1 ? x0 + cd_sweep_block : q1;
         size_t k0 = (size_t)d->pair_offset[c.prim_first[x0]];
         size_t k1 = x1 < n ? (size_t)d->pair_offset[c.prim_first[x1]] : n_pairs;
-        sweep_rows(c, NULL, k0, k1, p->law, p->dt, p->sin_parallel, p->parallel_blend, !next);
+        sweep_rows(prefetch, c, NULL, k0, k1, p, !next);
         sweep_walls(c, d->wall_rows, d->wall_out, d->wall_start[x0], d->wall_start[x1], walls, W, p->wall_law, p->dt,
                     p->sin_parallel, p->parallel_blend);
         size_t ready = x1 == q1 ? q1 : x1 > done + lag ? x1 - lag : done; /* rows up to x1 - 1 computed */
@@ -170,6 +212,16 @@ int cd_omp_sweep_interleaves(const cd_sim *sim)
     return step_bytes(sim) > (cd_sweep_min_bytes >= 0 ? (size_t)cd_sweep_min_bytes : (size_t)16 << 20);
 }
 
+/* Beyond 4 MiB (four times a core's 1 MiB L2 on the development machine's
+ * EPYC) a row's primitive j is asked for ahead (prefetch_row_j): 10,000
+ * hexapods (13 MB) 1.03-1.05x, 30,000 1.16-1.19x; below, 1,000 hexapods
+ * (1.3 MB) 0.97-0.98x (docs/performance.md, "Session 21, rows' reads
+ * asked for ahead"). */
+static int sweep_prefetches(const cd_sim *sim)
+{
+    return step_bytes(sim) > (cd_sweep_prefetch_min_bytes >= 0 ? (size_t)cd_sweep_prefetch_min_bytes : (size_t)4 << 20);
+}
+
 /* What the host threads' sweep (above)
  * needs of new rows: its lag, the largest distance in memory slots between
  * the two particles of a row (a particle's rows are all computed once the
@@ -205,6 +257,7 @@ int cd_omp_sweep_lists(cd_sim *sim)
         return -1;
     }
     nb->sweep_lag = cd_omp_sweep_interleaves(sim) ? (size_t)lag : n;
+    nb->sweep_prefetch = sweep_prefetches(sim);
     nb->sweep_span = (size_t)lag;
     return 0;
 }
@@ -220,7 +273,7 @@ int cd_omp_sweep(cd_sim *sim, int next)
     size_t n = sim->s.n_particles, most = sim->s.n_pairs > n ? sim->s.n_pairs : n;
     unsigned char *edge = sim->nb.sweep_edge; /* n of them (each build makes room) */
     size_t lag = sim->nb.sweep_lag, n_pairs = sim->s.n_pairs;
-    int made = sim->nb.sweep_threads, used = 1, moved = 0, interleave = lag < n;
+    int made = sim->nb.sweep_threads, used = 1, moved = 0, interleave = lag < n, prefetch = sim->nb.sweep_prefetch;
     /* not interleaved: the passes as loops over all rows, each split evenly
      * among the threads (a mixture's pair rows kind by kind), a barrier
      * before the moves, as the step ran before the sweep */
@@ -235,8 +288,7 @@ int cd_omp_sweep(cd_sim *sim, int next)
 #endif
         size_t q0 = n * t / T, q1 = n * (t + 1) / T;
         if (!interleave) {
-            sweep_rows(c, visit, n_pairs * t / T, n_pairs * (t + 1) / T, p.law, p.dt, p.sin_parallel, p.parallel_blend,
-                       !next);
+            sweep_rows(prefetch, c, visit, n_pairs * t / T, n_pairs * (t + 1) / T, &p, !next);
             sweep_walls(c, d.wall_rows, d.wall_out, (cd_int)(n_walls * t / T), (cd_int)(n_walls * (t + 1) / T), walls,
                         W, p.wall_law, p.dt, p.sin_parallel, p.parallel_blend);
 #pragma omp barrier
@@ -246,7 +298,8 @@ int cd_omp_sweep(cd_sim *sim, int next)
                 mark_edges(c, d, q0, q1, edge);
 #pragma omp barrier
             }
-            moved |= sweep_range(c, &d, q0, q1, n, n_pairs, lag, T > 1 ? edge : NULL, &p, walls, W, limit2, next);
+            moved |=
+                sweep_range(c, &d, q0, q1, n, n_pairs, lag, T > 1 ? edge : NULL, &p, walls, W, limit2, next, prefetch);
             if (T > 1) {
 #pragma omp barrier
                 moved |= sweep_moves(next, c, d, q0, q1, edge, 1, &p, limit2);
